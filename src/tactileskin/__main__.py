@@ -1,0 +1,5 @@
+import sys
+
+from tactileskin.cli import main
+
+sys.exit(main())

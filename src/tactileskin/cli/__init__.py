@@ -1,0 +1,74 @@
+"""Command-line interface. One module per command; only this layer prints and exits.
+
+Commands are registered lazily by module name so that `tactileskin solve` never pays
+for build123d or pyvista imports.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import logging
+import sys
+
+import click
+
+from tactileskin.errors import TactileSkinError
+
+# command name -> module under tactileskin.cli that defines `command`
+COMMANDS = {
+    "build": "build",
+    "mesh": "mesh",
+    "solve": "solve",
+    "sweep": "sweep",
+    "film": "film",
+}
+
+
+class _LazyGroup(click.Group):
+    def list_commands(self, ctx):
+        return sorted(n for n, m in COMMANDS.items()
+                      if importlib.util.find_spec(f"tactileskin.cli.{m}") is not None)
+
+    def get_command(self, ctx, name):
+        mod = COMMANDS.get(name)
+        if mod is None or importlib.util.find_spec(f"tactileskin.cli.{mod}") is None:
+            return None
+        return importlib.import_module(f"tactileskin.cli.{mod}").command
+
+
+@click.group(cls=_LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
+@click.version_option(package_name="tactileskin")
+def cli(verbose: int) -> None:
+    """tactileskin: soft artificial skins over tactile sensors.
+
+    Units everywhere: mm, s, N, MPa.
+    """
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI in-process; returns the exit code (tests call this directly)."""
+    from rich.console import Console
+
+    err = Console(stderr=True)
+    try:
+        rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
+    except TactileSkinError as e:
+        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        return 2
+    except click.exceptions.Exit as e:
+        return e.exit_code
+    except click.ClickException as e:
+        e.show()
+        return e.exit_code
+    except click.exceptions.Abort:
+        err.print("aborted")
+        return 1
+    return rv if isinstance(rv, int) else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

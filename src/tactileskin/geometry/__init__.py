@@ -1,0 +1,3 @@
+"""Geometry: the fingertip section (pure numpy) and, at the edges, build123d solids."""
+
+from tactileskin.geometry.fingertip import Fingertip, Section  # noqa: F401

@@ -1,0 +1,152 @@
+"""Scene: the single, validated, hashable description that every stage reads.
+
+Units: mm, s, N, MPa. A Scene is immutable; `replace()` returns a changed copy. Its
+`key()` is a stable content hash (SHA-256 of canonical JSON) that keys the result cache.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import tomllib
+from dataclasses import dataclass, field
+from enum import Enum
+from pathlib import Path
+
+from tactileskin.errors import ParameterError, check_range
+
+SCHEMA_VERSION = 1  # bump when a field's meaning changes, so cached results are not reused
+
+
+class IndenterKind(str, Enum):
+    FLAT = "flat"
+    CURVED = "curved"
+    BRAILLE = "braille"
+
+
+class Formulation(str, Enum):
+    MIXED = "mixed"                # locking-free (F-bar / three-field); the default
+    DISPLACEMENT = "displacement"  # plain displacement formulation, kept for comparison
+
+
+def _enum(cls, name, value):
+    try:
+        return cls(value)
+    except ValueError:
+        raise ParameterError(name, value, "one of " + ", ".join(m.value for m in cls)) from None
+
+
+@dataclass(frozen=True)
+class Scene:
+    thickness: float = 3.0                 # skin thickness t (mm)
+    material: str = "silicone"             # preset name (see tactileskin.materials)
+    indenter: IndenterKind = IndenterKind.FLAT
+    braille_text: str = ""                 # empty: a single dot on the symmetry line
+    braille_standard: str = "standard_american"
+    depth: float | None = None             # indentation (mm); None -> depth_fraction * t
+    depth_fraction: float = 0.2            # the paper's 20 % nominal strain
+    rate: float = 1.0                      # indentation rate (mm/s)
+    dim: int = 2                           # 2: plane-strain half section; 3: extruded slab
+    order: int = 2                         # element order
+    mesh_size: float = 0.25                # global element size (mm)
+    refinement: float = 3.0                # size ratio: global / refined (contact and bone zones)
+    formulation: Formulation = Formulation.MIXED
+    viscoelastic: bool = True
+    fingertip: tuple[tuple[str, float], ...] = field(default_factory=tuple)  # overrides of fingertip.toml
+
+    def __post_init__(self):
+        set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
+        set_("indenter", _enum(IndenterKind, "indenter", self.indenter))
+        set_("formulation", _enum(Formulation, "formulation", self.formulation))
+        if isinstance(self.fingertip, dict):
+            set_("fingertip", tuple(sorted(self.fingertip.items())))
+        ft = self.fingertip_model()
+        set_("thickness", ft.check_thickness(self.thickness))
+        set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, 0.6, lo_open=True))
+        if self.depth is not None:
+            set_("depth", check_range("depth", self.depth, 0.0, 0.6 * self.thickness, lo_open=True, unit="mm"))
+        set_("rate", check_range("rate", self.rate, 1e-6, 1e6, unit="mm/s"))
+        if self.dim not in (2, 3):
+            raise ParameterError("dim", self.dim, "2 or 3")
+        if self.order not in (1, 2):
+            raise ParameterError("order", self.order, "1 or 2")
+        set_("mesh_size", check_range("mesh_size", self.mesh_size, 0.01, 5.0, unit="mm"))
+        set_("refinement", check_range("refinement", self.refinement, 1.0, 20.0))
+        if not isinstance(self.material, str) or not self.material:
+            raise ParameterError("material", self.material, "a material preset name")
+        if self.indenter is IndenterKind.BRAILLE:
+            from tactileskin.geometry import braille
+
+            braille.get_standard(self.braille_standard)  # raises ParameterError if unknown
+            if self.braille_text:
+                braille.text_to_cells(self.braille_text)   # raises on unknown characters
+
+    # --- derived -----------------------------------------------------------------------
+    @property
+    def indentation(self) -> float:
+        """Final indentation depth (mm)."""
+        return self.depth if self.depth is not None else self.depth_fraction * self.thickness
+
+    @property
+    def duration(self) -> float:
+        """Loading time (s) at the scene's rate, from first touch to full depth."""
+        return self.indentation / self.rate
+
+    def fingertip_model(self):
+        from tactileskin.geometry.fingertip import Fingertip
+
+        return Fingertip.from_params(**dict(self.fingertip))
+
+    def section(self):
+        return self.fingertip_model().section(self.thickness)
+
+    def replace(self, **changes) -> "Scene":
+        return dataclasses.replace(self, **changes)
+
+    # --- serialisation -------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, Enum):
+                v = v.value
+            if f.name == "fingertip":
+                v = dict(v)
+            if v is None:
+                continue
+            d[f.name] = v
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scene":
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(d) - names)
+        if unknown:
+            raise ParameterError("scene field", unknown[0], "one of " + ", ".join(sorted(names)))
+        return cls(**d)
+
+    def key(self) -> str:
+        """Stable content hash of everything that can change a result."""
+        payload = json.dumps({"schema": SCHEMA_VERSION, **self.to_dict()}, sort_keys=True,
+                             separators=(",", ":"))
+        return hashlib.sha256(payload.encode()).hexdigest()[:20]
+
+    def label(self) -> str:
+        ind = self.indenter.value + (f"[{self.braille_text}]" if self.braille_text else "")
+        return f"t{self.thickness:g}-{self.material}-{ind}-{self.dim}d"
+
+    def to_toml(self, path: str | Path) -> None:
+        import tomli_w
+
+        Path(path).write_text(tomli_w.dumps(self.to_dict()))
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> "Scene":
+        try:
+            with open(path, "rb") as fh:
+                return cls.from_dict(tomllib.load(fh))
+        except FileNotFoundError:
+            raise ParameterError("scene file", str(path), "an existing TOML file") from None
+        except tomllib.TOMLDecodeError as e:
+            raise ParameterError("scene file", str(path), f"valid TOML ({e})") from None
