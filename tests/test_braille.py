@@ -1,0 +1,115 @@
+"""Braille standards, Grade-1/Unicode transcription and dot layout."""
+
+import math
+
+import numpy as np
+import pytest
+
+from tactileskin.errors import ParameterError
+from tactileskin.geometry import braille
+from tactileskin.geometry.braille import BrailleStandard, dot_centres, get_standard, text_to_cells
+
+# Standard English braille in Unicode (independent of our table: published code points).
+ALPHABET_UNICODE = "⠁⠃⠉⠙⠑⠋⠛⠓⠊⠚⠅⠇⠍⠝⠕⠏⠟⠗⠎⠞⠥⠧⠺⠭⠽⠵"
+PUNCT_UNICODE = "⠂⠆⠒⠲⠖⠦⠄⠤⠶⠶"  # , ; : . ! ? ' - ( )
+
+
+def test_letters_match_unicode_braille():
+    assert text_to_cells("abc") == [[1, 3, 9]]
+    assert text_to_cells("abcdefghijklmnopqrstuvwxyz") == text_to_cells(ALPHABET_UNICODE)
+    assert text_to_cells(",;:.!?'-()") == text_to_cells(PUNCT_UNICODE)
+
+
+def test_unicode_passes_through_and_round_trips():
+    assert text_to_cells("⠁⠃") == text_to_cells("ab") == [[1, 3]]
+    masks = list(range(64))
+    text = "".join(chr(0x2800 + m) for m in masks)
+    assert text_to_cells(text) == [masks]
+    assert braille.cells_to_unicode(text_to_cells("hi\nyou")) == "⠓⠊\n⠽⠕⠥"
+
+
+def test_number_capital_and_letter_signs():
+    ns, cap, ls = 0b111100, 0b100000, 0b110000   # dots 3456, 6, 56
+    assert text_to_cells("a1") == [[1, ns, 1]]
+    assert text_to_cells("1990") == [[ns, 1, 10, 10, 26]]      # one sign per run; 0 = j
+    assert text_to_cells("1 2") == [[ns, 1, 0, ns, 3]]         # a space ends the run
+    assert text_to_cells("2b") == [[ns, 3, ls, 3]]            # b after digits needs the letter sign
+    assert text_to_cells("2k") == [[ns, 3, 5]]                # k cannot be read as a digit
+    assert text_to_cells("Ab") == [[cap, 1, 3]]
+    assert text_to_cells("a\n\nb") == [[1], [], [3]]
+    assert text_to_cells("") == [[]]
+
+
+@pytest.mark.parametrize("text, char, pos", [("ab€", "€", 2), ("x\nyé", "é", 3), ("a\u2840", "\u2840", 1)])
+def test_unknown_character_is_an_error(text, char, pos):
+    with pytest.raises(ParameterError) as e:
+        text_to_cells(text)
+    msg = str(e.value)
+    assert repr(char) in msg and f"position {pos}" in msg and "braille_text" in msg
+
+
+def test_standards_table():
+    sa = get_standard("standard_american")
+    assert (sa.base_diameter, sa.height, sa.dot_pitch, sa.cell_pitch, sa.line_pitch) == (1.44, 0.48, 2.34, 6.2, 10.0)
+    # design.md: R = (r^2 + h^2)/2h ~ 0.78 mm, centre 0.30 mm from the base plane
+    assert sa.sphere_radius == pytest.approx(0.78, abs=0.005)
+    assert sa.centre_offset == pytest.approx(0.30, abs=1e-12)
+    ada = get_standard("ada_2010")
+    assert dict((k, (lo, hi)) for k, lo, hi in ada.ranges) == {
+        "base_diameter": (1.5, 1.6), "height": (0.6, 0.9), "dot_pitch": (2.3, 2.5),
+        "cell_pitch": (6.1, 7.6), "line_pitch": (10.0, 10.2)}
+    for k, lo, hi in ada.ranges:  # nominal = midpoint
+        assert getattr(ada, k) == pytest.approx(0.5 * (lo + hi), abs=1e-12)
+    mm = get_standard("marburg_medium")
+    assert (mm.dot_pitch, mm.cell_pitch, mm.line_pitch) == (2.5, 6.0, 10.0)
+    assert 1.3 <= mm.base_diameter <= 1.6 and "ASSUMPTION" in mm.source
+    assert all(get_standard(n).source for n in braille.standard_names())
+
+
+@pytest.mark.parametrize("name", ["standard_american", "ada_2010", "marburg_medium"])
+def test_cap_geometry_consistent(name):
+    s = get_standard(name)
+    # the sphere centred centre_offset above the base plane cuts it in a circle of the base
+    # radius, and its lowest point is `height` below the plane (closed form, round-off only)
+    assert math.sqrt(s.sphere_radius**2 - s.centre_offset**2) == pytest.approx(s.base_radius, abs=1e-12)
+    assert s.sphere_radius - s.centre_offset == pytest.approx(s.height, abs=1e-12)
+    assert s.centre_offset >= 0.0
+
+
+def test_unknown_standard_lists_names():
+    with pytest.raises(ParameterError, match="ada_2010.*marburg_medium.*standard_american"):
+        get_standard("grade3")
+
+
+def test_invalid_standard_values():
+    with pytest.raises(ParameterError, match="height"):  # taller than the base radius: overhang
+        BrailleStandard("x", base_diameter=1.44, height=0.8, dot_pitch=2.34, cell_pitch=6.2, line_pitch=10.0)
+    with pytest.raises(ParameterError, match="dot_pitch"):
+        BrailleStandard("x", base_diameter=1.44, height=0.48, dot_pitch=1.0, cell_pitch=6.2, line_pitch=10.0)
+
+
+def test_dot_centres_layout():
+    sa = get_standard("standard_american")
+    assert dot_centres("", sa).tolist() == [[0.0, 0.0]]       # paper default: one dot at the origin
+    assert dot_centres("a", sa).tolist() == [[0.0, 0.0]]
+    full = dot_centres("⠿", sa)                                 # dots 1..6 in order
+    p = sa.dot_pitch / 2
+    np.testing.assert_allclose(full, [[-p, -2 * p], [-p, 0], [-p, 2 * p], [p, -2 * p], [p, 0], [p, 2 * p]], atol=1e-12)
+    ab = dot_centres("ab", sa)                                 # a: dot 1; b: dots 1, 2
+    c, q = sa.cell_pitch / 2, sa.dot_pitch / 2
+    np.testing.assert_allclose(ab, [[-c, -q], [c, -q], [c, q]], atol=1e-12)
+    two_lines = dot_centres("a\na", sa)
+    np.testing.assert_allclose(two_lines, [[0, -sa.line_pitch / 2], [0, sa.line_pitch / 2]], atol=1e-12)
+    word = dot_centres("Braille 2", "marburg_medium")          # bounding box centred on the origin
+    np.testing.assert_allclose(word.min(axis=0) + word.max(axis=0), 0.0, atol=1e-12)
+    with pytest.raises(ParameterError, match="raised dot"):
+        dot_centres("   ", sa)
+
+
+def test_footprint():
+    sa = get_standard("standard_american")
+    r = sa.base_radius
+    assert braille.footprint("", sa) == pytest.approx((-r, r, -r, r))
+    xmin, xmax, zmin, zmax = braille.footprint("c", sa)        # dots 1 and 4
+    assert (xmin, xmax) == pytest.approx((-sa.dot_pitch / 2 - r, sa.dot_pitch / 2 + r))
+    assert (zmin, zmax) == pytest.approx((-r, r))
