@@ -78,7 +78,8 @@ def expand_grid(
     scenes: list[Scene] = []
     seen: set[str] = set()
     for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
-        texts = braille_texts if IndenterKind(ind) is IndenterKind.BRAILLE else ("",)
+        kind = base.replace(thickness=t, indenter=ind).indenter  # validates the name
+        texts = braille_texts if kind is IndenterKind.BRAILLE else ("",)
         for text in texts:
             s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text)
             if s.key() not in seen:

@@ -1,0 +1,86 @@
+"""`tactileskin sweep`: the paper's thickness sweep (or any grid), cached and parallel."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import click
+
+from tactileskin.errors import ParameterError
+
+
+@click.command("sweep")
+@click.option("--out", "out", type=click.Path(file_okay=False), default="out", show_default=True,
+              help="Output folder: results.csv, profiles.csv, figures, report.md.")
+@click.option("--config", type=click.Path(dir_okay=False), default=None,
+              help="Sweep TOML ([sweep] lists, optional [scene] base); flags override it.")
+@click.option("--thickness", "-t", default=None, help="Thicknesses (mm): '1,3,5' or '1:5:0.5'. Default 1,3,5.")
+@click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone,polyurethane.")
+@click.option("--indenter", "-i", default=None, help="Indenters, comma-separated. Default flat,curved,braille.")
+@click.option("--depth", default=None, help="Depths (mm), comma-separated; default 20 % of each thickness.")
+@click.option("--braille-text", multiple=True, help="Braille text(s) for Braille cases (repeatable).")
+@click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
+@click.option("--mesh-size", type=float, default=None, help="Global element size (mm).")
+@click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
+@click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
+@click.option("--workers", type=int, default=None, help="Local worker processes (default: all cores).")
+@click.option("--serial", is_flag=True, help="Run in this process, without Dask.")
+@click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
+              help="Result cache folder (default OUT/cache).")
+@click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
+def command(out, config, thickness, material, indenter, depth, braille_text, rate, mesh_size,
+            formulation, scheduler, workers, serial, cache_dir, no_render):
+    """Run a sweep; rerunning reuses every finished case from the cache."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from tactileskin.report.outputs import write_outputs
+    from tactileskin.scene import Scene
+    from tactileskin.sweep import (PAPER_INDENTERS, PAPER_MATERIALS, PAPER_THICKNESSES, ResultCache,
+                                   expand_grid, load_spec, parse_values, run_sweep)
+
+    console = Console()
+    spec = load_spec(config) if config else {}
+    base = spec.pop("base", Scene())
+    changes = {k: v for k, v in dict(rate=rate, mesh_size=mesh_size, formulation=formulation).items()
+               if v is not None}
+    if changes:
+        base = base.replace(**changes)
+    grid = dict(
+        thicknesses=parse_values(thickness, "thickness") if thickness else spec.get("thicknesses", PAPER_THICKNESSES),
+        materials=_names(material, "material") if material else spec.get("materials", PAPER_MATERIALS),
+        indenters=_names(indenter, "indenter") if indenter else spec.get("indenters", PAPER_INDENTERS),
+        depths=parse_values(depth, "depth") if depth else spec.get("depths", (None,)),
+        braille_texts=tuple(braille_text) if braille_text else spec.get("braille_texts", ("",)),
+    )
+    scenes = expand_grid(base=base, **grid)
+    out = Path(out)
+    cache = ResultCache(cache_dir or out / "cache")
+    console.print(f"sweep: {len(scenes)} cases → {out}")
+
+    t0 = time.perf_counter()
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), console=console, transient=False) as bar:
+        task = bar.add_task("solving", total=len(scenes))
+
+        def on_event(oc):
+            style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
+            extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
+            bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
+            bar.advance(task)
+
+        outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
+                             on_event=on_event)
+    wall = time.perf_counter() - t0
+    paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
+    nfail = len(paths["failures"])
+    console.print(f"report: {paths['report']}  ({len(scenes) - nfail}/{len(scenes)} ok, {wall:.1f} s)")
+    return 1 if nfail else 0
+
+
+def _names(text: str, name: str) -> tuple[str, ...]:
+    items = tuple(x.strip() for x in text.split(",") if x.strip())
+    if not items:
+        raise ParameterError(name, text, "a comma-separated list of names")
+    return items

@@ -1,0 +1,101 @@
+"""The paper's figures from sweep records: Fig. 10 (profiles), 11 (peak), 12 (span), 13 (AUC).
+
+Each figure is written as PNG and SVG. matplotlib runs on the Agg backend (no display).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+INDENTER_ORDER = ("flat", "curved", "braille")
+COLOURS = {"flat": "#1f77b4", "curved": "#d62728", "braille": "#2ca02c"}
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, out: Path, stem: str) -> list[Path]:
+    paths = []
+    for ext in ("png", "svg"):
+        p = out / f"{stem}.{ext}"
+        fig.savefig(p, dpi=150, bbox_inches="tight")
+        paths.append(p)
+    _plt().close(fig)
+    return paths
+
+
+def _axes_keys(records):
+    mats = sorted({r.scene.material for r in records})
+    thick = sorted({r.scene.thickness for r in records})
+    return mats, thick
+
+
+def _ind_name(r) -> str:
+    return r.scene.indenter.value + (f" '{r.scene.braille_text}'" if r.scene.braille_text else "")
+
+
+def profiles_figure(records, out: Path) -> list[Path]:
+    """Fig. 10 style: P(s) along the bone; rows materials, columns thicknesses."""
+    plt = _plt()
+    mats, thick = _axes_keys(records)
+    fig, axes = plt.subplots(len(mats), len(thick), figsize=(3.6 * len(thick), 2.8 * len(mats)),
+                             squeeze=False, sharex=True)
+    for i, m in enumerate(mats):
+        for j, t in enumerate(thick):
+            ax = axes[i][j]
+            for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t),
+                            key=lambda r: INDENTER_ORDER.index(r.scene.indenter.value)):
+                ax.plot(r.s, r.pressure, color=COLOURS.get(r.scene.indenter.value), label=_ind_name(r))
+            ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
+            ax.axhline(0, color="0.7", lw=0.5)
+            ax.set_xlim(0, 8)
+            if j == 0:
+                ax.set_ylabel("mean pressure P (MPa)")
+            if i == len(mats) - 1:
+                ax.set_xlabel("distance along bone s (mm)")
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)", fontsize=10)
+    return _save(fig, out, "fig10_profiles")
+
+
+def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: str, out: Path) -> list[Path]:
+    """Fig. 11-13 style grouped bars: x thickness, bars per indenter, one panel per material."""
+    plt = _plt()
+    mats = sorted({r["material"] for r in rows})
+    thick = sorted({r["thickness_mm"] for r in rows})
+    inds = [i for i in INDENTER_ORDER if any(r["indenter"] == i for r in rows)]
+    fig, axes = plt.subplots(1, len(mats), figsize=(4.2 * len(mats), 3.2), squeeze=False)
+    w = 0.8 / max(len(inds), 1)
+    for k, m in enumerate(mats):
+        ax = axes[0][k]
+        for q, ind in enumerate(inds):
+            vals = []
+            for t in thick:
+                v = [r[metric] for r in rows if r["material"] == m and r["thickness_mm"] == t
+                     and r["indenter"] == ind and r.get("status", "ok") == "ok"]
+                vals.append(v[0] if v else np.nan)
+            ax.bar(np.arange(len(thick)) + (q - (len(inds) - 1) / 2) * w, vals, w,
+                   label=ind, color=COLOURS.get(ind))
+        ax.set_xticks(np.arange(len(thick)), [f"{t:g} mm" for t in thick])
+        ax.set_title(m, fontsize=9)
+        ax.set_ylabel(ylabel)
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, out, stem)
+
+
+def all_figures(records, rows, out: Path) -> list[Path]:
+    out.mkdir(parents=True, exist_ok=True)
+    paths = profiles_figure(records, out)
+    paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
+    paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)
+    paths += metric_figure(rows, "auc", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)
+    return paths

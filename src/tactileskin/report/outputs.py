@@ -1,0 +1,98 @@
+"""Turn sweep outcomes into results.csv, profiles.csv, figures, renders and report.md."""
+
+from __future__ import annotations
+
+import csv
+import io
+import logging
+import math
+import os
+import tempfile
+from pathlib import Path
+
+from tactileskin.errors import TactileSkinError
+
+log = logging.getLogger(__name__)
+
+RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter", "braille_text",
+                  "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc", "reaction_n_per_mm",
+                  "dofs", "increments", "newton_iterations", "wall_s", "error"]
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", newline="") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def collect(outcomes, cache):
+    """(records, rows, failures) from run_sweep outcomes."""
+    records, rows, failures = [], [], []
+    for oc in outcomes:
+        sc = oc.scene
+        row = dict(case=sc.label(), key=sc.key(), thickness_mm=sc.thickness, material=sc.material,
+                   indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
+                   rate_mm_s=sc.rate)
+        if oc.status == "failed":
+            row.update(status="failed", error=oc.error)
+            failures.append(oc)
+        else:
+            rec = cache.load(sc)
+            records.append(rec)
+            row.update(status="ok", **{k: rec.summary.get(k) for k in
+                                       ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "dofs",
+                                        "increments", "newton_iterations", "wall_s")})
+            for k in ("peak_mpa", "span_mm", "auc"):
+                v = row[k]
+                if v is None or not math.isfinite(float(v)):
+                    raise TactileSkinError(f"cached case {sc.label()} has a non-finite {k}: {v}")
+        rows.append(row)
+    return records, rows, failures
+
+
+def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = True) -> dict:
+    from tactileskin.report.figures import all_figures
+    from tactileskin.report.markdown import build_report
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    records, rows, failures = collect(outcomes, cache)
+
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=RESULT_COLUMNS, extrasaction="ignore")
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(out / "results.csv", buf.getvalue())
+
+    buf = io.StringIO()
+    buf.write("case,s_mm,pressure_mpa\n")
+    for rec in records:
+        for s, p in zip(rec.s, rec.pressure):
+            buf.write(f"{rec.scene.label()},{s:.6g},{p:.6g}\n")
+    atomic_write_text(out / "profiles.csv", buf.getvalue())
+
+    figures = all_figures(records, rows, out) if records else []
+    renders = []
+    if render and records:
+        from tactileskin.report.render import render_case
+
+        for rec in records:  # one Fig. 9A-style render per material at the thinnest skin, flat plate
+            sc = rec.scene
+            thinnest = min(r.scene.thickness for r in records if r.scene.material == sc.material)
+            vtu = rec.path / "result.vtu"
+            if sc.indenter.value == "flat" and sc.thickness == thinnest and vtu.is_file():
+                try:
+                    renders.append(render_case(vtu, out / f"fig9_{sc.label()}.png", title=sc.label()))
+                except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
+                    log.warning("render of %s failed: %s", sc.label(), e)
+    report = build_report(rows, records, failures, figures, renders, wall_s)
+    atomic_write_text(out / "report.md", report)
+    return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",
+                figures=figures, renders=renders, failures=failures)

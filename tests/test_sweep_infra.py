@@ -1,0 +1,82 @@
+"""Sweep plumbing that does not need a solve: grids, parsing, the atomic cache, discrimination."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tactileskin.discrimination import THRESHOLD, discriminate, profile_distance
+from tactileskin.errors import ParameterError
+from tactileskin.scene import Scene
+from tactileskin.sweep import ResultCache, expand_grid, parse_values
+
+
+def test_paper_grid_has_18_distinct_cases():
+    scenes = expand_grid()
+    assert len(scenes) == 18 and len({s.key() for s in scenes}) == 18
+    assert sorted({round(s.indentation, 12) for s in scenes}) == pytest.approx([0.2, 0.6, 1.0])
+
+
+def test_braille_texts_only_multiply_braille_cases():
+    scenes = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_texts=["", "ab"])
+    assert len(scenes) == 4  # flat, curved, braille, braille 'ab'
+
+
+@pytest.mark.parametrize("text, expect", [("1,3,5", [1, 3, 5]), ("1:2:0.5", [1, 1.5, 2]), (" 2 ", [2])])
+def test_parse_values(text, expect):
+    assert parse_values(text, "thickness") == pytest.approx(expect)
+
+
+@pytest.mark.parametrize("text", ["", "a,b", "1:0:1", "1:2:0", "0:1e6:1"])
+def test_parse_values_rejects(text):
+    with pytest.raises(ParameterError, match="thickness"):
+        parse_values(text, "thickness")
+
+
+def test_unknown_indenter_in_grid():
+    with pytest.raises(ParameterError, match="indenter"):
+        expand_grid(indenters=["pyramid"])
+
+
+class _Written:
+    """Minimal object with the Result.write contract, to exercise the cache alone."""
+
+    def __init__(self, fail=False):
+        self.fail = fail
+
+    def write(self, d):
+        d.mkdir(parents=True)
+        (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1.5\n1,0.5\n")
+        if self.fail:
+            raise OSError("disk full")
+        (d / "summary.json").write_text(json.dumps({"peak_mpa": 1.5}))
+
+
+def test_cache_store_is_atomic(tmp_path):
+    cache = ResultCache(tmp_path / "c")
+    sc = Scene(thickness=1.0)
+    with pytest.raises(OSError):
+        cache.store(sc, _Written(fail=True))
+    assert not cache.has(sc) and not cache.path(sc).exists()
+    assert list((tmp_path / "c").iterdir()) == []  # no staging debris
+    cache.store(sc, _Written())
+    rec = cache.load(sc)
+    assert rec.summary["peak_mpa"] == 1.5 and np.allclose(rec.pressure, [1.5, 0.5])
+    assert Scene.from_toml(cache.path(sc) / "scene.toml") == sc
+
+
+def test_profile_distance_properties():
+    s = np.linspace(0, 5, 101)
+    p = np.exp(-s**2)
+    assert profile_distance(s, p, s, p) == 0.0
+    assert profile_distance(s, p, s, 2 * p) == pytest.approx(0.5, rel=1e-6)  # ||p|| / ||2p||
+    assert profile_distance(s, p, s, np.zeros_like(p)) == pytest.approx(1.0)
+
+
+def test_discriminate_verdict():
+    s = np.linspace(0, 6, 301)
+    wide, narrow = np.exp(-(s / 3) ** 2), np.exp(-(s / 0.7) ** 2)
+    v = discriminate({"a": (s, wide), "b": (s, narrow)})
+    assert v.distinguishable and v.min_distance > THRESHOLD
+    v2 = discriminate({"a": (s, wide), "b": (s, 1.05 * wide)})
+    assert not v2.distinguishable and v2.min_distance == pytest.approx(0.05 / 1.05, rel=1e-3)
