@@ -1,0 +1,24 @@
+"""Meshes of the skin (gmsh at the edge) handed to scikit-fem with named boundaries.
+
+`build_mesh(scene) -> SkinMesh`: the 2D plane-strain half section (scene.dim == 2) or the
+3D slab (scene.dim == 3), P2 curved cells by default (scene.order). Boundaries by name:
+`bone_interface`, `outer_surface`, `symmetry`, `nail_edge` (+ `end_front`, `end_back` in 3D).
+"""
+
+from __future__ import annotations
+
+from tactileskin.mesh.skinmesh import BOUNDARIES_2D, BOUNDARIES_3D, FORMATS, SkinMesh
+
+__all__ = ["build_mesh", "SkinMesh", "BOUNDARIES_2D", "BOUNDARIES_3D", "FORMATS"]
+
+
+def build_mesh(scene, **overrides) -> SkinMesh:
+    """Mesh the skin of `scene`. Keyword overrides (mesh_size, refinement, order) take
+    precedence over the scene's fields without changing it."""
+    if scene.dim == 2:
+        from tactileskin.mesh.section2d import build_section_mesh
+
+        return build_section_mesh(scene, **overrides)
+    from tactileskin.mesh.slab3d import build_slab_mesh
+
+    return build_slab_mesh(scene, **overrides)

@@ -1,0 +1,152 @@
+"""gmsh session handling and the hand-off of gmsh's second-order mesh to scikit-fem.
+
+gmsh keeps global state, so every build runs inside `session()`: one lock per process,
+`initialize(interruptible=False)` (works off the main thread, e.g. in Dask workers),
+terminal output silenced unless this logger is at DEBUG, and always finalized.
+
+Second-order nodes are read straight from the gmsh API (no file round trip): scikit-fem's
+meshio import drops second-order boundary tags, so the named facet sets are rebuilt here by
+matching the vertex tuples of gmsh's boundary elements against `mesh.facets`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import threading
+
+import numpy as np
+
+from tactileskin.errors import MeshError
+
+logger = logging.getLogger(__name__)
+_LOCK = threading.Lock()
+
+# gmsh element type ids
+LINE2, LINE3, TRI3, TRI6, TET4, TET10 = 1, 8, 2, 9, 4, 11
+CELL_TYPE = {(2, 1): TRI3, (2, 2): TRI6, (3, 1): TET4, (3, 2): TET10}
+FACET_TYPE = {(2, 1): LINE2, (2, 2): LINE3, (3, 1): TRI3, (3, 2): TRI6}
+# gmsh tetra10 edges: (0,1) (1,2) (0,2) (0,3) (2,3) (1,3); scikit-fem (RefTet.edges):
+# (0,1) (1,2) (0,2) (0,3) (1,3) (2,3) -> swap the last two mid-nodes.
+_TET10_GMSH_TO_SKFEM = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 8])
+
+
+@contextlib.contextmanager
+def session(name: str, params: dict):
+    """A fresh gmsh model; gmsh errors become MeshError naming `params`."""
+    import gmsh
+
+    with _LOCK:
+        owned = not gmsh.isInitialized()
+        if owned:
+            gmsh.initialize(interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 1 if logger.isEnabledFor(logging.DEBUG) else 0)
+            gmsh.option.setNumber("General.Verbosity", 5 if logger.isEnabledFor(logging.DEBUG) else 2)
+            gmsh.logger.start()
+            gmsh.model.add(name)
+            try:
+                yield gmsh
+            except MeshError:
+                raise
+            except Exception as e:  # gmsh raises plain Exception
+                log = [m for m in gmsh.logger.get() if m.startswith(("Error", "Warning"))][-5:]
+                raise MeshError(f"gmsh failed to mesh {name} with {params}: {e}"
+                                + (f" (gmsh log: {' | '.join(log)})" if log else "")) from e
+            finally:
+                gmsh.logger.stop()
+                gmsh.model.remove()
+        finally:
+            if owned:
+                gmsh.finalize()
+
+
+def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
+    """Read the current gmsh mesh into scikit-fem.
+
+    groups: boundary name -> list of gmsh entity tags of dimension dim-1.
+    Returns (mesh, boundaries, gmsh cell tags in mesh order).
+    """
+    import skfem
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    coords = coords.reshape(-1, 3)[:, :dim]
+    etype = CELL_TYPE[(dim, order)]
+    etags, enodes = gmsh.model.mesh.getElementsByType(etype)
+    nper = {TRI3: 3, TRI6: 6, TET4: 4, TET10: 10}[etype]
+    if len(etags) == 0:
+        raise MeshError(f"gmsh produced no {dim}D elements of order {order}")
+    # contiguous node numbering 0..N-1 over the nodes the cells use (drops stray nodes)
+    index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+    index[tags.astype(np.int64)] = np.arange(len(tags))
+    conn = index[enodes.astype(np.int64)].reshape(-1, nper)
+    used = np.unique(conn)
+    renum = np.full(len(tags), -1, dtype=np.int64)
+    renum[used] = np.arange(len(used))
+    conn = renum[conn]
+    points = coords[used]
+    node_of_tag = np.full_like(index, -1)
+    node_of_tag[tags.astype(np.int64)] = renum
+    if etype == TET10:
+        conn = conn[:, _TET10_GMSH_TO_SKFEM]
+    conn = _orient_positive(points, conn, dim)
+
+    cls = {(2, 1): skfem.MeshTri1, (2, 2): skfem.MeshTri2,
+           (3, 1): skfem.MeshTet1, (3, 2): skfem.MeshTet2}[(dim, order)]
+    # scikit-fem puts vertex nodes first and renumbers them in order of np.unique; the
+    # extra rows of t are assigned to its own edge dofs in refdom edge order.
+    mesh = cls(np.ascontiguousarray(points.T), np.ascontiguousarray(conn.T))
+    nv = dim + 1
+    vert_orig = np.unique(conn[:, :nv])           # original index of skfem vertex k
+    boundaries = {}
+    bfacets = mesh.boundary_facets()
+    fkeys = {tuple(k): f for k, f in zip(np.sort(mesh.facets[:, bfacets], axis=0).T.tolist(), bfacets)}
+    ftype = FACET_TYPE[(dim, order)]
+    for name, ents in groups.items():
+        found = []
+        for ent in ents:
+            types, _, fnodes = gmsh.model.mesh.getElements(dim - 1, ent)
+            for ty, nodes in zip(types, fnodes):
+                if ty != ftype:
+                    continue
+                nper_f = _nnodes(ty)
+                verts = node_of_tag[nodes.astype(np.int64)].reshape(-1, nper_f)[:, :dim]
+                verts = np.searchsorted(vert_orig, verts)
+                for key in np.sort(verts, axis=1).tolist():
+                    f = fkeys.get(tuple(key))
+                    if f is None:
+                        raise MeshError(f"boundary '{name}': a gmsh facet is not a boundary facet of the mesh")
+                    found.append(f)
+        if not found:
+            raise MeshError(f"boundary '{name}' has no facets (gmsh entities {ents})")
+        boundaries[name] = np.unique(np.asarray(found, dtype=np.int64))
+    return mesh, boundaries, etags
+
+
+def _nnodes(gmsh_type: int) -> int:
+    return {LINE2: 2, LINE3: 3, TRI3: 3, TRI6: 6}[gmsh_type]
+
+
+def _orient_positive(points: np.ndarray, conn: np.ndarray, dim: int) -> np.ndarray:
+    """Flip cells whose vertex ordering has a negative (straight-sided) Jacobian."""
+    v = points[conn[:, : dim + 1]]
+    J = np.stack([v[:, i + 1] - v[:, 0] for i in range(dim)], axis=-1)
+    neg = np.linalg.det(J) < 0
+    if not np.any(neg):
+        return conn
+    conn = conn.copy()
+    if dim == 2:
+        # swap vertices 1<->2; edges (0,1) (1,2) (0,2) -> (0,2) (2,1) (0,1)
+        perm = np.array([0, 2, 1, 5, 4, 3]) if conn.shape[1] == 6 else np.array([0, 2, 1])
+    else:
+        # swap vertices 1<->2; edges (0,1)(1,2)(0,2)(0,3)(1,3)(2,3) -> (0,2)(2,1)(0,1)(0,3)(2,3)(1,3)
+        perm = np.array([0, 2, 1, 3, 6, 5, 4, 7, 9, 8]) if conn.shape[1] == 10 else np.array([0, 2, 1, 3])
+    conn[neg] = conn[neg][:, perm]
+    return conn
+
+
+def element_quality(gmsh, etags: np.ndarray) -> dict:
+    """Minimum and mean scaled Jacobian of the gmsh cells (curved cells included)."""
+    q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSJ"))
+    return {"min_scaled_jacobian": float(q.min()), "mean_scaled_jacobian": float(q.mean()),
+            "n_bad_lt_0.1": int(np.sum(q < 0.1))}

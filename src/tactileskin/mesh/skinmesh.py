@@ -1,0 +1,145 @@
+"""SkinMesh: a scikit-fem mesh of the skin with named boundaries, quality and export."""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin.errors import MeshError, ParameterError
+
+logger = logging.getLogger(__name__)
+
+BOUNDARIES_2D = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
+BOUNDARIES_3D = BOUNDARIES_2D + ("end_front", "end_back")
+# meshio format names by suffix
+FORMATS = {".msh": "gmsh", ".vtu": "vtu", ".inp": "abaqus"}
+
+
+@dataclass
+class SkinMesh:
+    """The meshed skin.
+
+    mesh: skfem MeshTri2/MeshTri1 (2D) or MeshTet2/MeshTet1 (3D); its `boundaries` hold the
+      same named facet sets as `boundaries` here.
+    boundaries: name -> facet indices into `mesh.facets` (`bone_interface`, `outer_surface`,
+      `symmetry` (plane x = 0), `nail_edge`, and in 3D `end_front`, `end_back`).
+    dim: 2 (plane-strain half section) or 3 (slab along z).
+    quality: min/mean scaled Jacobian (gmsh minSJ of the curved cells), cell/node counts.
+    z_symmetric (3D): True if the slab is the half z >= 0 and `end_back` is the mid-plane
+      z = 0 (a symmetry plane: u_z = 0); False if `end_back` is the free end z = -length/2.
+    sizes: the size plan that made the mesh (coarse, fine, contact zone, estimate).
+    """
+
+    mesh: object
+    boundaries: dict[str, np.ndarray]
+    dim: int
+    quality: dict
+    section: object = None
+    z_symmetric: bool = False
+    length: float | None = None
+    sizes: dict = field(default_factory=dict)
+
+    @property
+    def order(self) -> int:
+        return 2 if type(self.mesh).__name__.endswith("2") else 1
+
+    # --- export ----------------------------------------------------------------------
+    def to_meshio(self):
+        """meshio.Mesh with the cells, the named boundary facets (cell sets, gmsh physical
+        tags) and node sets per boundary; second-order cells as triangle6 / tetra10."""
+        import meshio
+
+        m = self.mesh
+        pts = m.doflocs.T
+        if self.dim == 2:
+            pts = np.column_stack([pts, np.zeros(len(pts))])
+        cell_nodes = m.dofs.element_dofs[: _cell_nnodes(self.dim, self.order)].T
+        ctype = {(2, 1): "triangle", (2, 2): "triangle6", (3, 1): "tetra", (3, 2): "tetra10"}[(self.dim, self.order)]
+        ftype = {(2, 1): "line", (2, 2): "line3", (3, 1): "triangle", (3, 2): "triangle6"}[(self.dim, self.order)]
+        cells = [(ctype, cell_nodes)]
+        phys = [np.zeros(len(cell_nodes), dtype=int)]
+        field_data = {"skin": np.array([len(self.boundaries) + 1, self.dim])}
+        phys[0][:] = len(self.boundaries) + 1
+        cell_sets = {"skin": [np.arange(len(cell_nodes))] + [np.array([], dtype=int)] * len(self.boundaries)}
+        point_sets = {}
+        for i, (name, facets) in enumerate(self.boundaries.items()):
+            fn = facet_nodes(m, facets, self.dim, self.order)
+            cells.append((ftype, fn))
+            phys.append(np.full(len(fn), i + 1))
+            field_data[name] = np.array([i + 1, self.dim - 1])
+            sets = [np.array([], dtype=int)] * (len(self.boundaries) + 1)
+            sets[i + 1] = np.arange(len(fn))
+            cell_sets[name] = sets
+            point_sets[name] = np.unique(fn)
+        return meshio.Mesh(pts, cells, cell_data={"gmsh:physical": phys, "gmsh:geometrical": phys},
+                           field_data=field_data, cell_sets=cell_sets, point_sets=point_sets)
+
+    def write(self, path: str | os.PathLike) -> Path:
+        """Write by suffix (.msh, .vtu, .inp) atomically: temp file in the target folder, then rename."""
+        path = Path(path)
+        fmt = FORMATS.get(path.suffix.lower())
+        if fmt is None:
+            raise ParameterError("path", str(path), "a file name ending in " + ", ".join(FORMATS))
+        out = self.to_meshio()
+        if fmt == "abaqus":
+            out.cell_data = {}  # Abaqus keeps the groups as ELSET/NSET; no per-cell arrays
+        if fmt == "vtu":
+            out.cell_sets, out.point_sets, out.field_data = {}, {}, {}
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+        os.close(fd)
+        try:
+            kw = {"file_format": fmt}
+            if fmt == "gmsh":
+                kw.update(file_format="gmsh22", binary=False)
+            out.write(tmp, **kw)
+            os.replace(tmp, path)
+        except Exception as e:
+            Path(tmp).unlink(missing_ok=True)
+            raise MeshError(f"could not write {path} ({fmt}): {e}") from e
+        logger.info("wrote %s", path)
+        return path
+
+    # --- checks ----------------------------------------------------------------------
+    def boundary_measure(self, name: str) -> float:
+        """Length (2D) or area (3D) of a named boundary, integrated on the curved facets."""
+        from skfem import Functional, FacetBasis
+
+        fb = FacetBasis(self.mesh, self.mesh.elem(), facets=self.boundaries[name])
+        return float(Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(fb))
+
+    def measure(self) -> float:
+        """Area (2D) or volume (3D) of the mesh on the curved cells."""
+        from skfem import Functional, CellBasis
+
+        cb = CellBasis(self.mesh, self.mesh.elem())
+        return float(Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(cb))
+
+    def min_jacobian(self) -> float:
+        """Smallest Jacobian determinant over the quadrature points (> 0: no inverted cell)."""
+        from skfem import CellBasis
+
+        cb = CellBasis(self.mesh, self.mesh.elem())
+        return float(np.min(cb.mapping.detDF(cb.X)))
+
+
+def _cell_nnodes(dim: int, order: int) -> int:
+    return {(2, 1): 3, (2, 2): 6, (3, 1): 4, (3, 2): 10}[(dim, order)]
+
+
+def facet_nodes(m, facets: np.ndarray, dim: int, order: int) -> np.ndarray:
+    """Node indices (meshio line3/triangle6 order) of the given facets of a skfem mesh."""
+    verts = m.facets[:, facets].T
+    if order == 1:
+        return verts
+    if dim == 2:
+        return np.column_stack([verts, m.dofs.facet_dofs[0, facets]])
+    # triangle facet: edges (0,1) (1,2) (0,2) of the facet's own (sorted) vertices
+    edges = m.f2e[:, facets]  # (3, nf), in brefdom edge order of the facet
+    mids = m.dofs.edge_dofs[0, edges].T
+    return np.column_stack([verts, mids])
