@@ -1,0 +1,85 @@
+"""Rigid frictionless contact on the quadrature points of a boundary (augmented Lagrangian).
+
+The indenter is any object with `gap(points, d) -> (g, n)` (signed distance, g < 0
+penetrating; unit normal out of the indenter). The contact pressure per reference area at
+a point is lambda_N = max(0, lambda_k - eps g) with the Uzawa multiplier lambda_k held fixed
+during a Newton solve; after it, lambda_k <- lambda_N until the penetration is below the
+tolerance and the multipliers settle. The tangent includes the curvature of the indenter
+surface (dn/dx, by central differences of the normal, since `gap` gives only g and n).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from skfem import FacetBasis
+
+from tactileskin.fe.assembly import vector_dofs
+
+_FD_STEP = 1e-6  # mm; central difference of the unit normal (error ~ h^2 kappa^3, negligible)
+
+
+class ContactSurface:
+    def __init__(self, mesh, element, facets: np.ndarray, m: int, intorder: int = 6):
+        fb = FacetBasis(mesh, element, facets=facets, intorder=intorder)
+        self.m = m
+        self.X = np.moveaxis(fb.global_coordinates().value, 0, -1)        # (Fc, Qc, m)
+        self.N = np.stack([fb.basis[a][0].value for a in range(fb.Nbfun)], axis=-1)  # (Fc, Qc, A)
+        self.w = np.asarray(fb.dx)                                             # (Fc, Qc)
+        self.sdofs = fb.element_dofs.T                                         # (Fc, A)
+        self.vdofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)   # (Fc, A*m)
+        # tangent of the reference boundary (2D) to convert to current-area pressure
+        self.lam = np.zeros(self.w.shape)
+        self.shape = self.w.shape
+
+    def displacement(self, u: np.ndarray) -> np.ndarray:
+        U = u.reshape(-1, self.m)
+        return np.einsum("fqa,fai->fqi", self.N, U[self.sdofs])
+
+    def evaluate(self, u, indenter, d: float, eps: float, lam_k: np.ndarray, tangent: bool):
+        """Residual contribution (Fc, A*m), tangent blocks (Fc, A*m, A*m) or None, and the
+        point data (g, lambda_N, x)."""
+        x = self.X + self.displacement(u)
+        g, n = indenter.gap(x, d)
+        lamN = np.maximum(0.0, lam_k - eps * g)
+        active = lamN > 0.0
+        Fc, Qc, A = self.N.shape
+        m = self.m
+        # R_c = - int lambda_N n_i N_a
+        fc = -np.einsum("fq,fqi,fqa->fai", self.w * lamN, n, self.N).reshape(Fc, A * m)
+        Kc = None
+        if tangent:
+            Kpt = eps * active[..., None, None] * np.einsum("fqi,fqk->fqik", n, n)
+            if np.any(active):
+                dn = self._dn_dx(x, indenter, d, active)
+                Kpt = Kpt - lamN[..., None, None] * dn
+            Kc = np.einsum("fq,fqa,fqb,fqik->faibk", self.w, self.N, self.N, Kpt).reshape(Fc, A * m, A * m)
+        return fc, Kc, (g, lamN, x, n)
+
+    def _dn_dx(self, x, indenter, d, active):
+        m = self.m
+        dn = np.zeros(x.shape + (m,))
+        xa = x[active]
+        out = np.zeros((len(xa), m, m))
+        for k in range(m):
+            e = np.zeros(m)
+            e[k] = _FD_STEP
+            _, n1 = indenter.gap(xa + e, d)
+            _, n0 = indenter.gap(xa - e, d)
+            out[:, :, k] = (n1 - n0) / (2 * _FD_STEP)
+        out = 0.5 * (out + np.swapaxes(out, 1, 2))  # Hessian of a distance: symmetric
+        dn[active] = out
+        return dn
+
+    def current_pressure(self, u, lamN) -> np.ndarray:
+        """Contact pressure per current area: lambda_N * dA0/da (2D: reference/current length)."""
+        if self.m != 2:
+            return lamN
+        # stretch of the boundary: |dx/dS| from the displacement derivative along the facet,
+        # estimated by the ratio of current/reference distances between neighbouring points
+        X, x = self.X, self.X + self.displacement(u)
+        dX = np.gradient(X, axis=1) if X.shape[1] > 1 else None
+        if dX is None:
+            return lamN
+        dx = np.gradient(x, axis=1)
+        ratio = np.linalg.norm(dX, axis=-1) / np.maximum(np.linalg.norm(dx, axis=-1), 1e-300)
+        return lamN * ratio

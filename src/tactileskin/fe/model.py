@@ -1,0 +1,215 @@
+"""A discretised boundary-value problem: mesh, material law, QLV history, BCs, contact.
+
+`Model` evaluates the global residual (and, when asked, the consistent tangent) for a
+trial displacement at a given time, without changing its committed state; `commit()`
+accepts a converged increment (QLV internal variables).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from skfem import CellBasis
+from skfem.element import (ElementQuad1, ElementQuad2, ElementTetP1, ElementTetP2,
+                           ElementTriP1, ElementTriP2, ElementHex1, ElementHex2)
+
+from tactileskin.errors import ParameterError
+from tactileskin.fe import kernels
+from tactileskin.fe.assembly import Pattern, assemble_vector, vector_dofs
+from tactileskin.fe.contact import ContactSurface
+
+log = logging.getLogger(__name__)
+
+Law = Callable[[np.ndarray], tuple]  # C (...,3,3) -> (S, D, ok)
+
+
+def scalar_element(mesh, order: int):
+    name = type(mesh).__name__
+    table = {
+        "Tri": (ElementTriP1, ElementTriP2),
+        "Quad": (ElementQuad1, ElementQuad2),
+        "Tet": (ElementTetP1, ElementTetP2),
+        "Hex": (ElementHex1, ElementHex2),
+    }
+    for key, els in table.items():
+        if key in name:
+            return els[order - 1]()
+    raise ParameterError("mesh", name, "a scikit-fem triangle, quad, tetrahedral or hexahedral mesh")
+
+
+@dataclass(frozen=True)
+class Dirichlet:
+    """Prescribed displacement component(s) on a named boundary; value(t) or a constant."""
+
+    boundary: str
+    components: tuple[int, ...]
+    value: float | Callable[[float], float] = 0.0
+
+    def at(self, t: float) -> float:
+        return float(self.value(t)) if callable(self.value) else float(self.value)
+
+
+@dataclass
+class Contact:
+    """Rigid indenter on a named boundary; travel d(t) = rate * t."""
+
+    indenter: object
+    boundary: str = "outer_surface"
+    rate: float = 1.0
+    penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
+    tol_penetration: float = 1e-4  # mm
+    tol_multiplier: float = 1e-3   # relative change of the multipliers between Uzawa updates
+    max_uzawa: int = 30
+
+
+@dataclass
+class Evaluation:
+    R: np.ndarray                  # global residual (internal - external), (ndof,)
+    ok: bool                       # admissible state everywhere
+    K: np.ndarray | None = None    # CSR data of the tangent
+    contact: tuple | None = None   # (g, lamN, x, n) at contact points
+    S0: np.ndarray | None = None   # elastic PK2 (E, Q, 3, 3) at the trial state
+    kin: kernels.Kinematics | None = None
+    fint: np.ndarray | None = None
+    why: str = ""
+
+
+class Model:
+    def __init__(self, mesh, boundaries: dict, law: Law, dirichlet: list[Dirichlet], *,
+                 prony=None, formulation: str = "mixed", contact: Contact | None = None,
+                 order: int = 2, intorder: int | None = None, stiffness: float = 1.0):
+        if formulation not in ("mixed", "displacement"):
+            raise ParameterError("formulation", formulation, "'mixed' or 'displacement'")
+        self.mesh, self.boundaries, self.law, self.prony = mesh, dict(boundaries), law, prony
+        self.mixed = formulation == "mixed"
+        self.formulation = formulation
+        self.element = scalar_element(mesh, order)
+        kw = {} if intorder is None else {"intorder": intorder}
+        self.basis = CellBasis(mesh, self.element, **kw)
+        b = self.basis
+        self.m = m = mesh.dim()
+        self.nsdof = b.N
+        self.ndof = b.N * m
+        self.G = np.stack([np.moveaxis(b.basis[a][0].grad, 0, -1) for a in range(b.Nbfun)], axis=2)
+        self.w = np.asarray(b.dx)
+        self.sdofs = b.element_dofs.T                                   # (E, A)
+        self.edofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)
+        self.stiffness = stiffness  # a modulus (MPa) for scaling penalties and tolerances
+
+        # Dirichlet dofs
+        self.dirichlet = list(dirichlet)
+        fixed, self._bc_groups = [], []
+        for bc in self.dirichlet:
+            if bc.boundary not in self.boundaries:
+                raise ParameterError("boundary", bc.boundary, "one of " + ", ".join(sorted(self.boundaries)))
+            sd = self.facet_scalar_dofs(bc.boundary)
+            dofs = (sd[:, None] * m + np.asarray(bc.components)[None, :]).ravel()
+            self._bc_groups.append((bc, dofs))
+            fixed.append(dofs)
+        self.fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
+        self.free = np.setdiff1d(np.arange(self.ndof), self.fixed)
+        self.pattern = Pattern(self.ndof, self.edofs, self.free)
+
+        # contact
+        self.contact = contact
+        self.surface = None
+        if contact is not None:
+            if contact.boundary not in self.boundaries:
+                raise ParameterError("contact boundary", contact.boundary, "one of " + ", ".join(sorted(self.boundaries)))
+            self.surface = ContactSurface(mesh, self.element, self.boundaries[contact.boundary], m)
+            if contact.penalty is None:
+                h = self.surface_size()
+                contact.penalty = 20.0 * stiffness / h
+                log.debug("contact penalty %.3g MPa/mm (h = %.3g mm)", contact.penalty, h)
+
+        # committed state
+        E, Q = self.w.shape
+        self.u = np.zeros(self.ndof)
+        self.S0_old = np.zeros((E, Q, 3, 3))
+        nterms = 0 if prony is None else len(prony.g)
+        self.H = np.zeros((nterms, E, Q, 3, 3))
+        self.t = 0.0
+
+    # -- helpers ------------------------------------------------------------------------------
+    def facet_scalar_dofs(self, name: str) -> np.ndarray:
+        return np.unique(self.basis.get_dofs(self.boundaries[name]).all())
+
+    def surface_size(self) -> float:
+        """Typical facet size on the contact boundary (mm)."""
+        w = self.surface.w.sum(axis=1)
+        return float(np.median(w)) if self.m == 2 else float(np.sqrt(np.median(w)))
+
+    def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        dofs, vals = [], []
+        for bc, d in self._bc_groups:
+            dofs.append(d)
+            vals.append(np.full(len(d), bc.at(t)))
+        if not dofs:
+            return np.zeros(0, int), np.zeros(0)
+        return np.concatenate(dofs), np.concatenate(vals)
+
+    def travel(self, t: float) -> float:
+        return self.contact.rate * t if self.contact is not None else 0.0
+
+    def qlv(self, dt: float):
+        """(gamma, decay, gain) of the Prony update for a step dt; elastic: (1, [], [])."""
+        if self.prony is None:
+            return 1.0, np.zeros(0), np.zeros(0)
+        decay, gain = self.prony.step_factors(dt)
+        decay, gain = np.atleast_1d(decay), np.atleast_1d(gain)
+        return float(self.prony.g_inf + gain.sum()), decay, gain
+
+    # -- evaluation ---------------------------------------------------------------------------
+    def evaluate(self, u: np.ndarray, t: float, dt: float, lam_k: np.ndarray | None = None,
+                 tangent: bool = True) -> Evaluation:
+        m = self.m
+        ue = u.reshape(-1, m)[self.sdofs]
+        kin = kernels.Kinematics(ue, self.G, self.w, self.mixed)
+        if not kin.admissible:
+            return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="J <= 0")
+        S0, D0, ok = self.law(kin.C)
+        if not np.all(ok) or not np.all(np.isfinite(S0)):
+            return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="material state inadmissible")
+        gamma, decay, gain = self.qlv(dt)
+        S = gamma * S0
+        for i in range(len(decay)):
+            S = S + decay[i] * self.H[i] - gain[i] * self.S0_old
+        Sm = S[..., :m, :m]
+        fe = kernels.residual(kin, Sm)
+        fint = assemble_vector(self.ndof, self.edofs, fe)
+        R = fint.copy()
+        Kd = None
+        if tangent:
+            Dm = gamma * D0[..., :m, :m, :m, :m]
+            Kd = self.pattern.data(kernels.tangent(kin, Sm, Dm))
+        cinfo = None
+        if self.surface is not None:
+            c = self.contact
+            fc, Kc, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty,
+                                                  self.surface.lam if lam_k is None else lam_k, tangent)
+            R += assemble_vector(self.ndof, self.surface.vdofs, fc)
+            if tangent:
+                self.pattern.add(Kd, self.surface.vdofs, Kc)
+        if not np.all(np.isfinite(R)) or (Kd is not None and not np.all(np.isfinite(Kd))):
+            return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="non-finite residual")
+        ev = Evaluation(R=R, ok=True, K=Kd, contact=cinfo, S0=S0, kin=kin, fint=fint)
+        ev.S = S
+        return ev
+
+    def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
+        _, decay, gain = self.qlv(dt)
+        for i in range(len(decay)):
+            self.H[i] = decay[i] * self.H[i] + gain[i] * (ev.S0 - self.S0_old)
+        self.S0_old = ev.S0
+        self.u = u.copy()
+        self.t = t
+        if self.surface is not None and ev.contact is not None:
+            self.surface.lam = ev.contact[1].copy()
+
+    # -- output -------------------------------------------------------------------------------
+    def stress(self, ev: Evaluation) -> np.ndarray:
+        """Cauchy stress (E, Q, 3, 3) at the evaluation's state (total QLV stress)."""
+        return kernels.cauchy(ev.kin, ev.S)

@@ -1,0 +1,203 @@
+"""Newton with a backtracking line search, augmented-Lagrangian contact loop, adaptive time steps.
+
+- Newton uses the consistent tangent and a sparse direct solve (SuperLU) of the free block.
+  A line search halves the step while the trial state is inadmissible (J <= 0, material
+  overflow guard) or the residual norm does not decrease; the residual norm of every
+  iteration is logged (quadratic convergence is visible at DEBUG).
+- Each increment: Newton at fixed multipliers, then Uzawa updates until the largest
+  penetration is below tolerance; the penalty grows when the penetration stalls.
+- Increments grow after easy convergence and are cut back after a failure; below the
+  minimum increment a ConvergenceError carries a diagnosis (time, increment, residual
+  history, where the worst residual sits).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from tactileskin.errors import ConvergenceError
+from tactileskin.fe.model import Evaluation, Model
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class SolverOptions:
+    rtol: float = 1e-8            # residual norm relative to the internal-force norm
+    atol: float = 1e-12           # absolute residual floor (N)
+    max_newton: int = 20
+    max_halvings: int = 8
+    dt0_fraction: float = 0.1     # first increment as a fraction of the total time
+    dt_min_fraction: float = 1e-5
+    dt_max_fraction: float = 0.25
+    growth: float = 1.5
+    cutback: float = 0.35
+    easy_iterations: int = 5      # grow the increment when Newton needed at most this many
+    max_increments: int = 2000
+
+
+class _Failure(Exception):
+    def __init__(self, why: str, diag: dict):
+        super().__init__(why)
+        self.why, self.diag = why, diag
+
+
+@dataclass
+class Stats:
+    increments: int = 0
+    cutbacks: int = 0
+    newton_iterations: int = 0
+    uzawa_iterations: int = 0
+    factorizations: int = 0
+    wall_s: float = 0.0
+    history: list = field(default_factory=list)
+
+
+def _worst(model: Model, R: np.ndarray) -> dict:
+    Rf = np.zeros_like(R)
+    Rf[model.free] = np.nan_to_num(R[model.free], nan=np.inf)
+    k = int(np.argmax(np.abs(Rf)))
+    node = k // model.m
+    return {"dof": k, "component": k % model.m, "point_mm": model.basis.doflocs[:, node].tolist(),
+            "value": float(R[k]) if np.isfinite(R[k]) else None}
+
+
+def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverOptions, stats: Stats):
+    """Solve R(u) = 0 at time t; returns (u, evaluation, iterations)."""
+    u = u0.copy()
+    dofs, vals = model.prescribed(t)
+    u[dofs] = vals
+    free = model.free
+    ev = model.evaluate(u, t, dt, lam, tangent=True)
+    if not ev.ok:
+        raise _Failure(f"start state inadmissible ({ev.why})", {"history": []})
+    hist = []
+    for it in range(opts.max_newton + 1):
+        Rf = ev.R[free]
+        rn = float(np.linalg.norm(Rf))
+        scale = float(np.linalg.norm(ev.fint))
+        hist.append(rn)
+        log.debug("  newton %2d  |R| = %.3e  (scale %.3e)", it, rn, scale)
+        if rn <= opts.rtol * scale + opts.atol:
+            return u, ev, it, hist
+        if it == opts.max_newton:
+            break
+        K = model.pattern.free_matrix(ev.K).tocsc()
+        try:
+            lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A")
+        except RuntimeError as e:  # singular factor
+            raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
+        stats.factorizations += 1
+        du = np.zeros_like(u)
+        du[free] = -lu.solve(Rf)
+        if not np.all(np.isfinite(du)):
+            raise _Failure("non-finite Newton step", {"history": hist, **_worst(model, ev.R)})
+        eta, best = 1.0, None
+        for _ in range(opts.max_halvings + 1):
+            trial = model.evaluate(u + eta * du, t, dt, lam, tangent=False)
+            if trial.ok:
+                tn = float(np.linalg.norm(trial.R[free]))
+                if tn <= (1.0 - 1e-4 * eta) * rn:
+                    best = (eta, tn)
+                    break
+                if best is None or tn < best[1]:
+                    best = (eta, tn)
+            eta *= 0.5
+        if best is None:
+            raise _Failure("line search found no admissible state", {"history": hist, **_worst(model, ev.R)})
+        eta = best[0]
+        if best[1] > 10.0 * rn:  # diverging even along the best admissible step
+            raise _Failure("residual diverges", {"history": hist + [best[1]], **_worst(model, ev.R)})
+        if eta < 1.0:
+            log.debug("  line search eta = %.4g", eta)
+        u = u + eta * du
+        ev = model.evaluate(u, t, dt, lam, tangent=True)
+        stats.newton_iterations += 1
+        if not ev.ok:
+            raise _Failure(f"accepted state inadmissible ({ev.why})", {"history": hist})
+    raise _Failure("Newton did not converge", {"history": hist, **_worst(model, ev.R)})
+
+
+def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts: SolverOptions, stats: Stats):
+    """Newton + Uzawa at time t; returns (u, evaluation, newton iterations of the first solve)."""
+    c = model.contact
+    lam = None if model.surface is None else model.surface.lam.copy()
+    u, ev, its, hist = newton(model, u_pred, t, dt, lam, opts, stats)
+    if model.surface is None:
+        return u, ev, its
+    last_pen = np.inf
+    for k in range(c.max_uzawa):
+        g, lamN = ev.contact[0], ev.contact[1]
+        act = lamN > 0
+        pen = float(max(0.0, -g[act].min())) if np.any(act) else 0.0
+        change = float(np.abs(lamN - lam).max() / max(lamN.max(), 1e-300)) if np.any(act) else 0.0
+        log.debug(" uzawa %d: penetration %.2e mm, multiplier change %.2e", k, pen, change)
+        if pen <= c.tol_penetration and change <= max(c.tol_multiplier, 0.0) or (pen <= 0.1 * c.tol_penetration):
+            return u, ev, its
+        if pen > 0.3 * last_pen:  # slow Uzawa contraction: stiffen the penalty
+            c.penalty *= 4.0
+            log.debug(" uzawa: penalty raised to %.3g MPa/mm", c.penalty)
+        last_pen = pen
+        lam = lamN.copy()
+        stats.uzawa_iterations += 1
+        u, ev, _, hist = newton(model, u, t, dt, lam, opts, stats)
+    raise _Failure("augmented Lagrangian did not settle", {"penetration_mm": pen, "multiplier_change": change})
+
+
+def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: bool = False,
+        record: callable = None) -> tuple[Evaluation, Stats]:
+    """Integrate from the committed state at model.t to time T; returns the last evaluation."""
+    opts = opts or SolverOptions()
+    stats = Stats()
+    t0 = time.perf_counter()
+    t = model.t
+    span = T - t
+    dt = opts.dt0_fraction * span
+    dt_min = opts.dt_min_fraction * span
+    u_last, dt_last = None, None
+    ev = None
+    if span <= 0:
+        ev = model.evaluate(model.u, t, 0.0, tangent=False)
+    while t < T - 1e-12 * span:
+        dt = min(dt, T - t, opts.dt_max_fraction * span)
+        if T - (t + dt) < 1e-3 * dt:
+            dt = T - t
+        u = model.u
+        pred = u
+        if u_last is not None and dt_last:
+            pred = u + (dt / dt_last) * (u - u_last)  # linear extrapolation
+        try:
+            try:
+                unew, ev, its = _solve_increment(model, pred, t + dt, dt, opts, stats)
+            except _Failure:
+                if pred is u:
+                    raise
+                log.debug("predictor failed; retry from the last converged state")
+                unew, ev, its = _solve_increment(model, u, t + dt, dt, opts, stats)
+        except _Failure as f:
+            stats.cutbacks += 1
+            log.info("increment t=%.5g dt=%.3g failed (%s); cutting back", t + dt, dt, f.why)
+            if dt * opts.cutback < dt_min:
+                diag = {"time": t, "dt": dt, "reason": f.why, **f.diag}
+                raise ConvergenceError(f"no convergence at t = {t:.6g} s with dt = {dt:.3g} s: {f.why}",
+                                       diag) from None
+            dt *= opts.cutback
+            continue
+        model.commit(ev, unew, t + dt, dt)
+        u_last, dt_last = u, dt
+        t += dt
+        stats.increments += 1
+        log.info("increment %d: t = %.5g s (dt %.3g), %d Newton iterations", stats.increments, t, dt, its)
+        if history:
+            stats.history.append({"t": t, **(record(model, ev) if record else {})})
+        if its <= opts.easy_iterations:
+            dt *= opts.growth
+        if stats.increments >= opts.max_increments:
+            raise ConvergenceError(f"more than {opts.max_increments} increments", {"time": t, "dt": dt})
+    stats.wall_s = time.perf_counter() - t0
+    return ev, stats
