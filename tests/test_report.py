@@ -1,0 +1,57 @@
+"""Report plumbing on synthetic sweep records: verdict logic, figures, files."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tactileskin.report.markdown import paper_checks
+from tactileskin.scene import Scene
+from tactileskin.sweep import CaseRecord
+
+
+def _records(widths):
+    """Gaussian-like profiles with a given width per (material, t, indenter)."""
+    recs, rows = [], []
+    s = np.linspace(0, 8, 161)
+    for (mat, t, ind), (peak, w) in widths.items():
+        p = peak * np.exp(-(s / w) ** 2)
+        sc = Scene(thickness=t, material=mat, indenter=ind)
+        recs.append(CaseRecord(sc, s, p, {}, Path(".")))
+        span = w * np.sqrt(np.log(10))
+        rows.append(dict(status="ok", material=mat, thickness_mm=t, indenter=ind, braille_text="",
+                         peak_mpa=peak, span_mm=span, auc=float(np.trapezoid(p, s))))
+    return recs, rows
+
+
+def test_verdicts_follow_the_numbers():
+    data = {}
+    for t, scale in ((1.0, 1.0), (3.0, 0.6), (5.0, 0.3)):
+        for ind, (pk, w) in {"flat": (0.5, 4.0), "curved": (0.4, 2.0), "braille": (0.3, 0.8)}.items():
+            if t == 5.0:  # at 5 mm all three alike
+                pk, w = 0.2, 1.55
+            data[("silicone", t, ind)] = (pk * scale / (1 if t < 5 else 0.3), w / (1 + t / 10))
+    recs, rows = _records(data)
+    checks = {c["claim"]: c["verdict"] for c in paper_checks(rows, recs)}
+    assert checks["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm"] == "agrees"
+    assert checks["silicone 1 mm: peak order flat > curved > Braille holds"] == "agrees"
+    assert checks["silicone 5 mm: peak order flat > curved > Braille breaks down"] == "agrees"
+    assert checks["silicone 1 mm: indenters distinguishable"] == "agrees"
+    assert checks["silicone 5 mm: indenters indistinguishable"] == "agrees"
+    assert checks["silicone 5 mm: AUC alike for the three indenters"] == "agrees"
+    assert checks["silicone, flat: span shrinks as the skin thickens"] == "agrees"
+
+
+def test_peak_far_from_paper_is_reported_with_its_size():
+    recs, rows = _records({("polyurethane", 1.0, "flat"): (1.6, 3.0)})
+    (c,) = [c for c in paper_checks(rows, recs) if "peak" in c["claim"] and "polyurethane" in c["claim"]]
+    assert c["verdict"] == "differs by +100%"
+
+
+def test_figures_written(tmp_path):
+    from tactileskin.report.figures import all_figures
+
+    recs, rows = _records({("silicone", 1.0, "flat"): (0.5, 3.0), ("silicone", 3.0, "curved"): (0.3, 2.0)})
+    paths = all_figures(recs, rows, tmp_path)
+    assert {p.name for p in paths} >= {"fig10_profiles.png", "fig11_peak.svg", "fig12_span.png", "fig13_auc.png"}
+    assert all(p.stat().st_size > 1000 for p in paths)
