@@ -1,0 +1,141 @@
+"""Measured (film) against simulated pressure profile: metrics and percent differences.
+
+The simulation is a half model: its profile runs over s >= 0 from the symmetry line. The
+film profile is two-sided, centred on its origin (the peak by default); it is folded onto
+s >= 0 (``scan.fold_profile``: mean of P(+s) and P(-s)) and peak, span (10 % of peak,
+one-sided, as the paper's "distance from the center") and area (over s >= 0, the half
+model's) are computed on both with ``tactileskin.results``.
+
+Percent difference (paper Sec. V-B): 100 (sim - film) / film, signed; the paper reports
+magnitudes (e.g. 231 %), and values above 200 % rule out the symmetric |a-b|/mean(a,b)
+form, so the measurement is the reference. Units: the film reads in its calibration's unit
+(MPa, or MPa/mm for paper_eq8); numbers are compared directly with the simulation's MPa as
+the paper does (see calibration module docstring).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin.errors import ParameterError
+from tactileskin.film._io import staged_dir
+from tactileskin.film.scan import FilmProfile, fold_profile, profile_metrics
+
+log = logging.getLogger(__name__)
+
+METRICS = ("peak", "span_mm", "auc")
+
+
+def read_profile_csv(path, s_col: str, p_col: str) -> tuple[np.ndarray, np.ndarray]:
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as e:
+        raise ParameterError("profile", str(path), "a readable profile.csv", hint=str(e)) from None
+    if not rows or s_col not in rows[0] or p_col not in rows[0]:
+        raise ParameterError("profile", str(path), f"CSV with columns {s_col}, {p_col} and >= 2 rows")
+    try:
+        s = np.array([float(r[s_col]) for r in rows])
+        p = np.array([float(r[p_col]) for r in rows])
+    except ValueError as e:
+        raise ParameterError("profile", str(path), "numeric columns", hint=str(e)) from None
+    if s.size < 2 or not (np.all(np.isfinite(s)) and np.all(np.isfinite(p))):
+        raise ParameterError("profile", str(path), ">= 2 finite rows")
+    order = np.argsort(s)
+    return s[order], p[order]
+
+
+def load_simulation(sim_dir) -> tuple[np.ndarray, np.ndarray, dict]:
+    """profile.csv (s_mm, pressure_mpa) and, if present, summary.json of a solver result."""
+    sim_dir = Path(sim_dir)
+    s, p = read_profile_csv(sim_dir / "profile.csv", "s_mm", "pressure_mpa")
+    meta = {}
+    if (sim_dir / "summary.json").exists():
+        try:
+            meta = json.loads((sim_dir / "summary.json").read_text())
+        except ValueError as e:
+            raise ParameterError("simulation summary", str(sim_dir / "summary.json"),
+                                 "valid JSON", hint=str(e)) from None
+    return s, p, meta
+
+
+def load_film(film_dir) -> tuple[np.ndarray, np.ndarray, dict]:
+    """profile.csv (s_mm, pressure) and summary.json written by ``FilmProfile.write``."""
+    film_dir = Path(film_dir)
+    s, p = read_profile_csv(film_dir / "profile.csv", "s_mm", "pressure")
+    try:
+        meta = json.loads((film_dir / "summary.json").read_text())
+    except (OSError, ValueError) as e:
+        raise ParameterError("film result", str(film_dir), "a directory written by `film analyze`",
+                             hint=str(e)) from None
+    return s, p, meta
+
+
+@dataclass
+class Comparison:
+    film_s: np.ndarray
+    film_p: np.ndarray
+    film_fold_s: np.ndarray
+    film_fold_p: np.ndarray
+    sim_s: np.ndarray
+    sim_p: np.ndarray
+    film_metrics: dict
+    sim_metrics: dict
+    percent_diff: dict
+    film_unit: str
+    asymmetry: float
+    sim_meta: dict
+
+    def to_dict(self) -> dict:
+        return {
+            "film_metrics_folded": self.film_metrics, "sim_metrics": self.sim_metrics,
+            "percent_diff": self.percent_diff,
+            "percent_diff_definition": "100 * (sim - film) / film, film folded onto s >= 0",
+            "film_unit": self.film_unit, "sim_unit": "MPa",
+            "unit_note": ("numbers compared directly, as the paper does"
+                          if self.film_unit != "MPa" else "same unit"),
+            "film_asymmetry": self.asymmetry, "sim_meta": self.sim_meta,
+        }
+
+    def write(self, out) -> dict[str, Path]:
+        """comparison.json and overlay.png into ``out`` (atomically)."""
+        from tactileskin.film import plots
+
+        out = Path(out)
+        with staged_dir(out) as tmp:
+            (tmp / "comparison.json").write_text(json.dumps(self.to_dict(), indent=2, default=str))
+            plots.overlay(self, tmp / "overlay.png")
+        return {"comparison": out / "comparison.json", "overlay": out / "overlay.png"}
+
+
+def compare(film, sim) -> Comparison:
+    """film: FilmProfile or a `film analyze` directory; sim: directory or (s, p) arrays."""
+    if isinstance(film, FilmProfile):
+        fs, fpr, unit = film.s_mm, film.pressure, film.unit
+    else:
+        fs, fpr, meta = load_film(film)
+        unit = meta.get("unit", "MPa")
+    if isinstance(sim, (str, Path)):
+        ss, sp, smeta = load_simulation(sim)
+    else:
+        ss, sp = (np.asarray(a, float) for a in sim)
+        smeta = {}
+    if ss[0] < -1e-9:  # a full (two-sided) simulated profile: fold it the same way
+        ss, sp, _ = fold_profile(ss, sp)
+    hs, hp, asym = fold_profile(fs, fpr)
+    fm, sm = profile_metrics(hs, hp), profile_metrics(ss, sp)
+    diff = {}
+    for k in METRICS:
+        if fm[k] == 0:
+            raise ParameterError(f"film {k}", 0.0, "non-zero (percent difference is relative "
+                                 "to the film)")
+        diff[k] = 100.0 * (sm[k] - fm[k]) / fm[k]
+    log.info("film vs sim: %s", diff)
+    return Comparison(fs, fpr, hs, hp, ss, sp, fm, sm, diff, unit, asym, smeta)
