@@ -1,0 +1,287 @@
+"""Storakers hyperfoam (Abaqus HYPERFOAM), any number of terms, as pure vectorised functions.
+
+    U = sum_i 2 mu_i / alpha_i^2 [ l1^a_i + l2^a_i + l3^a_i - 3 + (J^(-a_i beta) - 1) / beta ],
+    beta = nu / (1 - 2 nu).
+
+Written in the eigenvalues c_a = l_a^2 of the right Cauchy-Green tensor C:
+U = sum_a phi(c_a) + V(J), phi(c) = sum_i 2 mu_i/alpha_i^2 (c^(alpha_i/2) - 1),
+V(J) = sum_i 2 mu_i/(alpha_i^2 beta) (J^(-alpha_i beta) - 1).  Then
+
+    S = sum_a f(c_a) n_a n_a,   f(c) = sum_i k_i (c^(alpha_i/2) - J^(-alpha_i beta)) / c,
+    k_i = 2 mu_i / alpha_i,
+
+and D = 2 dS/dC follows from the Daleckii-Krein formula (divided differences of
+g(c) = sum_i k_i c^(alpha_i/2 - 1)) plus the standard volumetric tangent.
+
+Numerical care (see docs/architecture.md, "hard cases"):
+* Everything is evaluated from ln c_a = log1p(e_a), where e_a are the eigenvalues of C - I
+  (not of C): at strain 1e-8 the eigenvalues of C carry an absolute error of 1e-16,
+  i.e. a relative error of 1e-8 in the strain, those of C - I do not.
+* alpha -> 0 (silicone alpha_1 = 0.001): c^(alpha/2) - J^(-alpha beta) is formed as
+  exp(x2) * expm1(x1 - x2) with x1 - x2 = alpha (ln l + beta ln J) computed directly, so
+  the 1/alpha in k_i never meets a cancelled difference. The energy uses
+  psi2(x) = (expm1(x) - x)/x^2, free of 1/alpha and of 1/beta.
+* Divided differences (g(c_a) - g(c_b))/(c_a - c_b) use the same exp * expm1 form, which is
+  accurate for any gap down to exact coincidence (equal stretches, the undeformed state);
+  at exactly zero gap the derivative g'(c_a) is used. No threshold approximation, no NaN.
+* Overflow guard: an exponent (-alpha_i beta ln J or alpha_i/2 ln c_a) above EXP_CAP, or
+  |ln c_a| above LOG_C_CAP, or c_a <= 0, or a non-finite C, or detF <= 0 (if given) marks
+  the point inadmissible (ok=False); its values are computed from clipped exponents, so
+  they are finite but meaningless. EXP_CAP = 300 is far beyond any physical state: it means
+  a stress of ~1e130 MPa (silicone term 2, alpha beta = 379.75: J < exp(-300/379.75) = 0.454;
+  the confined-compression stress is already 4e5 MPa at J = 0.95).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tactileskin.errors import ParameterError
+
+log = logging.getLogger(__name__)
+
+EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even when squared)
+LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
+_CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
+
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2", "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
+
+
+def _as_float_tuple(name, value) -> tuple[float, ...]:
+    try:
+        t = tuple(float(v) for v in np.atleast_1d(np.asarray(value, dtype=float)).ravel())
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "a sequence of finite numbers") from None
+    return t
+
+
+@dataclass(frozen=True)
+class Hyperfoam:
+    """Storakers hyperfoam parameters. mu (MPa) and alpha: one entry per term; nu: Poisson ratio."""
+
+    mu: tuple[float, ...]
+    alpha: tuple[float, ...]
+    nu: float
+
+    def __post_init__(self):
+        mu = _as_float_tuple("mu", self.mu)
+        alpha = _as_float_tuple("alpha", self.alpha)
+        if len(mu) == 0:
+            raise ParameterError("mu", self.mu, "at least one term")
+        if len(alpha) != len(mu):
+            raise ParameterError("alpha", self.alpha, f"{len(mu)} values (one per mu term)")
+        for i, (m, a) in enumerate(zip(mu, alpha)):
+            if not math.isfinite(m):
+                raise ParameterError(f"mu[{i}]", m, "a finite number (MPa)")
+            if not math.isfinite(a) or a == 0.0:
+                raise ParameterError(f"alpha[{i}]", a, "a finite non-zero number")
+        try:
+            nu = float(self.nu)
+        except (TypeError, ValueError):
+            raise ParameterError("nu", self.nu, "(-1, 0.5)") from None
+        if not (-1.0 < nu < 0.5):
+            raise ParameterError("nu", self.nu, "(-1, 0.5)")
+        object.__setattr__(self, "mu", mu)
+        object.__setattr__(self, "alpha", alpha)
+        object.__setattr__(self, "nu", nu)
+        if not (self.mu0 > 0.0):
+            raise ParameterError("mu", mu, "sum(mu_i) > 0 (initial shear modulus)",
+                                 "each term's mu_i*alpha_i sign convention as in Abaqus")
+        if not (self.K0 > 0.0):
+            raise ParameterError("nu", nu, "a value giving a positive initial bulk modulus")
+
+    @property
+    def beta(self) -> float:
+        return self.nu / (1.0 - 2.0 * self.nu)
+
+    @property
+    def mu0(self) -> float:
+        """Initial shear modulus sum(mu_i) (MPa)."""
+        return float(sum(self.mu))
+
+    @property
+    def K0(self) -> float:
+        """Initial bulk modulus sum(2 mu_i (1/3 + beta)) (MPa)."""
+        return float(sum(2.0 * m * (1.0 / 3.0 + self.beta) for m in self.mu))
+
+    @property
+    def n_terms(self) -> int:
+        return len(self.mu)
+
+    def to_dict(self) -> dict:
+        return {"mu": list(self.mu), "alpha": list(self.alpha), "nu": self.nu}
+
+
+# --- scalar helpers (elementwise) ---------------------------------------------------------
+
+def _exp(x):
+    return np.exp(np.minimum(x, _CLIP))
+
+
+def _diffexp(x1, x2, d):
+    """exp(x1) - exp(x2) with d = x1 - x2 supplied accurately (no cancellation)."""
+    neg = d <= 0.0
+    base = np.where(neg, x2, x1)
+    dd = np.where(neg, d, -d)
+    mag = _exp(base) * np.expm1(np.maximum(dd, -_CLIP))
+    return np.where(neg, mag, -mag)
+
+
+def _psi2(x):
+    """(expm1(x) - x) / x^2, accurate for all x (series near 0); psi2(0) = 1/2."""
+    x = np.asarray(x, dtype=float)
+    small = np.abs(x) < 0.5
+    xs = np.where(small, x, 0.0)
+    # Horner on sum_{k>=2} x^(k-2)/k!; 20 terms: truncation 0.5^19/21! ~ 4e-26
+    acc = np.zeros_like(xs)
+    for k in range(21, 1, -1):
+        acc = acc * xs + 1.0 / math.factorial(k)
+    xl = np.where(small, 1.0, np.minimum(x, _CLIP))
+    big = (np.expm1(xl) - xl) / (xl * xl)
+    return np.where(small, acc, big)
+
+
+# --- kinematics ---------------------------------------------------------------------------
+
+def _spectral(C, detF=None):
+    """Eigen-decomposition of C - I. Returns e (...,3), Q (...,3,3) (columns n_a), lc, lJ, ok."""
+    C = np.asarray(C, dtype=float)
+    if C.shape[-2:] != (3, 3):
+        raise ParameterError("C.shape", C.shape, "(..., 3, 3)")
+    finite = np.all(np.isfinite(C), axis=(-2, -1))
+    E = C - np.eye(3)
+    E = np.where(finite[..., None, None], E, 0.0)
+    E = 0.5 * (E + np.swapaxes(E, -1, -2))
+    e, Q = np.linalg.eigh(E)
+    ok = finite & np.all(e > -1.0, axis=-1)
+    pd = e > -1.0
+    lc_raw = np.where(pd, np.log1p(np.where(pd, e, 0.0)), -2.0 * LOG_C_CAP)
+    ok &= np.all(np.abs(lc_raw) <= LOG_C_CAP, axis=-1)
+    lc = np.clip(lc_raw, -LOG_C_CAP, LOG_C_CAP)
+    # keep e consistent with the clipped logarithms so that divided differences stay finite
+    e = np.where(lc_raw == lc, e, np.expm1(lc))
+    if detF is not None:
+        ok &= np.asarray(detF) > 0.0
+    lJ = 0.5 * lc.sum(axis=-1)
+    return e, Q, lc, lJ, ok
+
+
+def _spectral_sum(Q, w):
+    """sum_a w_a n_a n_a^T for eigenvector columns Q (..., 3, 3) and weights w (..., 3)."""
+    return (Q * w[..., None, :]) @ np.swapaxes(Q, -1, -2)
+
+
+def _params(mat: Hyperfoam):
+    mu = np.asarray(mat.mu)
+    alpha = np.asarray(mat.alpha)
+    return mu, alpha, 2.0 * mu / alpha, mat.beta
+
+
+def _guard(ok, alpha, beta, lc, lJ):
+    """Flag exponents above EXP_CAP (both the deviatoric and the volumetric ones)."""
+    xv = -alpha * beta * lJ[..., None]                       # (..., m)
+    xd = 0.5 * alpha * lc[..., :, None]                      # (..., 3, m)
+    ok = ok & np.all(xv <= EXP_CAP, axis=-1) & np.all(xd <= EXP_CAP, axis=(-2, -1))
+    return ok
+
+
+# --- public functions ---------------------------------------------------------------------
+
+def energy(mat: Hyperfoam, C, *, detF=None):
+    """Strain energy density U (MPa) for C (..., 3, 3). Inadmissible states give finite values."""
+    _, _, lc, lJ, ok = _spectral(C, detF)
+    mu, alpha, _, beta = _params(mat)
+    ok = _guard(ok, alpha, beta, lc, lJ)
+    la = 0.5 * lc[..., :, None]                              # ln(stretch), (..., 3, 1)
+    dev = np.sum(la * la * _psi2(alpha * la), axis=-2)       # (..., m)
+    vol = beta * lJ[..., None] ** 2 * _psi2(-alpha * beta * lJ[..., None])
+    return np.sum(2.0 * mu * (dev + vol), axis=-1)
+
+
+def _principal_f(mu, alpha, k, beta, lc, lJ):
+    """f(c_a) = sum_i k_i (c_a^(alpha_i/2) - J^(-alpha_i beta)) / c_a, shape (..., 3)."""
+    lc3 = lc[..., :, None]
+    lJ3 = lJ[..., None, None]
+    x1 = (0.5 * alpha - 1.0) * lc3
+    x2 = -alpha * beta * lJ3 - lc3
+    d = alpha * (0.5 * lc3 + beta * lJ3)
+    return np.sum(k * _diffexp(x1, x2, d), axis=-1)
+
+
+def pk2(mat: Hyperfoam, C, *, detF=None):
+    """Second Piola-Kirchhoff stress S (..., 3, 3) and ok mask (no tangent)."""
+    e, Q, lc, lJ, ok = _spectral(C, detF)
+    mu, alpha, k, beta = _params(mat)
+    ok = _guard(ok, alpha, beta, lc, lJ)
+    f = _principal_f(mu, alpha, k, beta, lc, lJ)
+    return _spectral_sum(Q, f), ok
+
+
+def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
+    """S (..., 3, 3), D = 2 dS/dC (..., 3, 3, 3, 3) and ok (...) for C (..., 3, 3).
+
+    D has minor and major symmetry. Plane strain: pass C with C33 = 1, C13 = C23 = 0.
+    detF (optional, shape (...)): flags det F <= 0, which C = F^T F cannot reveal.
+    """
+    e, Q, lc, lJ, ok = _spectral(C, detF)
+    mu, alpha, k, beta = _params(mat)
+    ok = _guard(ok, alpha, beta, lc, lJ)
+
+    f = _principal_f(mu, alpha, k, beta, lc, lJ)            # (..., 3)
+
+    # Divided differences of g(c) + p/c at fixed J, where g(c) = sum k_i c^(q_i), q_i = alpha_i/2 - 1
+    # and p = -sum k_i J^(-alpha_i beta) (the volumetric part of S is p C^-1).
+    q = 0.5 * alpha - 1.0                                    # (m,)
+    lca = lc[..., :, None, None]                             # (..., 3, 1, 1)
+    lcb = lc[..., None, :, None]                             # (..., 1, 3, 1)
+    gap = e[..., :, None] - e[..., None, :]                  # c_a - c_b, (..., 3, 3)
+    ell = np.log1p(gap / np.exp(lc)[..., None, :])           # ln(c_a/c_b), accurate for small gaps
+    same = np.abs(gap) <= 1e-14 * np.exp(np.maximum(lc[..., :, None], lc[..., None, :]))
+    safe_gap = np.where(same, 1.0, gap)
+    dd = _diffexp(q * lca, q * lcb, q * ell[..., None]) / safe_gap[..., None]
+    deriv = q * _exp((q - 1.0) * 0.5 * (lca + lcb))        # g'(c) at the (geometric) mean
+    dd = np.where(same[..., None], deriv, dd)
+    xv = -alpha * beta * lJ[..., None, None, None]           # (..., 1, 1, m)
+    dv = _exp(xv - lca - lcb)                                # J^(-alpha beta) / (c_a c_b)
+    gamma = np.sum(k * (dd + dv), axis=-1)                   # (..., 3, 3)
+    gamma = 0.5 * (gamma + np.swapaxes(gamma, -1, -2))
+    qv = np.sum(2.0 * mu * beta * _exp(xv[..., 0, 0, :]), axis=-1)  # J dp/dJ
+
+    S = _spectral_sum(Q, f)
+    Cinv = _spectral_sum(Q, np.exp(-lc))
+    # D_ijkl = sum_ab gamma_ab (P_a,ik P_b,jl + P_a,il P_b,jk) + qv Cinv_ij Cinv_kl, P_a = n_a n_a,
+    # as batched 9x9 matrix products (several times faster than a 5-index einsum).
+    lead = gamma.shape[:-2]
+    Qt = np.swapaxes(Q, -1, -2)                              # rows n_a
+    Pm = (Qt[..., :, :, None] * Qt[..., :, None, :]).reshape(lead + (3, 9))   # [a, (i,k)]
+    T4 = (np.swapaxes(Pm, -1, -2) @ (gamma @ Pm)).reshape(lead + (3, 3, 3, 3))  # [i,k,j,l]
+    D = np.swapaxes(T4, -3, -2) + np.moveaxis(T4, -3, -1)   # [i,j,k,l] + [i,j,l,k]
+    D += (qv[..., None, None] * Cinv)[..., :, :, None, None] * Cinv[..., None, None, :, :]
+    return S, D, ok
+
+
+def cauchy_principal(mat: Hyperfoam, stretches):
+    """Principal Cauchy stresses (..., 3) for principal stretches (..., 3) (closed form).
+
+    sigma_j = (2/J) sum_i (mu_i/alpha_i)(l_j^alpha_i - J^(-alpha_i beta)), in log space.
+    Raises ParameterError for non-positive stretches or states beyond the overflow guard.
+    """
+    lam = np.asarray(stretches, dtype=float)
+    if lam.shape[-1:] != (3,):
+        raise ParameterError("stretches.shape", lam.shape, "(..., 3)")
+    if not np.all(lam > 0.0) or not np.all(np.isfinite(lam)):
+        raise ParameterError("stretches", "non-positive or non-finite values", "finite stretches > 0")
+    mu, alpha, k, beta = _params(mat)
+    ll = np.log(lam)[..., :, None]
+    lJ = np.sum(np.log(lam), axis=-1)[..., None, None]
+    x1 = alpha * ll - lJ
+    x2 = -alpha * beta * lJ - lJ
+    if np.any(x1 > EXP_CAP) or np.any(x2 > EXP_CAP):
+        raise ParameterError("stretches", "state beyond the overflow guard",
+                             f"exponents <= {EXP_CAP:g} (see hyperfoam.EXP_CAP)")
+    d = alpha * (ll + beta * lJ)
+    return np.sum(k * _diffexp(x1, x2, d), axis=-1)

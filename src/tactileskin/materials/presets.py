@@ -1,0 +1,101 @@
+"""Named materials: a hyperfoam law plus its Prony series, with where the numbers came from.
+
+Presets live in the package data file presets.toml (paper Table I). Users define their own
+in a TOML file of the same shape (see `Material.from_toml`).
+"""
+
+from __future__ import annotations
+
+import functools
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+from tactileskin.errors import ParameterError
+from tactileskin.materials.hyperfoam import Hyperfoam
+from tactileskin.materials.prony import Prony
+
+__all__ = ["Material", "get_material", "list_materials"]
+
+
+@dataclass(frozen=True)
+class Material:
+    name: str
+    hyperfoam: Hyperfoam
+    prony: Prony
+    source: str = ""
+
+    @classmethod
+    def from_dict(cls, name: str, d: dict) -> "Material":
+        """Build from {"source": str, "hyperfoam": {mu, alpha, nu}, "prony": {g, tau}} (prony optional)."""
+        if not isinstance(d, dict) or "hyperfoam" not in d:
+            raise ParameterError(f"material {name!r}", d, "a table with a [hyperfoam] sub-table (mu, alpha, nu)")
+        hf = d["hyperfoam"]
+        missing = [k for k in ("mu", "alpha", "nu") if k not in hf]
+        if missing:
+            raise ParameterError(f"material {name!r} hyperfoam", sorted(hf), "keys mu, alpha, nu",
+                                 "missing " + ", ".join(missing))
+        pr = d.get("prony", {"g": [], "tau": []})
+        if set(pr) - {"g", "tau"} or ("g" in pr) != ("tau" in pr):
+            raise ParameterError(f"material {name!r} prony", sorted(pr), "keys g and tau")
+        return cls(
+            name=str(d.get("name", name)),
+            hyperfoam=Hyperfoam(tuple(hf["mu"]), tuple(hf["alpha"]), hf["nu"]),
+            prony=Prony(tuple(pr.get("g", ())), tuple(pr.get("tau", ()))),
+            source=str(d.get("source", "")),
+        )
+
+    @classmethod
+    def from_toml(cls, path) -> "Material":
+        """Read a user-defined material.
+
+        The file holds either one material at top level (keys name?, source?, tables
+        [hyperfoam] and optional [prony]) or exactly one named table of that shape, like
+        presets.toml. Without [prony] the material is purely elastic.
+        """
+        path = Path(path)
+        try:
+            with open(path, "rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ParameterError("material file", str(path), "an existing TOML file") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ParameterError("material file", str(path), "valid TOML", str(exc)) from None
+        if "hyperfoam" in data:
+            return cls.from_dict(str(data.get("name", path.stem)), data)
+        tables = {k: v for k, v in data.items() if isinstance(v, dict)}
+        if len(tables) != 1:
+            raise ParameterError("material file", str(path),
+                                 "one material: top-level [hyperfoam] table, or exactly one named table")
+        (name, d), = tables.items()
+        return cls.from_dict(name, d)
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "source": self.source,
+                "hyperfoam": self.hyperfoam.to_dict(), "prony": self.prony.to_dict()}
+
+
+@functools.cache
+def _presets() -> dict[str, Material]:
+    text = resources.files("tactileskin.materials").joinpath("presets.toml").read_text(encoding="utf-8")
+    data = tomllib.loads(text)
+    return {name: Material.from_dict(name, d) for name, d in data.items()}
+
+
+def list_materials() -> list[str]:
+    """Names of the preset materials."""
+    return sorted(_presets())
+
+
+def get_material(name: str) -> Material:
+    """A preset by name, or a user material from a path ending in .toml."""
+    if isinstance(name, Material):
+        return name
+    if isinstance(name, (str, Path)) and str(name).endswith(".toml"):
+        return Material.from_toml(name)
+    try:
+        return _presets()[name]
+    except (KeyError, TypeError):
+        raise ParameterError("material", name,
+                             "one of " + ", ".join(list_materials()) + ", or a path to a .toml file") from None

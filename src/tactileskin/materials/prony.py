@@ -1,0 +1,122 @@
+"""Prony-series relaxation and quasi-linear viscoelasticity (QLV) on the PK2 stress.
+
+g(t) = g_inf + sum_i g_i exp(-t / tau_i),  g_inf = 1 - sum_i g_i  (paper Eq. 6).
+
+Abaqus applies the Prony series to the whole hyperfoam stress (deviatoric and volumetric
+alike), so the viscoelastic PK2 stress is the hereditary integral of the instantaneous
+(elastic) stress S0:
+
+    S(t) = g_inf S0(t) + sum_i H_i(t),   H_i(t) = g_i int_0^t exp(-(t - s)/tau_i) dS0/ds ds,
+
+with S0(0) = 0 (the undeformed start). The recursive update
+
+    H_i^{n+1} = exp(-h_i) H_i^n + g_i (1 - exp(-h_i)) / h_i (S0^{n+1} - S0^n),  h_i = dt / tau_i,
+
+is exact when S0 varies linearly over the increment. dS^{n+1}/dS0^{n+1} is the scalar
+g_inf + sum_i gain_i (the consistent tangent factor). Internal variables H have the shape
+(n_terms, ...) + S.shape[-2:], term axis first.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tactileskin.errors import ParameterError
+
+__all__ = ["Prony"]
+
+
+@dataclass(frozen=True)
+class Prony:
+    """Prony series: relative moduli g (each >= 0, sum < 1) and relaxation times tau (s, > 0)."""
+
+    g: tuple[float, ...]
+    tau: tuple[float, ...]
+
+    def __post_init__(self):
+        try:
+            g = tuple(float(v) for v in np.atleast_1d(np.asarray(self.g, dtype=float)).ravel())
+            tau = tuple(float(v) for v in np.atleast_1d(np.asarray(self.tau, dtype=float)).ravel())
+        except (TypeError, ValueError):
+            raise ParameterError("prony", (self.g, self.tau), "sequences of finite numbers") from None
+        if len(tau) != len(g):
+            raise ParameterError("tau", self.tau, f"{len(g)} values (one per g term)")
+        for i, (gi, ti) in enumerate(zip(g, tau)):
+            if not (math.isfinite(gi) and gi >= 0.0):
+                raise ParameterError(f"g[{i}]", gi, ">= 0")
+            if not (math.isfinite(ti) and ti > 0.0):
+                raise ParameterError(f"tau[{i}]", ti, "> 0 s")
+        if not sum(g) < 1.0:
+            raise ParameterError("g", g, "sum(g_i) < 1 (long-term modulus g_inf > 0)")
+        object.__setattr__(self, "g", g)
+        object.__setattr__(self, "tau", tau)
+
+    @classmethod
+    def elastic(cls) -> "Prony":
+        """No relaxation (g_inf = 1)."""
+        return cls((), ())
+
+    @property
+    def n_terms(self) -> int:
+        return len(self.g)
+
+    @property
+    def g_inf(self) -> float:
+        """Long-term relative modulus 1 - sum(g_i)."""
+        return 1.0 - float(sum(self.g))
+
+    def relaxation(self, t):
+        """g(t) = g_inf + sum g_i exp(-t/tau_i) for t >= 0 (array-like)."""
+        t = np.asarray(t, dtype=float)
+        out = np.full(t.shape, self.g_inf)
+        for gi, ti in zip(self.g, self.tau):
+            out = out + gi * np.exp(-t / ti)
+        return out
+
+    def step_factors(self, dt: float):
+        """(decay, gain), each shape (n_terms,): exp(-h), g_i (1 - exp(-h))/h, h = dt/tau_i.
+
+        Via expm1, so gain -> g_i smoothly as dt -> 0 (dt = 0 allowed).
+        """
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt >= 0.0):
+            raise ParameterError("dt", dt, ">= 0 s")
+        g = np.asarray(self.g, dtype=float)
+        h = dt / np.asarray(self.tau, dtype=float)
+        em = np.expm1(-h)                                    # exp(-h) - 1, accurate for small h
+        decay = 1.0 + em
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.where(h > 0.0, -em / np.where(h > 0.0, h, 1.0), 1.0)
+        return decay, g * ratio
+
+    def tangent_factor(self, dt: float) -> float:
+        """dS^{n+1}/dS0^{n+1} = g_inf + sum(gain_i): scales the elastic tangent."""
+        return self.g_inf + float(np.sum(self.step_factors(dt)[1]))
+
+    def initial_state(self, stress_shape) -> np.ndarray:
+        """Zero internal variables H for stresses of shape stress_shape."""
+        return np.zeros((self.n_terms,) + tuple(stress_shape))
+
+    def update(self, H, S0_old, S0_new, dt: float):
+        """One increment: returns (S, H_new) with S = g_inf S0_new + sum_i H_new_i.
+
+        H: (n_terms, *S0.shape); S0_old/S0_new: elastic PK2 at the start/end of the increment.
+        Pure: H is not modified.
+        """
+        decay, gain = self.step_factors(dt)
+        S0_old = np.asarray(S0_old, dtype=float)
+        S0_new = np.asarray(S0_new, dtype=float)
+        H = np.asarray(H, dtype=float)
+        if H.shape != (self.n_terms,) + S0_new.shape:
+            raise ParameterError("H.shape", H.shape, f"{(self.n_terms,) + S0_new.shape}")
+        bshape = (self.n_terms,) + (1,) * S0_new.ndim
+        dS0 = S0_new - S0_old
+        H_new = decay.reshape(bshape) * H + gain.reshape(bshape) * dS0[None]
+        S = self.g_inf * S0_new + H_new.sum(axis=0)
+        return S, H_new
+
+    def to_dict(self) -> dict:
+        return {"g": list(self.g), "tau": list(self.tau)}
