@@ -1,0 +1,62 @@
+"""`tactileskin build`: printable STL/STEP of the fingertip, its casting mold and the indenters."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+
+@click.command("build")
+@click.option("--thickness", "-t", type=float, default=None,
+              help="Skin thickness (mm); default from geometry/fingertip.toml.")
+@click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
+              help="Output folder (replaced only if empty or a previous build).")
+@click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "all", "none"]), default="all",
+              show_default=True, help="Which indenter(s) to make.")
+@click.option("--braille-text", type=str, default="", help="Text for the Braille indenter (default: one dot).")
+@click.option("--braille-standard", type=str, default="standard_american", show_default=True,
+              help="Braille standard name (geometry/braille.toml).")
+@click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
+def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds):
+    """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
+
+    Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
+    watertight flag). Every STL is checked to be a closed, consistently wound volume.
+    """
+    from rich.console import Console
+    from rich.table import Table
+
+    from tactileskin.geometry.fingertip import Fingertip
+    from tactileskin.geometry.parts import default_thickness, resolve_indenters
+
+    console = Console()
+    t = default_thickness() if thickness is None else thickness
+    Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
+    resolve_indenters(indenter)
+
+    t0 = time.perf_counter()
+    with console.status("building solids (build123d)..."):
+        from tactileskin.geometry.export import export_parts
+        from tactileskin.geometry.parts import build_parts
+
+        parts = build_parts(t, indenters=indenter, braille_text=braille_text,
+                            braille_standard=braille_standard, molds=not no_molds)
+    t1 = time.perf_counter()
+    with console.status(f"writing {len(parts)} parts to {out_dir}..."):
+        manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
+                                                          braille_standard=braille_standard, molds=not no_molds))
+    t2 = time.perf_counter()
+
+    table = Table(title=f"t = {t:g} mm -> {out_dir}/<part>.stl, .step")
+    table.add_column("part", no_wrap=True)
+    table.add_column("volume mm³", justify="right", no_wrap=True)
+    table.add_column("x × y × z mm", justify="right", no_wrap=True)
+    table.add_column("closed", justify="center")
+    table.add_column("what")
+    for e in manifest["parts"]:
+        size = "×".join(f"{hi - lo:.1f}" for lo, hi in zip(e["bbox_min"], e["bbox_max"]))
+        table.add_row(e["name"], f"{e['volume_mm3']:.1f}", size,
+                      "yes" if e["is_volume"] else "[red]no[/]", e["description"])
+    console.print(table)
+    console.print(f"solids {t1 - t0:.1f} s, export {t2 - t1:.1f} s; manifest: {out_dir}/manifest.json")

@@ -1,0 +1,120 @@
+"""Two-part casting mold for the skin; the printed rigid base is its core.
+
+Layout (dimensions in geometry/molds.toml, frame as in solids.py):
+- The cavity is the full-width outer contour (the ellipse) extruded over the sample length,
+  z in [-L/2, L/2]; the end walls close it.
+- The rigid base sits in the lower half: below the nail edges it fills the contour exactly,
+  so the contour locates it in x and y and the end walls in z. What is left of the cavity is
+  exactly the skin (tests/test_cad.py checks the volumes agree within 0.5 %).
+- Split plane y = 0, the contour's widest section: neither half has an undercut, and the
+  lower half releases the cast skin together with its base.
+- Four alignment pins on the lower half's split face, in clearance holes in the upper half.
+- A sprue at the middle of the skin's ridge (x = 0, z = 0) and an air vent near each end,
+  both through the upper half's roof.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import build123d as bd
+
+from tactileskin import params
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.fingertip import Section
+from tactileskin.geometry.solids import _box, check_solid, contour_solid, occ_guard
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class MoldParams:
+    wall: float
+    pin_diameter: float
+    pin_height: float
+    pin_clearance: float
+    pin_depth_clearance: float
+    pin_flange: float
+    pour_diameter: float
+    vent_diameter: float
+    vent_inset: float
+
+    @classmethod
+    def from_params(cls, **overrides) -> "MoldParams":
+        p = params.load("molds")
+        kw = dict(wall=p["block"]["wall"], pin_diameter=p["pins"]["diameter"], pin_height=p["pins"]["height"],
+                  pin_clearance=p["pins"]["clearance"], pin_depth_clearance=p["pins"]["depth_clearance"],
+                  pin_flange=p["pins"]["flange"], pour_diameter=p["pour"]["pour_diameter"],
+                  vent_diameter=p["pour"]["vent_diameter"], vent_inset=p["pour"]["vent_inset"])
+        kw.update(overrides)
+        return cls(**{k: float(v) for k, v in kw.items()})
+
+    def check(self, sec: Section) -> None:
+        """Raise ParameterError if the mold cannot be made for this fingertip."""
+        ft = sec.fingertip
+        for name in ("wall", "pin_diameter", "pin_height", "pour_diameter", "vent_diameter", "pin_flange"):
+            if not getattr(self, name) > 0.0:
+                raise ParameterError(f"molds.{name}", getattr(self, name), "> 0 mm")
+        if self.pin_clearance < 0.0 or self.pin_depth_clearance < 0.0:
+            raise ParameterError("molds.pin_clearance", self.pin_clearance, ">= 0 mm")
+        roof = ft.height + self.wall
+        if self.pin_height + self.pin_depth_clearance >= roof:
+            raise ParameterError("molds.pins.height", self.pin_height,
+                                 f"< {roof - self.pin_depth_clearance:g} mm (the upper half is {roof:g} mm thick)")
+        half_l = 0.5 * ft.sample_length
+        if not 0.5 * self.vent_diameter <= self.vent_inset <= half_l:
+            raise ParameterError("molds.pour.vent_inset", self.vent_inset,
+                                 f"[{0.5 * self.vent_diameter:g}, {half_l:g}] mm")
+        if self.pour_diameter >= 2.0 * ft.half_width:
+            raise ParameterError("molds.pour.pour_diameter", self.pour_diameter, f"< {2 * ft.half_width:g} mm")
+
+
+@dataclass(frozen=True)
+class MoldLayout:
+    """Derived positions (mm) shared by the two halves."""
+
+    half_width: float     # block x half-extent
+    half_length: float    # block z half-extent
+    floor: float          # y of the lower half's bottom (negative)
+    roof: float           # y of the upper half's top
+    pins: tuple[tuple[float, float], ...]   # (x, z) pin axes
+
+    @classmethod
+    def of(cls, sec: Section, mp: MoldParams) -> "MoldLayout":
+        ft = sec.fingertip
+        hole = mp.pin_diameter + mp.pin_clearance
+        xp = ft.half_width + mp.wall + 0.5 * hole         # `wall` between the cavity and the hole
+        half_l = 0.5 * ft.sample_length
+        return cls(half_width=xp + 0.5 * hole + mp.pin_flange, half_length=half_l + mp.wall,
+                   floor=-(ft.height + mp.wall), roof=ft.height + mp.wall,
+                   pins=tuple((sx * xp, sz * half_l) for sx in (-1, 1) for sz in (-1, 1)))
+
+
+def _vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: float) -> bd.Solid:
+    return bd.Solid.make_cylinder(0.5 * diameter, y_to - y_from,
+                                  plane=bd.Plane((x, y_from, z), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
+
+
+def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.Solid]:
+    """(lower half, upper half) of the skin's casting mold, in the fingertip's frame."""
+    mp = mp or MoldParams.from_params()
+    mp.check(sec)
+    lay = MoldLayout.of(sec, mp)
+    ft = sec.fingertip
+    A, Z = lay.half_width, lay.half_length
+    p = dict(thickness=sec.thickness, wall=mp.wall, pin_diameter=mp.pin_diameter,
+             pour_diameter=mp.pour_diameter, vent_diameter=mp.vent_diameter)
+    with occ_guard("building the casting mold", **p):
+        cavity = contour_solid(sec)
+        pins = [_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
+        lower = _box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
+        # the upper half: pin holes, a sprue at the ridge's middle and a vent near each end;
+        # the holes start at the split plane (inside the cavity) so they open into it
+        holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance,
+                                    mp.pin_diameter + mp.pin_clearance) for x, z in lay.pins]
+        zv = 0.5 * ft.sample_length - mp.vent_inset
+        holes += [_vertical_cylinder(0.0, 0.0, 0.0, lay.roof + 1.0, mp.pour_diameter)]
+        holes += [_vertical_cylinder(0.0, s * zv, 0.0, lay.roof + 1.0, mp.vent_diameter) for s in (-1, 1)]
+        upper = _box(-A, A, 0.0, lay.roof, -Z, Z).cut(cavity, *holes).clean()
+    return check_solid(lower, "mold lower half", **p), check_solid(upper, "mold upper half", **p)

@@ -1,0 +1,101 @@
+"""The printable part set: skin, rigid base, casting mold halves and indenters.
+
+`build_parts` turns the user's choices (thickness, indenters, Braille text and standard)
+into named build123d solids; `export.export_parts` writes and checks them.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+
+import build123d as bd
+
+from tactileskin import params
+from tactileskin.errors import ParameterError
+from tactileskin.geometry import braille as _braille
+from tactileskin.geometry.fingertip import Fingertip
+from tactileskin.geometry.indenters import KINDS, make_indenter
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Part:
+    name: str                      # file stem in the output folder
+    description: str
+    shape: bd.Solid
+    parameters: dict = field(default_factory=dict)  # what the part was made from (manifest)
+
+
+def default_thickness() -> float:
+    return float(params.load("fingertip")["thickness"]["default"])
+
+
+def resolve_indenters(indenters) -> tuple[str, ...]:
+    """'all' -> every kind; a kind or an iterable of kinds -> validated tuple; None/'none' -> ()."""
+    if indenters is None or indenters == "none":
+        return ()
+    if indenters == "all":
+        return KINDS
+    kinds = (indenters,) if isinstance(indenters, str) else tuple(indenters)
+    for k in kinds:
+        if k not in KINDS:
+            raise ParameterError("indenter", k, "one of " + ", ".join(KINDS + ("all", "none")))
+    return kinds
+
+
+def build_parts(thickness: float | None = None, *, indenters="all", braille_text: str = "",
+                braille_standard: str = "standard_american", fingertip: bool = True, molds: bool = True,
+                fingertip_overrides: dict | None = None) -> list[Part]:
+    """Build the requested parts (full width) for skin thickness `thickness` (mm).
+
+    Parameters are validated before any CAD work, so a bad value costs no kernel time.
+    Raises ParameterError for invalid inputs and CadError if the kernel fails.
+    """
+    from tactileskin.geometry import molds as _molds
+    from tactileskin.geometry import solids
+
+    ft = Fingertip.from_params(**(fingertip_overrides or {}))
+    t = default_thickness() if thickness is None else thickness
+    sec = ft.section(t)  # validates t
+    kinds = resolve_indenters(indenters)
+    if "braille" in kinds:
+        std = _braille.get_standard(braille_standard)
+        if braille_text:
+            _braille.text_to_cells(braille_text)
+    mold_params = _molds.MoldParams.from_params() if molds else None
+    if mold_params is not None:
+        mold_params.check(sec)
+
+    parts: list[Part] = []
+    fp = dict(thickness=sec.thickness, sample_length=ft.sample_length, half_width=ft.half_width,
+              height=ft.height, nail_angle_deg=ft.nail_angle_deg)
+    t0 = time.perf_counter()
+    if fingertip or molds:
+        base = solids.base_solid(sec)
+    if fingertip:
+        parts.append(Part("skin", f"skin, t = {sec.thickness:g} mm (cast in the mold)", solids.skin_solid(sec), fp))
+        parts.append(Part("rigid_base", "rigid bone/nail base (mold core)", base, fp))
+    if molds:
+        lower, upper = _molds.skin_mold(sec, mold_params)
+        mp = dict(fp, **{k: getattr(mold_params, k) for k in ("wall", "pin_diameter", "pour_diameter", "vent_diameter")})
+        parts.append(Part("mold_lower", "casting mold, lower half (holds the base, pins)", lower, mp))
+        parts.append(Part("mold_upper", "casting mold, upper half (sprue, vents)", upper, mp))
+    log.info("fingertip parts in %.2f s", time.perf_counter() - t0)
+    for kind in kinds:
+        t1 = time.perf_counter()
+        ind = make_indenter(kind, y0=sec.top, dim=3, braille_text=braille_text,
+                            braille_standard=braille_standard, sample_length=ft.sample_length)
+        ip = dict(kind=kind, y0=ind.y0, width=ind.width, length=ind.length,
+                  stem_diameter=ind.stem_diameter, stem_length=ind.stem_length)
+        desc = {"flat": "flat plate indenter", "curved": f"convex indenter, R = {getattr(ind, 'radius', 0):g} mm"}.get(kind)
+        if kind == "braille":
+            ip.update(text=braille_text, standard=std.name, dots=int(len(ind.dots)), base_diameter=std.base_diameter,
+                      height=std.height, dot_pitch=std.dot_pitch, cell_pitch=std.cell_pitch, line_pitch=std.line_pitch)
+            desc = f"Braille indenter {braille_text!r} ({std.name}, {len(ind.dots)} dots)" if braille_text \
+                else f"Braille indenter, single dot ({std.name})"
+        parts.append(Part(f"indenter_{kind}", desc, solids.indenter_solid(ind), ip))
+        log.info("%s indenter in %.2f s", kind, time.perf_counter() - t1)
+    return parts
