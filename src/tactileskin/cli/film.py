@@ -1,0 +1,108 @@
+"""`tactileskin film ...`: pressure-film calibration, scan analysis, comparison."""
+
+from __future__ import annotations
+
+import click
+
+from tactileskin.film import models
+
+
+@click.group("film")
+def command() -> None:
+    """Pressure-film calibration and scan analysis (paper Sec. IV, Eqs. 7-8)."""
+
+
+@command.command()
+@click.argument("cal_csv", type=click.Path(dir_okay=False))
+@click.option("--out", "-o", type=click.Path(dir_okay=False), required=True,
+              help="Calibration JSON to write.")
+@click.option("--model", type=click.Choice(["auto", *models.MODELS]), default="auto",
+              show_default=True, help="Fitting function; auto selects by AICc.")
+@click.option("--activation-range", nargs=2, type=float, default=None,
+              help="Clip range LO HI of the readings (default 0 .. darkest press).")
+@click.option("--plot", type=click.Path(dir_okay=False), default=None,
+              help="Also write a PNG of the fit, its 90 % band and residuals.")
+def calibrate(cal_csv, out, model, activation_range, plot):
+    """Fit grayscale -> pressure (P = F/A, MPa) from calibration presses in CAL_CSV.
+
+    Columns: force_n, area_mm2, and gray (mean grayscale 0-255) or image (path relative
+    to the CSV; optional x0,y0,x1,y1 crop in px).
+    """
+    from tactileskin.film import calibrate_csv
+
+    cal = calibrate_csv(cal_csv, model=model, activation_range=activation_range)
+    if plot:
+        from tactileskin.film import plots
+
+        plots.calibration_plot(cal, plot)
+    cal.save(out)
+    r = cal.report
+    lin = r["linear"]
+    (a_lo, a_hi), (b_lo, b_hi) = lin["param_ci90"]
+    click.echo(f"{r['n_points']} presses; linear P = a*GS + b: a = {lin['params'][0]:.5g} "
+               f"[{a_lo:.5g}, {a_hi:.5g}], b = {lin['params'][1]:.5g} [{b_lo:.5g}, {b_hi:.5g}] "
+               f"(90 %), R^2 = {lin['r2']:.4f}")
+    for alt in r["alternatives"]:
+        aicc = f"{alt['aicc']:.2f}" if alt["aicc"] is not None else "n/a"
+        note = alt["reason"] or ("" if alt["monotonic"] else "non-monotonic")
+        click.echo(f"  {alt['model']:<12} AICc {aicc:>9}  {note}")
+    click.echo(f"selected: {cal.model} ({r['selected_because']}); activation range "
+               f"{cal.p_range[0]:g}-{cal.p_range[1]:.4g} {cal.unit}; wrote {out}")
+
+
+@command.command()
+@click.argument("scan", type=click.Path(dir_okay=False))
+@click.option("--calibration", "-c", default="paper_eq8", show_default=True,
+              help="Calibration JSON, or paper_eq8 (the paper's Eq. 8).")
+@click.option("--px-per-mm", type=float, default=8.0, show_default=True, help="Scan scale.")
+@click.option("--box-px", nargs=4, type=int, default=None, help="Region X0 Y0 X1 Y1 (pixels).")
+@click.option("--box-mm", nargs=4, type=float, default=None, help="Region X0 Y0 X1 Y1 (mm).")
+@click.option("--axis", type=click.Choice(["x", "y"]), default="x", show_default=True,
+              help="Direction of the strip in the image.")
+@click.option("--centre", default="peak", show_default=True,
+              help="Origin of s: peak, midspan, or a position in mm from the image edge.")
+@click.option("--cmap", default="viridis", show_default=True,
+              help="Colour map (viridis: perceptually uniform; jet: as in the paper).")
+@click.option("--out", "-o", type=click.Path(file_okay=False), required=True,
+              help="Output directory: profile.csv, summary.json, pressure_map.png.")
+def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, out):
+    """Convert a scanned film to pressure and its profile along the strip."""
+    from tactileskin.film import analyze_scan, load_calibration
+    from tactileskin.film.plots import _check_cmap
+
+    _check_cmap(cmap)  # before any work, so a typo writes nothing
+    if centre not in ("peak", "midspan"):
+        try:
+            centre = float(centre)
+        except ValueError:
+            raise click.BadParameter("peak, midspan or a number (mm)", param_hint="--centre")
+    cal = load_calibration(calibration)
+    fp = analyze_scan(scan, cal, px_per_mm=px_per_mm, box_px=box_px or None,
+                      box_mm=box_mm or None, axis=axis, centre=centre)
+    fp.write(out, cmap=cmap)
+    m, f = fp.metrics, fp.folded["metrics"]
+    click.echo(f"origin {fp.origin_mm:.3f} mm; two-sided: peak {m['peak']:.4g} {fp.unit}, "
+               f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g}; folded: peak "
+               f"{f['peak']:.4g}, span {f['span_mm']:.3f} mm, area {f['auc']:.4g}; "
+               f"asymmetry {fp.folded['asymmetry']:.3f}; saturated "
+               f"{100 * fp.saturated_fraction:.1f} % of pixels")
+    click.echo(f"wrote {out}")
+
+
+@command.command()
+@click.argument("film_dir", type=click.Path(file_okay=False))
+@click.argument("sim_dir", type=click.Path(file_okay=False))
+@click.option("--out", "-o", type=click.Path(file_okay=False), default=None,
+              help="Where to write comparison.json and overlay.png (default FILM_DIR).")
+def compare(film_dir, sim_dir, out):
+    """Compare a `film analyze` result with a simulated profile (percent differences)."""
+    from tactileskin.film import compare as do_compare
+
+    comp = do_compare(film_dir, sim_dir)
+    comp.write(out or film_dir)
+    click.echo(f"{'metric':<8} {'film':>10} {'sim':>10} {'diff %':>8}   (film {comp.film_unit}, "
+               "sim MPa; diff = 100 (sim - film)/film)")
+    for k in ("peak", "span_mm", "auc"):
+        click.echo(f"{k:<8} {comp.film_metrics[k]:>10.4g} {comp.sim_metrics[k]:>10.4g} "
+                   f"{comp.percent_diff[k]:>+8.1f}")
+    click.echo(f"wrote {out or film_dir}")

@@ -1,0 +1,156 @@
+"""Scan analysis: round trips through synthetic scans rendered from closed-form profiles
+(noise, blur, saturation), image formats, region selection, folding and bad input."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tactileskin.errors import ParameterError
+from tactileskin.film import analyze_scan, fit_calibration, fold_profile, load_grayscale, paper_eq8
+from tactileskin.film.synthetic import blurred_gaussian_profile, gaussian_profile, render_scan, save_scan
+
+PPM = 8.0
+SLOPE = 0.00425                  # |dP/dGS| of Eq. 8 (MPa/mm per gray level)
+NOISE, BLUR = 2.0, 1.5           # gray levels, px
+P0, W = 0.5, 1.0                 # Gaussian test profile: peak (MPa/mm), sd (mm)
+# strip rows 16..55 (2 mm margin, 5 mm wide); analyse rows 24..48: 8 px (> 5 blur sd) from
+# each edge, so the across-width blur never mixes in the background.
+BOX = (0, 24, 160, 48)
+WIDTH = BOX[3] - BOX[1]
+# Column-mean noise in pressure: per-pixel noise plus 8-bit rounding (uniform, var 1/12),
+# averaged over WIDTH independent pixels, through the slope. Five of these bound the
+# largest of 160 column errors (P(|z| > 5) ~ 6e-7 per column).
+SIGMA_COL = SLOPE * np.sqrt((NOISE ** 2 + 1 / 12) / WIDTH)
+TOL = 5 * SIGMA_COL
+
+
+def _scan(profile, **kw):
+    kw = {"noise_gs": NOISE, "blur_px": BLUR, "background_gs": 245.0, "seed": 1, **kw}
+    return render_scan(profile, paper_eq8(), px_per_mm=PPM, **kw)
+
+
+def test_round_trip_gaussian_with_noise_and_blur():
+    centre = 9.93  # off the pixel grid
+    img = _scan(gaussian_profile(P0, W), centre_mm=centre)
+    fp = analyze_scan(img, box_px=BOX, centre=centre)
+    # blur is a Gaussian of BLUR px: the truth seen by the scanner is the convolution,
+    # again a Gaussian (closed form)
+    truth = blurred_gaussian_profile(P0, W, BLUR / PPM)(fp.s_mm)
+    err = np.abs(fp.pressure - truth)
+    # away from the film's threshold (where noise is rectified by the zero clip)
+    inside = truth > 5 * NOISE * SLOPE
+    assert inside.sum() > 20
+    assert err[inside].max() < TOL
+    # and the noise model behind TOL is right: the rms error is SIGMA_COL (chi-square with
+    # ~40 samples: sd of the ratio ~0.11, so [0.6, 1.4] is a 3.6 sd band)
+    assert np.sqrt(np.mean(err[inside] ** 2)) / SIGMA_COL == pytest.approx(1.0, abs=0.4)
+    w_eff = np.hypot(W, BLUR / PPM)
+    assert fp.metrics["peak"] == pytest.approx(P0 * W / w_eff, abs=TOL)
+    # span: both 10 % crossings move by sigma/|dP/ds| there; 5 sigma each, in quadrature
+    s10 = w_eff * np.sqrt(2 * np.log(10))
+    dpds = 0.1 * P0 * W / w_eff * s10 / w_eff ** 2
+    assert fp.metrics["span_mm"] == pytest.approx(2 * s10, abs=np.sqrt(2) * TOL / dpds)
+    # area: blur conserves it, P0 W sqrt(2 pi); noise adds sqrt(N) ds sigma over the active
+    # columns; the tails below half a gray level (P < 0.002) that render as background lose
+    # at most 2 * 0.002 * W^2 / s_t, s_t = 3.3 mm
+    n_active = int((truth > 0.002).sum())
+    tol_auc = 5 * SIGMA_COL / PPM * np.sqrt(n_active) + 2 * 0.002 * W ** 2 / 3.3
+    assert fp.metrics["auc"] == pytest.approx(P0 * W * np.sqrt(2 * np.pi), abs=tol_auc)
+    assert fp.saturated_fraction == 0
+
+
+def test_peak_centring_finds_the_true_centre():
+    # vertex of a parabola through the top samples; noise moves it by about
+    # sqrt(2) sigma / (2 |P''| h^2) ~ 45 sigma/P0 px = 0.15 px here: half a pixel is > 3 sd
+    for centre in (9.93, 10.0, 7.31):
+        fp = analyze_scan(_scan(gaussian_profile(P0, W), centre_mm=centre), box_px=BOX)
+        assert fp.origin_mm == pytest.approx(centre, abs=0.5 / PPM)
+        assert fp.folded["asymmetry"] < 4 * TOL / P0
+        mid = analyze_scan(_scan(gaussian_profile(P0, W), centre_mm=centre), box_px=BOX,
+                           centre="midspan")
+        assert mid.origin_mm == pytest.approx(centre, abs=0.5 / PPM)
+
+
+def test_saturation_clips_at_the_activation_range():
+    # a peak of 1.5 MPa/mm exceeds Eq. 8's range (0.978 at GS = 0): the top reads 0.978
+    # minus the rectified noise at black, E[max(0, N)] = 0.4 sigma gray levels
+    fp = analyze_scan(_scan(gaussian_profile(1.5, W), blur_px=0), box_px=BOX)
+    assert fp.saturated_fraction > 0.02
+    assert fp.metrics["peak"] <= 0.978
+    assert fp.metrics["peak"] == pytest.approx(0.978 - 0.4 * NOISE * SLOPE, abs=TOL)
+
+
+def test_fitted_calibration_round_trip_and_band():
+    rng = np.random.default_rng(2)
+    gs = np.linspace(20, 225, 10)
+    cal = fit_calibration(gs, 1.1 * np.exp(-0.011 * gs) * (1 + rng.normal(0, 0.004, gs.size)))
+    assert cal.model == "exponential"
+    img = render_scan(gaussian_profile(0.6, 1.5), cal, noise_gs=0, seed=0)
+    fp = analyze_scan(img, cal, box_px=(0, 20, 160, 52), centre=10.0)
+    truth = gaussian_profile(0.6, 1.5)(fp.s_mm)
+    inside = (truth > cal.pressure(225.0)) & (truth < cal.p_range[1])
+    # noise-free: only 8-bit rounding, +-0.5 gray level times the local |dP/dGS|
+    dpdg = np.abs(cal.params[0] * cal.params[1]) * np.exp(cal.params[1] * 20)  # steepest
+    assert np.abs(fp.pressure - truth)[inside].max() <= 0.5 * dpdg
+    assert np.all(fp.band_lo <= fp.pressure + 1e-12) and np.all(fp.band_hi >= fp.pressure - 1e-12)
+    assert np.any(fp.band_hi > fp.band_lo)
+
+
+def test_formats_and_regions_agree(tmp_path):
+    img = _scan(gaussian_profile(P0, W))
+    ref = analyze_scan(save_scan(img, tmp_path / "a.png"), box_px=BOX)
+    # 16-bit TIFF (x257 maps 0-255 onto 0-65535 exactly)
+    Image.fromarray(img.astype(np.uint16) * 257).save(tmp_path / "b.tif")
+    assert load_grayscale(tmp_path / "b.tif") == pytest.approx(img.astype(float), abs=1e-9)
+    t16 = analyze_scan(tmp_path / "b.tif", box_px=BOX)
+    assert t16.pressure == pytest.approx(ref.pressure, abs=1e-12)
+    # colour: a neutral gray RGB scan has luma equal to its gray value
+    Image.fromarray(np.repeat(img[..., None], 3, -1)).save(tmp_path / "c.png")
+    assert analyze_scan(tmp_path / "c.png", box_px=BOX).pressure == pytest.approx(ref.pressure)
+    # mm box at 8 px/mm = the same pixel box; axis "y" on the transposed image
+    assert analyze_scan(img, box_mm=(0, 3, 20, 6)).box_px == BOX
+    ty = analyze_scan(img.T.copy(), box_px=(BOX[1], BOX[0], BOX[3], BOX[2]), axis="y")
+    assert ty.pressure == pytest.approx(ref.pressure, abs=1e-12)
+
+
+def test_bt601_luminance_of_a_colour_pixel(tmp_path):
+    Image.new("RGB", (4, 3), (200, 100, 50)).save(tmp_path / "c.png")
+    assert load_grayscale(tmp_path / "c.png") == pytest.approx(
+        np.full((3, 4), 0.299 * 200 + 0.587 * 100 + 0.114 * 50))
+
+
+def test_fold_profile():
+    s = np.arange(-40, 41) / PPM
+    p = np.exp(-s ** 2)
+    sh, ph, asym = fold_profile(s, p)
+    assert sh[0] == 0 and sh[-1] == pytest.approx(5.0)
+    assert ph == pytest.approx(np.exp(-sh ** 2), abs=1e-12) and asym < 1e-12
+    # a one-sided bump of height 0.2 on the right: folded mean halves it, asymmetry 0.2
+    q = p + 0.2 * (np.abs(s - 2) < 0.3)
+    sh, ph, asym = fold_profile(s, q)
+    assert asym == pytest.approx(0.2) and ph[16] == pytest.approx(np.exp(-4) + 0.1)
+    # uneven extents: beyond the shorter side only the measured side counts
+    sh, ph, _ = fold_profile(s[20:], p[20:])
+    assert sh[-1] == pytest.approx(5.0) and ph[-1] == pytest.approx(p[-1])
+
+
+def test_bad_images_and_regions(tmp_path):
+    (tmp_path / "junk.png").write_text("not an image")
+    with pytest.raises(ParameterError, match="scan.*unreadable"):
+        analyze_scan(tmp_path / "junk.png")
+    (tmp_path / "empty.png").write_bytes(b"")
+    with pytest.raises(ParameterError, match="scan"):
+        analyze_scan(tmp_path / "empty.png")
+    with pytest.raises(ParameterError, match="not found"):
+        analyze_scan(tmp_path / "missing.tif")
+    img = _scan(gaussian_profile(P0, W))
+    with pytest.raises(ParameterError, match=r"box_px.*0 <= x0 < x1 <= 160.*outside"):
+        analyze_scan(img, box_px=(100, 0, 200, 10))
+    with pytest.raises(ParameterError, match="box_mm"):
+        analyze_scan(img, box_mm=(0, 0, 25, 5))
+    with pytest.raises(ParameterError, match="blank"):
+        analyze_scan(np.full((20, 40), 245.0))
+    with pytest.raises(ParameterError, match="saturated"):
+        analyze_scan(np.zeros((20, 40)))
+    with pytest.raises(ParameterError, match="px_per_mm"):
+        analyze_scan(img, px_per_mm=0)
