@@ -65,7 +65,7 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
     """Read the current gmsh mesh into scikit-fem.
 
     groups: boundary name -> list of gmsh entity tags of dimension dim-1.
-    Returns (mesh, boundaries, gmsh cell tags in mesh order).
+    Returns (mesh, boundaries).
     """
     import skfem
 
@@ -120,7 +120,7 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
         if not found:
             raise MeshError(f"boundary '{name}' has no facets (gmsh entities {ents})")
         boundaries[name] = np.unique(np.asarray(found, dtype=np.int64))
-    return mesh, boundaries, etags
+    return mesh, boundaries
 
 
 def _nnodes(gmsh_type: int) -> int:
@@ -145,8 +145,11 @@ def _orient_positive(points: np.ndarray, conn: np.ndarray, dim: int) -> np.ndarr
     return conn
 
 
-def element_quality(gmsh, etags: np.ndarray) -> dict:
-    """Minimum and mean scaled Jacobian of the gmsh cells (curved cells included)."""
-    q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSJ"))
-    return {"min_scaled_jacobian": float(q.min()), "mean_scaled_jacobian": float(q.mean()),
-            "n_bad_lt_0.1": int(np.sum(q < 0.1))}
+def shape_quality(gmsh, dim: int) -> dict:
+    """Shape quality of the straight-sided (first-order) cells: gmsh's signed inverse
+    condition number (1 for the equilateral simplex, 0 degenerate, < 0 inverted). gmsh's
+    minSJ is identically 1 on straight simplices, so the curving is measured separately
+    (skinmesh.jacobian_ratio)."""
+    etags = gmsh.model.mesh.getElementsByType(CELL_TYPE[(dim, 1)])[0]
+    q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSICN"))
+    return {"min_sicn": float(q.min()), "mean_sicn": float(q.mean()), "n_sicn_lt_0.2": int(np.sum(q < 0.2))}

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from tactileskin.mesh import _gmsh, sizing
-from tactileskin.mesh.skinmesh import SkinMesh
+from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
 
 logger = logging.getLogger(__name__)
 
@@ -85,14 +85,15 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
         sizing.apply_fields(gmsh, plan, tags["interface_roi"], dim=2)
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: well-shaped triangles
         gmsh.model.mesh.generate(2)
+        quality = _gmsh.shape_quality(gmsh, 2)
         if order == 2:
             gmsh.model.mesh.setOrder(2)
         groups = {n: tags[n] for n in ("bone_interface", "outer_surface", "symmetry", "nail_edge")}
-        mesh, boundaries, etags = _gmsh.to_skfem(gmsh, 2, order, groups)
-        quality = _gmsh.element_quality(gmsh, etags)
+        mesh, boundaries = _gmsh.to_skfem(gmsh, 2, order, groups)
     quality.update(elements=int(mesh.nelements), nodes=int(mesh.doflocs.shape[1]),
-                   vertices=int(mesh.nvertices), wall_s=time.perf_counter() - t0)
+                   vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh),
+                   wall_s=time.perf_counter() - t0)
     mesh = mesh.with_boundaries(boundaries)
-    logger.info("2D mesh: %(elements)d cells, %(nodes)d nodes, min SJ %(min_scaled_jacobian).3f", quality)
+    logger.info("2D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, min scaled Jacobian %(min_scaled_jacobian).3f", quality)
     return SkinMesh(mesh=mesh, boundaries=boundaries, dim=2, quality=quality, section=section,
                     sizes=plan.as_dict())

@@ -29,7 +29,10 @@ class SkinMesh:
     boundaries: name -> facet indices into `mesh.facets` (`bone_interface`, `outer_surface`,
       `symmetry` (plane x = 0), `nail_edge`, and in 3D `end_front`, `end_back`).
     dim: 2 (plane-strain half section) or 3 (slab along z).
-    quality: min/mean scaled Jacobian (gmsh minSJ of the curved cells), cell/node counts.
+    quality: `min_sicn`/`mean_sicn` (gmsh shape quality of the straight-sided cells, 1 =
+      equilateral), `min_scaled_jacobian` (min over cells of min/max det J at quadrature
+      points of the curved cells; 1 = straight, <= 0 inverted), `elements`, `nodes`
+      (all P2 nodes), `vertices`, `wall_s`.
     z_symmetric (3D): True if the slab is the half z >= 0 and `end_back` is the mid-plane
       z = 0 (a symmetry plane: u_z = 0); False if `end_back` is the free end z = -length/2.
     sizes: the size plan that made the mesh (coarse, fine, contact zone, estimate).
@@ -122,10 +125,20 @@ class SkinMesh:
 
     def min_jacobian(self) -> float:
         """Smallest Jacobian determinant over the quadrature points (> 0: no inverted cell)."""
-        from skfem import CellBasis
+        from skfem.quadrature import get_quadrature
 
-        cb = CellBasis(self.mesh, self.mesh.elem())
-        return float(np.min(cb.mapping.detDF(cb.X)))
+        X, _ = get_quadrature(self.mesh.elem.refdom, 2 * self.order)
+        return float(np.min(self.mesh._mapping().detDF(X)))
+
+
+def jacobian_ratio(mesh) -> float:
+    """min over cells of (min / max Jacobian determinant at the cell's quadrature points):
+    1 for straight-sided simplices, <= 0 for an inverted (or folded) curved cell."""
+    from skfem.quadrature import get_quadrature
+
+    X, _ = get_quadrature(mesh.elem.refdom, 4)
+    d = mesh._mapping().detDF(X)  # (cells, points)
+    return float(np.min(d.min(axis=1) / d.max(axis=1)))
 
 
 def _cell_nnodes(dim: int, order: int) -> int:

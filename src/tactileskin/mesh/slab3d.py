@@ -1,0 +1,121 @@
+"""3D slab of the skin: the 2D half section extruded along the finger axis z.
+
+Symmetry: the slab is always the half x >= 0 (boundary `symmetry` is the plane x = 0). If
+the indenter is mirror-symmetric about z = 0 (flat plate, cylinder, Braille dots symmetric in
+z) only the half z in [0, L/2] is meshed and `end_back` is the mid-plane z = 0 (a symmetry
+plane, u_z = 0; SkinMesh.z_symmetric = True); otherwise z in [-L/2, L/2] and `end_back` is
+the free end z = -L/2. `end_front` is always the free end z = +L/2. L = sample length
+(geometry/fingertip.toml).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+
+from tactileskin.mesh import _gmsh, sizing
+from tactileskin.mesh.section2d import add_section_curves
+from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
+from tactileskin.mesh.snap import snap_boundary_nodes
+
+logger = logging.getLogger(__name__)
+
+
+def _dots(scene) -> np.ndarray:
+    from tactileskin.geometry import braille
+
+    return braille.dot_centres(scene.braille_text, braille.get_standard(scene.braille_standard))
+
+
+def _mirror_symmetric(xz: np.ndarray, axis: int) -> bool:
+    m = xz.copy()
+    m[:, axis] *= -1.0
+    key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
+    return key(m) == key(xz)
+
+
+def z_symmetric(scene) -> bool:
+    """True if the indenter is mirror-symmetric about the plane z = 0."""
+    if scene.indenter.value in ("flat", "curved"):
+        return True
+    return _mirror_symmetric(_dots(scene), 1)
+
+
+def x_symmetric(scene) -> bool:
+    """True if the indenter is mirror-symmetric about the plane x = 0 (assumed by the half slab)."""
+    if scene.indenter.value in ("flat", "curved"):
+        return True
+    return _mirror_symmetric(_dots(scene), 0)
+
+
+def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
+                    refinement: float | None = None, order: int | None = None,
+                    length: float | None = None, use_z_symmetry: bool = True) -> SkinMesh:
+    """Mesh the 3D slab of `scene` (P2 tetrahedra with curved faces by default)."""
+    section = scene.section() if section is None else section
+    order = scene.order if order is None else order
+    length = section.fingertip.sample_length if length is None else length
+    zsym = use_z_symmetry and z_symmetric(scene)
+    if not x_symmetric(scene):
+        logger.warning("the indenter (braille_text=%r) is not symmetric about x = 0, but the slab "
+                       "is the half x >= 0 with a symmetry plane there", scene.braille_text)
+    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3,
+                       length=length, z_symmetric=zsym)
+    z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
+    params = {"thickness": section.thickness, "order": order, "length": length, "z_symmetric": zsym,
+              **plan.as_dict()}
+    logger.info("meshing 3D slab: %s", params)
+    t0 = time.perf_counter()
+    with _gmsh.session("slab3d", params) as gmsh:
+        occ = gmsh.model.occ
+        tags = add_section_curves(gmsh, section, plan.roi_s)
+        occ.synchronize()
+        com = {c: np.array(occ.getCenterOfMass(1, c)[:2])
+               for name in ("outer_surface", "nail_edge", "bone_interface", "symmetry") for c in tags[name]}
+        out = occ.extrude([(2, tags["surface"][0])], 0.0, 0.0, z1 - z0)
+        vol = [t for d, t in out if d == 3]
+        if z0 != 0.0:
+            occ.translate([(3, v) for v in vol], 0.0, 0.0, z0)
+        occ.synchronize()
+        faces = {k: [] for k in ("outer_surface", "nail_edge", "bone_interface", "symmetry",
+                                 "end_front", "end_back", "interface_roi")}
+        curve_name = {c: n for n in ("outer_surface", "nail_edge", "bone_interface", "symmetry")
+                      for c in tags[n]}
+        for _, s in gmsh.model.getBoundary([(3, v) for v in vol], oriented=False):
+            c = np.array(occ.getCenterOfMass(2, s))
+            if abs(c[2] - z0) < 1e-9:
+                faces["end_back"].append(s)
+            elif abs(c[2] - z1) < 1e-9:
+                faces["end_front"].append(s)
+            else:  # a lateral face: swept from the curve with the same (x, y) centre of mass
+                src = min(com, key=lambda k: np.linalg.norm(com[k] - c[:2]))
+                if np.linalg.norm(com[src] - c[:2]) > 1e-6:
+                    raise _gmsh.MeshError(f"cannot identify slab face {s} (centre {c}) with {params}")
+                faces[curve_name[src]].append(s)
+                if src in tags["interface_roi"]:
+                    faces["interface_roi"].append(s)
+        names = ("bone_interface", "outer_surface", "symmetry", "nail_edge", "end_front", "end_back")
+        for name in names:
+            gmsh.model.addPhysicalGroup(2, faces[name], name=name)
+        gmsh.model.addPhysicalGroup(3, vol, name="skin")
+        sizing.apply_fields(gmsh, plan, faces["interface_roi"], dim=3)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: robust and fast
+        gmsh.model.mesh.generate(3)
+        quality = _gmsh.shape_quality(gmsh, 3)
+        if order == 2:
+            # straight mid-nodes here (fast); snap.py puts the boundary ones on the true surfaces
+            gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)
+            gmsh.model.mesh.setOrder(2)
+        mesh, boundaries = _gmsh.to_skfem(gmsh, 3, order, {n: faces[n] for n in names})
+    if order == 2:
+        mesh = snap_boundary_nodes(mesh, boundaries, section)
+    quality.update(elements=int(mesh.nelements), nodes=int(mesh.doflocs.shape[1]),
+                   vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh),
+                   wall_s=time.perf_counter() - t0)
+    mesh = mesh.with_boundaries(boundaries)
+    logger.info("3D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, min scaled Jacobian %(min_scaled_jacobian).3f", quality)
+    return SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality, section=section,
+                    z_symmetric=zsym, length=length, sizes=plan.as_dict())
