@@ -1,0 +1,56 @@
+"""End-to-end sweep on a coarse mesh: Dask execution, cache reuse, outputs, failure handling."""
+
+import csv
+
+import pytest
+
+from tactileskin.cli import main
+from tactileskin.errors import ConvergenceError
+from tactileskin.scene import Scene
+from tactileskin.sweep import ResultCache, expand_grid, run_sweep
+
+COARSE = dict(mesh_size=0.6, refinement=2.0)
+
+
+@pytest.mark.slow
+def test_cli_sweep_dask_then_cached_rerun(tmp_path, capsys):
+    out = tmp_path / "out"
+    args = ["sweep", "--out", str(out), "--thickness", "1", "--material", "polyurethane",
+            "--indenter", "flat,curved", "--mesh-size", str(COARSE["mesh_size"]), "--workers", "2",
+            "--no-render"]
+    assert main(args) == 0
+    with open(out / "results.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    peaks = {r["indenter"]: float(r["peak_mpa"]) for r in rows}
+    assert all(p > 0 for p in peaks.values())
+    assert (out / "report.md").read_text().count("| t1-polyurethane-") == 2
+    assert (out / "fig10_profiles.png").is_file()
+    capsys.readouterr()
+    # rerun: everything comes from the cache, nothing is solved again
+    assert main(args + ["--serial"]) == 0
+    text = capsys.readouterr().out
+    assert text.count("cached") == 2 and " done " not in text
+
+
+def test_failed_case_is_reported_and_others_go_on(tmp_path, monkeypatch):
+    # Inject a convergence failure for one scene (the solver's own failure paths are tested
+    # in the solver's tests); the sweep must record it, keep going and cache only successes.
+    import tactileskin.sweep as sw
+
+    real = sw.solve_case
+    bad = Scene(thickness=1.0, material="polyurethane", indenter="curved", **COARSE)
+
+    def flaky(scene):
+        if scene == bad:
+            raise ConvergenceError("did not converge", {"time": 0.1, "residuals": [1.0, 0.5]})
+        return real(scene)
+
+    monkeypatch.setattr(sw, "solve_case", flaky)
+    scenes = expand_grid(thicknesses=[1.0], materials=["polyurethane"], indenters=["flat", "curved"],
+                         base=Scene(**COARSE))
+    cache = ResultCache(tmp_path / "cache")
+    outcomes = run_sweep(scenes, cache, serial=True)
+    assert [o.status for o in outcomes] == ["done", "failed"]
+    assert outcomes[1].diagnosis["residuals"] == [1.0, 0.5]
+    assert cache.has(scenes[0]) and not cache.has(scenes[1])
