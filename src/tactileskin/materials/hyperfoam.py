@@ -170,6 +170,9 @@ def _spectral(C, detF=None):
     return e, Q, lc, lJ, ok
 
 
+_IA, _IB, _ID = np.array([0, 0, 1]), np.array([1, 2, 2]), np.arange(3)
+
+
 def _spectral_sum(Q, w):
     """sum_a w_a n_a n_a^T for eigenvector columns Q (..., 3, 3) and weights w (..., 3)."""
     return (Q * w[..., None, :]) @ np.swapaxes(Q, -1, -2)
@@ -236,20 +239,26 @@ def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     # Divided differences of g(c) + p/c at fixed J, where g(c) = sum k_i c^(q_i), q_i = alpha_i/2 - 1
     # and p = -sum k_i J^(-alpha_i beta) (the volumetric part of S is p C^-1).
     q = 0.5 * alpha - 1.0                                    # (m,)
-    lca = lc[..., :, None, None]                             # (..., 3, 1, 1)
-    lcb = lc[..., None, :, None]                             # (..., 1, 3, 1)
-    gap = e[..., :, None] - e[..., None, :]                  # c_a - c_b, (..., 3, 3)
-    ell = np.log1p(gap / np.exp(lc)[..., None, :])           # ln(c_a/c_b), accurate for small gaps
-    same = np.abs(gap) <= 1e-14 * np.exp(np.maximum(lc[..., :, None], lc[..., None, :]))
-    safe_gap = np.where(same, 1.0, gap)
-    dd = _diffexp(q * lca, q * lcb, q * ell[..., None]) / safe_gap[..., None]
-    deriv = q * _exp((q - 1.0) * 0.5 * (lca + lcb))        # g'(c) at the (geometric) mean
-    dd = np.where(same[..., None], deriv, dd)
-    xv = -alpha * beta * lJ[..., None, None, None]           # (..., 1, 1, m)
-    dv = _exp(xv - lca - lcb)                                # J^(-alpha beta) / (c_a c_b)
-    gamma = np.sum(k * (dd + dv), axis=-1)                   # (..., 3, 3)
-    gamma = 0.5 * (gamma + np.swapaxes(gamma, -1, -2))
-    qv = np.sum(2.0 * mu * beta * _exp(xv[..., 0, 0, :]), axis=-1)  # J dp/dJ
+    xv = -alpha * beta * lJ[..., None]                       # (..., m)
+    ev = _exp(xv)                                            # J^(-alpha_i beta)
+    lc1 = lc[..., :, None]                                   # (..., 3, 1)
+    # diagonal a = b: g'(c_a) + J^(-alpha beta) / c_a^2
+    gdiag = np.sum(k * (q * _exp((q - 1.0) * lc1) + _exp(xv[..., None, :] - 2.0 * lc1)), axis=-1)
+    # off-diagonal pairs (0,1), (0,2), (1,2): exp * expm1 form, exact down to zero gap
+    ea, eb = e[..., _IA], e[..., _IB]
+    la, lb = lc[..., _IA, None], lc[..., _IB, None]          # (..., 3, 1)
+    gap = ea - eb                                            # c_a - c_b, from eigenvalues of C - I
+    ell = np.log1p(gap / (1.0 + eb))[..., None]              # ln(c_a / c_b), accurate for small gaps
+    same = np.abs(gap) <= 1e-14 * np.maximum(1.0 + ea, 1.0 + eb)
+    safe_gap = np.where(same, 1.0, gap)[..., None]
+    dd = np.where(same[..., None], q * _exp((q - 1.0) * 0.5 * (la + lb)),   # g' at the mean
+                  _diffexp(q * la, q * lb, q * ell) / safe_gap)
+    goff = np.sum(k * (dd + _exp(xv[..., None, :] - la - lb)), axis=-1)
+    gamma = np.empty(lc.shape[:-1] + (3, 3))
+    gamma[..., _ID, _ID] = gdiag
+    gamma[..., _IA, _IB] = goff
+    gamma[..., _IB, _IA] = goff
+    qv = np.sum(2.0 * mu * beta * ev, axis=-1)               # J dp/dJ
 
     S = _spectral_sum(Q, f)
     Cinv = _spectral_sum(Q, np.exp(-lc))
