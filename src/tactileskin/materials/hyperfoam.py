@@ -196,9 +196,8 @@ def _guard(ok, alpha, beta, lc, lJ):
 
 def energy(mat: Hyperfoam, C, *, detF=None):
     """Strain energy density U (MPa) for C (..., 3, 3). Inadmissible states give finite values."""
-    _, _, lc, lJ, ok = _spectral(C, detF)
+    _, _, lc, lJ, _ = _spectral(C, detF)   # clipped logs: finite everywhere
     mu, alpha, _, beta = _params(mat)
-    ok = _guard(ok, alpha, beta, lc, lJ)
     la = 0.5 * lc[..., :, None]                              # ln(stretch), (..., 3, 1)
     dev = np.sum(la * la * _psi2(alpha * la), axis=-2)       # (..., m)
     vol = beta * lJ[..., None] ** 2 * _psi2(-alpha * beta * lJ[..., None])
@@ -270,6 +269,9 @@ def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     T4 = (np.swapaxes(Pm, -1, -2) @ (gamma @ Pm)).reshape(lead + (3, 3, 3, 3))  # [i,k,j,l]
     D = np.swapaxes(T4, -3, -2) + np.moveaxis(T4, -3, -1)   # [i,j,k,l] + [i,j,l,k]
     D += (qv[..., None, None] * Cinv)[..., :, :, None, None] * Cinv[..., None, None, :, :]
+    if not np.all(ok):
+        log.debug("hyperfoam: %d of %d states inadmissible (beyond the overflow guard or J <= 0)",
+                  int(np.size(ok) - np.count_nonzero(ok)), int(np.size(ok)))
     return S, D, ok
 
 
