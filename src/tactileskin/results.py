@@ -6,9 +6,16 @@ two compare like for like. Pure numpy.
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
 import numpy as np
 
-from tactileskin.errors import ParameterError
+from tactileskin.errors import ConvergenceError, ParameterError
 
 
 def _check(s, p):
@@ -55,3 +62,114 @@ def auc(s, p) -> float:
     """Area under P(s), trapezoid rule (MPa mm for a pressure profile)."""
     s, p = _check(s, p)
     return float(np.trapezoid(p, s))
+
+
+# --- solver results ------------------------------------------------------------------------
+
+@dataclass
+class Result:
+    """Output of one solve (units mm, MPa, N; plane-strain forces per mm of depth).
+
+    s, pressure: mean pressure P = -(sx+sy+sz)/3 (positive in compression) at the nodes of
+      the bone interface, L2-projected from the quadrature points, sorted by curvilinear
+      distance s from the symmetry line.
+    contact_x, contact_pressure: contact pressure (per current area) at the contact points
+      of the outer surface, sorted by the current x.
+    reaction: vertical force the fixed boundaries exert on the modelled (half) domain.
+    stats: dofs, increments, newton_iterations, wall_s (and more).
+    fields: optional nodal data for the .vtu (points, cells, cell_type, point_data).
+    history: per-increment records when requested.
+    """
+
+    s: np.ndarray
+    pressure: np.ndarray
+    contact_x: np.ndarray
+    contact_pressure: np.ndarray
+    reaction: float
+    stats: dict
+    fields: dict | None = None
+    history: list = field(default_factory=list)
+    scene: dict | None = None
+
+    def __post_init__(self):
+        for name in ("s", "pressure", "contact_x", "contact_pressure"):
+            v = np.asarray(getattr(self, name), float)
+            if not np.all(np.isfinite(v)):
+                raise ConvergenceError(f"non-finite values in result field {name!r}", {"field": name})
+            setattr(self, name, v)
+        if not np.isfinite(self.reaction):
+            raise ConvergenceError("non-finite reaction force", {"field": "reaction"})
+
+    @property
+    def peak(self) -> float:
+        return peak(*self._profile())
+
+    @property
+    def span(self) -> float:
+        return span(*self._profile())
+
+    @property
+    def auc(self) -> float:
+        return auc(*self._profile())
+
+    def _profile(self):
+        # nodes at (numerically) the same s: keep their mean so that s is strictly increasing
+        s, inv = np.unique(np.round(self.s, 9), return_inverse=True)
+        p = np.bincount(inv, weights=self.pressure) / np.bincount(inv)
+        return s, p
+
+    def summary(self) -> dict:
+        return {
+            "peak_mpa": self.peak,
+            "span_mm": self.span,
+            "auc": self.auc,
+            "reaction_n_per_mm": float(self.reaction),
+            "dofs": int(self.stats.get("dofs", 0)),
+            "newton_iterations": int(self.stats.get("newton_iterations", 0)),
+            "increments": int(self.stats.get("increments", 0)),
+            "wall_s": float(self.stats.get("wall_s", 0.0)),
+            **({"scene": self.scene} if self.scene else {}),
+        }
+
+    def write(self, directory) -> Path:
+        """Write profile.csv, summary.json, contact.csv and result.vtu into `directory`
+        atomically (a temporary sibling directory renamed into place)."""
+        directory = Path(directory)
+        directory.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", dir=directory.parent))
+        try:
+            s, p = self._profile()
+            np.savetxt(tmp / "profile.csv", np.column_stack([s, p]), delimiter=",",
+                       header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+            np.savetxt(tmp / "contact.csv", np.column_stack([self.contact_x, self.contact_pressure]),
+                       delimiter=",", header="x_mm,contact_pressure_mpa", comments="", fmt="%.10g")
+            (tmp / "summary.json").write_text(json.dumps(self.summary(), indent=2))
+            if self.fields is not None:
+                _write_vtu(tmp / "result.vtu", self.fields)
+            if directory.exists():
+                old = Path(tempfile.mkdtemp(prefix=f".{directory.name}.old.", dir=directory.parent))
+                os.replace(directory, old / "d")
+                os.replace(tmp, directory)
+                shutil.rmtree(old, ignore_errors=True)
+            else:
+                os.replace(tmp, directory)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        return directory
+
+
+def _write_vtu(path: Path, fields: dict) -> None:
+    import meshio  # only when writing files (keeps the solver import light)
+
+    pts = np.asarray(fields["points"], float)
+    if pts.shape[1] == 2:
+        pts = np.column_stack([pts, np.zeros(len(pts))])
+    pdata = {}
+    for k, v in fields["point_data"].items():
+        v = np.asarray(v, float)
+        if v.ndim == 2 and v.shape[1] == 2:
+            v = np.column_stack([v, np.zeros(len(v))])
+        pdata[k] = v
+    meshio.Mesh(pts, [(fields["cell_type"], np.asarray(fields["cells"]))], point_data=pdata).write(
+        path, file_format="vtu")

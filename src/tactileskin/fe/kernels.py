@@ -99,43 +99,55 @@ def residual(kin: Kinematics, S: np.ndarray) -> np.ndarray:
     return f
 
 
+def _sumq(left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """sum_q left_q^T right_q for (E, Q, k, nd) stacks, as one batched matmul (E, nd, nd)."""
+    E, Q, k, nd = left.shape
+    return np.swapaxes(left.reshape(E, Q * k, nd), 1, 2) @ right.reshape(E, Q * k, nd)
+
+
 def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
     """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m)."""
     E, Q, A, m = kin.G.shape
     nd = A * m
-    I = np.eye(m)
+    mm = m * m
     Fb = kin.Fbar
-    # material + geometric tangent in F_bar: AA_iJkL = d_ik S_JL + Fb_iI Fb_kK D_IJKL
-    FD = np.einsum("eqiI,eqIJKL->eqiJKL", Fb, D)
-    AA = np.einsum("ik,eqJL->eqiJkL", I, S) + np.einsum("eqiJKL,eqkK->eqiJkL", FD, Fb)
-    AA = AA.reshape(E, Q, m * m, m * m)
+    # AA_iJkL = d_ik S_JL + Fb_iI Fb_kK D_IJKL as an (m*m, m*m) matrix per point
+    Fk = np.einsum("eqiI,eqkK->eqikIK", Fb, Fb).reshape(E, Q, mm, mm)       # [(i,k),(I,K)]
+    Dr = D.transpose(0, 1, 2, 4, 3, 5).reshape(E, Q, mm, mm)                # [(I,K),(J,L)]
+    AA = (Fk @ Dr).reshape(E, Q, m, m, m, m).transpose(0, 1, 2, 4, 3, 5)     # [i,J,k,L]
+    AA = AA + np.eye(m)[None, None, :, None, :, None] * S[:, :, None, :, None, :]
+    AA = AA.reshape(E, Q, mm, mm)
     # B: dF_iJ from local dof (a, k) = d_ik G_aJ   -> (E, Q, m*m, nd)
-    B = np.einsum("ik,eqaJ->eqiJak", I, kin.G).reshape(E, Q, m * m, nd)
+    B = np.zeros((E, Q, m, m, A, m))
+    for i in range(m):
+        B[:, :, i, :, :, i] = np.swapaxes(kin.G, 2, 3)
+    B = B.reshape(E, Q, mm, nd)
+    w = kin.w
     if not kin.mixed:
-        Bw = B * kin.w[..., None, None]
-        return np.einsum("eqxd,eqxy,eqyc->edc", Bw, AA, B, optimize=True)
+        return _sumq(B * w[..., None, None], AA @ B)
     dphi = kin.phi_grad()                                                    # (E, Q, nd)
-    Bbar = kin.alpha[..., None, None] * (B + kin.F.reshape(E, Q, m * m)[..., None] * dphi[..., None, :])
+    Bbar = kin.alpha[..., None, None] * (B + kin.F.reshape(E, Q, mm)[..., None] * dphi[..., None, :])
+    K = _sumq(Bbar * w[..., None, None], AA @ Bbar)
     P = Fb @ S
     tau = np.einsum("eqij,eqij->eq", P, Fb)
     p = kin.alpha[..., None] * np.einsum("eqij,eqaj->eqai", P, kin.G).reshape(E, Q, nd)
-    h = kin.h
-    # tr(F^-1 dF F^-1 dF) = sum_ab (h_a . du_b)(h_b . du_a):  M[(a,i),(b,k)] = h_b,i h_a,k
-    M = np.einsum("eqbi,eqak->eqaibk", h, h).reshape(E, Q, nd, nd)
     L, v2, th = kin._L, kin._v2, kin.theta
-    w = kin.w
-    K = np.einsum("eqxd,eqxy,eqyc->edc", Bbar * w[..., None, None], AA, Bbar, optimize=True)
     wt = w * tau
-    K += np.einsum("eq,eqd,eqc->edc", wt, dphi, dphi)
-    K += np.einsum("eq,eqdc->edc", wt / m, M)
-    K -= (wt.sum(axis=1) / m / th**2)[:, None, None] * np.einsum("ed,ec->edc", v2, v2)
-    K += np.einsum("eq,eqd,eqc->edc", w, dphi, p)
-    K += np.einsum("eq,eqd,eqc->edc", w, p, dphi)
-    # d2theta term: (sum_q w tau /(m theta)) * avg_q J (L L^T - M)
     V = w.sum(axis=1)
     coef = wt.sum(axis=1) / (m * th) / V
     wJ = w * kin.J
-    K += coef[:, None, None] * (np.einsum("eq,eqd,eqc->edc", wJ, L, L) - np.einsum("eq,eqdc->edc", wJ, M))
+    # tau dphi dphi + dphi p + p dphi = dphi r + r dphi, r = p + tau dphi / 2
+    r = p + 0.5 * tau[..., None] * dphi
+    wd = (w[..., None] * dphi)[:, :, None, :]
+    K += _sumq(wd, r[:, :, None, :])
+    K += _sumq(r[:, :, None, :], wd)
+    # tr(F^-1 dF F^-1 dF) terms: sum_q c_q h_q,bi h_q,ak at [(a,i),(b,k)]
+    c = wt / m - coef[:, None] * wJ
+    hq = kin.h.reshape(E, Q, 1, nd)
+    N = _sumq(c[..., None, None] * hq, hq)                                   # [(a,k),(b,i)]
+    K += N.reshape(E, A, m, A, m).transpose(0, 1, 4, 3, 2).reshape(E, nd, nd)
+    K -= (wt.sum(axis=1) / m / th**2)[:, None, None] * (v2[:, :, None] * v2[:, None, :])
+    K += coef[:, None, None] * _sumq((wJ[..., None] * L)[:, :, None, :], L[:, :, None, :])
     return K
 
 

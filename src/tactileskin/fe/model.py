@@ -61,7 +61,6 @@ class Contact:
     rate: float = 1.0
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
     tol_penetration: float = 1e-4  # mm
-    tol_multiplier: float = 1e-3   # relative change of the multipliers between Uzawa updates
     max_uzawa: int = 30
 
 
@@ -87,8 +86,11 @@ class Model:
         self.mixed = formulation == "mixed"
         self.formulation = formulation
         self.element = scalar_element(mesh, order)
-        kw = {} if intorder is None else {"intorder": intorder}
-        self.basis = CellBasis(mesh, self.element, **kw)
+        if intorder is None:
+            # the rule of Abaqus' CPE6/C3D10 (3 / 4 points): exact for the straight-sided
+            # P2 stiffness, half the material evaluations of the default 6-point rule
+            intorder = 2 if order == 2 and ("Tri" in type(mesh).__name__ or "Tet" in type(mesh).__name__) else None
+        self.basis = CellBasis(mesh, self.element, **({} if intorder is None else {"intorder": intorder}))
         b = self.basis
         self.m = m = mesh.dim()
         self.nsdof = b.N
@@ -165,6 +167,7 @@ class Model:
     # -- evaluation ---------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, t: float, dt: float, lam_k: np.ndarray | None = None,
                  tangent: bool = True) -> Evaluation:
+        """Residual at a trial state; with tangent=True also the tangent (else `tangent(ev)` later)."""
         m = self.m
         ue = u.reshape(-1, m)[self.sdofs]
         kin = kernels.Kinematics(ue, self.G, self.w, self.mixed)
@@ -178,26 +181,38 @@ class Model:
         for i in range(len(decay)):
             S = S + decay[i] * self.H[i] - gain[i] * self.S0_old
         Sm = S[..., :m, :m]
-        fe = kernels.residual(kin, Sm)
-        fint = assemble_vector(self.ndof, self.edofs, fe)
+        fint = assemble_vector(self.ndof, self.edofs, kernels.residual(kin, Sm))
         R = fint.copy()
-        Kd = None
-        if tangent:
-            Dm = gamma * D0[..., :m, :m, :m, :m]
-            Kd = self.pattern.data(kernels.tangent(kin, Sm, Dm))
         cinfo = None
         if self.surface is not None:
             c = self.contact
-            fc, Kc, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty,
-                                                  self.surface.lam if lam_k is None else lam_k, tangent)
+            lam = self.surface.lam if lam_k is None else lam_k
+            fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False)
             R += assemble_vector(self.ndof, self.surface.vdofs, fc)
-            if tangent:
-                self.pattern.add(Kd, self.surface.vdofs, Kc)
-        if not np.all(np.isfinite(R)) or (Kd is not None and not np.all(np.isfinite(Kd))):
+        if not np.all(np.isfinite(R)):
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="non-finite residual")
-        ev = Evaluation(R=R, ok=True, K=Kd, contact=cinfo, S0=S0, kin=kin, fint=fint)
-        ev.S = S
+        ev = Evaluation(R=R, ok=True, contact=cinfo, S0=S0, kin=kin, fint=fint)
+        ev.S, ev._D, ev._gamma, ev._u, ev._t, ev._lam = S, D0, gamma, u, t, (
+            None if self.surface is None else lam)
+        if tangent:
+            self.tangent(ev)
         return ev
+
+    def tangent(self, ev: Evaluation) -> np.ndarray:
+        """CSR data of the consistent tangent at an admissible evaluation (cached on it)."""
+        if ev.K is not None:
+            return ev.K
+        m = self.m
+        Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
+        Kd = self.pattern.data(kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm))
+        if self.surface is not None:
+            c = self.contact
+            _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True)
+            self.pattern.add(Kd, self.surface.vdofs, Kc)
+        if not np.all(np.isfinite(Kd)):
+            raise FloatingPointError("non-finite tangent")
+        ev.K = Kd
+        return Kd
 
     def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
         _, decay, gain = self.qlv(dt)

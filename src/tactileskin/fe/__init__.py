@@ -1,0 +1,74 @@
+"""Finite-strain hyperfoam-viscoelastic contact solver on scikit-fem.
+
+High level: `solve(scene, mesh=None, *, history=False) -> Result`.
+Low level (any mesh + named boundaries + BCs + indenter): `Model`, `Dirichlet`, `Contact`,
+`run`, `SolverOptions`, `make_result`.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+
+from tactileskin.fe.model import Contact, Dirichlet, Model
+from tactileskin.fe.output import make_result, reaction
+from tactileskin.fe.solver import SolverOptions, run
+
+log = logging.getLogger(__name__)
+
+__all__ = ["solve", "model_for_scene", "material_law", "Model", "Dirichlet", "Contact", "run",
+           "SolverOptions", "make_result", "reaction"]
+
+
+def material_law(hyperfoam):
+    """C -> (S, D, ok) for a Hyperfoam (tactileskin.materials)."""
+    from tactileskin.materials import pk2_tangent
+
+    def law(C):
+        return pk2_tangent(hyperfoam, C)
+
+    return law
+
+
+def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
+    """The Model of a scene (fingertip skin, bone and nail fixed, symmetry x = 0, indenter)."""
+    from tactileskin.geometry.indenters import indenter_for_scene
+    from tactileskin.materials import get_material
+
+    if mesh is None:
+        from tactileskin.mesh import build_mesh  # gmsh only when no mesh is given
+
+        mesh = build_mesh(scene)
+    mat = get_material(scene.material)
+    hf = mat.hyperfoam
+    prony = mat.prony if scene.viscoelastic and mat.prony.n_terms else None
+    m = scene.dim
+    allc = tuple(range(m))
+    bcs = [Dirichlet("bone_interface", allc), Dirichlet("nail_edge", allc), Dirichlet("symmetry", (0,))]
+    if m == 3 and getattr(mesh, "z_symmetric", False):
+        bcs.append(Dirichlet("end_back", (2,)))
+    contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate)
+    model = Model(mesh.mesh, mesh.boundaries, material_law(hf), bcs, prony=prony,
+                  formulation=scene.formulation.value, contact=contact, order=scene.order,
+                  stiffness=max(hf.K0, hf.mu0))
+    return model, mesh
+
+
+def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None):
+    """Indent the scene's skin from first touch to its full depth at its rate; return a Result."""
+    t0 = time.perf_counter()
+    model, sm = model_for_scene(scene, mesh)
+    section = scene.section()
+
+    def record(model, ev):
+        return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1])}
+
+    ev, stats = run(model, scene.duration, options, history=history, record=record)
+    stats.wall_s = time.perf_counter() - t0
+    res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
+    log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
+             scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
+             stats.wall_s)
+    return res
