@@ -179,3 +179,29 @@ def test_off_main_thread():
     th.start()
     th.join(60)
     assert out["m"].mesh.nelements > 0
+
+
+def test_meshes_are_reproducible():
+    # the result cache is keyed by the scene: the same scene must give the same mesh
+    a = build_mesh(Scene(thickness=3.0), mesh_size=1.0)
+    b = build_mesh(Scene(thickness=3.0), mesh_size=1.0)
+    np.testing.assert_array_equal(a.mesh.doflocs, b.mesh.doflocs)
+    np.testing.assert_array_equal(a.mesh.t, b.mesh.t)
+
+
+def test_gmsh_failure_becomes_mesh_error():
+    from tactileskin.errors import MeshError
+    from tactileskin.mesh import _gmsh
+
+    with pytest.raises(MeshError, match=r"thickness.*3"):
+        with _gmsh.session("broken", {"thickness": 3.0}) as gmsh:
+            gmsh.model.occ.addCurveLoop([12345])  # no such curve: gmsh raises
+    import gmsh
+
+    assert not gmsh.isInitialized()  # finalized after the failure
+
+
+def test_order_one_gives_straight_triangles():
+    sm = build_mesh(Scene(thickness=3.0, order=1), mesh_size=1.0)
+    assert type(sm.mesh).__name__ == "MeshTri1" and sm.min_jacobian() > 0
+    assert set(sm.boundaries) == set(BOUNDARIES_2D)

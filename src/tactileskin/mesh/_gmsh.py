@@ -43,6 +43,7 @@ def session(name: str, params: dict):
         try:
             gmsh.option.setNumber("General.Terminal", 1 if logger.isEnabledFor(logging.DEBUG) else 0)
             gmsh.option.setNumber("General.Verbosity", 5 if logger.isEnabledFor(logging.DEBUG) else 2)
+            gmsh.option.setNumber("General.NumThreads", 1)  # reproducible meshes (cache keys)
             gmsh.logger.start()
             gmsh.model.add(name)
             try:
@@ -95,7 +96,8 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
            (3, 1): skfem.MeshTet1, (3, 2): skfem.MeshTet2}[(dim, order)]
     # scikit-fem puts vertex nodes first and renumbers them in order of np.unique; the
     # extra rows of t are assigned to its own edge dofs in refdom edge order.
-    mesh = cls(np.ascontiguousarray(points.T), np.ascontiguousarray(conn.T))
+    # sort_t=False: keep gmsh's (positively oriented) vertex order; MeshTri1 would sort it
+    mesh = cls(np.ascontiguousarray(points.T), np.ascontiguousarray(conn.T), sort_t=False)
     nv = dim + 1
     vert_orig = np.unique(conn[:, :nv])           # original index of skfem vertex k
     boundaries = {}

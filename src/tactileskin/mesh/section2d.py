@@ -87,6 +87,7 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
         gmsh.model.mesh.generate(2)
         quality = _gmsh.shape_quality(gmsh, 2)
         if order == 2:
+            gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)  # mid-nodes on the true curves
             gmsh.model.mesh.setOrder(2)
         groups = {n: tags[n] for n in ("bone_interface", "outer_surface", "symmetry", "nail_edge")}
         mesh, boundaries = _gmsh.to_skfem(gmsh, 2, order, groups)
@@ -94,6 +95,7 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
                    vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh),
                    wall_s=time.perf_counter() - t0)
     mesh = mesh.with_boundaries(boundaries)
-    logger.info("2D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, min scaled Jacobian %(min_scaled_jacobian).3f", quality)
+    logger.info("2D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, "
+                "min scaled Jacobian %(min_scaled_jacobian).3f", quality)
     return SkinMesh(mesh=mesh, boundaries=boundaries, dim=2, quality=quality, section=section,
                     sizes=plan.as_dict())

@@ -19,8 +19,9 @@ logger = logging.getLogger(__name__)
 ROI_S = 6.0  # mm: the paper reports bone pressure within 6 mm of s = 0; refine the interface there
 MAX_ELEMENTS = {2: 2_000_000, 3: 5_000_000}
 # cells per (size^dim) of area/volume for gmsh's Delaunay/Frontal meshes, measured on the
-# fingertip section (benchmarks/mesh.py): ~2.3 triangles per h^2, ~6 tetrahedra per h^3.
-_CELLS_PER_UNIT = {2: 2.3, 3: 6.5}
+# fingertip section (benchmarks/mesh.py); with the zone areas below the estimate is 1-1.5x
+# the actual count (an upper-side guess).
+_CELLS_PER_UNIT = {2: 2.0, 3: 3.0}
 
 
 @dataclass(frozen=True)

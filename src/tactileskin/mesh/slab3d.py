@@ -10,6 +10,7 @@ the free end z = -L/2. `end_front` is always the free end z = +L/2. L = sample l
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 
@@ -102,7 +103,7 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
         gmsh.model.addPhysicalGroup(3, vol, name="skin")
         sizing.apply_fields(gmsh, plan, faces["interface_roi"], dim=3)
         gmsh.option.setNumber("Mesh.Algorithm", 6)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay: robust and fast
+        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fastest here, best min SICN
         gmsh.model.mesh.generate(3)
         quality = _gmsh.shape_quality(gmsh, 3)
         if order == 2:
@@ -110,12 +111,13 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
             gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)
             gmsh.model.mesh.setOrder(2)
         mesh, boundaries = _gmsh.to_skfem(gmsh, 3, order, {n: faces[n] for n in names})
-    if order == 2:
-        mesh = snap_boundary_nodes(mesh, boundaries, section)
+    # one rebuild of the skfem mesh: snapped nodes and the named boundaries together
+    doflocs = snap_boundary_nodes(mesh, boundaries, section) if order == 2 else mesh.doflocs
+    mesh = dataclasses.replace(mesh, doflocs=doflocs, _boundaries=boundaries)
     quality.update(elements=int(mesh.nelements), nodes=int(mesh.doflocs.shape[1]),
                    vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh),
                    wall_s=time.perf_counter() - t0)
-    mesh = mesh.with_boundaries(boundaries)
-    logger.info("3D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, min scaled Jacobian %(min_scaled_jacobian).3f", quality)
+    logger.info("3D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, "
+                "min scaled Jacobian %(min_scaled_jacobian).3f", quality)
     return SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality, section=section,
                     z_symmetric=zsym, length=length, sizes=plan.as_dict())

@@ -10,8 +10,6 @@ over a planar curve, so this is a point of the true surface.
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -33,9 +31,9 @@ def curve_parameter(curve, p: np.ndarray, u_max: float) -> np.ndarray:
     return u
 
 
-def snap_boundary_nodes(mesh, boundaries: dict, section):
-    """Return a copy of the (3D, P2) skfem mesh with outer-surface and bone-interface nodes
-    on the analytic curves."""
+def snap_boundary_nodes(mesh, boundaries: dict, section) -> np.ndarray:
+    """Node coordinates (doflocs) of the (3D, P2) skfem mesh with the outer-surface and
+    bone-interface nodes moved onto the analytic curves."""
     ft = section.fingertip
     p = mesh.doflocs.copy()
     curves = {"outer_surface": (ft.outer, section.u_outer_end),
@@ -55,4 +53,4 @@ def snap_boundary_nodes(mesh, boundaries: dict, section):
             mid = mesh.dofs.edge_dofs[0, edges]
             p[:2, mid] = curve(u_v[name][ends].mean(axis=0)).T
             p[2, mid] = p[2, ends].mean(axis=0)
-    return dataclasses.replace(mesh, doflocs=p)
+    return p

@@ -1,0 +1,55 @@
+"""`tactileskin mesh`: mesh the skin of a scene, report counts and quality, export."""
+
+from __future__ import annotations
+
+import click
+
+from tactileskin.cli._common import scene_from_options, scene_options
+
+
+@click.command("mesh")
+@scene_options
+@click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
+              help="Mesh file to write: .msh (gmsh 2.2), .vtu (ParaView) or .inp (Abaqus/CalculiX).")
+@click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default: scene).")
+def command(out, order, **scene_kw):
+    """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from tactileskin.mesh import FORMATS, build_mesh
+    from tactileskin.errors import ParameterError
+
+    if out is not None and not any(out.lower().endswith(s) for s in FORMATS):
+        raise ParameterError("--out", out, "a file name ending in " + ", ".join(FORMATS))
+    scene = scene_from_options(**scene_kw)
+    if order is not None:
+        scene = scene.replace(order=int(order))
+    sm = build_mesh(scene)
+    q, sec = sm.quality, sm.section
+
+    table = Table(title=f"skin mesh {scene.label()} (mesh_size {scene.mesh_size:g} mm, "
+                        f"refinement {scene.refinement:g})")
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    kind = {2: "P2 triangles", 3: "P2 tetrahedra"}[sm.dim] if sm.order == 2 else \
+        {2: "P1 triangles", 3: "P1 tetrahedra"}[sm.dim]
+    table.add_row("cells", f"{q['elements']} {kind}")
+    table.add_row("nodes (vertices)", f"{q['nodes']} ({q['vertices']})")
+    table.add_row("refined size (mm)", f"{sm.sizes['fine']:.4g}")
+    table.add_row("min / mean SICN (shape)", f"{q['min_sicn']:.3f} / {q['mean_sicn']:.3f}")
+    table.add_row("min scaled Jacobian (curved)", f"{q['min_scaled_jacobian']:.3f}")
+    lz = 1.0 if sm.dim == 2 else (0.5 if sm.z_symmetric else 1.0) * sm.length
+    L = sm.boundary_measure("bone_interface") / lz
+    table.add_row("bone interface length (mm)",
+                  f"{L:.6f} (CAD {sec.interface_length:.6f}, rel. err {abs(L / sec.interface_length - 1):.1e})")
+    for name, f in sm.boundaries.items():
+        table.add_row(f"facets: {name}", str(len(f)))
+    if sm.dim == 3:
+        table.add_row("z symmetry", "yes (end_back is z = 0)" if sm.z_symmetric else "no")
+    table.add_row("wall time (s)", f"{q['wall_s']:.2f}")
+    console = Console()
+    console.print(table)
+    if out is not None:
+        path = sm.write(out)
+        console.print(f"wrote {path}")
