@@ -241,6 +241,10 @@ def run_sweep(
         from dask.distributed import Client, LocalCluster, as_completed
 
         cluster = None
+        if not log.isEnabledFor(logging.INFO):  # dask's scheduler logs at INFO by default
+            for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
+                         "distributed.http.proxy", "distributed.worker"):
+                logging.getLogger(name).setLevel(logging.ERROR)
         if scheduler:
             client = Client(scheduler)
         else:
