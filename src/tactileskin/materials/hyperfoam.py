@@ -267,8 +267,10 @@ def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     Qt = np.swapaxes(Q, -1, -2)                              # rows n_a
     Pm = (Qt[..., :, :, None] * Qt[..., :, None, :]).reshape(lead + (3, 9))   # [a, (i,k)]
     T4 = (np.swapaxes(Pm, -1, -2) @ (gamma @ Pm)).reshape(lead + (3, 3, 3, 3))  # [i,k,j,l]
-    D = np.swapaxes(T4, -3, -2) + np.moveaxis(T4, -3, -1)   # [i,j,k,l] + [i,j,l,k]
-    D += (qv[..., None, None] * Cinv)[..., :, :, None, None] * Cinv[..., None, None, :, :]
+    D = np.empty(lead + (3, 3, 3, 3))                        # C-contiguous: reshape below is a view
+    np.add(np.swapaxes(T4, -3, -2), np.moveaxis(T4, -3, -1), out=D)   # [i,j,k,l] + [i,j,l,k]
+    c9 = Cinv.reshape(lead + (9, 1))
+    D.reshape(lead + (9, 9))[...] += (qv[..., None, None] * c9) @ np.swapaxes(c9, -1, -2)
     if not np.all(ok):
         log.debug("hyperfoam: %d of %d states inadmissible (beyond the overflow guard or J <= 0)",
                   int(np.size(ok) - np.count_nonzero(ok)), int(np.size(ok)))
