@@ -11,6 +11,8 @@
 Prints the recovered peak against the true (scanner-blurred) peak and checks that they
 agree within the calibration's 90 % band plus five column-noise sd; exits 1 otherwise.
 
+EXPECT peak_error_over_tolerance 0 1
+
     python examples/film_roundtrip.py [OUT_DIR]
 """
 
@@ -80,6 +82,7 @@ def main(out: Path) -> int:
           ", ".join(f"{k} {v:+.1f} %" for k, v in comp.percent_diff.items()))
     print(f"recovered peak {got:.4f} MPa vs true (blurred) {true_peak:.4f} MPa: "
           f"error {got - true_peak:+.4f}, tolerance {tol:.4f}")
+    print(f"RESULT peak_error_over_tolerance={abs(got - true_peak) / tol:.4f}")
     return 0 if abs(got - true_peak) <= tol else 1
 
 

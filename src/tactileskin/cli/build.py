@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import click
 
@@ -37,9 +38,10 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
 
     t0 = time.perf_counter()
     with console.status("building solids (build123d)..."):
-        from tactileskin.geometry.export import export_parts
+        from tactileskin.geometry.export import check_target, export_parts
         from tactileskin.geometry.parts import build_parts
 
+        check_target(Path(out_dir).absolute())  # refuse a folder of other files before the work
         parts = build_parts(t, indenters=indenter, braille_text=braille_text,
                             braille_standard=braille_standard, molds=not no_molds)
     t1 = time.perf_counter()

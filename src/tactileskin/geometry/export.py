@@ -98,7 +98,7 @@ def _write_part(part: Part, folder: Path, tolerance: float, angular_tolerance: f
     }
 
 
-def _check_target(out: Path) -> None:
+def check_target(out: Path) -> None:
     """Only an empty folder or a previous build (has a manifest) may be replaced."""
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
@@ -111,7 +111,7 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
                  angular_tolerance: float = STL_ANGULAR_TOLERANCE, meta: dict | None = None) -> dict:
     """Write every part to out_dir (STL + STEP + manifest.json) atomically; return the manifest."""
     out = Path(out_dir).absolute()
-    _check_target(out)
+    check_target(out)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ParameterError("parts", names, "unique part names")

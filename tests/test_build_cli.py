@@ -1,0 +1,68 @@
+"""`tactileskin build`, run in-process through tactileskin.cli.main."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tactileskin import params
+from tactileskin.cli import main
+from tactileskin.geometry import braille
+from tactileskin.geometry.fingertip import Fingertip
+
+
+def test_default_build_makes_every_part(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["build", "--out", str(out)]) == 0
+    m = json.loads((out / "manifest.json").read_text())
+    names = [e["name"] for e in m["parts"]]
+    assert names == ["skin", "rigid_base", "mold_lower", "mold_upper",
+                     "indenter_flat", "indenter_curved", "indenter_braille"]
+    assert m["parameters"]["thickness"] == params.load("fingertip")["thickness"]["default"]
+    for e in m["parts"]:
+        assert e["watertight"] and e["is_volume"] and e["volume_mm3"] > 0
+        assert (out / e["stl"]).is_file() and (out / e["step"]).is_file()
+    text = capsys.readouterr().out
+    assert all(n in text for n in names)  # the table lists what was made
+    # a rebuild replaces the previous build in place
+    assert main(["build", "--out", str(out), "--thickness", "2", "--indenter", "none", "--no-molds"]) == 0
+    m2 = json.loads((out / "manifest.json").read_text())
+    assert [e["name"] for e in m2["parts"]] == ["skin", "rigid_base"]
+    assert sorted(p.name for p in out.iterdir()) == ["manifest.json", "rigid_base.step", "rigid_base.stl",
+                                                     "skin.step", "skin.stl"]
+
+
+def test_braille_word_option(tmp_path):
+    out = tmp_path / "w"
+    assert main(["build", "-t", "1", "--out", str(out), "--indenter", "braille", "--braille-text", "Hi",
+                 "--braille-standard", "ada_2010", "--no-molds"]) == 0
+    m = json.loads((out / "manifest.json").read_text())
+    e = {p["name"]: p for p in m["parts"]}["indenter_braille"]
+    assert e["parameters"]["standard"] == "ada_2010"
+    assert e["parameters"]["dots"] == len(braille.dot_centres("Hi", "ada_2010"))
+    # the dots protrude the ADA height below the base plane; the lowest point is the skin top
+    assert e["bbox_min"][1] == pytest.approx(Fingertip.from_params().height, abs=0.005)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--thickness", "9"], ["thickness=9", "[0.5, 5.513] mm"]),
+    (["--thickness", "0.1"], ["thickness=0.1", "valid"]),
+    (["--indenter", "braille", "--braille-text", "a\u00e9"], ["braille_text", "U+00E9"]),
+    (["--indenter", "braille", "--braille-standard", "klingon"], ["braille_standard", "standard_american"]),
+])
+def test_invalid_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys, argv, words):
+    out = tmp_path / "out"
+    assert main(["build", "--out", str(out), *argv]) == 2
+    cap = capsys.readouterr()
+    err = " ".join(cap.err.split())  # rich wraps long lines
+    assert "error:" in err and all(w in err for w in words), err
+    assert "Traceback" not in cap.err + cap.out
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_out_folder_with_other_files_is_refused(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("keep me")
+    assert main(["build", "--out", str(tmp_path), "--indenter", "none", "--no-molds"]) == 2
+    assert "out=" in " ".join(capsys.readouterr().err.split())
+    assert [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
