@@ -23,6 +23,7 @@ from tactileskin.fe.contact import ContactSurface
 
 log = logging.getLogger(__name__)
 
+PENALTY_FACTOR = 20.0  # penalty = factor * modulus / facet size (MPa/mm)
 Law = Callable[[np.ndarray], tuple]  # C (...,3,3) -> (S, D, ok)
 
 
@@ -124,7 +125,7 @@ class Model:
             self.surface = ContactSurface(mesh, self.element, self.boundaries[contact.boundary], m)
             if contact.penalty is None:
                 h = self.surface_size()
-                contact.penalty = 20.0 * stiffness / h
+                contact.penalty = PENALTY_FACTOR * stiffness / h
                 log.debug("contact penalty %.3g MPa/mm (h = %.3g mm)", contact.penalty, h)
 
         # committed state

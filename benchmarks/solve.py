@@ -1,0 +1,63 @@
+"""Solve the 18 paper cases (t = 1, 3, 5 mm x silicone, polyurethane x flat, curved, braille).
+
+Prints, per case: DOFs, increments, Newton iterations, mesh and solve wall time, peak bone
+pressure and where it sits, reaction. Usage:
+
+    .venv/bin/python benchmarks/solve.py [--formulation mixed|displacement] [--only t1-silicone]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import logging
+import time
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+from tactileskin.errors import TactileSkinError
+from tactileskin.fe import solve
+from tactileskin.mesh import build_mesh
+from tactileskin.scene import Scene
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--formulation", default="mixed")
+    ap.add_argument("--only", default="", help="substring of the case label")
+    ap.add_argument("--mesh-size", type=float, default=None)
+    ap.add_argument("-v", action="store_true")
+    a = ap.parse_args()
+    logging.basicConfig(level=logging.INFO if a.v else logging.WARNING)
+    table = Table(title=f"paper cases, {a.formulation} formulation")
+    for c in ("case", "dofs", "incr", "newton", "mesh s", "solve s", "peak MPa", "s_peak mm",
+              "span mm", "reaction N/mm"):
+        table.add_column(c, justify="right")
+    total = time.perf_counter()
+    for t, mat, ind in itertools.product((1.0, 3.0, 5.0), ("silicone", "polyurethane"),
+                                         ("flat", "curved", "braille")):
+        kw = {} if a.mesh_size is None else {"mesh_size": a.mesh_size}
+        sc = Scene(thickness=t, material=mat, indenter=ind, formulation=a.formulation, **kw)
+        if a.only and a.only not in sc.label():
+            continue
+        t0 = time.perf_counter()
+        sm = build_mesh(sc)
+        tm = time.perf_counter() - t0
+        try:
+            r = solve(sc, sm)
+        except TactileSkinError as e:
+            table.add_row(sc.label(), "-", "-", "-", f"{tm:.2f}", "failed", str(e)[:40], "", "", "")
+            continue
+        st = r.stats
+        i = int(np.argmax(r.pressure))
+        table.add_row(sc.label(), str(st["dofs"]), str(st["increments"]), str(st["newton_iterations"]),
+                      f"{tm:.2f}", f"{st['wall_s']:.2f}", f"{r.peak:.4f}", f"{r.s[i]:.2f}",
+                      f"{r.span:.2f}", f"{r.reaction:.4f}")
+    Console().print(table)
+    Console().print(f"total wall time {time.perf_counter() - total:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
