@@ -11,6 +11,8 @@ from tactileskin.cli import main
 from tactileskin.geometry import braille
 from tactileskin.geometry.fingertip import Fingertip
 
+_FT = Fingertip.from_params()
+
 
 def test_default_build_makes_every_part(tmp_path, capsys):
     out = tmp_path / "out"
@@ -46,7 +48,7 @@ def test_braille_word_option(tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--thickness", "9"], ["thickness=9", "[0.5, 5.513] mm"]),
+    (["--thickness", "9"], ["thickness=9", f"[{_FT.thickness_min:g}, {round(_FT.thickness_max, 3):g}] mm"]),
     (["--thickness", "0.1"], ["thickness=0.1", "valid"]),
     (["--indenter", "braille", "--braille-text", "a\u00e9"], ["braille_text", "U+00E9"]),
     (["--indenter", "braille", "--braille-standard", "klingon"], ["braille_standard", "standard_american"]),
