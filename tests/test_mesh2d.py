@@ -205,3 +205,24 @@ def test_order_one_gives_straight_triangles():
     sm = build_mesh(Scene(thickness=3.0, order=1), mesh_size=1.0)
     assert type(sm.mesh).__name__ == "MeshTri1" and sm.min_jacobian() > 0
     assert set(sm.boundaries) == set(BOUNDARIES_2D)
+
+
+@pytest.mark.parametrize("t", [1.0, 5.0])
+def test_quadrilateral_option(t, tmp_path):
+    sm = build_mesh(Scene(thickness=t), mesh_size=COARSE, cell="quad")
+    m, sec = sm.mesh, sm.section
+    assert type(m).__name__ == "MeshQuad2" and set(sm.boundaries) == set(BOUNDARIES_2D)
+    assert sm.min_jacobian() > 0.0
+    # same curved-edge accuracy as the triangles (1e-6, see the default-size test)
+    assert abs(sm.boundary_measure("bone_interface") / sec.interface_length - 1) < 1e-6
+    assert abs(sm.measure() / sec.area() - 1) < 1e-6
+    interior = np.setdiff1d(np.arange(m.nfacets), m.boundary_facets())  # quad9 node order
+    mid = m.doflocs[:, m.dofs.facet_dofs[0, interior]]
+    assert np.abs(mid - m.doflocs[:, m.facets[:, interior]].mean(axis=1)).max() < 1e-12
+    back = meshio.read(sm.write(tmp_path / "q.vtu"))
+    np.testing.assert_array_equal(back.get_cells_type("quad9"), m.dofs.element_dofs.T)
+
+
+def test_quadrilateral_option_is_2d_only():
+    with pytest.raises(ParameterError, match="cell"):
+        build_mesh(Scene(thickness=3.0, dim=3), cell="quad")

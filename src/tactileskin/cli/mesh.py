@@ -12,7 +12,9 @@ from tactileskin.cli._common import scene_from_options, scene_options
 @click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
               help="Mesh file to write: .msh (gmsh 2.2), .vtu (ParaView) or .inp (Abaqus/CalculiX).")
 @click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default: scene).")
-def command(out, order, **scene_kw):
+@click.option("--cell", type=click.Choice(["tri", "quad"]), default="tri", show_default=True,
+              help="2D cell shape (quad: all-quadrilateral, 9-node when order 2).")
+def command(out, order, cell, **scene_kw):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
     from rich.console import Console
     from rich.table import Table
@@ -25,15 +27,15 @@ def command(out, order, **scene_kw):
     scene = scene_from_options(**scene_kw)
     if order is not None:
         scene = scene.replace(order=int(order))
-    sm = build_mesh(scene)
+    sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
 
     table = Table(title=f"skin mesh {scene.label()} (mesh_size {scene.mesh_size:g} mm, "
                         f"refinement {scene.refinement:g})")
     table.add_column("quantity")
     table.add_column("value", justify="right")
-    kind = {2: "P2 triangles", 3: "P2 tetrahedra"}[sm.dim] if sm.order == 2 else \
-        {2: "P1 triangles", 3: "P1 tetrahedra"}[sm.dim]
+    shape = {"tri": {2: "triangles", 3: "tetrahedra"}[sm.dim], "quad": "quadrilaterals"}[sm.cell]
+    kind = f"{'Q' if sm.cell == 'quad' else 'P'}{sm.order} {shape}"
     table.add_row("cells", f"{q['elements']} {kind}")
     table.add_row("nodes (vertices)", f"{q['nodes']} ({q['vertices']})")
     table.add_row("refined size (mm)", f"{sm.sizes['fine']:.4g}")

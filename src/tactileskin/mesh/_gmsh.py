@@ -23,8 +23,10 @@ logger = logging.getLogger(__name__)
 _LOCK = threading.Lock()
 
 # gmsh element type ids
-LINE2, LINE3, TRI3, TRI6, TET4, TET10 = 1, 8, 2, 9, 4, 11
-CELL_TYPE = {(2, 1): TRI3, (2, 2): TRI6, (3, 1): TET4, (3, 2): TET10}
+LINE2, LINE3, TRI3, TRI6, TET4, TET10, QUAD4, QUAD9 = 1, 8, 2, 9, 4, 11, 3, 10
+CELL_TYPE = {(2, 1): TRI3, (2, 2): TRI6, (3, 1): TET4, (3, 2): TET10,
+             (2, 1, "quad"): QUAD4, (2, 2, "quad"): QUAD9}
+NODES = {TRI3: 3, TRI6: 6, TET4: 4, TET10: 10, QUAD4: 4, QUAD9: 9}
 FACET_TYPE = {(2, 1): LINE2, (2, 2): LINE3, (3, 1): TRI3, (3, 2): TRI6}
 # gmsh tetra10 edges: (0,1) (1,2) (0,2) (0,3) (2,3) (1,3); scikit-fem (RefTet.edges):
 # (0,1) (1,2) (0,2) (0,3) (1,3) (2,3) -> swap the last two mid-nodes.
@@ -62,19 +64,21 @@ def session(name: str, params: dict):
                 gmsh.finalize()
 
 
-def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
+def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]], cell: str = "tri"):
     """Read the current gmsh mesh into scikit-fem.
 
     groups: boundary name -> list of gmsh entity tags of dimension dim-1.
+    cell: "tri" (simplices) or "quad" (2D quadrilaterals: MeshQuad1 / 9-node MeshQuad2;
+    gmsh's quad9 order -- vertices, edges (0,1) (1,2) (2,3) (3,0), centre -- is scikit-fem's).
     Returns (mesh, boundaries).
     """
     import skfem
 
     tags, coords, _ = gmsh.model.mesh.getNodes()
     coords = coords.reshape(-1, 3)[:, :dim]
-    etype = CELL_TYPE[(dim, order)]
+    etype = CELL_TYPE[(dim, order, "quad") if cell == "quad" else (dim, order)]
     etags, enodes = gmsh.model.mesh.getElementsByType(etype)
-    nper = {TRI3: 3, TRI6: 6, TET4: 4, TET10: 10}[etype]
+    nper = NODES[etype]
     if len(etags) == 0:
         raise MeshError(f"gmsh produced no {dim}D elements of order {order}")
     # contiguous node numbering 0..N-1 over the nodes the cells use (drops stray nodes)
@@ -92,13 +96,14 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]]):
         conn = conn[:, _TET10_GMSH_TO_SKFEM]
     conn = _orient_positive(points, conn, dim)
 
-    cls = {(2, 1): skfem.MeshTri1, (2, 2): skfem.MeshTri2,
-           (3, 1): skfem.MeshTet1, (3, 2): skfem.MeshTet2}[(dim, order)]
+    cls = {(2, 1): skfem.MeshTri1, (2, 2): skfem.MeshTri2, (3, 1): skfem.MeshTet1,
+           (3, 2): skfem.MeshTet2, (2, 1, "quad"): skfem.MeshQuad1,
+           (2, 2, "quad"): skfem.MeshQuad2}[(dim, order, "quad") if cell == "quad" else (dim, order)]
     # scikit-fem puts vertex nodes first and renumbers them in order of np.unique; the
     # extra rows of t are assigned to its own edge dofs in refdom edge order.
     # sort_t=False: keep gmsh's (positively oriented) vertex order; MeshTri1 would sort it
     mesh = cls(np.ascontiguousarray(points.T), np.ascontiguousarray(conn.T), sort_t=False)
-    nv = dim + 1
+    nv = 4 if cell == "quad" else dim + 1
     vert_orig = np.unique(conn[:, :nv])           # original index of skfem vertex k
     boundaries = {}
     bfacets = mesh.boundary_facets()
@@ -131,13 +136,18 @@ def _nnodes(gmsh_type: int) -> int:
 
 def _orient_positive(points: np.ndarray, conn: np.ndarray, dim: int) -> np.ndarray:
     """Flip cells whose vertex ordering has a negative (straight-sided) Jacobian."""
-    v = points[conn[:, : dim + 1]]
-    J = np.stack([v[:, i + 1] - v[:, 0] for i in range(dim)], axis=-1)
+    quad = conn.shape[1] in (4, 9) and dim == 2
+    v = points[conn[:, : 4 if quad else dim + 1]]
+    cols = [1, 3] if quad else list(range(1, dim + 1))  # quads: the Jacobian at vertex 0
+    J = np.stack([v[:, i] - v[:, 0] for i in cols], axis=-1)
     neg = np.linalg.det(J) < 0
     if not np.any(neg):
         return conn
     conn = conn.copy()
-    if dim == 2:
+    if quad:
+        # reverse the vertex cycle 0 1 2 3 -> 0 3 2 1; edges (0,1)(1,2)(2,3)(3,0) -> old 3 2 1 0
+        perm = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8]) if conn.shape[1] == 9 else np.array([0, 3, 2, 1])
+    elif dim == 2:
         # swap vertices 1<->2; edges (0,1) (1,2) (0,2) -> (0,2) (2,1) (0,1)
         perm = np.array([0, 2, 1, 5, 4, 3]) if conn.shape[1] == 6 else np.array([0, 2, 1])
     else:
@@ -152,6 +162,7 @@ def shape_quality(gmsh, dim: int) -> dict:
     condition number (1 for the equilateral simplex, 0 degenerate, < 0 inverted). gmsh's
     minSJ is identically 1 on straight simplices, so the curving is measured separately
     (skinmesh.jacobian_ratio)."""
-    etags = gmsh.model.mesh.getElementsByType(CELL_TYPE[(dim, 1)])[0]
+    etags = np.concatenate([gmsh.model.mesh.getElementsByType(CELL_TYPE[k])[0]
+                            for k in CELL_TYPE if k[0] == dim and k[1] == 1])
     q = np.asarray(gmsh.model.mesh.getElementQualities(etags, "minSICN"))
     return {"min_sicn": float(q.min()), "mean_sicn": float(q.mean()), "n_sicn_lt_0.2": int(np.sum(q < 0.2))}

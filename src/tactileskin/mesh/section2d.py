@@ -15,6 +15,7 @@ import time
 
 import numpy as np
 
+from tactileskin.errors import ParameterError
 from tactileskin.mesh import _gmsh, sizing
 from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
 
@@ -68,12 +69,19 @@ def add_section_curves(gmsh, section, roi_s: float) -> dict[str, list[int]]:
 
 
 def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
-                       refinement: float | None = None, order: int | None = None) -> SkinMesh:
-    """Mesh the 2D half section of `scene` (P2 triangles with curved edges by default)."""
+                       refinement: float | None = None, order: int | None = None,
+                       cell: str = "tri") -> SkinMesh:
+    """Mesh the 2D half section of `scene` (P2 triangles with curved edges by default).
+
+    cell="quad": all-quadrilateral mesh (gmsh recombination + full-quad subdivision), read
+    as MeshQuad2 (9-node quads with curved edges) or MeshQuad1.
+    """
+    if cell not in ("tri", "quad"):
+        raise ParameterError("cell", cell, "'tri' or 'quad'")
     section = scene.section() if section is None else section
     order = scene.order if order is None else order
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=2)
-    params = {"thickness": section.thickness, "order": order, **plan.as_dict()}
+    params = {"thickness": section.thickness, "order": order, "cell": cell, **plan.as_dict()}
     logger.info("meshing 2D section: %s", params)
     t0 = time.perf_counter()
     with _gmsh.session("section2d", params) as gmsh:
@@ -83,14 +91,19 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
             gmsh.model.addPhysicalGroup(1, tags[name], name=name)
         gmsh.model.addPhysicalGroup(2, tags["surface"], name="skin")
         sizing.apply_fields(gmsh, plan, tags["interface_roi"], dim=2)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: well-shaped triangles
+        if cell == "quad":
+            gmsh.option.setNumber("Mesh.Algorithm", 8)  # Frontal-Delaunay for quads
+            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)  # full-quad: no triangle left
+            gmsh.model.mesh.setRecombine(2, tags["surface"][0])
+        else:
+            gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay: well-shaped triangles
         gmsh.model.mesh.generate(2)
         quality = _gmsh.shape_quality(gmsh, 2)
         if order == 2:
             gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)  # mid-nodes on the true curves
             gmsh.model.mesh.setOrder(2)
         groups = {n: tags[n] for n in ("bone_interface", "outer_surface", "symmetry", "nail_edge")}
-        mesh, boundaries = _gmsh.to_skfem(gmsh, 2, order, groups)
+        mesh, boundaries = _gmsh.to_skfem(gmsh, 2, order, groups, cell=cell)
     quality.update(elements=int(mesh.nelements), nodes=int(mesh.doflocs.shape[1]),
                    vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh),
                    wall_s=time.perf_counter() - t0)

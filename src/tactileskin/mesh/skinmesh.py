@@ -51,6 +51,10 @@ class SkinMesh:
     def order(self) -> int:
         return 2 if type(self.mesh).__name__.endswith("2") else 1
 
+    @property
+    def cell(self) -> str:
+        return "quad" if "Quad" in type(self.mesh).__name__ else "tri"
+
     # --- export ----------------------------------------------------------------------
     def to_meshio(self):
         """meshio.Mesh with the cells, the named boundary facets (cell sets, gmsh physical
@@ -61,8 +65,9 @@ class SkinMesh:
         pts = m.doflocs.T
         if self.dim == 2:
             pts = np.column_stack([pts, np.zeros(len(pts))])
-        cell_nodes = m.dofs.element_dofs[: _cell_nnodes(self.dim, self.order)].T
-        ctype = {(2, 1): "triangle", (2, 2): "triangle6", (3, 1): "tetra", (3, 2): "tetra10"}[(self.dim, self.order)]
+        key = (self.dim, self.order, self.cell)
+        cell_nodes = m.dofs.element_dofs[: _CELL_NODES[key][1]].T
+        ctype = _CELL_NODES[key][0]
         ftype = {(2, 1): "line", (2, 2): "line3", (3, 1): "triangle", (3, 2): "triangle6"}[(self.dim, self.order)]
         cells = [(ctype, cell_nodes)]
         phys = [np.zeros(len(cell_nodes), dtype=int)]
@@ -141,8 +146,11 @@ def jacobian_ratio(mesh) -> float:
     return float(np.min(d.min(axis=1) / d.max(axis=1)))
 
 
-def _cell_nnodes(dim: int, order: int) -> int:
-    return {(2, 1): 3, (2, 2): 6, (3, 1): 4, (3, 2): 10}[(dim, order)]
+# meshio cell type and node count; scikit-fem's element_dofs start with these nodes in
+# meshio's order (vertices, edges in refdom order, then the quad centre)
+_CELL_NODES = {(2, 1, "tri"): ("triangle", 3), (2, 2, "tri"): ("triangle6", 6),
+               (3, 1, "tri"): ("tetra", 4), (3, 2, "tri"): ("tetra10", 10),
+               (2, 1, "quad"): ("quad", 4), (2, 2, "quad"): ("quad9", 9)}
 
 
 def facet_nodes(m, facets: np.ndarray, dim: int, order: int) -> np.ndarray:
