@@ -329,12 +329,13 @@ def test_failed_build_leaves_no_files(builds, tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 
 
-def test_refuses_to_replace_a_folder_with_other_files(tmp_path):
+def test_refuses_to_replace_a_folder_with_other_files(builds, tmp_path):
+    ps = [builds(1.0).parts["skin"]]
     (tmp_path / "keep.txt").write_text("mine")
-    ps = parts.build_parts(2.0, indenters="none", molds=False)
+    (tmp_path / "manifest.json").write_text('{"kind": "somebody else"}')  # e.g. another tool's output
     with pytest.raises(ParameterError, match="out"):
         export.export_parts(ps, tmp_path)
-    assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt", "manifest.json"]
 
 
 def test_kernel_failure_names_the_parameters(monkeypatch):

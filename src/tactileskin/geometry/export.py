@@ -26,6 +26,7 @@ from tactileskin.geometry.solids import _fmt, occ_guard
 log = logging.getLogger(__name__)
 
 MANIFEST = "manifest.json"
+MANIFEST_KIND = "tactileskin.parts"  # marks a folder this module wrote (and may replace)
 
 # Tessellation (absolute, unlike build123d.export_stl whose deflection is relative to each
 # edge's size): chordal deviation 5 um, angular deflection 0.1 rad. Mesh vertices lie on the
@@ -98,12 +99,19 @@ def _write_part(part: Part, folder: Path, tolerance: float, angular_tolerance: f
     }
 
 
+def _is_previous_build(out: Path) -> bool:
+    try:
+        return json.loads((out / MANIFEST).read_text()).get("kind") == MANIFEST_KIND
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def check_target(out: Path) -> None:
-    """Only an empty folder or a previous build (has a manifest) may be replaced."""
+    """Only a new or empty folder, or a previous parts build (our manifest), may be replaced."""
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
-    if out.is_dir() and any(out.iterdir()) and not (out / MANIFEST).is_file():
-        raise ParameterError("out", str(out), "a new or empty folder, or a previous build's folder (with manifest.json)",
+    if out.is_dir() and any(out.iterdir()) and not _is_previous_build(out):
+        raise ParameterError("out", str(out), "a new or empty folder, or the folder of a previous `tactileskin build`",
                              hint="refusing to replace a folder holding other files")
 
 
@@ -125,6 +133,7 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
             entries.append(_write_part(part, tmp, tolerance, angular_tolerance))
             log.info("exported %s in %.2f s", part.name, time.perf_counter() - t1)
         manifest = {
+            "kind": MANIFEST_KIND,
             "units": "mm",
             "stl_tolerance_mm": tolerance,
             "stl_angular_tolerance_rad": angular_tolerance,
