@@ -116,7 +116,15 @@ def test_braille_text_without_z_symmetry_meshes_full_length(caplog):
 
 def test_export_round_trip_3d(slab_t3, tmp_path):
     sm = slab_t3
-    for suffix in (".msh", ".vtu"):
+    for suffix in (".msh", ".vtu", ".inp"):
         back = meshio.read(sm.write(tmp_path / f"slab{suffix}"))
         np.testing.assert_allclose(back.points, sm.mesh.doflocs.T, atol=1e-9)
         np.testing.assert_array_equal(back.get_cells_type("tetra10"), sm.mesh.dofs.element_dofs.T)
+
+
+def test_absurd_3d_request_is_refused_before_gmsh():
+    from tactileskin.errors import ParameterError
+
+    # refined size 0.02 mm over a 10 mm slab: ~1e9 tetrahedra; must fail fast, naming the knob
+    with pytest.raises(ParameterError, match=r"mesh_size.*5e\+06 cells in 3D"):
+        build_mesh(Scene(thickness=5.0, dim=3), mesh_size=0.1, refinement=5.0)

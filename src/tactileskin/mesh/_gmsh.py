@@ -57,6 +57,9 @@ def session(name: str, params: dict):
                 raise MeshError(f"gmsh failed to mesh {name} with {params}: {e}"
                                 + (f" (gmsh log: {' | '.join(log)})" if log else "")) from e
             finally:
+                for msg in gmsh.logger.get():
+                    if msg.startswith("Warning"):
+                        logger.warning("gmsh (%s): %s", name, msg)
                 gmsh.logger.stop()
                 gmsh.model.remove()
         finally:

@@ -17,7 +17,7 @@ logger = logging.getLogger(__name__)
 BOUNDARIES_2D = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
 BOUNDARIES_3D = BOUNDARIES_2D + ("end_front", "end_back")
 # meshio format names by suffix
-FORMATS = {".msh": "gmsh", ".vtu": "vtu", ".inp": "abaqus"}
+FORMATS = {".msh": "gmsh", ".vtu": "vtu", ".inp": "abaqus"}  # .inp: own writer (abaqus.py)
 
 
 @dataclass
@@ -94,18 +94,21 @@ class SkinMesh:
         if fmt is None:
             raise ParameterError("path", str(path), "a file name ending in " + ", ".join(FORMATS))
         out = self.to_meshio()
-        if fmt == "abaqus":
-            out.cell_data = {}  # Abaqus keeps the groups as ELSET/NSET; no per-cell arrays
         if fmt == "vtu":
             out.cell_sets, out.point_sets, out.field_data = {}, {}, {}
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
         os.close(fd)
         try:
-            kw = {"file_format": fmt}
-            if fmt == "gmsh":
-                kw.update(file_format="gmsh22", binary=False)
-            out.write(tmp, **kw)
+            if fmt == "abaqus":
+                from tactileskin.mesh.abaqus import inp_text
+
+                Path(tmp).write_text(inp_text(out.points[:, : self.dim], out.cells[0].type,
+                                              out.cells[0].data, out.point_sets))
+            elif fmt == "gmsh":
+                out.write(tmp, file_format="gmsh22", binary=False)
+            else:
+                out.write(tmp, file_format=fmt)
             os.replace(tmp, path)
         except Exception as e:
             Path(tmp).unlink(missing_ok=True)
