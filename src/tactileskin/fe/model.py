@@ -43,14 +43,26 @@ def scalar_element(mesh, order: int):
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed displacement component(s) on a named boundary; value(t) or a constant."""
+    """Prescribed displacement component(s) on a named boundary.
+
+    value: a constant, value(t), or (with `field=True`) value(t, X) -> (n, len(components))
+    from the reference coordinates X (n, m) of the boundary nodes.
+    """
 
     boundary: str
     components: tuple[int, ...]
-    value: float | Callable[[float], float] = 0.0
+    value: float | Callable = 0.0
+    field: bool = False
 
-    def at(self, t: float) -> float:
-        return float(self.value(t)) if callable(self.value) else float(self.value)
+    def at(self, t: float, X: np.ndarray) -> np.ndarray:
+        n, k = len(X), len(self.components)
+        if self.field:
+            v = np.asarray(self.value(t, X), float)
+        elif callable(self.value):
+            v = float(self.value(t))
+        else:
+            v = float(self.value)
+        return np.broadcast_to(v, (n, k)).ravel()
 
 
 @dataclass
@@ -110,7 +122,7 @@ class Model:
                 raise ParameterError("boundary", bc.boundary, "one of " + ", ".join(sorted(self.boundaries)))
             sd = self.facet_scalar_dofs(bc.boundary)
             dofs = (sd[:, None] * m + np.asarray(bc.components)[None, :]).ravel()
-            self._bc_groups.append((bc, dofs))
+            self._bc_groups.append((bc, dofs, b.doflocs[:, sd].T))
             fixed.append(dofs)
         self.fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
         self.free = np.setdiff1d(np.arange(self.ndof), self.fixed)
@@ -147,9 +159,9 @@ class Model:
 
     def prescribed(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         dofs, vals = [], []
-        for bc, d in self._bc_groups:
+        for bc, d, X in self._bc_groups:
             dofs.append(d)
-            vals.append(np.full(len(d), bc.at(t)))
+            vals.append(bc.at(t, X))
         if not dofs:
             return np.zeros(0, int), np.zeros(0)
         return np.concatenate(dofs), np.concatenate(vals)

@@ -18,7 +18,7 @@ def reaction(model: Model, ev: Evaluation, names=None) -> np.ndarray:
     """Resultant force (m,) that the Dirichlet boundaries (all, or those named) exert on the body."""
     dofs = model.fixed
     if names is not None:
-        dofs = np.unique(np.concatenate([d for bc, d in model._bc_groups if bc.boundary in names]))
+        dofs = np.unique(np.concatenate([d for bc, d, _ in model._bc_groups if bc.boundary in names]))
     comp = dofs % model.m
     return np.bincount(comp, weights=ev.fint[dofs], minlength=model.m)
 
