@@ -21,7 +21,7 @@ import trimesh
 
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.parts import Part
-from tactileskin.geometry.solids import _fmt, occ_guard
+from tactileskin.geometry.solids import format_params, occ_guard
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +62,7 @@ def check_stl(path: Path, what: str = "", parameters: dict | None = None) -> tri
     if not mesh.is_volume:
         raise CadError(f"{what or path.name}: exported STL is not a valid volume (watertight="
                        f"{mesh.is_watertight}, winding_consistent={mesh.is_winding_consistent}, "
-                       f"volume={mesh.volume:g} mm^3) for {_fmt(parameters or {})}")
+                       f"volume={mesh.volume:g} mm^3) for {format_params(parameters or {})}")
     return mesh
 
 
@@ -80,7 +80,7 @@ def _write_part(part: Part, folder: Path, tolerance: float, angular_tolerance: f
         ok_stl = write_stl(part.shape, stl, tolerance, angular_tolerance)
         ok_step = bd.export_step(part.shape, step)
     if not (ok_stl and ok_step and stl.is_file() and step.is_file()):
-        raise CadError(f"exporting {part.name} failed (stl={ok_stl}, step={ok_step}) for {_fmt(part.parameters)}")
+        raise CadError(f"exporting {part.name} failed (stl={ok_stl}, step={ok_step}) for {format_params(part.parameters)}")
     mesh = check_stl(stl, part.name, part.parameters)
     lo, hi = mesh.bounds
     return {

@@ -23,7 +23,7 @@ import build123d as bd
 from tactileskin import params
 from tactileskin.errors import ParameterError
 from tactileskin.geometry.fingertip import Section
-from tactileskin.geometry.solids import _box, check_solid, contour_solid, occ_guard
+from tactileskin.geometry.solids import box, check_solid, contour_solid, occ_guard
 
 log = logging.getLogger(__name__)
 
@@ -56,8 +56,9 @@ class MoldParams:
         for name in ("wall", "pin_diameter", "pin_height", "pour_diameter", "vent_diameter", "pin_flange"):
             if not getattr(self, name) > 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), "> 0 mm")
-        if self.pin_clearance < 0.0 or self.pin_depth_clearance < 0.0:
-            raise ParameterError("molds.pin_clearance", self.pin_clearance, ">= 0 mm")
+        for name in ("pin_clearance", "pin_depth_clearance"):
+            if not getattr(self, name) >= 0.0:
+                raise ParameterError(f"molds.{name}", getattr(self, name), ">= 0 mm")
         roof = ft.height + self.wall
         if self.pin_height + self.pin_depth_clearance >= roof:
             raise ParameterError("molds.pins.height", self.pin_height,
@@ -108,7 +109,7 @@ def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.
     with occ_guard("building the casting mold", **p):
         cavity = contour_solid(sec)
         pins = [_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
-        lower = _box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
+        lower = box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
         # the upper half: pin holes, a sprue at the ridge's middle and a vent near each end;
         # the holes start at the split plane (inside the cavity) so they open into it
         holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance,
@@ -116,5 +117,5 @@ def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.
         zv = 0.5 * ft.sample_length - mp.vent_inset
         holes += [_vertical_cylinder(0.0, 0.0, 0.0, lay.roof + 1.0, mp.pour_diameter)]
         holes += [_vertical_cylinder(0.0, s * zv, 0.0, lay.roof + 1.0, mp.vent_diameter) for s in (-1, 1)]
-        upper = _box(-A, A, 0.0, lay.roof, -Z, Z).cut(cavity, *holes).clean()
+        upper = box(-A, A, 0.0, lay.roof, -Z, Z).cut(cavity, *holes).clean()
     return check_solid(lower, "mold lower half", **p), check_solid(upper, "mold upper half", **p)

@@ -90,8 +90,12 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
                             braille_standard=braille_standard, sample_length=ft.sample_length)
         ip = dict(kind=kind, y0=ind.y0, width=ind.width, length=ind.length,
                   stem_diameter=ind.stem_diameter, stem_length=ind.stem_length)
-        desc = {"flat": "flat plate indenter", "curved": f"convex indenter, R = {getattr(ind, 'radius', 0):g} mm"}.get(kind)
-        if kind == "braille":
+        if kind == "flat":
+            desc = "flat plate indenter"
+        elif kind == "curved":
+            desc = f"convex indenter, R = {ind.radius:g} mm"
+            ip.update(radius=ind.radius)
+        else:
             ip.update(text=braille_text, standard=std.name, dots=int(len(ind.dots)), base_diameter=std.base_diameter,
                       height=std.height, dot_pitch=std.dot_pitch, cell_pitch=std.cell_pitch, line_pitch=std.line_pitch)
             desc = f"Braille indenter {braille_text!r} ({std.name}, {len(ind.dots)} dots)" if braille_text \

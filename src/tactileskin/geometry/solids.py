@@ -45,10 +45,10 @@ def occ_guard(what: str, **parameters):
     except TactileSkinError:
         raise
     except Exception as e:  # OCC raises StdFail_NotDone, RuntimeError, ValueError, ...
-        raise CadError(f"{what} failed for {_fmt(parameters)}: {type(e).__name__}: {e}") from e
+        raise CadError(f"{what} failed for {format_params(parameters)}: {type(e).__name__}: {e}") from e
 
 
-def _fmt(parameters: dict) -> str:
+def format_params(parameters: dict) -> str:
     return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v!r}" for k, v in parameters.items()) or "defaults"
 
 
@@ -57,11 +57,11 @@ def check_solid(shape, what: str, **parameters) -> bd.Solid:
     with occ_guard(f"checking {what}", **parameters):
         solids = shape.solids() if not isinstance(shape, bd.Solid) else [shape]
         if len(solids) != 1:
-            raise CadError(f"{what}: expected one solid, got {len(solids)} for {_fmt(parameters)}")
+            raise CadError(f"{what}: expected one solid, got {len(solids)} for {format_params(parameters)}")
         s = solids[0]
         ok, vol = s.is_valid, s.volume
     if not ok or not (vol > 0.0 and math.isfinite(vol)):
-        raise CadError(f"{what}: invalid solid (valid={ok}, volume={vol:g} mm^3) for {_fmt(parameters)}")
+        raise CadError(f"{what}: invalid solid (valid={ok}, volume={vol:g} mm^3) for {format_params(parameters)}")
     return s
 
 
@@ -166,7 +166,7 @@ def _single(result):
     return result
 
 
-def _box(x0, x1, y0, y1, z0, z1) -> bd.Solid:
+def box(x0, x1, y0, y1, z0, z1) -> bd.Solid:
     return bd.Solid.make_box(x1 - x0, y1 - y0, z1 - z0, plane=bd.Plane((x0, y0, z0), x_dir=(1, 0, 0), z_dir=(0, 0, 1)))
 
 
@@ -183,7 +183,7 @@ def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) 
                     if e.geom_type == bd.GeomType.CIRCLE and abs(e.radius - r) < 1e-6
                     and abs(e.center().Y - y_back) < 1e-6]
             if len(root) != 1:
-                raise CadError(f"{what}: found {len(root)} stem root edges, expected 1 for {_fmt(p)}")
+                raise CadError(f"{what}: found {len(root)} stem root edges, expected 1 for {format_params(p)}")
             solid = solid.fillet(fillet, root)
     return check_solid(solid, what, **p)
 
@@ -203,7 +203,7 @@ def _flat(ind: FlatIndenter) -> bd.Solid:
     w, L, y0 = ind.width, ind.length, ind.y0
     p = dict(kind="flat", width=w, length=L, thickness=ind.thickness)
     with occ_guard("building the flat indenter plate", **p):
-        plate = _box(-w / 2, w / 2, y0, y0 + ind.thickness, -L / 2, L / 2)
+        plate = box(-w / 2, w / 2, y0, y0 + ind.thickness, -L / 2, L / 2)
     return _add_stem(plate, ind, y0 + ind.thickness, "flat indenter", p)
 
 
@@ -212,7 +212,7 @@ def _curved(ind: CurvedIndenter) -> bd.Solid:
     y_back = y0 + ind.sagitta + ind.back_thickness
     p = dict(kind="curved", radius=R, chord_width=w, length=L, back_thickness=ind.back_thickness)
     with occ_guard("building the curved indenter", **p):
-        block = _box(-w / 2, w / 2, y0, y_back, -L / 2, L / 2)
+        block = box(-w / 2, w / 2, y0, y_back, -L / 2, L / 2)
         # the block top (y0 + sagitta + back) stays below the axis only if back < R - sagitta;
         # then block ∩ cylinder is exactly the arc face under a flat back
         if y_back >= y0 + R:
@@ -234,9 +234,9 @@ def _braille(ind: BrailleIndenter) -> bd.Solid:
     y_back = yb + ind.plate_thickness
     if yc + R > y_back:
         raise CadError(f"braille indenter: plate_thickness={ind.plate_thickness:g} mm is thinner than the "
-                       f"dot sphere above the base plane ({yc + R - yb:g} mm) for {_fmt(p)}")
+                       f"dot sphere above the base plane ({yc + R - yb:g} mm) for {format_params(p)}")
     with occ_guard("building the Braille indenter", **p):
-        plate = _box(-w / 2, w / 2, yb, y_back, -L / 2, L / 2)
+        plate = box(-w / 2, w / 2, yb, y_back, -L / 2, L / 2)
         # Whole spheres fused with the plate: the part above the base plane lies inside the
         # plate, so the union is the plate plus exact spherical caps. The sphere axis is along
         # z: its poles (degenerate points that OCC meshes into a zero-area facet, breaking the
