@@ -21,7 +21,7 @@ def test_user_error_is_one_line_without_traceback(capsys, tmp_path):
     rc = main(["sweep", "--thickness", "9", "--out", str(tmp_path / "o"), "--serial"])
     err = capsys.readouterr().err
     assert rc == 2
-    assert "thickness" in err and "[0.5, 5.513]" in err and "Traceback" not in err
+    assert "thickness" in err and "[0.5, 5.512]" in err and "Traceback" not in err
     assert not (tmp_path / "o").exists()  # nothing written for a rejected request
 
 

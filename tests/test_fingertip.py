@@ -66,7 +66,7 @@ def test_invalid_thickness_names_parameter_and_range(ft, t):
     with pytest.raises(ParameterError) as e:
         ft.section(t)
     msg = str(e.value)
-    assert "thickness" in msg and "[0.5, 5.513]" in msg
+    assert "thickness" in msg and "[0.5, 5.512]" in msg
 
 
 def test_s_out_of_range(ft):

@@ -74,7 +74,9 @@ class Fingertip:
         return self.max_fraction_of_min_radius * self.min_radius_of_curvature
 
     def check_thickness(self, t: float) -> float:
-        return check_range("thickness", t, self.thickness_min, round(self.thickness_max, 3), unit="mm")
+        # round the bound down so the stated range never admits a value beyond thickness_max
+        return check_range("thickness", t, self.thickness_min, math.floor(self.thickness_max * 1000) / 1000,
+                           unit="mm")
 
     def section(self, thickness: float) -> "Section":
         return Section(self, self.check_thickness(thickness))
