@@ -121,6 +121,8 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]], cell: str
                     continue
                 nper_f = _nnodes(ty)
                 verts = node_of_tag[nodes.astype(np.int64)].reshape(-1, nper_f)[:, :dim]
+                if np.any(verts < 0):
+                    raise MeshError(f"boundary '{name}': gmsh facet nodes that no cell uses")
                 verts = np.searchsorted(vert_orig, verts)
                 for key in np.sort(verts, axis=1).tolist():
                     f = fkeys.get(tuple(key))
