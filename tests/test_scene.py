@@ -55,3 +55,12 @@ def test_unknown_field_in_toml(tmp_path):
     p.write_text("thicknes = 2.0\n")
     with pytest.raises(ParameterError, match="scene field"):
         Scene.from_toml(p)
+
+
+def test_mesh_defaults_follow_dimension():
+    from tactileskin.scene import DEFAULT_MESH
+
+    assert (Scene().mesh_size, Scene().refinement) == DEFAULT_MESH[2]
+    assert (Scene(dim=3).mesh_size, Scene(dim=3).refinement) == DEFAULT_MESH[3]
+    assert Scene().replace(dim=3) == Scene(dim=3)            # defaults re-derived
+    assert Scene(mesh_size=0.4).replace(dim=3).mesh_size == 0.4  # explicit choices kept

@@ -19,6 +19,11 @@ from tactileskin.errors import ParameterError, check_range
 SCHEMA_VERSION = 1  # bump when a field's meaning changes, so cached results are not reused
 
 
+# Element size and refinement defaults per dimension: 0.25 mm in 2D resolves the bone
+# pressure (benchmarks/speed_vs_error.py); the same size in 3D would be ~1e6 P2 tetrahedra.
+DEFAULT_MESH = {2: (0.25, 3.0), 3: (0.6, 2.0)}
+
+
 class IndenterKind(str, Enum):
     FLAT = "flat"
     CURVED = "curved"
@@ -49,8 +54,8 @@ class Scene:
     rate: float = 1.0                      # indentation rate (mm/s)
     dim: int = 2                           # 2: plane-strain half section; 3: extruded slab
     order: int = 2                         # element order
-    mesh_size: float = 0.25                # global element size (mm)
-    refinement: float = 3.0                # size ratio: global / refined (contact and bone zones)
+    mesh_size: float | None = None         # global element size (mm); None: DEFAULT_MESH[dim]
+    refinement: float | None = None        # size ratio global / refined (contact, bone); None: default
     formulation: Formulation = Formulation.MIXED
     viscoelastic: bool = True
     fingertip: tuple[tuple[str, float], ...] = field(default_factory=tuple)  # overrides of fingertip.toml
@@ -71,8 +76,11 @@ class Scene:
             raise ParameterError("dim", self.dim, "2 or 3")
         if self.order not in (1, 2):
             raise ParameterError("order", self.order, "1 or 2")
-        set_("mesh_size", check_range("mesh_size", self.mesh_size, 0.01, 5.0, unit="mm"))
-        set_("refinement", check_range("refinement", self.refinement, 1.0, 20.0))
+        size0, ref0 = DEFAULT_MESH[self.dim]
+        set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
+                                      0.01, 5.0, unit="mm"))
+        set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
+                                       1.0, 20.0))
         if not isinstance(self.material, str) or not self.material:
             raise ParameterError("material", self.material, "a material preset name")
         if self.indenter is IndenterKind.BRAILLE:
@@ -102,6 +110,14 @@ class Scene:
         return self.fingertip_model().section(self.thickness)
 
     def replace(self, **changes) -> "Scene":
+        """A changed copy. Changing `dim` re-derives mesh defaults that were left at default."""
+        new_dim = changes.get("dim", self.dim)
+        if new_dim != self.dim and new_dim in DEFAULT_MESH:
+            size0, ref0 = DEFAULT_MESH.get(self.dim, (None, None))
+            if "mesh_size" not in changes and self.mesh_size == size0:
+                changes["mesh_size"] = None
+            if "refinement" not in changes and self.refinement == ref0:
+                changes["refinement"] = None
         return dataclasses.replace(self, **changes)
 
     # --- serialisation -------------------------------------------------------------------
