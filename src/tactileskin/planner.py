@@ -1,0 +1,298 @@
+"""Scene planner: the cheapest model that answers a scene within a tolerance, and why.
+
+`plan(scene, tolerance=0.01) -> Plan`. The plan's `scene` is what to solve; `choices`
+say, one model aspect at a time, what was chosen, why, and what it costs in relative error
+of the bone-pressure peak (0 for exact reductions, a bound or a measured value otherwise,
+None where nothing is known). The costs of the simplifications it accepts add up to at
+most `tolerance` (the discretisation error is not part of the plan: see
+docs/speed_vs_error.md for the quality presets).
+
+Aspects:
+
+- symmetry: the solver models the half x >= 0 (2D section, 3D slab) and, in 3D, the
+  quarter z >= 0 when the indenter is mirror-symmetric about z = 0. Exact for indenters
+  symmetric about the plane(s); for an asymmetric Braille text the half model is an
+  approximation the solver cannot avoid (no full model exists), and the plan says so.
+- dimension: plane strain (2D) is exact for an indenter uniform along the finger (flat
+  plate, cylinder) on the paper's idealisation of a long finger. Braille dots are not:
+  the exact model is the 3D slab; the 2D model treats the dot row as a ridge (as the
+  paper does), whose difference to 3D is stated where it has been measured
+  (`MEASURED_RIDGE_VS_DOTS`) and accepted only when below the tolerance.
+- truncation: the skin far from contact carries negligible pressure (the paper reports
+  P within 6 mm of s = 0). The section is truncated by moving its clamped end (the nail
+  edge, `fingertip.nail_angle_deg`) so that the bone interface keeps `WINDOW_S` plus a
+  margin. The cost is measured: `check_truncation` solves the truncated and the full
+  section on a coarse mesh and compares P(s) on s <= 6 mm. Without a measurement
+  (`verify=False` and no entry in `MEASURED_TRUNCATION`) the plan does not truncate.
+- viscoelasticity: QLV gives S(T) = int_0^T g(T - s) dS0(s). For a stress that grows
+  monotonically during loading, g(T - s) >= g(T) and so
+  (1 - g(T)) S0(T) >= S0(T) - S(T) >= 0: the relaxed fraction is at most
+  `viscoelastic_bound = 1 - g(T)` with T = depth / rate the loading time. The elastic
+  model is used only when that bound is within the tolerance left.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, check_range
+from tactileskin.scene import IndenterKind, Scene
+
+log = logging.getLogger(__name__)
+
+WINDOW_S = 6.0          # mm: bone-pressure window of the paper (s <= 6 mm)
+TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin thickness)
+
+# Measured relative differences of the peak bone pressure, 2D ridge versus 3D dots, keyed by
+# (thickness, material): filled from docs/hard_cases.md measurements (coarse meshes).
+MEASURED_RIDGE_VS_DOTS: dict[tuple[float, str], dict] = {}
+
+# Measured truncation errors (relative L2 of P(s) on s <= 6 mm, relative to the peak; and
+# the relative peak change), keyed by (thickness, material, indenter), from
+# `check_truncation` on coarse meshes (benchmarks/hard_cases.py --truncation).
+MEASURED_TRUNCATION: dict[tuple[float, str, str], dict] = {}
+
+
+@dataclass(frozen=True)
+class Choice:
+    aspect: str            # symmetry | dimension | truncation | viscoelasticity
+    decision: str          # short text of what the plan does
+    reason: str
+    cost: float | None     # relative peak error it costs (0: exact; None: unknown)
+    basis: str = "exact"   # exact | bound | measured | unknown
+
+    def __str__(self) -> str:
+        c = "unknown" if self.cost is None else f"{self.cost:.2%}"
+        return f"{self.aspect}: {self.decision} (cost {c}, {self.basis}) - {self.reason}"
+
+
+@dataclass(frozen=True)
+class Plan:
+    requested: Scene
+    scene: Scene                       # the model to solve
+    tolerance: float
+    choices: tuple[Choice, ...] = field(default_factory=tuple)
+
+    @property
+    def expected_error(self) -> float | None:
+        """Sum of the costs of the accepted simplifications (None if one is unknown)."""
+        costs = [c.cost for c in self.choices]
+        return None if any(c is None for c in costs) else float(sum(costs))
+
+    def choice(self, aspect: str) -> Choice:
+        for c in self.choices:
+            if c.aspect == aspect:
+                return c
+        raise ParameterError("aspect", aspect, ", ".join(c.aspect for c in self.choices))
+
+    def describe(self) -> str:
+        e = self.expected_error
+        head = (f"plan for {self.requested.label()} (tolerance {self.tolerance:.2%}): solve "
+                f"{self.scene.label()}, expected model error "
+                f"{'unknown' if e is None else format(e, '.2%')}")
+        return "\n".join([head] + ["  - " + str(c) for c in self.choices])
+
+
+# --- individual estimates (pure) ----------------------------------------------------------
+
+def viscoelastic_bound(scene: Scene) -> float:
+    """1 - g(T), T = loading time: upper bound of the relative stress relaxed by the end of a
+    monotone loading (see the module docstring). 0 for an elastic material."""
+    from tactileskin.materials import get_material
+
+    prony = get_material(scene.material).prony
+    if prony is None or prony.n_terms == 0:
+        return 0.0
+    return float(1.0 - prony.relaxation(scene.duration))
+
+
+def _dots(scene: Scene) -> np.ndarray:
+    from tactileskin.geometry import braille
+
+    return braille.dot_centres(scene.braille_text, braille.get_standard(scene.braille_standard))
+
+
+def _mirror_symmetric(xz: np.ndarray, axis: int) -> bool:
+    m = xz.copy()
+    m[:, axis] *= -1.0
+    key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
+    return key(m) == key(xz)
+
+
+def symmetric(scene: Scene) -> tuple[bool, bool]:
+    """(about x = 0, about z = 0) mirror symmetry of the indenter."""
+    if scene.indenter is not IndenterKind.BRAILLE:
+        return True, True
+    xz = _dots(scene)
+    return _mirror_symmetric(xz, 0), _mirror_symmetric(xz, 1)
+
+
+def truncated_scene(scene: Scene, keep_s: float | None = None) -> Scene | None:
+    """The scene with its section ending (clamped, as at the nail) where the bone interface
+    reaches s = keep_s (default WINDOW_S + TRUNCATION_MARGIN + thickness); None if the
+    section is not longer than that (nothing to cut)."""
+    keep = WINDOW_S + TRUNCATION_MARGIN + scene.thickness if keep_s is None else keep_s
+    keep = check_range("keep_s", keep, 0.0, None, lo_open=True, unit="mm")
+    section = scene.section()
+    if keep >= section.interface_length - 0.5:
+        return None
+    x, y = section.point_at_s(keep)
+    angle = math.degrees(math.atan2(float(x), float(y)))  # polar angle from +y (ellipse centre)
+    ft = dict(scene.fingertip)
+    ft["nail_angle_deg"] = round(angle, 6)
+    return scene.replace(fingertip=ft)
+
+
+def profile_difference(a, b, window: float = WINDOW_S) -> dict:
+    """Compare two Results on s <= window: relative L2 (RMS over the window, divided by the
+    peak of b) and relative peak difference (b is the reference)."""
+    hi = min(window, a.s[-1], b.s[-1])
+    x = np.linspace(0.0, hi, 400)
+    pa = np.interp(x, a.s, a.pressure)
+    pb = np.interp(x, b.s, b.pressure)
+    ref = float(np.max(pb))
+    if not ref > 0:
+        raise ParameterError("reference peak", ref, "> 0 MPa")
+    return {"l2": float(np.sqrt(np.trapezoid((pa - pb) ** 2, x) / hi) / ref),
+            "peak": float(abs(np.max(pa) - ref) / ref)}
+
+
+def check_truncation(scene: Scene, *, mesh_size: float = 1.0, refinement: float = 2.0) -> dict:
+    """Solve the full and the truncated section at a coarse mesh; return the truncated
+    scene's keep length and the relative L2 and peak differences on s <= WINDOW_S."""
+    from tactileskin.fe import solve
+
+    cut = truncated_scene(scene)
+    if cut is None:
+        return {"available": False, "l2": 0.0, "peak": 0.0}
+    coarse = dict(mesh_size=mesh_size, refinement=refinement)
+    full = solve(scene.replace(**coarse))
+    part = solve(cut.replace(**coarse))
+    d = profile_difference(part, full)
+    d.update(available=True, keep_s=float(cut.section().interface_length),
+             full_s=float(scene.section().interface_length),
+             wall_full=full.stats["wall_s"], wall_truncated=part.stats["wall_s"])
+    return d
+
+
+# --- the plan -----------------------------------------------------------------------------
+
+def plan(scene: Scene, tolerance: float = 0.01, *, braille: str = "dots", verify: bool = False) -> Plan:
+    """Choose the cheapest model of `scene` whose simplifications cost at most `tolerance`
+    (relative peak bone pressure). braille: 'dots' (the real indenter: 3D unless the
+    measured ridge difference fits the tolerance) or 'ridge' (the paper's 2D model, cost
+    stated). verify: run `check_truncation` when no measurement is stored (two coarse
+    solves)."""
+    tolerance = check_range("tolerance", tolerance, 0.0, 1.0, lo_open=True)
+    if braille not in ("dots", "ridge"):
+        raise ParameterError("braille", braille, "'dots' or 'ridge'")
+    budget = tolerance
+    choices: list[Choice] = []
+    out = scene
+
+    # symmetry ---------------------------------------------------------------------------
+    sx, sz = symmetric(scene)
+    if sx:
+        choices.append(Choice("symmetry", "half model (x >= 0)" + (", quarter in 3D (z >= 0)" if sz else ""),
+                              "the indenter is mirror-symmetric about x = 0"
+                              + (" and z = 0" if sz else ""), 0.0))
+    else:
+        choices.append(Choice("symmetry", "half model (x >= 0), the only model the solver has",
+                              f"the Braille text {scene.braille_text!r} is not symmetric about x = 0: "
+                              "the half model mirrors it; no full model is available", None, "unknown"))
+
+    # dimension --------------------------------------------------------------------------
+    if scene.indenter is not IndenterKind.BRAILLE:
+        if scene.dim == 3:
+            out = out.replace(dim=2)
+        choices.append(Choice("dimension", "2D plane strain",
+                              f"the {scene.indenter.value} indenter is uniform along the finger", 0.0))
+    else:
+        meas = MEASURED_RIDGE_VS_DOTS.get((float(scene.thickness), scene.material))
+        if braille == "ridge":
+            out = out.replace(dim=2)
+            cost = None if meas is None else meas["peak"]
+            choices.append(Choice("dimension", "2D plane strain, dot row as a ridge (the paper's model)",
+                                  "asked for the ridge model; " + (
+                                      "2D vs 3D difference not measured for this thickness and material"
+                                      if meas is None else f"measured 2D vs 3D: {_meas_text(meas)}"),
+                                  cost, "unknown" if meas is None else "measured"))
+        elif meas is not None and meas["peak"] <= budget:
+            out = out.replace(dim=2)
+            choices.append(Choice("dimension", "2D plane strain, dot row as a ridge",
+                                  f"measured 2D vs 3D difference within tolerance: {_meas_text(meas)}",
+                                  meas["peak"], "measured"))
+        else:
+            out = out.replace(dim=3)
+            why = ("2D vs 3D difference not measured for this thickness and material" if meas is None
+                   else f"measured 2D vs 3D difference exceeds the tolerance: {_meas_text(meas)}")
+            choices.append(Choice("dimension", "3D slab (real dots)",
+                                  "Braille dots are not uniform along the finger; " + why, 0.0))
+    budget -= sum(c.cost for c in choices if c.cost is not None)
+
+    # viscoelasticity --------------------------------------------------------------------
+    if scene.viscoelastic:
+        bound = viscoelastic_bound(scene)
+        if bound <= budget:
+            out = out.replace(viscoelastic=False)
+            budget -= bound
+            choices.append(Choice("viscoelasticity", "elastic (relaxation dropped)",
+                                  f"loading time {scene.duration:.3g} s: relaxed fraction <= 1 - g(T) = "
+                                  f"{bound:.3%}", bound, "bound"))
+        else:
+            choices.append(Choice("viscoelasticity", "kept (QLV Prony series)",
+                                  f"loading time {scene.duration:.3g} s: the bound 1 - g(T) = {bound:.2%} "
+                                  f"exceeds the tolerance left ({max(budget, 0):.2%})", 0.0))
+    else:
+        choices.append(Choice("viscoelasticity", "elastic (as the scene asks)", "scene.viscoelastic is False",
+                              0.0))
+
+    # truncation -------------------------------------------------------------------------
+    choices.append(_truncation_choice(scene, out, budget, verify))
+    if choices[-1].decision.startswith("truncate"):
+        out = truncated_scene(out)
+
+    p = Plan(requested=scene, scene=out, tolerance=tolerance, choices=tuple(choices))
+    log.info("%s", p.describe())
+    return p
+
+
+def _meas_text(meas: dict) -> str:
+    parts = [f"peak {meas['peak']:.1%}"]
+    if "span" in meas:
+        parts.append(f"span {meas['span']:.1%}")
+    if "note" in meas:
+        parts.append(meas["note"])
+    return ", ".join(parts)
+
+
+def _truncation_choice(scene: Scene, out: Scene, budget: float, verify: bool) -> Choice:
+    if out.dim == 3:
+        return Choice("truncation", "not available in 3D",
+                      "the 3D slab has no truncation parameter (its z length is the cast sample's)", 0.0)
+    cut = truncated_scene(out)
+    if cut is None:
+        L = out.section().interface_length
+        return Choice("truncation", "none (nothing to cut)",
+                      f"the bone interface ({L:.1f} mm) is not longer than the window plus margin", 0.0)
+    key = (float(scene.thickness), scene.material, scene.indenter.value)
+    meas = MEASURED_TRUNCATION.get(key)
+    if meas is None and verify:
+        meas = check_truncation(out)
+    keep = cut.section().interface_length
+    if meas is None:
+        return Choice("truncation", "none (unverified)",
+                      f"truncating at s = {keep:.1f} mm is possible but its error is not measured "
+                      "for this case (plan(..., verify=True) measures it)", 0.0)
+    err = max(meas["l2"], meas["peak"])
+    if err <= budget:
+        return Choice("truncation", f"truncate the section at s = {keep:.1f} mm (clamped end)",
+                      f"measured on a coarse mesh: P(s <= {WINDOW_S:g} mm) changes by {meas['l2']:.2%} (L2), "
+                      f"peak by {meas['peak']:.2%}", err, "measured")
+    return Choice("truncation", "none",
+                  f"truncation at s = {keep:.1f} mm changes P(s <= {WINDOW_S:g} mm) by {err:.2%}, more than "
+                  f"the tolerance left ({max(budget, 0):.2%})", 0.0)
