@@ -48,7 +48,7 @@ def test_braille_word_option(tmp_path):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--thickness", "9"], ["thickness=9", f"[{_FT.thickness_min:g}, {round(_FT.thickness_max, 3):g}] mm"]),
+    (["--thickness", "9"], ["thickness=9", f"[{_FT.thickness_min:g}, {_FT.thickness_bounds[1]:g}] mm"]),
     (["--thickness", "0.1"], ["thickness=0.1", "valid"]),
     (["--indenter", "braille", "--braille-text", "a\u00e9"], ["braille_text", "U+00E9"]),
     (["--indenter", "braille", "--braille-standard", "klingon"], ["braille_standard", "standard_american"]),

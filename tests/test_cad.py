@@ -139,7 +139,7 @@ def test_skin_volume_is_section_area_times_length(builds, t):
 def test_interface_spline_follows_the_analytic_offset():
     import build123d as bd
 
-    sec = FT.section(round(FT.thickness_max, 3))  # the tightest interface curvature
+    sec = FT.section(FT.thickness_bounds[1])  # the tightest interface curvature
     face = solids.skin_face(sec, full=True)
     edge = max((e for e in face.edges() if e.geom_type == bd.GeomType.BSPLINE), key=lambda e: e.length)
     u = np.linspace(-sec.u_interface_end, sec.u_interface_end, 997)  # off the knots
@@ -370,7 +370,7 @@ def test_invalid_inputs_raise_parameter_errors_before_cad():
 @settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(t=st.floats(0.3, 6.5, allow_nan=False))
 def test_any_thickness_gives_valid_solids_or_the_documented_error(t, tmp_path_factory):
-    lo, hi = FT.thickness_min, round(FT.thickness_max, 3)
+    lo, hi = FT.thickness_bounds
     if not lo <= t <= hi:
         with pytest.raises(ParameterError, match=re.escape(f"valid: [{lo:g}, {hi:g}] mm")):
             parts.build_parts(t, indenters="none")

@@ -73,10 +73,13 @@ class Fingertip:
         """Largest skin thickness whose interface stays smooth (a margin below min radius)."""
         return self.max_fraction_of_min_radius * self.min_radius_of_curvature
 
+    @property
+    def thickness_bounds(self) -> tuple[float, float]:
+        """Valid skin thickness range as stated to users (max rounded down to 1 um)."""
+        return self.thickness_min, math.floor(self.thickness_max * 1000) / 1000
+
     def check_thickness(self, t: float) -> float:
-        # round the bound down so the stated range never admits a value beyond thickness_max
-        return check_range("thickness", t, self.thickness_min, math.floor(self.thickness_max * 1000) / 1000,
-                           unit="mm")
+        return check_range("thickness", t, *self.thickness_bounds, unit="mm")
 
     def section(self, thickness: float) -> "Section":
         return Section(self, self.check_thickness(thickness))
