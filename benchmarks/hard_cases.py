@@ -23,6 +23,7 @@ peak, ...). Usage (prints the table; --levels runs the mesh-convergence series):
 from __future__ import annotations
 
 import argparse
+import itertools
 import math
 import tempfile
 import time
@@ -156,6 +157,45 @@ def run_case(name: str, mesh_size: float, refinement: float = 2.0, options=None)
     return row
 
 
+def planner_checks(mesh_size: float, refinement: float) -> None:
+    """Measure what the planner's choices cost: truncation (full vs truncated section, P(s)
+    on s <= 6 mm) for the cases with skin to cut, and the elastic vs viscoelastic peak
+    against the bound 1 - g(T)."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from tactileskin.fe import solve
+    from tactileskin.planner import check_truncation, truncated_scene, viscoelastic_bound
+    from tactileskin.scene import Scene
+
+    con = Console()
+    tt = Table(title=f"truncation (h = {mesh_size:g}, refinement {refinement:g})")
+    for c in ("case", "interface mm", "kept mm", "L2 diff", "peak diff", "wall full s", "wall truncated s"):
+        tt.add_column(c, justify="right")
+    for t, mat, ind in itertools.product((1.0, 3.0, 5.0), ("silicone", "polyurethane"), ("flat", "curved", "braille")):
+        sc = Scene(thickness=t, material=mat, indenter=ind)
+        if truncated_scene(sc) is None:
+            continue
+        d = check_truncation(sc, mesh_size=mesh_size, refinement=refinement)
+        tt.add_row(sc.label(), f"{d['full_s']:.2f}", f"{d['keep_s']:.2f}", f"{d['l2']:.3%}", f"{d['peak']:.3%}",
+                   f"{d['wall_full']:.2f}", f"{d['wall_truncated']:.2f}")
+        con.print(sc.label(), d)
+    con.print(tt)
+    vt = Table(title=f"elastic vs viscoelastic peak (curved, h = {mesh_size:g})")
+    for c in ("case", "rate mm/s", "T s", "bound 1-g(T)", "peak VE", "peak elastic", "relative diff", "diff/bound"):
+        vt.add_column(c, justify="right")
+    for t, mat, rate in itertools.product((1.0, 3.0), ("silicone", "polyurethane"), (1.0, 100.0)):
+        sc = Scene(thickness=t, material=mat, indenter="curved", rate=rate, mesh_size=mesh_size,
+                   refinement=refinement)
+        ve, el = solve(sc), solve(sc.replace(viscoelastic=False))
+        diff = (el.peak - ve.peak) / el.peak
+        b = viscoelastic_bound(sc)
+        vt.add_row(sc.label(), f"{rate:g}", f"{sc.duration:.3g}", f"{b:.3%}", f"{ve.peak:.5g}", f"{el.peak:.5g}",
+                   f"{diff:.3%}", f"{diff / b:.2f}")
+        con.print(sc.label(), rate, b, diff)
+    con.print(vt)
+
+
 def main() -> None:
     import logging
 
@@ -167,9 +207,13 @@ def main() -> None:
     ap.add_argument("--h0", type=float, default=1.0, help="coarsest mesh size (mm)")
     ap.add_argument("--levels", type=int, default=1, help="mesh sizes h0 / 2^k, k < levels")
     ap.add_argument("--refinement", type=float, default=2.0)
+    ap.add_argument("--planner", action="store_true", help="only the planner checks (truncation, viscoelasticity)")
     ap.add_argument("-v", action="store_true")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.v else logging.WARNING)
+    if a.planner:
+        planner_checks(a.h0, a.refinement)
+        return
     table = Table(title="hard cases")
     for c in ("case", "h mm", "outcome", "dofs", "incr", "newton", "cutbacks", "wall s", "peak MPa",
               "span mm", "change vs previous h", "note"):
