@@ -19,7 +19,7 @@ _FD_STEP = 1e-6  # mm; central difference of the unit normal (error ~ h^2 kappa^
 
 
 class ContactSurface:
-    def __init__(self, mesh, element, facets: np.ndarray, m: int, intorder: int = 6):
+    def __init__(self, mesh, element, facets: np.ndarray, m: int, intorder: int = 3):
         fb = FacetBasis(mesh, element, facets=facets, intorder=intorder)
         self.m = m
         self.X = np.moveaxis(fb.global_coordinates().value, 0, -1)        # (Fc, Qc, m)

@@ -32,6 +32,7 @@ class SolverOptions:
     atol: float = 1e-12           # absolute residual floor (N)
     max_newton: int = 20
     max_halvings: int = 8
+    full_step_growth: float = 10.0  # accept a full Newton step raising |R| by up to this factor
     dt0_fraction: float = 0.1     # first increment as a fraction of the total time
     dt_min_fraction: float = 1e-5
     dt_max_fraction: float = 0.25
@@ -131,9 +132,14 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         eta, best = 1.0, None
         for _ in range(opts.max_halvings + 1):
             trial = model.evaluate(u + eta * du, t, dt, lam, tangent=False)
+            if not trial.ok:
+                log.debug("    eta %.4g: %s", eta, trial.why)
             if trial.ok:
                 tn = float(np.linalg.norm(trial.R[free]))
-                if tn <= (1.0 - 1e-4 * eta) * rn:
+                log.debug("    eta %.4g: |R| = %.3e", eta, tn)
+                # the full step may raise |R| while the contact set changes (semi-smooth
+                # Newton); accept it up to a factor, otherwise ask for a decrease
+                if tn <= (1.0 - 1e-4 * eta) * rn or (eta == 1.0 and tn <= opts.full_step_growth * rn):
                     best = (eta, tn, trial)
                     break
                 if best is None or tn < best[1]:
