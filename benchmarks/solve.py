@@ -28,9 +28,12 @@ def main() -> None:
     ap.add_argument("--formulation", default="mixed")
     ap.add_argument("--only", default="", help="substring of the case label")
     ap.add_argument("--mesh-size", type=float, default=None)
+    ap.add_argument("--hertz", action="store_true", help="plane-strain Hertz refinement study instead")
     ap.add_argument("-v", action="store_true")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.v else logging.WARNING)
+    if a.hertz:
+        return hertz()
     table = Table(title=f"paper cases, {a.formulation} formulation")
     for c in ("case", "dofs", "incr", "newton", "mesh s", "solve s", "peak MPa", "s_peak mm",
               "span mm", "reaction N/mm"):
@@ -57,6 +60,22 @@ def main() -> None:
                       f"{r.span:.2f}", f"{r.reaction:.4f}")
     Console().print(table)
     Console().print(f"total wall time {time.perf_counter() - total:.1f} s")
+
+
+def hertz() -> None:
+    """Rigid cylinder R = 20 mm on a 10 mm polyurethane block: FE vs Hertz on refined meshes."""
+    from tactileskin.fe.verification import hertz_block
+
+    table = Table(title="plane-strain Hertz (a/R = 0.018)")
+    for c in ("h mm", "dofs", "newton", "a err %", "p0 (fit) err %", "p max err %", "cpu s"):
+        table.add_column(c, justify="right")
+    for h in (0.08, 0.04, 0.02):
+        t0 = time.process_time()
+        r = hertz_block(h=h)
+        table.add_row(f"{h:g}", str(r["res"].stats["dofs"]), str(r["res"].stats["newton_iterations"]),
+                      f"{100 * (r['a_fe'] / r['a_h'] - 1):+.2f}", f"{100 * (r['p0_fe'] / r['p0_h'] - 1):+.2f}",
+                      f"{100 * (r['pmax'] / r['p0_h'] - 1):+.2f}", f"{time.process_time() - t0:.1f}")
+    Console().print(table)
 
 
 if __name__ == "__main__":
