@@ -199,26 +199,26 @@ def planner_checks(mesh_size: float, refinement: float) -> None:
 def main() -> None:
     import logging
 
-    from rich.console import Console
-    from rich.table import Table
-
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", default="")
     ap.add_argument("--h0", type=float, default=1.0, help="coarsest mesh size (mm)")
     ap.add_argument("--levels", type=int, default=1, help="mesh sizes h0 / 2^k, k < levels")
     ap.add_argument("--refinement", type=float, default=2.0)
     ap.add_argument("--planner", action="store_true", help="only the planner checks (truncation, viscoelasticity)")
+    ap.add_argument("--out", default="hard_cases.md", help="markdown table in benchmarks/results/")
     ap.add_argument("-v", action="store_true")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.v else logging.WARNING)
     if a.planner:
         planner_checks(a.h0, a.refinement)
         return
-    table = Table(title="hard cases")
-    for c in ("case", "h mm", "outcome", "dofs", "incr", "newton", "cutbacks", "wall s", "peak MPa",
-              "span mm", "change vs previous h", "note"):
-        table.add_column(c, justify="right")
+    lines = [f"hard cases, refinement {a.refinement:g} ({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())})", "",
+             "| case | h mm | outcome | dofs | incr | Newton | cutbacks | wall s | peak MPa | span mm | "
+             "change vs previous h | note |", "|" + "---|" * 12]
+    results = Path(__file__).parent / "results"
+    results.mkdir(parents=True, exist_ok=True)
     total = time.perf_counter()
+    f = lambda v, s: "-" if v is None else format(v, s)  # noqa: E731
     for name in CASES:
         if a.only and a.only not in name:
             continue
@@ -233,17 +233,19 @@ def main() -> None:
                 prev = row["peak"]
                 if name.startswith("layer-confined"):
                     exact = confined_closed_form(name.split("-")[2], LAYER_STRAIN)
-                    note = f"closed form {exact:.5g}"
+                    note = f"closed form {exact:.5g} ({(row['peak'] - exact) / exact:+.2%})"
             else:
                 d = row["diagnosis"] or {}
-                note = f"{d.get('reason', '')} at t={d.get('time', math.nan):.3g}, dt={d.get('dt', math.nan):.2g}"
-            f = lambda v, s: "-" if v is None else format(v, s)  # noqa: E731
-            table.add_row(name, f"{h:g}", row["outcome"], f(row["dofs"], "d"), f(row["increments"], "d"),
-                          f(row["newton"], "d"), f(row["cutbacks"], "d"), f(row["wall_s"], ".1f"),
-                          f(row["peak"], ".5g"), f(row["span"], ".3g"), change, note)
-            Console().print(f"{name} h={h:g}: {row['outcome']} {row.get('peak')} {row.get('wall_s')}")
-    Console().print(table)
-    Console().print(f"total wall time {time.perf_counter() - total:.1f} s")
+                note = (f"{d.get('reason', '')} at t = {d.get('time', math.nan):.3g} s, dt = "
+                        f"{d.get('dt', math.nan):.2g} s, worst residual at {d.get('point_mm')}")
+            lines.append(f"| {name} | {h:g} | {row['outcome']} | {f(row['dofs'], 'd')} | {f(row['increments'], 'd')} | "
+                         f"{f(row['newton'], 'd')} | {f(row['cutbacks'], 'd')} | {f(row['wall_s'], '.1f')} | "
+                         f"{f(row['peak'], '.5g')} | {f(row['span'], '.3g')} | {change} | {note} |")
+            print(lines[-1], flush=True)
+            tmp = results / f".{a.out}.tmp"
+            tmp.write_text("\n".join(lines) + "\n")
+            tmp.replace(results / a.out)
+    print(f"total wall time {time.perf_counter() - total:.1f} s")
 
 
 if __name__ == "__main__":

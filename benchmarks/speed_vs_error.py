@@ -153,7 +153,7 @@ def run_case(t: float, mat: str, ind: str, a) -> dict:
         variants.append(Run(f"h{h:.3g}-r{a.ratio2:g}-P2", h, a.ratio2, 2, "adaptive", 1e-4))
         variants.append(Run(f"h{h:.3g}-r{a.ratio:g}-P2-coarse-steps", h, a.ratio, 2, "coarse-steps", 1e-4))
         variants.append(Run(f"h{h:.3g}-r{a.ratio:g}-P2-tol1e-3", h, a.ratio, 2, "adaptive", 1e-3))
-    for h in sizes[1:]:
+    for h in sizes[1:] if a.p1 else []:
         h1 = h / 2.0  # P1 at half the size: the same number of nodes as P2 at h
         variants.append(Run(f"h{h1:.3g}-r{a.ratio:g}-P1", h1, a.ratio, 1, "adaptive", 1e-4))
     if a.no_variants:
@@ -257,6 +257,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--repeat-below", type=float, default=5.0, help="repeat solves faster than this (s)")
     ap.add_argument("--no-variants", action="store_true")
+    ap.add_argument("--p1", action="store_true",
+                    help="also P1 elements (they lock on triangles: see docs/speed_vs_error.md)")
     ap.add_argument("--out", default="speed_vs_error.md")
     ap.add_argument("-v", action="store_true")
     a = ap.parse_args()
