@@ -55,6 +55,8 @@ def main() -> None:
             continue
         st = r.stats
         i = int(np.argmax(r.pressure))
+        logging.getLogger("benchmark").warning("%s done: peak %.4f MPa, %d Newton, %.1f s", sc.label(),
+                                               r.peak, st["newton_iterations"], st["wall_s"])
         table.add_row(sc.label(), str(st["dofs"]), str(st["increments"]), str(st["newton_iterations"]),
                       f"{tm:.2f}", f"{st['wall_s']:.2f}", f"{r.peak:.4f}", f"{r.s[i]:.2f}",
                       f"{r.span:.2f}", f"{r.reaction:.4f}")

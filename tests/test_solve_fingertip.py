@@ -15,7 +15,7 @@ from tactileskin.scene import Scene
 def flat_1mm():
     # a coarser mesh than the default keeps this a smoke test (~2 s); physics checks below
     # do not depend on the resolution
-    return solve(Scene(thickness=1.0, material="silicone", indenter="flat", mesh_size=0.4))
+    return solve(Scene(thickness=1.0, material="silicone", indenter="flat", mesh_size=0.4), history=True)
 
 
 def test_fingertip_flat_converges_with_a_finite_positive_peak_under_the_indenter(flat_1mm):
@@ -31,6 +31,17 @@ def test_fingertip_flat_converges_with_a_finite_positive_peak_under_the_indenter
     assert r.stats["increments"] >= 1 and r.stats["newton_iterations"] >= r.stats["increments"]
     # the contact zone is centred on the symmetry line
     assert r.contact_x.min() < 0.2 and np.all(r.contact_pressure > 0)
+
+
+def test_history_follows_the_indenter(flat_1mm):
+    h = flat_1mm.history
+    t = np.array([r["t"] for r in h])
+    d = np.array([r["d"] for r in h])
+    f = np.array([r["reaction"] for r in h])
+    assert len(h) == flat_1mm.stats["increments"]
+    assert np.all(np.diff(t) > 0) and t[-1] == pytest.approx(0.2)   # 0.2 mm at 1 mm/s
+    np.testing.assert_allclose(d, 1.0 * t)
+    assert np.all(np.diff(f) > 0) and f[-1] == pytest.approx(flat_1mm.reaction)
 
 
 def test_result_write_is_complete(flat_1mm, tmp_path):
