@@ -21,12 +21,18 @@ def geometry_dir() -> Path:
     return Path(__file__).resolve().parents[2] / "geometry"
 
 
-@functools.cache
-def load(name: str) -> dict:
-    """Parsed geometry/<name>.toml (cached; treat as read-only)."""
-    path = geometry_dir() / f"{name}.toml"
+def read_toml(path: str | Path, what: str) -> dict:
+    """Parse a user's TOML file; a missing or malformed file is a ParameterError naming `what`."""
     try:
         with open(path, "rb") as fh:
             return tomllib.load(fh)
     except FileNotFoundError:
-        raise ParameterError("parameter file", str(path), "an existing TOML file under geometry/") from None
+        raise ParameterError(what, str(path), "an existing TOML file") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ParameterError(what, str(path), f"valid TOML ({e})") from None
+
+
+@functools.cache
+def load(name: str) -> dict:
+    """Parsed geometry/<name>.toml (cached; treat as read-only)."""
+    return read_toml(geometry_dir() / f"{name}.toml", "parameter file")

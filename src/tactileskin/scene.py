@@ -9,7 +9,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import tomllib
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
@@ -159,10 +158,6 @@ class Scene:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "Scene":
-        try:
-            with open(path, "rb") as fh:
-                return cls.from_dict(tomllib.load(fh))
-        except FileNotFoundError:
-            raise ParameterError("scene file", str(path), "an existing TOML file") from None
-        except tomllib.TOMLDecodeError as e:
-            raise ParameterError("scene file", str(path), f"valid TOML ({e})") from None
+        from tactileskin.params import read_toml
+
+        return cls.from_dict(read_toml(path, "scene file"))

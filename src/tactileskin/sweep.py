@@ -91,15 +91,9 @@ def expand_grid(
 def load_spec(path: str | Path) -> dict:
     """A sweep TOML: [sweep] thicknesses/materials/indenters/depths/braille_texts lists,
     optional [scene] base fields."""
-    import tomllib
+    from tactileskin.params import read_toml
 
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise ParameterError("sweep file", str(path), "an existing TOML file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ParameterError("sweep file", str(path), f"valid TOML ({e})") from None
+    data = read_toml(path, "sweep file")
     allowed = {"thicknesses", "materials", "indenters", "depths", "braille_texts"}
     sw = data.get("sweep", {})
     bad = sorted(set(sw) - allowed)

@@ -15,6 +15,7 @@ from pathlib import Path
 from tactileskin.errors import ParameterError
 from tactileskin.materials.hyperfoam import Hyperfoam
 from tactileskin.materials.prony import Prony
+from tactileskin.params import read_toml
 
 __all__ = ["Material", "get_material", "list_materials"]
 
@@ -55,13 +56,7 @@ class Material:
         presets.toml. Without [prony] the material is purely elastic.
         """
         path = Path(path)
-        try:
-            with open(path, "rb") as fh:
-                data = tomllib.load(fh)
-        except FileNotFoundError:
-            raise ParameterError("material file", str(path), "an existing TOML file") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ParameterError("material file", str(path), "valid TOML", str(exc)) from None
+        data = read_toml(path, "material file")
         if "hyperfoam" in data:
             return cls.from_dict(str(data.get("name", path.stem)), data)
         tables = {k: v for k, v in data.items() if isinstance(v, dict)}
