@@ -10,7 +10,7 @@ import pytest
 from tactileskin import planner
 from tactileskin.errors import ParameterError
 from tactileskin.fe import solve
-from tactileskin.planner import plan, truncated_scene, viscoelastic_bound
+from tactileskin.planner import QUALITY, plan, truncated_scene, viscoelastic_bound, with_quality
 from tactileskin.scene import Scene
 
 COARSE = dict(mesh_size=1.0, refinement=2.0)
@@ -113,3 +113,14 @@ def test_viscoelastic_bound_holds_against_solves(material, rate):
     el = solve(sc.replace(viscoelastic=False))
     diff = (el.peak - ve.peak) / el.peak
     assert 0.0 < diff <= viscoelastic_bound(sc)
+
+
+def test_quality_presets_order_cost_and_error():
+    sc = Scene(thickness=3.0)
+    sizes = [with_quality(sc, q).mesh_size / with_quality(sc, q).refinement for q in ("preview", "default", "fine")]
+    assert sizes == sorted(sizes, reverse=True)  # finer preset, smaller refined size
+    errs = [QUALITY[q]["peak_error"] for q in ("preview", "default", "fine")]
+    assert errs == sorted(errs, reverse=True)
+    assert with_quality(sc.replace(dim=3, indenter="braille"), "fine").mesh_size == sc.replace(dim=3).mesh_size
+    with pytest.raises(ParameterError, match="quality"):
+        with_quality(sc, "ultra")

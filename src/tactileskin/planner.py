@@ -106,6 +106,26 @@ class Plan:
         return "\n".join([head] + ["  - " + str(c) for c in self.choices])
 
 
+# Quality presets for 2D solves (mesh_size mm, refinement), chosen from the Pareto fronts
+# of benchmarks/speed_vs_error.py (docs/speed_vs_error.md), with the relative peak error
+# expected from them (first-order convergence of the peak; measured or extrapolated there).
+QUALITY: dict[str, dict] = {
+    "preview": {"mesh_size": 1.0, "refinement": 2.0, "peak_error": 0.05},
+    "default": {"mesh_size": 0.25, "refinement": 3.0, "peak_error": 0.01},
+    "fine": {"mesh_size": 0.177, "refinement": 3.0, "peak_error": 0.007},
+}
+
+
+def with_quality(scene: Scene, quality: str) -> Scene:
+    """The scene meshed at a quality preset (2D; a 3D scene keeps its own sizes)."""
+    if quality not in QUALITY:
+        raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
+    if scene.dim == 3:
+        return scene
+    q = QUALITY[quality]
+    return scene.replace(mesh_size=q["mesh_size"], refinement=q["refinement"])
+
+
 # --- individual estimates (pure) ----------------------------------------------------------
 
 def viscoelastic_bound(scene: Scene) -> float:
