@@ -24,6 +24,8 @@ Aspects:
   margin. The cost is measured: `check_truncation` solves the truncated and the full
   section on a coarse mesh and compares P(s) on s <= 6 mm. Without a measurement
   (`verify=False` and no entry in `MEASURED_TRUNCATION`) the plan does not truncate.
+  Measured: it costs < 0.25 % but also saves little time in 2D (the far skin is meshed
+  coarsely already); the 3D slab has no truncation parameter.
 - viscoelasticity: QLV gives S(T) = int_0^T g(T - s) dS0(s). For a stress that grows
   monotonically during loading, g(T - s) >= g(T) and so
   (1 - g(T)) S0(T) >= S0(T) - S(T) >= 0: the relaxed fraction is at most
