@@ -21,7 +21,9 @@ from tactileskin.errors import ParameterError
 @click.option("--depth", default=None, help="Depths (mm), comma-separated; default 20 % of each thickness.")
 @click.option("--braille-text", multiple=True, help="Braille text(s) for Braille cases (repeatable).")
 @click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
-@click.option("--mesh-size", type=float, default=None, help="Global element size (mm).")
+@click.option("--quality", type=click.Choice(["preview", "default", "fine"]), default=None,
+              help="Mesh preset from the speed-vs-error study (docs/speed_vs_error.md).")
+@click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
 @click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
 @click.option("--workers", type=int, default=None, help="Local worker processes (default: all cores).")
@@ -29,7 +31,7 @@ from tactileskin.errors import ParameterError
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
 @click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
-def command(out, config, thickness, material, indenter, depth, braille_text, rate, mesh_size,
+def command(out, config, thickness, material, indenter, depth, braille_text, rate, quality, mesh_size,
             formulation, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
@@ -43,6 +45,10 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     console = Console()
     spec = load_spec(config) if config else {}
     base = spec.pop("base", Scene())
+    if quality:
+        from tactileskin.planner import with_quality
+
+        base = with_quality(base, quality)
     changes = {k: v for k, v in dict(rate=rate, mesh_size=mesh_size, formulation=formulation).items()
                if v is not None}
     if changes:
