@@ -108,11 +108,12 @@ def test_silicone_40_percent_reaction_grows_monotonically(tmp_path):
 
 def test_braille_dot_on_1mm_silicone(tmp_path):
     # The sharp dot (base 1.44 mm, height 0.48 mm) on 1 mm of silicone at 0.2 mm travel:
-    # only the dot touches (travel < dot height), so the contact stays within the dot's
-    # base radius plus the skin's bulge, and the bone pressure peaks under the dot (s < 1 mm).
+    # the base plate stays 0.28 mm above the undeformed skin, so only the spherical cap
+    # touches and the contact stays inside the cap's base radius 0.72 mm; the bone
+    # pressure peaks under the dot (s < 1 mm).
     sc = Scene(thickness=1.0, material="silicone", indenter="braille", **COARSE)
     res = solve(sc)
-    assert res.contact_x.max() < 0.72 + 0.3
+    assert 0.0 < res.contact_x.max() < 0.72
     i = int(np.argmax(res.pressure))
     assert res.s[i] < 1.0
     _files_finite(res, tmp_path)
