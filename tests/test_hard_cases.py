@@ -50,7 +50,7 @@ def test_confined_layer_matches_closed_form(material, tmp_path):
 
 def test_confined_silicone_lockup_stops_with_diagnosis(tmp_path):
     # 20 % uniaxial strain of silicone: J = 0.8, J^(-alpha beta) = 0.8^-379.75 ~ 1e37, so
-    # the closed-form stress is ~1e36 MPa; the penalty contact cannot get there. The solve
+    # the closed-form mean pressure is 1e34 MPa; the penalty contact cannot get there. The solve
     # must stop with a diagnosis (a larger minimum increment only makes it stop sooner).
     opts = SolverOptions(dt_min_fraction=1e-2, max_newton=12)
     try:
