@@ -29,11 +29,15 @@ def main() -> None:
     ap.add_argument("--only", default="", help="substring of the case label")
     ap.add_argument("--mesh-size", type=float, default=None)
     ap.add_argument("--hertz", action="store_true", help="plane-strain Hertz refinement study instead")
+    ap.add_argument("--locking", action="store_true",
+                    help="mesh refinement study, mixed vs displacement (design.md hard case 4)")
     ap.add_argument("-v", action="store_true")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.v else logging.WARNING)
     if a.hertz:
         return hertz()
+    if a.locking:
+        return locking(a.only or "t1-silicone-flat")
     table = Table(title=f"paper cases, {a.formulation} formulation")
     for c in ("case", "dofs", "incr", "newton", "mesh s", "solve s", "peak MPa", "s_peak mm",
               "span mm", "reaction N/mm"):
@@ -62,6 +66,30 @@ def main() -> None:
                       f"{r.span:.2f}", f"{r.reaction:.4f}")
     Console().print(table)
     Console().print(f"total wall time {time.perf_counter() - total:.1f} s")
+
+
+def locking(label: str) -> None:
+    """Peak bone pressure of one case at mesh sizes h, h/2 for both formulations."""
+    t, mat, ind = label.split("-")[:3]
+    base = Scene(thickness=float(t[1:]), material=mat, indenter=ind)
+    table = Table(title=f"refinement study {label}")
+    for c in ("formulation", "mesh size", "dofs", "peak MPa", "s_peak mm", "P(s=0) MPa", "change %"):
+        table.add_column(c, justify="right")
+    for form in ("mixed", "displacement"):
+        prev = None
+        for h in (base.mesh_size, base.mesh_size / 2):
+            sc = base.replace(formulation=form, mesh_size=h)
+            try:
+                r = solve(sc)
+            except TactileSkinError as e:
+                table.add_row(form, f"{h:g}", "-", "failed", str(e)[:30], "", "")
+                continue
+            i = int(np.argmax(r.pressure))
+            ch = "" if prev is None else f"{100 * (r.peak / prev - 1):+.2f}"
+            table.add_row(form, f"{h:g}", str(r.stats["dofs"]), f"{r.peak:.4f}", f"{r.s[i]:.2f}",
+                          f"{r.pressure[0]:.4f}", ch)
+            prev = r.peak
+    Console().print(table)
 
 
 def hertz() -> None:
