@@ -57,6 +57,14 @@ def test_result_write_is_complete(flat_1mm, tmp_path):
               "increments", "wall_s"):
         assert k in summ
     assert summ["peak_mpa"] == pytest.approx(flat_1mm.peak)
+    import meshio
+
+    vtu = meshio.read(out / "result.vtu")
+    assert vtu.cells[0].type == "triangle6"
+    for k in ("pressure", "displacement", "sxx", "syy", "szz", "sxy"):
+        assert np.all(np.isfinite(vtu.point_data[k]))
+    # the bone nodes of the profile are among the mesh nodes, with the same pressure
+    assert vtu.point_data["pressure"].max() >= flat_1mm.peak - 1e-12
     # rewriting replaces the folder without leaving temporary siblings
     flat_1mm.write(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]
