@@ -55,3 +55,25 @@ def test_figures_written(tmp_path):
     paths = all_figures(recs, rows, tmp_path)
     assert {p.name for p in paths} >= {"fig10_profiles.png", "fig11_peak.svg", "fig12_span.png", "fig13_auc.png"}
     assert all(p.stat().st_size > 1000 for p in paths)
+
+
+def test_render_is_coloured_by_pressure(tmp_path):
+    # Off-screen pyvista render of a small deformed mesh carrying a pressure field.
+    import meshio
+    from PIL import Image
+
+    from tactileskin.report.render import render_case
+
+    x, y = np.meshgrid(np.linspace(0, 4, 9), np.linspace(0, 1, 3))
+    pts = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    tris = []
+    for j in range(2):
+        for i in range(8):
+            a = j * 9 + i
+            tris += [[a, a + 1, a + 10], [a, a + 10, a + 9]]
+    vtu = tmp_path / "r.vtu"
+    meshio.write(vtu, meshio.Mesh(pts, [("triangle", np.array(tris))], point_data={"pressure": pts[:, 0]}))
+    png = render_case(vtu, tmp_path / "r.png", title="test")
+    img = np.asarray(Image.open(png).convert("RGB")).reshape(-1, 3)
+    # jet colours both ends of the range: a saturated blue and a saturated red must appear
+    assert np.any((img[:, 2] > 120) & (img[:, 0] < 60)) and np.any((img[:, 0] > 120) & (img[:, 2] < 60))
