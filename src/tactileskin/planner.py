@@ -192,9 +192,11 @@ def profile_difference(a, b, window: float = WINDOW_S) -> dict:
             "peak": float(abs(np.max(pa) - ref) / ref)}
 
 
-def check_truncation(scene: Scene, *, mesh_size: float = 1.0, refinement: float = 2.0) -> dict:
-    """Solve the full and the truncated section at a coarse mesh; return the truncated
-    scene's keep length and the relative L2 and peak differences on s <= WINDOW_S."""
+def check_truncation(scene: Scene, *, mesh_size: float = 0.5, refinement: float = 3.0) -> dict:
+    """Solve the full and the truncated section (h = 0.5 mm, refinement 3 by default: on
+    h = 1 mm the difference between the two gmsh meshes, ~1 %, hides the truncation
+    effect); return the kept length and the relative L2 and peak differences on
+    s <= WINDOW_S."""
     from tactileskin.fe import solve
 
     cut = truncated_scene(scene)
