@@ -49,8 +49,9 @@ log = logging.getLogger(__name__)
 WINDOW_S = 6.0          # mm: bone-pressure window of the paper (s <= 6 mm)
 TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin thickness)
 
-# Measured relative differences of the peak bone pressure, 2D ridge versus 3D dots, keyed by
-# (thickness, material): filled from docs/hard_cases.md measurements (coarse meshes).
+# Measured relative differences (2D ridge - 3D dots) / 3D dots of the peak bone pressure
+# ("peak") and span ("span"), keyed by (thickness, material), from docs/hard_cases.md
+# ("2D ridge against 3D dots"). Empty until a 3D Braille solve completes.
 MEASURED_RIDGE_VS_DOTS: dict[tuple[float, str], dict] = {}
 
 # Measured truncation errors (relative L2 of P(s) on s <= 6 mm, relative to the peak; and
