@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin.errors import ConvergenceError, TactileSkinError
+from tactileskin.errors import ConvergenceError
 
 LAYER_WIDTH = 4.0   # mm (half width modelled: x in [0, W], symmetry at x = 0)
 LAYER_HEIGHT = 1.0  # mm

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from tactileskin.errors import TactileSkinError
-from tactileskin.fe import SolverOptions, make_result, model_for_scene, reaction, run
+from tactileskin.fe import SolverOptions, make_result, model_for_scene, run
 from tactileskin.mesh import build_mesh
 from tactileskin.scene import Scene
 
