@@ -164,7 +164,8 @@ def run_case(t: float, mat: str, ind: str, a) -> dict:
     if a.no_variants:
         variants = []
     for r in variants:
-        sc = base.replace(mesh_size=r.mesh_size, refinement=r.refinement, order=r.order)
+        sc = base.replace(mesh_size=r.mesh_size, refinement=r.refinement, order=r.order,
+                          formulation="displacement" if r.order == 1 else base.formulation)
         runs.append(measure(sc, r, a.repeat, a.repeat_below))
         log.info("%s %s: %s", case, r.label, r.failed or f"peak {r.peak:.5g} in {r.wall_s:.2f} s")
 

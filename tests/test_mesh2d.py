@@ -202,7 +202,7 @@ def test_gmsh_failure_becomes_mesh_error():
 
 
 def test_order_one_gives_straight_triangles():
-    sm = build_mesh(Scene(thickness=3.0, order=1), mesh_size=1.0)
+    sm = build_mesh(Scene(thickness=3.0, order=1, formulation="displacement"), mesh_size=1.0)
     assert type(sm.mesh).__name__ == "MeshTri1" and sm.min_jacobian() > 0
     assert set(sm.boundaries) == set(BOUNDARIES_2D)
 

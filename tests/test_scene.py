@@ -44,6 +44,7 @@ def test_hash_is_stable_across_sessions():
     ("dim", 4, "2 or 3"),
     ("mesh_size", -1.0, "mesh_size"),
     ("depth", 5.0, "depth"),
+    ("order", 1, "2 with the mixed formulation"),
 ])
 def test_invalid_fields(field, value, needle):
     with pytest.raises(ParameterError, match=needle):

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
-from tactileskin.scene import IndenterKind, Scene
+from tactileskin.scene import DEFAULT_MESH, IndenterKind, Scene
 
 log = logging.getLogger(__name__)
 
@@ -114,7 +114,7 @@ class Plan:
 # expected from them (first-order convergence of the peak; measured or extrapolated there).
 QUALITY: dict[str, dict] = {
     "preview": {"mesh_size": 1.0, "refinement": 2.0, "peak_error": 0.05},
-    "default": {"mesh_size": 0.25, "refinement": 3.0, "peak_error": 0.01},
+    "default": {"mesh_size": DEFAULT_MESH[2][0], "refinement": DEFAULT_MESH[2][1], "peak_error": 0.01},
     "fine": {"mesh_size": 0.177, "refinement": 3.0, "peak_error": 0.007},
 }
 
@@ -142,25 +142,11 @@ def viscoelastic_bound(scene: Scene) -> float:
     return float(1.0 - prony.relaxation(scene.duration))
 
 
-def _dots(scene: Scene) -> np.ndarray:
-    from tactileskin.geometry import braille
-
-    return braille.dot_centres(scene.braille_text, braille.get_standard(scene.braille_standard))
-
-
-def _mirror_symmetric(xz: np.ndarray, axis: int) -> bool:
-    m = xz.copy()
-    m[:, axis] *= -1.0
-    key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
-    return key(m) == key(xz)
-
-
 def symmetric(scene: Scene) -> tuple[bool, bool]:
     """(about x = 0, about z = 0) mirror symmetry of the indenter."""
-    if scene.indenter is not IndenterKind.BRAILLE:
-        return True, True
-    xz = _dots(scene)
-    return _mirror_symmetric(xz, 0), _mirror_symmetric(xz, 1)
+    from tactileskin.geometry.indenters import indenter_symmetry
+
+    return indenter_symmetry(scene)
 
 
 def truncated_scene(scene: Scene, keep_s: float | None = None) -> Scene | None:

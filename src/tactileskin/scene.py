@@ -75,6 +75,11 @@ class Scene:
             raise ParameterError("dim", self.dim, "2 or 3")
         if self.order not in (1, 2):
             raise ParameterError("order", self.order, "1 or 2")
+        if self.order == 1 and self.formulation is Formulation.MIXED:
+            # On linear triangles/tets J is constant per element, so the element-mean dilatation
+            # of the mixed formulation equals J: it silently becomes the locking displacement one.
+            raise ParameterError("order", 1, "2 with the mixed formulation",
+                                 "order 1 locks; use formulation='displacement' to study it")
         size0, ref0 = DEFAULT_MESH[self.dim]
         set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
                                       0.01, 5.0, unit="mm"))

@@ -300,3 +300,13 @@ def indenter_for_scene(scene, *, row: int | None = None) -> Indenter:
     return make_indenter(scene.indenter, y0=scene.section().top, braille_text=scene.braille_text,
                          braille_standard=scene.braille_standard, dim=scene.dim, row=row,
                          sample_length=scene.fingertip_model().sample_length)
+
+
+def indenter_symmetry(scene) -> tuple[bool, bool]:
+    """(about x = 0, about z = 0): mirror symmetry of the scene's indenter. Flat plates and
+    cylinders are symmetric in both; Braille by its dot pattern (to 1e-9 mm)."""
+    if scene.indenter.value != "braille":
+        return True, True
+    xz = _braille.dot_centres(scene.braille_text, _braille.get_standard(scene.braille_standard))
+    key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
+    return tuple(key(xz * np.where(np.arange(2) == ax, -1.0, 1.0)) == key(xz) for ax in (0, 1))

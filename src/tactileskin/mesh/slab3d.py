@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from tactileskin.geometry.indenters import indenter_symmetry
 from tactileskin.mesh import _gmsh, sizing
 from tactileskin.mesh.section2d import add_section_curves
 from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
@@ -24,31 +25,14 @@ from tactileskin.mesh.snap import snap_boundary_nodes
 logger = logging.getLogger(__name__)
 
 
-def _dots(scene) -> np.ndarray:
-    from tactileskin.geometry import braille
-
-    return braille.dot_centres(scene.braille_text, braille.get_standard(scene.braille_standard))
-
-
-def _mirror_symmetric(xz: np.ndarray, axis: int) -> bool:
-    m = xz.copy()
-    m[:, axis] *= -1.0
-    key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
-    return key(m) == key(xz)
-
-
 def z_symmetric(scene) -> bool:
     """True if the indenter is mirror-symmetric about the plane z = 0."""
-    if scene.indenter.value in ("flat", "curved"):
-        return True
-    return _mirror_symmetric(_dots(scene), 1)
+    return indenter_symmetry(scene)[1]
 
 
 def x_symmetric(scene) -> bool:
     """True if the indenter is mirror-symmetric about the plane x = 0 (assumed by the half slab)."""
-    if scene.indenter.value in ("flat", "curved"):
-        return True
-    return _mirror_symmetric(_dots(scene), 0)
+    return indenter_symmetry(scene)[0]
 
 
 def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
