@@ -22,8 +22,8 @@ class ContactSurface:
     def __init__(self, mesh, element, facets: np.ndarray, m: int, intorder: int = 3):
         fb = FacetBasis(mesh, element, facets=facets, intorder=intorder)
         self.m = m
-        self.X = np.moveaxis(fb.global_coordinates().value, 0, -1)        # (Fc, Qc, m)
-        self.N = np.stack([fb.basis[a][0].value for a in range(fb.Nbfun)], axis=-1)  # (Fc, Qc, A)
+        self.X = np.moveaxis(np.asarray(fb.global_coordinates()), 0, -1)        # (Fc, Qc, m)
+        self.N = np.stack([np.asarray(fb.basis[a][0]) for a in range(fb.Nbfun)], axis=-1)  # (Fc, Qc, A)
         self.w = np.asarray(fb.dx)                                             # (Fc, Qc)
         self.sdofs = fb.element_dofs.T                                         # (Fc, A)
         self.vdofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)   # (Fc, A*m)

@@ -24,7 +24,7 @@ class Projector:
         q = model.basis.quadrature
         self.basis = CellBasis(model.mesh, scalar_element(model.mesh, 1), quadrature=q)
         b = self.basis
-        self.N = np.stack([b.basis[a][0].value for a in range(b.Nbfun)], axis=-1)  # (E, Q, A1)
+        self.N = np.stack([np.asarray(b.basis[a][0]) for a in range(b.Nbfun)], axis=-1)  # (E, Q, A1)
         self.dofs = b.element_dofs.T
         Me = np.einsum("eq,eqa,eqb->eab", model.w, self.N, self.N)
         A = self.dofs.shape[1]
