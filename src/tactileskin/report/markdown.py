@@ -29,6 +29,19 @@ def _index(rows):
     return idx
 
 
+def _profiles_by_group(records, *, with_text: bool):
+    """Sorted ((material, thickness), {indenter name: (s, P)}) groups of the sweep's profiles;
+    Braille cases with a text are named 'braille[text]', or left out when not with_text."""
+    groups = defaultdict(dict)
+    for rec in records:
+        sc = rec.scene
+        if sc.braille_text and not with_text:
+            continue
+        name = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
+        groups[(sc.material, sc.thickness)][name] = (rec.s, rec.pressure)
+    return sorted(groups.items())
+
+
 def paper_checks(rows, records) -> list[dict]:
     """Each paper claim with our value and a verdict."""
     idx = _index(rows)
@@ -85,12 +98,7 @@ def paper_checks(rows, records) -> list[dict]:
                                ours=f"spread {(spread):.0%} of the mean",
                                verdict="agrees" if spread < THRESHOLD else "differs"))
 
-    by_group = defaultdict(dict)
-    for rec in records:
-        sc = rec.scene
-        if not sc.braille_text:
-            by_group[(sc.material, sc.thickness)][sc.indenter.value] = (rec.s, rec.pressure)
-    for (mat, t), profs in sorted(by_group.items()):
+    for (mat, t), profs in _profiles_by_group(records, with_text=False):
         if len(profs) < 3:
             continue
         v = discriminate(profs)
@@ -102,12 +110,8 @@ def paper_checks(rows, records) -> list[dict]:
 
 
 def discrimination_table(records) -> list[str]:
-    by_group = defaultdict(dict)
-    for rec in records:
-        sc = rec.scene
-        by_group[(sc.material, sc.thickness)][sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")] = (rec.s, rec.pressure)
     lines = ["| material | t (mm) | pairwise distances | verdict |", "|---|---|---|---|"]
-    for (mat, t), profs in sorted(by_group.items()):
+    for (mat, t), profs in _profiles_by_group(records, with_text=True):
         v = discriminate(profs)
         d = ", ".join(f"{a}–{b} {x:.2f}" for (a, b), x in v.distances.items())
         lines.append(f"| {mat} | {t:g} | {d or 'n/a'} | {'distinguishable' if v.distinguishable else 'not distinguishable'} |")

@@ -83,11 +83,14 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     if render and records:
         from tactileskin.report.render import render_case
 
+        thinnest = {}
+        for r in records:
+            m = r.scene.material
+            thinnest[m] = min(thinnest.get(m, r.scene.thickness), r.scene.thickness)
         for rec in records:  # one Fig. 9A-style render per material at the thinnest skin, flat plate
             sc = rec.scene
-            thinnest = min(r.scene.thickness for r in records if r.scene.material == sc.material)
             vtu = rec.path / "result.vtu"
-            if sc.indenter.value == "flat" and sc.thickness == thinnest and vtu.is_file():
+            if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
                 try:
                     renders.append(render_case(vtu, out / f"fig9_{sc.label()}.png", title=sc.label()))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
