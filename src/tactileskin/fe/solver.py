@@ -1,6 +1,7 @@
 """Newton with a backtracking line search, augmented-Lagrangian contact loop, adaptive time steps.
 
-- Newton uses the consistent tangent and a sparse direct solve (SuperLU) of the free block.
+- Newton uses the consistent tangent and a sparse direct solve of the free block
+  (fe.linsolve: PARDISO with the ordering analysed once per model, else SuperLU).
   A line search halves the step while the trial state is inadmissible (J <= 0, material
   overflow guard) or the residual norm does not decrease; the residual norm of every
   iteration is logged (quadratic convergence is visible at DEBUG).
@@ -18,9 +19,9 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from tactileskin.errors import ConvergenceError
+from tactileskin.fe.linsolve import SymmetricSolver
 from tactileskin.fe.model import Evaluation, Model
 
 log = logging.getLogger(__name__)
@@ -42,6 +43,7 @@ class SolverOptions:
     cutback: float = 0.35
     easy_iterations: int = 5      # grow the increment when Newton needed at most this many
     max_increments: int = 2000
+    linear_solver: str = "auto"   # fe.linsolve backend: auto | pardiso | superlu
 
 
 class _Failure(Exception):
@@ -70,13 +72,15 @@ def _worst(model: Model, R: np.ndarray) -> dict:
             "value": float(R[k]) if np.isfinite(R[k]) else None}
 
 
-def _factor(K):
-    # symmetric tangent: symmetric ordering, diagonal pivots preferred (less fill)
-    return spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                     options={"SymmetricMode": True})
+def _factor(model: Model, K, opts: SolverOptions):
+    """Factorise the free block K; the solver (and its symbolic analysis) lives on the model."""
+    ls = getattr(model, "_linsolve", None)
+    if ls is None or opts.linear_solver not in ("auto", ls.backend):
+        ls = model._linsolve = SymmetricSolver(K, opts.linear_solver)
+    return ls.factor(K)
 
 
-def _lifted(model: Model, u0, dofs, vals, t, dt, lam, stats):
+def _lifted(model: Model, u0, dofs, vals, t, dt, lam, stats, opts):
     """Start state with the new prescribed values. A bare jump of the boundary values
     squeezes the first element layer, which the hyperfoam lock-up turns into a huge
     residual that Newton unwinds one e-fold per iteration; instead, spread the jump
@@ -91,7 +95,7 @@ def _lifted(model: Model, u0, dofs, vals, t, dt, lam, stats):
             K = model.pattern.matrix(ev0.K)
             rhs = -(ev0.R + K @ dup)[model.free]
             try:
-                du = _factor(model.pattern.free_matrix(ev0.K)).solve(rhs)
+                du = _factor(model, model.pattern.free_matrix(ev0.K), opts).solve(rhs)
                 stats.factorizations += 1
                 cand = u0 + dup
                 cand[model.free] += du
@@ -157,7 +161,7 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
     """Solve R(u) = 0 at time t; returns (u, evaluation, iterations)."""
     free = model.free
     dofs, vals = model.prescribed(t)
-    u = _lifted(model, u0, dofs, vals, t, dt, lam, stats)
+    u = _lifted(model, u0, dofs, vals, t, dt, lam, stats, opts)
     ev = model.evaluate(u, t, dt, lam, tangent=False)
     if not ev.ok:
         raise _Failure(f"start state inadmissible ({ev.why})", {"history": []})
@@ -178,7 +182,7 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         chord = lu is not None and chord_ok and rn < opts.chord_below * hist[0]
         if not chord:
             try:
-                lu = _factor(model.pattern.free_matrix(model.tangent(ev)))
+                lu = _factor(model, model.pattern.free_matrix(model.tangent(ev)), opts)
             except (RuntimeError, FloatingPointError) as e:  # singular factor
                 raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
             stats.factorizations += 1
