@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactileskin.errors import ConvergenceError
+from tactileskin.errors import ConvergenceError, ParameterError
 from tactileskin.fe import kernels
 from tactileskin.fe.model import Evaluation, Model
 from tactileskin.fe.recovery import Projector
@@ -48,6 +48,118 @@ def path_profile(model: Model, nodal: np.ndarray, boundary: str, s_of_point) -> 
     return s[order], nodal[sd][order]
 
 
+def _facet_nodes(model: Model, boundary: str) -> np.ndarray:
+    """(F, 3) or (F, 6) scalar dofs of the facets of a named 3D boundary: vertices v0 v1 v2,
+    then (P2) the mid-side nodes of edges v0v1, v1v2, v2v0 (the node order of `_tri_shape`)."""
+    mesh, b = model.mesh, model.basis
+    f = np.asarray(model.boundaries[boundary])
+    v = mesh.facets[:, f].T                                     # (F, 3) vertex indices
+    nodes = [b.dofs.nodal_dofs[0, v[:, k]] for k in range(3)]
+    if b.dofs.edge_dofs.size:
+        # the edge of each facet joining vertices (a, b): match on the sorted vertex pair
+        key = lambda a, c: np.minimum(a, c) * mesh.nvertices + np.maximum(a, c)  # noqa: E731
+        ev = mesh.edges
+        ekey = key(ev[0], ev[1])
+        order = np.argsort(ekey)
+        for a, c in ((0, 1), (1, 2), (2, 0)):
+            e = order[np.searchsorted(ekey[order], key(v[:, a], v[:, c]))]
+            nodes.append(b.dofs.edge_dofs[0, e])
+    return np.stack(nodes, axis=1)
+
+
+def _tri_shape(xi: np.ndarray, eta: np.ndarray, n: int) -> np.ndarray:
+    """(k, n) shape functions of the linear (n = 3) or quadratic (n = 6) triangle at
+    reference points (xi, eta); nodes (0,0) (1,0) (0,1) [(.5,0) (.5,.5) (0,.5)]."""
+    l0, l1, l2 = 1.0 - xi - eta, xi, eta
+    if n == 3:
+        return np.stack([l0, l1, l2], axis=-1)
+    return np.stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1),
+                     4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0], axis=-1)
+
+
+_REF_TRI = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+
+
+def _plane_trace(zf: np.ndarray, zc: float, tol: float) -> list:
+    """Reference points (xi, eta) where the affine interpolant of the vertex values zf (3,)
+    equals zc on the triangle: [] (no cut), [p] (touches a vertex), [p, q] (a segment)."""
+    f = zf - zc
+    pts = []
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        if abs(f[i]) <= tol:
+            pts.append(_REF_TRI[i])
+        elif abs(f[j]) > tol and f[i] * f[j] < 0:
+            t = f[i] / (f[i] - f[j])
+            pts.append((1 - t) * _REF_TRI[i] + t * _REF_TRI[j])
+    uniq = []
+    for p in pts:
+        if not any(np.allclose(p, q, atol=1e-12) for q in uniq):
+            uniq.append(p)
+    return uniq
+
+
+def plane_profile(model: Model, nodal: np.ndarray, boundary: str, s_of_point, z: float, *,
+                  per_segment: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """(s, values) of a nodal field on the trace of a 3D boundary on the plane z = const.
+
+    Each facet of the boundary cut by the plane contributes its cut segment (between the
+    points where its vertex-affine z equals `z`; exact when the facet's z is affine, as on the
+    extruded slab), sampled at `per_segment` + 1 equally spaced reference points and
+    evaluated with the facet's own (P1/P2) shape functions: the mesh's interpolation on that
+    facet, no mixing of nodes from other z. The sampled z is corrected to the plane by
+    Newton steps on the facet's geometry map. s = s_of_point((x, y)) of the mapped points.
+    Points at the same s (segment ends shared by neighbouring facets) are merged (mean).
+    Raises ParameterError if the plane does not cut the boundary.
+    """
+    if model.m != 3:
+        raise ParameterError("plane_profile dimension", model.m, "3 (a 2D model has its profile on its boundary)")
+    fn = _facet_nodes(model, boundary)
+    X = model.basis.doflocs                                      # (3, N) node positions
+    zv = X[2, fn[:, :3]]                                         # (F, 3) vertex z
+    scale = float(np.ptp(X[2])) or 1.0
+    tol = 1e-9 * scale
+    cut = np.flatnonzero((zv.min(axis=1) <= z + tol) & (zv.max(axis=1) >= z - tol))
+    n = fn.shape[1]
+    refs, owners = [], []
+    t = np.linspace(0.0, 1.0, per_segment + 1)
+    for f in cut:
+        pts = _plane_trace(zv[f], z, tol)
+        if len(pts) == 2:
+            refs.append(pts[0][None, :] * (1 - t)[:, None] + pts[1][None, :] * t[:, None])
+            owners.append(np.full(len(t), f))
+    if not refs:
+        zr = (float(X[2].min()), float(X[2].max()))
+        raise ParameterError("profile plane z", z, f"[{zr[0]:g}, {zr[1]:g}] mm (the slab's z range)")
+    ref = np.concatenate(refs)
+    own = np.concatenate(owners)
+    nodes = fn[own]                                              # (k, n)
+    P = X[:, nodes]                                              # (3, k, n)
+    grad_z = np.stack([P[2, :, 1] - P[2, :, 0], P[2, :, 2] - P[2, :, 0]], axis=-1)  # affine part
+    for _ in range(3):  # move along grad z (reference) until the P2 map's z is on the plane
+        zq = np.einsum("kn,kn->k", _tri_shape(ref[:, 0], ref[:, 1], n), P[2])
+        g2 = np.einsum("ki,ki->k", grad_z, grad_z)
+        ref = ref - ((zq - z) / np.where(g2 > 0, g2, 1.0))[:, None] * grad_z
+    N = _tri_shape(ref[:, 0], ref[:, 1], n)                      # (k, n)
+    xyz = np.einsum("kn,dkn->kd", N, P)
+    vals = np.einsum("kn,kn->k", N, nodal[nodes])
+    s = np.asarray(s_of_point(xyz[:, :2]), float)
+    # merge coincident samples (shared segment ends): group on s to 1e-9 of the path length
+    order = np.argsort(s, kind="stable")
+    s, vals = s[order], vals[order]
+    L = max(float(s[-1] - s[0]), 1.0)
+    new = np.concatenate([[True], np.diff(s) > 1e-9 * L])
+    grp = np.cumsum(new) - 1
+    cnt = np.bincount(grp)
+    return np.bincount(grp, weights=s) / cnt, np.bincount(grp, weights=vals) / cnt
+
+
+def profile_plane_z(model: Model) -> float:
+    """z of the section plane of a 3D model: the indenter's 2D section row
+    (`BrailleIndenter.section_z`, the dot row nearest z = 0), else z = 0."""
+    ind = getattr(model.contact, "indenter", None)
+    return float(getattr(ind, "section_z", 0.0))
+
+
 def arc_length(points: np.ndarray) -> np.ndarray:
     """A fallback s for generic meshes: distance from the point nearest x = 0, along a
     nearest-neighbour chain ordered by x (fine for open, x-monotone boundaries)."""
@@ -59,12 +171,18 @@ def arc_length(points: np.ndarray) -> np.ndarray:
 
 
 def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: str = "bone_interface",
-                vertical: int = 1, scene: dict | None = None) -> Result:
+                vertical: int = 1, scene: dict | None = None, plane_z: float | None = None) -> Result:
+    """Result of a converged state. 2D: the profile at the path's nodes. 3D: the profile on
+    the section plane z = plane_z (default `profile_plane_z(model)`), see `plane_profile`."""
     pj = Projector(model)
     fields = nodal_fields(model, ev, pj)
     if s_of_point is None:
         s_of_point = arc_length
-    s, p = path_profile(model, fields["pressure"], path, s_of_point)
+    if model.m == 3:
+        plane_z = profile_plane_z(model) if plane_z is None else float(plane_z)
+        s, p = plane_profile(model, fields["pressure"], path, s_of_point, plane_z)
+    else:
+        s, p = path_profile(model, fields["pressure"], path, s_of_point)
     if model.surface is not None and ev.contact is not None:
         g, lamN, x, n = ev.contact
         pc = model.surface.current_pressure(model.u, lamN)
@@ -91,6 +209,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           "increments": stats.increments, "newton_iterations": stats.newton_iterations,
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
           "wall_s": stats.wall_s, "formulation": model.formulation,
+          **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           "reaction_vector": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, reaction=float(r[vertical]),
                   stats=st, fields=vtk, history=list(stats.history), scene=scene)
