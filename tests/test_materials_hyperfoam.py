@@ -16,6 +16,7 @@ from tactileskin.materials import (
     pk2,
     pk2_tangent,
 )
+from tactileskin.materials.hyperfoam import pk2_tangent_plane
 
 SILICONE = get_material("silicone").hyperfoam
 POLYURETHANE = get_material("polyurethane").hyperfoam
@@ -388,3 +389,132 @@ def test_tangent_is_continuous_through_coincident_stretches(name):
         # the change is dominated by J: d ln J = gap/2, amplified by alpha*beta = 380 (silicone),
         # measured 190 gap (polyurethane 27 gap); allow 300 gap + 1e-12 (rounding of rotated C)
         assert np.abs(D - D0).max() <= (300 * gap + 1e-12) * np.abs(D0).max(), gap
+
+
+# --- plane strain fast path ------------------------------------------------------------
+
+def _embed(C2):
+    C = np.zeros(C2.shape[:-2] + (3, 3))
+    C[..., :2, :2] = C2
+    C[..., 2, 2] = 1.0
+    return C
+
+
+def _rot2(theta, M):
+    c, s = np.cos(theta), np.sin(theta)
+    R = np.array([[c, -s], [s, c]])
+    return R @ M @ R.T
+
+
+def plane_states(name, n=40, seed=5):
+    """In-plane C2: random (rotated, moderate J), undeformed, equal and nearly equal in-plane
+    stretches (relative gaps 1e-16 .. 1e-6), one in-plane stretch 1 (c = c_3), shear only."""
+    rng = np.random.default_rng(seed)
+    l1 = rng.uniform(0.8, 1.25, n)
+    l2 = np.exp(rng.uniform(-1, 1, n) * LNJ_RANGE[name]) / l1
+    Cs = [_rot2(t, np.diag([a * a, b * b])) for t, a, b in zip(rng.uniform(0, np.pi, n), l1, l2)]
+    Cs += [np.eye(2), np.diag([0.99**2] * 2), _rot2(0.3, np.diag([1.01**2] * 2)),
+           np.diag([1.0, 0.98**2]), np.array([[1.0, 0.02], [0.02, 1.0]])]
+    Cs += [_rot2(0.9, np.diag([0.995**2 * (1 + g), 0.995**2])) for g in (1e-16, 1e-14, 1e-12, 1e-9, 1e-6)]
+    return np.array(Cs)
+
+
+def guard_states():
+    """Just inside / outside every guard, plus garbage: the ok masks must be identical."""
+    lnj_cap = -EXP_CAP / (15.5 * SILICONE.beta)      # silicone term 2: J^(-alpha beta) = e^300
+    return np.array([
+        np.diag([np.exp(2 * (lnj_cap + 1e-3)), 1.0]),  # J just above the silicone cap
+        np.diag([np.exp(2 * (lnj_cap - 1e-3)), 1.0]),  # just below
+        np.diag([np.exp(29.99), 1.0]),                  # |ln c| just inside LOG_C_CAP
+        np.diag([np.exp(30.01), 1.0]),                  # just outside
+        np.diag([np.exp(-30.01), 1.0]),
+        np.diag([-0.1, 1.0]),                           # not positive definite
+        np.zeros((2, 2)),
+        np.full((2, 2), np.nan),
+        np.diag([np.inf, 1.0]),
+    ])
+
+
+def _max_rel(a, b, ok):
+    """Worst per-point difference relative to the point's largest entry (admissible points;
+    a point with b = 0, the undeformed S, must match exactly)."""
+    a = a.reshape(a.shape[0], -1)[ok]
+    b = b.reshape(b.shape[0], -1)[ok]
+    return np.max(np.abs(a - b).max(axis=1) / np.maximum(np.abs(b).max(axis=1), np.finfo(float).tiny))
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+def test_plane_strain_path_equals_general_path(name):
+    """The closed-form 2x2 path evaluates the same formulas as the 3x3 eigh path: agreement
+    to rounding. eigh's eigenvectors carry ~1e-16 absolute error, amplified at most by the
+    spread of the principal values (~10 here): 1e-12 relative is a safe, still sharp bound."""
+    mat = MATERIALS[name]
+    C2 = np.concatenate([plane_states(name), guard_states()])
+    detF = np.ones(len(C2))
+    detF[3] = -1.0                                              # flagged by detF only
+    S, D, ok = pk2_tangent(mat, _embed(C2), detF=detF)
+    S2, D2, ok2 = pk2_tangent_plane(mat, C2, detF=detF)
+    S3, D3, ok3 = pk2_tangent_plane(mat, C2, detF=detF, out_of_plane=True)
+    assert D2.shape == (len(C2), 2, 2, 2, 2) and D3.shape == D.shape and S2.shape == S.shape
+    assert np.array_equal(ok2, ok) and np.array_equal(ok3, ok)
+    assert np.delete(ok[:len(C2) - 9], 3).all() and not ok[3]  # the ordinary states pass
+    assert all(np.isfinite(x).all() for x in (S2, D2, D3))     # inadmissible: finite values
+    assert _max_rel(S2, S, ok) < 1e-12
+    assert _max_rel(D2, D[..., :2, :2, :2, :2], ok) < 1e-12
+    assert _max_rel(D3, D, ok) < 1e-12
+    assert np.array_equal(D3[..., :2, :2, :2, :2], D2)
+    # plane strain: S13 = S23 = 0 exactly, S33 kept
+    assert not np.any(S2[..., 2, :2]) and not np.any(S2[..., :2, 2])
+
+
+def test_plane_strain_path_at_the_undeformed_state_is_exact():
+    for mat in MATERIALS.values():
+        S, D, ok = pk2_tangent_plane(mat, np.eye(2), out_of_plane=True)
+        S3, D3, _ = pk2_tangent(mat, np.eye(3))
+        assert ok and np.all(S == 0.0)
+        assert D[0, 1, 0, 1] == pytest.approx(mat.mu0, rel=1e-14)
+        assert np.abs(D - D3).max() <= 1e-14 * np.abs(D3).max()
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+def test_plane_strain_tangent_matches_finite_differences(name):
+    """D_ijkl = 2 dS_ij/dC_kl over in-plane k, l (and S33's in-plane derivatives) by central
+    differences of the plane path itself; same FD budget as the 3D test (1e-6)."""
+    mat = MATERIALS[name]
+    C2 = plane_states(name, n=8)
+    _, D, ok = pk2_tangent_plane(mat, C2, out_of_plane=True)
+    assert ok.all()
+    h = 1e-6
+    Dfd = np.zeros(C2.shape[:-2] + (3, 3, 2, 2))
+    for k in range(2):
+        for l in range(2):
+            E = _sym_unit(k, l)[:2, :2]
+            Dfd[..., k, l] = (pk2_tangent_plane(mat, C2 + h * E)[0]
+                              - pk2_tangent_plane(mat, C2 - h * E)[0]) / h
+    assert _rel_err(Dfd, D[..., :2, :2]) < 1e-6
+
+
+def test_plane_strain_path_shapes_and_errors():
+    C2 = np.broadcast_to(np.diag([1.1, 0.95]), (4, 5, 2, 2))
+    S, D, ok = pk2_tangent_plane(POLYURETHANE, C2)
+    assert S.shape == (4, 5, 3, 3) and D.shape == (4, 5, 2, 2, 2, 2) and ok.shape == (4, 5)
+    S1, D1, _ = pk2_tangent_plane(POLYURETHANE, C2[0, 0])
+    assert S1.shape == (3, 3) and D1.shape == (2, 2, 2, 2)
+    assert np.array_equal(S[2, 3], S1)
+    with pytest.raises(ParameterError):
+        pk2_tangent_plane(POLYURETHANE, np.eye(3))
+
+
+def test_blocked_evaluation_equals_one_block(monkeypatch):
+    """Large inputs are evaluated in blocks of _BLOCK points: results must not depend on it."""
+    from tactileskin.materials import hyperfoam
+    C = np.concatenate([random_states("polyurethane", 7), special_states()])
+    C2 = plane_states("polyurethane", n=7)
+    detF = np.ones(len(C))
+    detF[2] = -1.0
+    ref = pk2_tangent(POLYURETHANE, C, detF=detF) + pk2_tangent_plane(POLYURETHANE, C2)
+    monkeypatch.setattr(hyperfoam, "_BLOCK", 3)
+    got = pk2_tangent(POLYURETHANE, C, detF=detF) + pk2_tangent_plane(POLYURETHANE, C2)
+    assert not got[2][2]
+    for a, b in zip(got, ref):
+        assert a.shape == b.shape and np.array_equal(a, b)

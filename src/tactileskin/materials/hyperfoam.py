@@ -48,7 +48,7 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2", "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
 def _as_float_tuple(name, value) -> tuple[float, ...]:
@@ -184,11 +184,19 @@ def _params(mat: Hyperfoam):
     return mu, alpha, 2.0 * mu / alpha, mat.beta
 
 
+def _terms(v, like):
+    """Per-term parameters (m,) shaped (m, 1, ..., 1) to broadcast against `like`.
+
+    The term axis leads: numpy's inner loops then run over the contiguous points instead of
+    over the 1-3 terms (several times faster than a trailing term axis)."""
+    return np.reshape(v, (-1,) + (1,) * np.ndim(like))
+
+
 def _guard(ok, alpha, beta, lc, lJ):
     """Flag exponents above EXP_CAP (both the deviatoric and the volumetric ones)."""
-    xv = -alpha * beta * lJ[..., None]                       # (..., m)
-    xd = 0.5 * alpha * lc[..., :, None]                      # (..., 3, m)
-    ok = ok & np.all(xv <= EXP_CAP, axis=-1) & np.all(xd <= EXP_CAP, axis=(-2, -1))
+    xv = -_terms(alpha, lJ) * beta * lJ                      # (m, ...)
+    xd = 0.5 * _terms(alpha, lc) * lc                        # (m, ..., 3)
+    ok = ok & np.all(xv <= EXP_CAP, axis=0) & np.all(xd <= EXP_CAP, axis=(0, -1))
     return ok
 
 
@@ -206,12 +214,12 @@ def energy(mat: Hyperfoam, C, *, detF=None):
 
 def _principal_f(mu, alpha, k, beta, lc, lJ):
     """f(c_a) = sum_i k_i (c_a^(alpha_i/2) - J^(-alpha_i beta)) / c_a, shape (..., 3)."""
-    lc3 = lc[..., :, None]
-    lJ3 = lJ[..., None, None]
-    x1 = (0.5 * alpha - 1.0) * lc3
-    x2 = -alpha * beta * lJ3 - lc3
-    d = alpha * (0.5 * lc3 + beta * lJ3)
-    return np.sum(k * _diffexp(x1, x2, d), axis=-1)
+    a = _terms(alpha, lc)                                    # (m, 1, ..., 1)
+    lJ3 = lJ[..., None]
+    x1 = (0.5 * a - 1.0) * lc
+    x2 = -a * beta * lJ3 - lc
+    d = a * (0.5 * lc + beta * lJ3)
+    return np.sum(_terms(k, lc) * _diffexp(x1, x2, d), axis=0)
 
 
 def pk2(mat: Hyperfoam, C, *, detF=None):
@@ -223,41 +231,94 @@ def pk2(mat: Hyperfoam, C, *, detF=None):
     return _spectral_sum(Q, f), ok
 
 
+def _gamma(mu, alpha, k, beta, e, lc, lJ):
+    """Divided differences gamma (..., 3, 3) and qv = J dp/dJ (...) of the spectral tangent.
+
+    gamma_ab: divided differences of g(c) + p/c at fixed J, where g(c) = sum k_i c^(q_i),
+    q_i = alpha_i/2 - 1, and p = -sum k_i J^(-alpha_i beta) (the volumetric part of S is p C^-1).
+    """
+    kt = _terms(k, lc)                                       # (m, 1, ..., 1): term axis first
+    q = _terms(0.5 * alpha - 1.0, lc)
+    xv = -_terms(alpha, lJ) * beta * lJ                      # (m, ...)
+    ev = _exp(xv)                                            # J^(-alpha_i beta)
+    xv3 = xv[..., None]                                      # (m, ..., 1)
+    # diagonal a = b: g'(c_a) + J^(-alpha beta) / c_a^2
+    gdiag = np.sum(kt * (q * _exp((q - 1.0) * lc) + _exp(xv3 - 2.0 * lc)), axis=0)
+    # off-diagonal pairs (0,1), (0,2), (1,2): exp * expm1 form, exact down to zero gap
+    ea, eb = e[..., _IA], e[..., _IB]
+    la, lb = lc[..., _IA], lc[..., _IB]                      # (..., 3)
+    gap = ea - eb                                            # c_a - c_b, from eigenvalues of C - I
+    ell = np.log1p(gap / (1.0 + eb))                         # ln(c_a / c_b), accurate for small gaps
+    same = np.abs(gap) <= 1e-14 * np.maximum(1.0 + ea, 1.0 + eb)
+    safe_gap = np.where(same, 1.0, gap)
+    dd = np.where(same, q * _exp((q - 1.0) * 0.5 * (la + lb)),   # g' at the mean
+                  _diffexp(q * la, q * lb, q * ell) / safe_gap)
+    goff = np.sum(kt * (dd + _exp(xv3 - la - lb)), axis=0)
+    gamma = np.empty(lc.shape[:-1] + (3, 3))
+    gamma[..., _ID, _ID] = gdiag
+    gamma[..., _IA, _IB] = goff
+    gamma[..., _IB, _IA] = goff
+    qv = np.sum(_terms(2.0 * mu * beta, lJ) * ev, axis=0)    # J dp/dJ
+    return gamma, qv
+
+
+def _log_debug_inadmissible(ok):
+    if not np.all(ok):
+        log.debug("hyperfoam: %d of %d states inadmissible (beyond the overflow guard or J <= 0)",
+                  int(np.size(ok) - np.count_nonzero(ok)), int(np.size(ok)))
+
+
+# Points per block: the tangent's temporaries of one block (~100 kB each) stay in cache
+# and below glibc's mmap threshold; whole-array temporaries of 10^4 points cost 2-4x more
+# time (page faults of freshly mapped memory) than the arithmetic itself.
+_BLOCK = 2048
+
+
+def _blocked(fn, X, detF):
+    """fn(X_block, detF_block) -> arrays (n_block, ...), applied to blocks of _BLOCK points
+    of X (..., k, k); the results are reassembled to (..., ...)."""
+    lead = X.shape[:-2]
+    n = math.prod(lead)
+    if n <= _BLOCK:
+        return fn(X, detF)
+    Xf = X.reshape((n,) + X.shape[-2:])
+    df = None if detF is None else np.broadcast_to(np.asarray(detF), lead).reshape(n)
+    outs = None
+    for s in range(0, n, _BLOCK):
+        res = fn(Xf[s:s + _BLOCK], None if df is None else df[s:s + _BLOCK])
+        if outs is None:
+            outs = [np.empty((n,) + r.shape[1:], r.dtype) for r in res]
+        for o, r in zip(outs, res):
+            o[s:s + len(r)] = r
+    return tuple(o.reshape(lead + o.shape[1:]) for o in outs)
+
+
+def _check_shape(name, X, k):
+    if X.ndim < 2 or X.shape[-2:] != (k, k):
+        raise ParameterError(f"{name}.shape", X.shape, f"(..., {k}, {k})")
+
+
 def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     """S (..., 3, 3), D = 2 dS/dC (..., 3, 3, 3, 3) and ok (...) for C (..., 3, 3).
 
-    D has minor and major symmetry. Plane strain: pass C with C33 = 1, C13 = C23 = 0.
+    D has minor and major symmetry. Plane strain: pass C with C33 = 1, C13 = C23 = 0
+    (or, faster, the in-plane block to `pk2_tangent_plane`).
     detF (optional, shape (...)): flags det F <= 0, which C = F^T F cannot reveal.
     """
+    C = np.asarray(C, dtype=float)
+    _check_shape("C", C, 3)
+    S, D, ok = _blocked(lambda Cb, db: _pk2_tangent(mat, Cb, db), C, detF)
+    _log_debug_inadmissible(ok)
+    return S, D, ok
+
+
+def _pk2_tangent(mat, C, detF):
     e, Q, lc, lJ, ok = _spectral(C, detF)
     mu, alpha, k, beta = _params(mat)
     ok = _guard(ok, alpha, beta, lc, lJ)
 
     f = _principal_f(mu, alpha, k, beta, lc, lJ)            # (..., 3)
-
-    # Divided differences of g(c) + p/c at fixed J, where g(c) = sum k_i c^(q_i), q_i = alpha_i/2 - 1
-    # and p = -sum k_i J^(-alpha_i beta) (the volumetric part of S is p C^-1).
-    q = 0.5 * alpha - 1.0                                    # (m,)
-    xv = -alpha * beta * lJ[..., None]                       # (..., m)
-    ev = _exp(xv)                                            # J^(-alpha_i beta)
-    lc1 = lc[..., :, None]                                   # (..., 3, 1)
-    # diagonal a = b: g'(c_a) + J^(-alpha beta) / c_a^2
-    gdiag = np.sum(k * (q * _exp((q - 1.0) * lc1) + _exp(xv[..., None, :] - 2.0 * lc1)), axis=-1)
-    # off-diagonal pairs (0,1), (0,2), (1,2): exp * expm1 form, exact down to zero gap
-    ea, eb = e[..., _IA], e[..., _IB]
-    la, lb = lc[..., _IA, None], lc[..., _IB, None]          # (..., 3, 1)
-    gap = ea - eb                                            # c_a - c_b, from eigenvalues of C - I
-    ell = np.log1p(gap / (1.0 + eb))[..., None]              # ln(c_a / c_b), accurate for small gaps
-    same = np.abs(gap) <= 1e-14 * np.maximum(1.0 + ea, 1.0 + eb)
-    safe_gap = np.where(same, 1.0, gap)[..., None]
-    dd = np.where(same[..., None], q * _exp((q - 1.0) * 0.5 * (la + lb)),   # g' at the mean
-                  _diffexp(q * la, q * lb, q * ell) / safe_gap)
-    goff = np.sum(k * (dd + _exp(xv[..., None, :] - la - lb)), axis=-1)
-    gamma = np.empty(lc.shape[:-1] + (3, 3))
-    gamma[..., _ID, _ID] = gdiag
-    gamma[..., _IA, _IB] = goff
-    gamma[..., _IB, _IA] = goff
-    qv = np.sum(2.0 * mu * beta * ev, axis=-1)               # J dp/dJ
+    gamma, qv = _gamma(mu, alpha, k, beta, e, lc, lJ)
 
     S = _spectral_sum(Q, f)
     Cinv = _spectral_sum(Q, np.exp(-lc))
@@ -271,10 +332,116 @@ def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     np.add(np.swapaxes(T4, -3, -2), np.moveaxis(T4, -3, -1), out=D)   # [i,j,k,l] + [i,j,l,k]
     c9 = Cinv.reshape(lead + (9, 1))
     D.reshape(lead + (9, 9))[...] += (qv[..., None, None] * c9) @ np.swapaxes(c9, -1, -2)
-    if not np.all(ok):
-        log.debug("hyperfoam: %d of %d states inadmissible (beyond the overflow guard or J <= 0)",
-                  int(np.size(ok) - np.count_nonzero(ok)), int(np.size(ok)))
     return S, D, ok
+
+
+# --- plane strain fast path ----------------------------------------------------------------
+
+def _spectral_plane(C2, detF=None):
+    """Closed-form eigen-decomposition of a plane-strain C (in-plane block C2 (..., 2, 2),
+    C33 = 1, C13 = C23 = 0). Returns e (..., 3) (e_3 = 0: the third direction is e_z),
+    the in-plane projectors P (..., 2, 3) as [a, (11, 12, 22)] of n_a n_a, lc, lJ, ok,
+    with the guards of `_spectral`."""
+    finite = np.all(np.isfinite(C2), axis=(-2, -1))
+    E = np.where(finite[..., None, None], C2, 1.0)           # non-finite -> E = 0 below
+    a = E[..., 0, 0] - 1.0
+    b = E[..., 1, 1] - 1.0
+    c = 0.5 * (E[..., 0, 1] + E[..., 1, 0])
+    h = 0.5 * (a - b)
+    r = np.hypot(h, c)                                       # half the eigenvalue gap
+    mid = 0.5 * (a + b)
+    # the eigenvalue of larger magnitude from mid +- r, the other from the determinant
+    # (no cancellation: e_small = det / e_big)
+    big = np.where(mid >= 0.0, mid + r, mid - r)
+    det = a * b - c * c
+    small = np.where(big != 0.0, det / np.where(big != 0.0, big, 1.0), 0.0)
+    e1 = np.where(mid >= 0.0, small, big)                    # e1 <= e2
+    e2 = np.where(mid >= 0.0, big, small)
+    # projector of the larger eigenvalue: (I + R(2 theta)) / 2, tan 2 theta = c / h
+    iso = r == 0.0
+    rr = np.where(iso, 1.0, r)
+    cos2 = np.where(iso, 1.0, h / rr)
+    sin2 = np.where(iso, 0.0, c / rr)
+    p11, p12 = 0.5 * (1.0 + cos2), 0.5 * sin2
+    P = np.empty(a.shape + (2, 3))
+    P[..., 1, 0], P[..., 1, 1], P[..., 1, 2] = p11, p12, 1.0 - p11
+    P[..., 0, 0], P[..., 0, 1], P[..., 0, 2] = 1.0 - p11, -p12, p11
+    e = np.stack([e1, e2, np.zeros_like(e1)], axis=-1)
+    ok = finite & np.all(e > -1.0, axis=-1)
+    pd = e > -1.0
+    lc_raw = np.where(pd, np.log1p(np.where(pd, e, 0.0)), -2.0 * LOG_C_CAP)
+    ok &= np.all(np.abs(lc_raw) <= LOG_C_CAP, axis=-1)
+    lc = np.clip(lc_raw, -LOG_C_CAP, LOG_C_CAP)
+    e = np.where(lc_raw == lc, e, np.expm1(lc))
+    if detF is not None:
+        ok &= np.asarray(detF) > 0.0
+    lJ = 0.5 * lc.sum(axis=-1)
+    return e, P, lc, lJ, ok
+
+
+def _plane_tables():
+    """Gather indices of the plane-strain path (symmetric 2x2 stored as (11, 12, 22))."""
+    V = np.array([[0, 1], [1, 2]])                           # (a, b) -> compact index
+    a, b, c, d = np.indices((2, 2, 2, 2)).reshape(4, -1)
+    T1 = 3 * V[a, c] + V[b, d]                               # T[(ac),(bd)] in T.reshape(9)
+    T2 = 3 * V[a, d] + V[b, c]                               # T[(ad),(bc)]
+    C1, C2 = V[a, b], V[c, d]
+    S9 = np.array([0, 1, 4, 1, 2, 4, 4, 4, 3])               # from (S11, S12, S22, S33, 0)
+    # full D from vals = (D2 (16), qv Cinv (3), D3333, G3 (3), 0)
+    zero, d33 = 23, 19
+    D81 = np.full((3, 3, 3, 3), zero)
+    D81[:2, :2, :2, :2] = np.arange(16).reshape(2, 2, 2, 2)
+    D81[:2, :2, 2, 2] = D81[2, 2, :2, :2] = 16 + V
+    D81[2, 2, 2, 2] = d33
+    for idx in ((slice(2), 2, slice(2), 2), (slice(2), 2, 2, slice(2)),
+                (2, slice(2), slice(2), 2), (2, slice(2), 2, slice(2))):
+        D81[idx] = 20 + V
+    return T1, T2, C1, C2, S9, D81.ravel()
+
+
+_T1, _T2, _C1, _C2, _S9, _D81 = _plane_tables()
+
+
+def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False):
+    """Plane-strain `pk2_tangent` from the in-plane block C2 (..., 2, 2) of C (C33 = 1).
+
+    Same formulas and guards as `pk2_tangent`, with the 2x2 eigenproblem solved in closed
+    form (the third principal direction is e_z, c_3 = 1). Returns S (..., 3, 3) (S33 is the
+    out-of-plane stress, S13 = S23 = 0), D = 2 dS/dC (..., 2, 2, 2, 2), the in-plane block,
+    and ok (...). out_of_plane=True returns the full D (..., 3, 3, 3, 3) instead.
+    """
+    C2 = np.asarray(C2, dtype=float)
+    _check_shape("C2", C2, 2)
+    S, D, ok = _blocked(lambda Cb, db: _pk2_tangent_plane(mat, Cb, db, out_of_plane), C2, detF)
+    _log_debug_inadmissible(ok)
+    return S, D, ok
+
+
+def _pk2_tangent_plane(mat, C2, detF, out_of_plane):
+    e, P, lc, lJ, ok = _spectral_plane(C2, detF)
+    mu, alpha, k, beta = _params(mat)
+    ok = _guard(ok, alpha, beta, lc, lJ)
+    f = _principal_f(mu, alpha, k, beta, lc, lJ)            # (..., 3)
+    gamma, qv = _gamma(mu, alpha, k, beta, e, lc, lJ)
+    lead = lc.shape[:-1]
+
+    Sv = f[..., 0, None] * P[..., 0, :] + f[..., 1, None] * P[..., 1, :]       # (11, 12, 22)
+    S = np.concatenate([Sv, f[..., 2:], np.zeros(lead + (1,))], axis=-1)[..., _S9].reshape(lead + (3, 3))
+    Civ = np.exp(-lc[..., 0, None]) * P[..., 0, :] + np.exp(-lc[..., 1, None]) * P[..., 1, :]
+    # in-plane D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd with
+    # T = sum_ab gamma_ab P_a x P_b over the in-plane directions (n_3 = e_z has no in-plane part)
+    T = (np.swapaxes(P, -1, -2) @ (gamma[..., :2, :2] @ P)).reshape(lead + (9,))
+    qC = qv[..., None] * Civ
+    D2 = T[..., _T1] + T[..., _T2] + qC[..., _C1] * Civ[..., _C2]           # (..., 16)
+    if not out_of_plane:
+        return S, D2.reshape(lead + (2, 2, 2, 2)), ok
+    # out-of-plane components (P_3 = e_z e_z): D_ab33 = D_33ab = qv Cinv_ab,
+    # D_3333 = 2 gamma_33 + qv, D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab;
+    # the rest (an odd number of 3s) vanish. One gather from the distinct values.
+    G3 = gamma[..., 0, 2, None] * P[..., 0, :] + gamma[..., 1, 2, None] * P[..., 1, :]
+    d33 = (2.0 * gamma[..., 2, 2] + qv)[..., None]
+    vals = np.concatenate([D2, qC, d33, G3, np.zeros(lead + (1,))], axis=-1)
+    return S, vals[..., _D81].reshape(lead + (3, 3, 3, 3)), ok
 
 
 def cauchy_principal(mat: Hyperfoam, stretches):
