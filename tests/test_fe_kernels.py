@@ -88,3 +88,103 @@ def test_inadmissible_state_never_yields_nan_and_raises_a_diagnosis():
     d = ei.value.diagnosis
     assert {"time", "dt", "reason"} <= set(d)
     assert 0.0 < d["time"] < 1.0
+
+
+# --- optimised kernels vs a literal transcription of the formulas ------------------------
+
+def _reference_kernels(kin_ue, G, w, mixed, S, D):
+    """Residual and tangent written literally: F, F_bar, B (dF per dof), AA, B_bar as in the
+    module docstring of fe.kernels, with numpy's det/inv and einsum (the pre-optimisation code)."""
+    E, Q, A, m = G.shape
+    nd = A * m
+    F = np.eye(m) + np.einsum("eai,eqaj->eqij", kin_ue, G)
+    J = np.linalg.det(F)
+    h = np.einsum("eqaj,eqji->eqai", G, np.linalg.inv(F))
+    V = w.sum(axis=1)
+    theta = (w * J).sum(axis=1) / V
+    alpha = (theta[:, None] / J) ** (1.0 / m) if mixed else np.ones_like(J)
+    Fb = alpha[..., None, None] * F
+    P = Fb @ S
+    AA = np.einsum("eqiI,eqkK,eqIJKL->eqiJkL", Fb, Fb, D) + np.einsum("ik,eqJL->eqiJkL", np.eye(m), S)
+    AA = AA.reshape(E, Q, m * m, m * m)
+    B = np.einsum("ik,eqaJ->eqiJak", np.eye(m), G).reshape(E, Q, m * m, nd)
+    p = np.einsum("eqiJ,eqiJd->eqd", P, B.reshape(E, Q, m, m, nd))
+    L = h.reshape(E, Q, nd)
+    if not mixed:
+        return np.einsum("eq,eqd->ed", w, p), np.einsum("eq,eqrd,eqrs,eqsf->edf", w, B, AA, B)
+    v2 = np.einsum("eq,eqd->ed", w * J, L) / V[:, None]
+    dphi = (v2[:, None, :] / theta[:, None, None] - L) / m
+    tau = np.einsum("eqij,eqij->eq", P, Fb)
+    f = np.einsum("eq,eqd->ed", w, alpha[..., None] * p + tau[..., None] * dphi)
+    Bbar = alpha[..., None, None] * (B + F.reshape(E, Q, m * m)[..., None] * dphi[..., None, :])
+    K = np.einsum("eq,eqrd,eqrs,eqsf->edf", w, Bbar, AA, Bbar)
+    pa = alpha[..., None] * p
+    K += np.einsum("eq,eqd,eqf->edf", w, dphi, pa) + np.einsum("eq,eqd,eqf->edf", w, pa, dphi)
+    # tau (dphi dphi + d2phi), m d2phi = d2theta/theta - dtheta^2/theta^2 + tr(F^-1 dF F^-1 dF)
+    # with d2theta = avg_q J [tr(F^-1 dF)^2 - tr(F^-1 dF F^-1 dF)]
+    K += np.einsum("eq,eqd,eqf->edf", w * tau, dphi, dphi)
+    hh = np.einsum("eqak,eqbi->eaibk", h, h).reshape(E, nd, nd)   # tr(F^-1 dF F^-1 dF)
+    hh_q = np.einsum("eqak,eqbi->eqaibk", h, h).reshape(E, Q, nd, nd)
+    LL_q = np.einsum("eqd,eqf->eqdf", L, L)
+    d2theta = np.einsum("eq,eqdf->edf", w * J, LL_q - hh_q) / V[:, None, None]
+    trace2 = np.einsum("eq,eqdf->edf", w * tau, hh_q)
+    wt = (w * tau).sum(axis=1)
+    K += (wt[:, None, None] * (d2theta / theta[:, None, None]
+                                - v2[:, :, None] * v2[:, None, :] / theta[:, None, None] ** 2)
+          + trace2) / m
+    del hh
+    return f, K
+
+
+@pytest.mark.parametrize("formulation", ["mixed", "displacement"])
+@pytest.mark.parametrize("kind", ["tri", "tet"])
+def test_kernels_match_literal_formulas(kind, formulation, monkeypatch):
+    """The Voigt/rank-one evaluation of the tangent, the blocked loop (forced to several
+    blocks here) and the cofactor det/inv change only the order of floating-point
+    operations: agreement to 1e-12 relative (observed ~1e-15)."""
+    from tactileskin.fe import kernels
+
+    monkeypatch.setattr(kernels, "_TANGENT_BLOCK_DOUBLES", 1)     # blocks of 8 elements
+    mesh = (MeshTri.init_tensor(*(np.linspace(0, 1, 4),) * 2) if kind == "tri"
+            else MeshTet.init_tensor(*(np.linspace(0, 1, 3),) * 3))
+    law = material_law(get_material("polyurethane").hyperfoam)
+    model = Model(mesh, {"x0": mesh.facets_satisfying(lambda x: x[0] < 1e-9)}, law,
+                  [Dirichlet("x0", (0,))], formulation=formulation)
+    assert model.w.shape[0] > 8
+    m = model.m
+    u = 0.02 * np.random.default_rng(2).standard_normal(model.ndof)
+    ue = u.reshape(-1, m)[model.sdofs]
+    kin = kernels.Kinematics(ue, model.G, model.w, model.mixed)
+    assert kin.admissible
+    S3, D3, ok = law(kin.C)
+    assert ok.all()
+    S, D = S3[..., :m, :m], np.ascontiguousarray(D3[..., :m, :m, :m, :m])
+    f_ref, K_ref = _reference_kernels(ue, model.G, model.w, model.mixed, S, D)
+    f, K = kernels.residual(kin, S), kernels.tangent(kin, S, D)
+    assert np.abs(f - f_ref).max() <= 1e-12 * np.abs(f_ref).max()
+    assert np.abs(K - K_ref).max() <= 1e-12 * np.abs(K_ref).max()
+    F = kin.F
+    assert np.abs(kin.J - np.linalg.det(F)).max() <= 1e-14
+    assert np.abs(kin.Finv - np.linalg.inv(F)).max() <= 1e-13
+
+
+def test_material_law_plane_path_serves_2d_and_3d():
+    """fe.material_law takes the closed-form plane path for a plane C and must return the
+    full 3x3x3x3 D there (a 3D model at C = I passes a plane C too)."""
+    from tactileskin.materials import pk2_tangent
+
+    hf = get_material("silicone").hyperfoam
+    law = material_law(hf)
+    rng = np.random.default_rng(4)
+    F = np.eye(3) + 0.03 * rng.standard_normal((6, 3, 3))
+    F[:, 2, :2] = F[:, :2, 2] = 0.0
+    F[:, 2, 2] = 1.0
+    C = np.einsum("nki,nkj->nij", F, F)
+    C[0] = np.eye(3)
+    for Cs in (C, C[:1]):
+        S, D, ok = law(Cs)
+        S0, D0, ok0 = pk2_tangent(hf, Cs)
+        assert D.shape == D0.shape and np.array_equal(ok, ok0)
+        # same formulas, closed-form vs LAPACK eigenvectors: rounding only
+        assert np.abs(D - D0).max() <= 1e-12 * np.abs(D0).max()
+        assert np.abs(S - S0).max() <= 1e-12 * np.abs(D0).max() * 0.03

@@ -34,7 +34,8 @@ def deformation_gradient(ue: np.ndarray, G: np.ndarray) -> np.ndarray:
     """In-plane/3D deformation gradient (E, Q, m, m) from element displacements (E, A, m)
     and reference shape-function gradients G (E, Q, A, m)."""
     m = ue.shape[-1]
-    return np.eye(m) + np.einsum("eai,eqaj->eqij", ue, G)
+    # F_ij = d_ij + sum_a ue_ai G_aj: one (m, A) @ (A, m) product per point
+    return np.eye(m) + np.swapaxes(ue, 1, 2)[:, None] @ G
 
 
 def embed3(M: np.ndarray, fill33: float = 1.0) -> np.ndarray:
@@ -47,6 +48,33 @@ def embed3(M: np.ndarray, fill33: float = 1.0) -> np.ndarray:
     return out
 
 
+def _det_inv(F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """det F and F^-1 of (..., m, m), m = 2 or 3, by cofactors (numpy's LU-based det/inv
+    cost a LAPACK call per 2x2/3x3 matrix). Call only where det F != 0."""
+    if F.shape[-1] == 2:
+        a, b, c, d = F[..., 0, 0], F[..., 0, 1], F[..., 1, 0], F[..., 1, 1]
+        det = a * d - b * c
+        adj = np.stack([d, -b, -c, a], axis=-1).reshape(F.shape)
+        return det, adj / det[..., None, None]
+    r0, r1, r2 = F[..., 0, :], F[..., 1, :], F[..., 2, :]
+    # columns of the adjugate are cross products of the rows
+    adjT = np.stack([np.cross(r1, r2), np.cross(r2, r0), np.cross(r0, r1)], axis=-2)   # cof(F)
+    det = np.sum(r0 * adjT[..., 0, :], axis=-1)
+    return det, np.swapaxes(adjT, -1, -2) / det[..., None, None]
+
+
+def _det(F: np.ndarray) -> np.ndarray:
+    if F.shape[-1] == 2:
+        return F[..., 0, 0] * F[..., 1, 1] - F[..., 0, 1] * F[..., 1, 0]
+    r0, r1, r2 = F[..., 0, :], F[..., 1, :], F[..., 2, :]
+    return np.sum(r0 * np.cross(r1, r2), axis=-1)
+
+
+def _wsum(w: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """sum_q w_q X_q for w (E, Q) and X (E, Q, d): one (1, Q) @ (Q, d) product per element."""
+    return (w[:, None, :] @ X)[:, 0, :]
+
+
 class Kinematics:
     """Kinematic quantities of one trial displacement, shared by residual, tangent and output."""
 
@@ -55,13 +83,14 @@ class Kinematics:
         self.mixed = mixed
         self.G, self.w = G, w
         self.F = deformation_gradient(ue, G)
-        self.J = np.linalg.det(self.F)
+        with np.errstate(over="ignore", invalid="ignore"):   # a wild trial state: caught below
+            self.J = _det(self.F)
         self.admissible = bool(np.all(self.J > 0.0) and np.all(np.isfinite(self.J)))
         if not self.admissible:
             return
-        self.Finv = np.linalg.inv(self.F)
+        self.J, self.Finv = _det_inv(self.F)
         # spatial gradients h_a = G_a F^-1, (E, Q, A, m)
-        self.h = np.einsum("eqaj,eqji->eqai", G, self.Finv)
+        self.h = G @ self.Finv
         if mixed:
             V = w.sum(axis=1)
             self.theta = (w * self.J).sum(axis=1) / V                       # (E,)
@@ -72,8 +101,8 @@ class Kinematics:
             self.alpha = np.ones_like(self.J)
             self.Fbar = self.F
             self.Jbar = self.J
-        Fb3 = embed3(self.Fbar)
-        self.C = np.einsum("...ki,...kj->...ij", Fb3, Fb3)                  # C_bar (E, Q, 3, 3)
+        Cm = np.swapaxes(self.Fbar, -1, -2) @ self.Fbar
+        self.C = embed3(Cm)                                                  # C_bar (E, Q, 3, 3)
 
     def phi_grad(self) -> np.ndarray:
         """dphi as element vectors (E, Q, A*m); zero in the displacement formulation."""
@@ -82,21 +111,25 @@ class Kinematics:
         if not self.mixed:
             return np.zeros_like(L)
         V = self.w.sum(axis=1)
-        v2 = np.einsum("eq,eqd->ed", self.w * self.J, L) / V[:, None]       # dtheta
+        v2 = _wsum(self.w * self.J, L) / V[:, None]                         # dtheta
         self._v2, self._L = v2, L
         return (v2[:, None, :] / self.theta[:, None, None] - L) / m
 
 
+def _nodal(kin: Kinematics, P: np.ndarray) -> np.ndarray:
+    """alpha P : dF per dof, (E, Q, A*m): sum_J P_iJ G_aJ at local dof (a, i)."""
+    E, Q, A, m = kin.G.shape
+    return kin.alpha[..., None] * (kin.G @ np.swapaxes(P, -1, -2)).reshape(E, Q, A * m)
+
+
 def residual(kin: Kinematics, S: np.ndarray) -> np.ndarray:
     """Internal force element vectors (E, A*m) from the in-plane PK2 stress S (E, Q, m, m)."""
-    E, Q, A, m = kin.G.shape
     P = kin.Fbar @ S                                                         # P_bar
-    p = kin.alpha[..., None] * np.einsum("eqij,eqaj->eqai", P, kin.G).reshape(E, Q, A * m)
-    f = np.einsum("eq,eqd->ed", kin.w, p)
+    p = _nodal(kin, P)
     if kin.mixed:
-        tau = np.einsum("eqij,eqij->eq", P, kin.Fbar)
-        f += np.einsum("eq,eqd->ed", kin.w * tau, kin.phi_grad())
-    return f
+        tau = np.sum(P * kin.Fbar, axis=(-2, -1))
+        p = p + tau[..., None] * kin.phi_grad()
+    return _wsum(kin.w, p)
 
 
 def _sumq(left: np.ndarray, right: np.ndarray) -> np.ndarray:
@@ -105,50 +138,96 @@ def _sumq(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return np.swapaxes(left.reshape(E, Q * k, nd), 1, 2) @ right.reshape(E, Q * k, nd)
 
 
+# Voigt pairs (I, J), I <= J, of a symmetric m x m tensor
+_VOIGT = {2: (np.array([0, 1, 0]), np.array([0, 1, 1])),
+          3: (np.array([0, 1, 2, 1, 0, 0]), np.array([0, 1, 2, 2, 2, 1]))}
+# elements per block of the tangent: its temporaries (~(Q * 2 * 6 + 3) * nd doubles per
+# element) then stay cache-sized; whole-mesh temporaries of 3D meshes run to 100 MB
+_TANGENT_BLOCK_DOUBLES = 1 << 17
+
+
 def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m)."""
+    """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m).
+
+    D must have minor symmetry (any D = 2 dS/dC of a symmetric S has). With B the map from
+    dofs to dF (dF_iJ = d_ik G_aJ at dof (a, k)) and AA_iJkL = d_ik S_JL + Fb_iI Fb_kK D_IJKL,
+    the displacement part sum_q w B^T AA B is evaluated as
+        material:  Y^T Dv Y, Y_(IJ),(a,i) = Fb_iI G_aJ + Fb_iJ G_aI (Voigt pairs IJ),
+        geometric: (G S G^T)_ab d_ik,
+    and the mixed B_bar = alpha (B + F dphi) adds the rank-one terms of AA F (no AA formed).
+    Evaluated in blocks of elements (see _TANGENT_BLOCK_DOUBLES).
+    """
     E, Q, A, m = kin.G.shape
     nd = A * m
-    mm = m * m
-    Fb = kin.Fbar
-    # AA_iJkL = d_ik S_JL + Fb_iI Fb_kK D_IJKL as an (m*m, m*m) matrix per point
-    Fk = np.einsum("eqiI,eqkK->eqikIK", Fb, Fb).reshape(E, Q, mm, mm)       # [(i,k),(I,K)]
-    Dr = D.transpose(0, 1, 2, 4, 3, 5).reshape(E, Q, mm, mm)                # [(I,K),(J,L)]
-    AA = (Fk @ Dr).reshape(E, Q, m, m, m, m).transpose(0, 1, 2, 4, 3, 5)     # [i,J,k,L]
-    AA = AA + np.eye(m)[None, None, :, None, :, None] * S[:, :, None, :, None, :]
-    AA = AA.reshape(E, Q, mm, mm)
-    # B: dF_iJ from local dof (a, k) = d_ik G_aJ   -> (E, Q, m*m, nd)
-    B = np.zeros((E, Q, m, m, A, m))
+    K = np.empty((E, nd, nd))
+    fields = {"G": kin.G, "w": kin.w, "Fb": kin.Fbar, "S": S, "D": D}
+    if kin.mixed:
+        fields.update(F=kin.F, alpha=kin.alpha, J=kin.J, h=kin.h, theta=kin.theta,
+                      dphi=kin.phi_grad(), L=kin._L, v2=kin._v2, Cb=kin.C[..., :m, :m])
+    blk = max(8, _TANGENT_BLOCK_DOUBLES // ((2 * Q * len(_VOIGT[m]) + 3) * nd))
+    for s in range(0, E, blk):
+        _tangent_block(K[s:s + blk], kin.mixed, **{k: v[s:s + blk] for k, v in fields.items()})
+    return K
+
+
+def _tangent_block(K, mixed, G, w, Fb, S, D, F=None, alpha=None, J=None, h=None, theta=None,
+                   dphi=None, L=None, v2=None, Cb=None):
+    """The tangent of a block of elements into K (E, nd, nd); see `tangent`."""
+    E, Q, A, m = G.shape
+    nd = A * m
+    w0 = w
+    if mixed:
+        w = w * alpha**2
+    vi, vj = _VOIGT[m]
+    nv = len(vi)
+    FbT = np.swapaxes(Fb, -1, -2)                                            # [I, i]
+    GT = np.ascontiguousarray(np.swapaxes(G, -1, -2))                        # [J, a]
+    Y = np.empty((E, Q, nv, A, m))
+    for r in range(nv):
+        I, J_ = vi[r], vj[r]
+        for i in range(m):
+            y = Y[:, :, r, :, i]
+            np.multiply(FbT[:, :, I, i, None], GT[:, :, J_, :], out=y)
+            if I == J_:
+                y *= 2.0
+            else:
+                y += FbT[:, :, J_, i, None] * GT[:, :, I, :]
+    Y = Y.reshape(E, Q, nv, nd)
+    half = np.where(vi == vj, 0.5, 1.0)
+    wDv = D[:, :, vi[:, None], vj[:, None], vi[None, :], vj[None, :]] * (
+        w[..., None, None] * (half[:, None] * half[None, :]))
+    np.matmul(np.swapaxes(Y.reshape(E, Q * nv, nd), 1, 2), (wDv @ Y).reshape(E, Q * nv, nd), out=K)
+    Kg = _sumq((w[..., None, None] * S) @ GT, GT)                            # (E, A, A)
+    Kv = K.reshape(E, A, m, A, m)
     for i in range(m):
-        B[:, :, i, :, :, i] = np.swapaxes(kin.G, 2, 3)
-    B = B.reshape(E, Q, mm, nd)
-    w = kin.w
-    if not kin.mixed:
-        return _sumq(B * w[..., None, None], AA @ B)
-    dphi = kin.phi_grad()                                                    # (E, Q, nd)
-    Bbar = kin.alpha[..., None, None] * (B + kin.F.reshape(E, Q, mm)[..., None] * dphi[..., None, :])
-    K = _sumq(Bbar * w[..., None, None], AA @ Bbar)
+        Kv[:, :, i, :, i] += Kg
+    if not mixed:
+        return
+    # B^T AA F = g, F : AA F = s with AA F = Fb (D : C_bar + S) / alpha (S symmetric)
+    DC = (D.reshape(E, Q, m * m, m * m) @ Cb.reshape(E, Q, m * m, 1)).reshape(E, Q, m, m)
+    v = Fb @ (DC + S) / alpha[..., None, None]
+    g = (G @ np.swapaxes(v, -1, -2)).reshape(E, Q, nd)
+    s = np.sum(F * v, axis=(-2, -1))
     P = Fb @ S
-    tau = np.einsum("eqij,eqij->eq", P, Fb)
-    p = kin.alpha[..., None] * np.einsum("eqij,eqaj->eqai", P, kin.G).reshape(E, Q, nd)
-    L, v2, th = kin._L, kin._v2, kin.theta
-    wt = w * tau
-    V = w.sum(axis=1)
-    coef = wt.sum(axis=1) / (m * th) / V
-    wJ = w * kin.J
-    # tau dphi dphi + dphi p + p dphi = dphi r + r dphi, r = p + tau dphi / 2
-    r = p + 0.5 * tau[..., None] * dphi
-    wd = (w[..., None] * dphi)[:, :, None, :]
-    K += _sumq(wd, r[:, :, None, :])
-    K += _sumq(r[:, :, None, :], wd)
+    tau = np.sum(P * Fb, axis=(-2, -1))
+    p = alpha[..., None] * (G @ np.swapaxes(P, -1, -2)).reshape(E, Q, nd)
+    wt = w0 * tau
+    V = w0.sum(axis=1)
+    coef = wt.sum(axis=1) / (m * theta) / V
+    wJ = w0 * J
+    # alpha^2 (g dphi + dphi g + s dphi dphi) + tau dphi dphi + dphi p + p dphi
+    #   = dphi r + r dphi,  r = p + tau dphi / 2 + alpha^2 (g + s dphi / 2)
+    a2 = alpha**2
+    r = p + (0.5 * (tau + a2 * s))[..., None] * dphi + a2[..., None] * g
+    wd = w0[..., None] * dphi
+    K += _sumq(np.stack([wd, r, coef[:, None, None] * wJ[..., None] * L], axis=2),
+               np.stack([r, wd, L], axis=2))
     # tr(F^-1 dF F^-1 dF) terms: sum_q c_q h_q,bi h_q,ak at [(a,i),(b,k)]
     c = wt / m - coef[:, None] * wJ
-    hq = kin.h.reshape(E, Q, 1, nd)
+    hq = h.reshape(E, Q, 1, nd)
     N = _sumq(c[..., None, None] * hq, hq)                                   # [(a,k),(b,i)]
-    K += N.reshape(E, A, m, A, m).transpose(0, 1, 4, 3, 2).reshape(E, nd, nd)
-    K -= (wt.sum(axis=1) / m / th**2)[:, None, None] * (v2[:, :, None] * v2[:, None, :])
-    K += coef[:, None, None] * _sumq((wJ[..., None] * L)[:, :, None, :], L[:, :, None, :])
-    return K
+    Kv += N.reshape(E, A, m, A, m).transpose(0, 1, 4, 3, 2)
+    K -= ((wt.sum(axis=1) / m / theta**2)[:, None] * v2)[:, :, None] * v2[:, None, :]
 
 
 def cauchy(kin: Kinematics, S3: np.ndarray) -> np.ndarray:
