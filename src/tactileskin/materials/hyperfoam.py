@@ -274,22 +274,17 @@ def _log_debug_inadmissible(ok):
 _BLOCK = 2048
 
 
-def _blocked(fn, X, detF):
-    """fn(X_block, detF_block) -> arrays (n_block, ...), applied to blocks of _BLOCK points
-    of X (..., k, k); the results are reassembled to (..., ...)."""
+def _blocked(fn, X, detF, tails):
+    """Evaluate fn(X_block, detF_block, outs_block) on blocks of _BLOCK points of X (..., k, k);
+    fn writes its results into outs_block, views of arrays (n_block,) + tail for each tail in
+    `tails` (the last one boolean: the ok mask). Returns the outputs shaped (...,) + tail."""
     lead = X.shape[:-2]
     n = math.prod(lead)
-    if n <= _BLOCK:
-        return fn(X, detF)
     Xf = X.reshape((n,) + X.shape[-2:])
     df = None if detF is None else np.broadcast_to(np.asarray(detF), lead).reshape(n)
-    outs = None
+    outs = [np.empty((n,) + t, dtype=float) for t in tails[:-1]] + [np.empty((n,) + tails[-1], bool)]
     for s in range(0, n, _BLOCK):
-        res = fn(Xf[s:s + _BLOCK], None if df is None else df[s:s + _BLOCK])
-        if outs is None:
-            outs = [np.empty((n,) + r.shape[1:], r.dtype) for r in res]
-        for o, r in zip(outs, res):
-            o[s:s + len(r)] = r
+        fn(Xf[s:s + _BLOCK], None if df is None else df[s:s + _BLOCK], [o[s:s + _BLOCK] for o in outs])
     return tuple(o.reshape(lead + o.shape[1:]) for o in outs)
 
 
@@ -307,12 +302,15 @@ def pk2_tangent(mat: Hyperfoam, C, *, detF=None):
     """
     C = np.asarray(C, dtype=float)
     _check_shape("C", C, 3)
-    S, D, ok = _blocked(lambda Cb, db: _pk2_tangent(mat, Cb, db), C, detF)
+    S, D, ok = _blocked(lambda Cb, db, out: _pk2_tangent(mat, Cb, db, out), C, detF,
+                        [(3, 3), (3, 3, 3, 3), ()])
     _log_debug_inadmissible(ok)
     return S, D, ok
 
 
-def _pk2_tangent(mat, C, detF):
+def _pk2_tangent(mat, C, detF, out):
+    """pk2_tangent of points C (n, 3, 3), written into out = [S, D, ok] (n, ...)."""
+    S, D, ok_out = out
     e, Q, lc, lJ, ok = _spectral(C, detF)
     mu, alpha, k, beta = _params(mat)
     ok = _guard(ok, alpha, beta, lc, lJ)
@@ -320,7 +318,8 @@ def _pk2_tangent(mat, C, detF):
     f = _principal_f(mu, alpha, k, beta, lc, lJ)            # (..., 3)
     gamma, qv = _gamma(mu, alpha, k, beta, e, lc, lJ)
 
-    S = _spectral_sum(Q, f)
+    np.matmul(Q * f[..., None, :], np.swapaxes(Q, -1, -2), out=S)   # _spectral_sum(Q, f)
+    ok_out[...] = ok
     Cinv = _spectral_sum(Q, np.exp(-lc))
     # D_ijkl = sum_ab gamma_ab (P_a,ik P_b,jl + P_a,il P_b,jk) + qv Cinv_ij Cinv_kl, P_a = n_a n_a,
     # as batched 9x9 matrix products (several times faster than a 5-index einsum).
@@ -328,11 +327,10 @@ def _pk2_tangent(mat, C, detF):
     Qt = np.swapaxes(Q, -1, -2)                              # rows n_a
     Pm = (Qt[..., :, :, None] * Qt[..., :, None, :]).reshape(lead + (3, 9))   # [a, (i,k)]
     T4 = (np.swapaxes(Pm, -1, -2) @ (gamma @ Pm)).reshape(lead + (3, 3, 3, 3))  # [i,k,j,l]
-    D = np.empty(lead + (3, 3, 3, 3))                        # C-contiguous: reshape below is a view
+    # D is a block of a C-contiguous array: the reshape below is a view
     np.add(np.swapaxes(T4, -3, -2), np.moveaxis(T4, -3, -1), out=D)   # [i,j,k,l] + [i,j,l,k]
     c9 = Cinv.reshape(lead + (9, 1))
     D.reshape(lead + (9, 9))[...] += (qv[..., None, None] * c9) @ np.swapaxes(c9, -1, -2)
-    return S, D, ok
 
 
 # --- plane strain fast path ----------------------------------------------------------------
@@ -412,12 +410,15 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     """
     C2 = np.asarray(C2, dtype=float)
     _check_shape("C2", C2, 2)
-    S, D, ok = _blocked(lambda Cb, db: _pk2_tangent_plane(mat, Cb, db, out_of_plane), C2, detF)
+    S, D, ok = _blocked(lambda Cb, db, out: _pk2_tangent_plane(mat, Cb, db, out_of_plane, out), C2,
+                        detF, [(3, 3), (3, 3, 3, 3) if out_of_plane else (2, 2, 2, 2), ()])
     _log_debug_inadmissible(ok)
     return S, D, ok
 
 
-def _pk2_tangent_plane(mat, C2, detF, out_of_plane):
+def _pk2_tangent_plane(mat, C2, detF, out_of_plane, out):
+    """pk2_tangent_plane of points C2 (n, 2, 2), written into out = [S, D, ok] (n, ...)."""
+    S_out, D_out, ok_out = out
     e, P, lc, lJ, ok = _spectral_plane(C2, detF)
     mu, alpha, k, beta = _params(mat)
     ok = _guard(ok, alpha, beta, lc, lJ)
@@ -426,22 +427,27 @@ def _pk2_tangent_plane(mat, C2, detF, out_of_plane):
     lead = lc.shape[:-1]
 
     Sv = f[..., 0, None] * P[..., 0, :] + f[..., 1, None] * P[..., 1, :]       # (11, 12, 22)
-    S = np.concatenate([Sv, f[..., 2:], np.zeros(lead + (1,))], axis=-1)[..., _S9].reshape(lead + (3, 3))
+    # gathers with mode="clip" write straight into the output (indices are in range)
+    np.take(np.concatenate([Sv, f[..., 2:], np.zeros(lead + (1,))], axis=-1), _S9, axis=-1,
+            out=S_out.reshape(lead + (9,)), mode="clip")
+    ok_out[...] = ok
     Civ = np.exp(-lc[..., 0, None]) * P[..., 0, :] + np.exp(-lc[..., 1, None]) * P[..., 1, :]
     # in-plane D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd with
     # T = sum_ab gamma_ab P_a x P_b over the in-plane directions (n_3 = e_z has no in-plane part)
     T = (np.swapaxes(P, -1, -2) @ (gamma[..., :2, :2] @ P)).reshape(lead + (9,))
     qC = qv[..., None] * Civ
-    D2 = T[..., _T1] + T[..., _T2] + qC[..., _C1] * Civ[..., _C2]           # (..., 16)
+    D2 = D_out.reshape(lead + (16,)) if not out_of_plane else np.empty(lead + (16,))
+    np.add(T[..., _T1], T[..., _T2], out=D2)
+    D2 += qC[..., _C1] * Civ[..., _C2]
     if not out_of_plane:
-        return S, D2.reshape(lead + (2, 2, 2, 2)), ok
+        return
     # out-of-plane components (P_3 = e_z e_z): D_ab33 = D_33ab = qv Cinv_ab,
     # D_3333 = 2 gamma_33 + qv, D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab;
     # the rest (an odd number of 3s) vanish. One gather from the distinct values.
     G3 = gamma[..., 0, 2, None] * P[..., 0, :] + gamma[..., 1, 2, None] * P[..., 1, :]
     d33 = (2.0 * gamma[..., 2, 2] + qv)[..., None]
     vals = np.concatenate([D2, qC, d33, G3, np.zeros(lead + (1,))], axis=-1)
-    return S, vals[..., _D81].reshape(lead + (3, 3, 3, 3)), ok
+    np.take(vals, _D81, axis=-1, out=D_out.reshape(lead + (81,)), mode="clip")
 
 
 def cauchy_principal(mat: Hyperfoam, stretches):
