@@ -50,9 +50,31 @@ WINDOW_S = 6.0          # mm: bone-pressure window of the paper (s <= 6 mm)
 TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin thickness)
 
 # Measured relative differences (2D ridge - 3D dots) / 3D dots of the peak bone pressure
-# ("peak") and span ("span"), keyed by (thickness, material), from docs/hard_cases.md
-# ("2D ridge against 3D dots"). Empty until a 3D Braille solve completes.
-MEASURED_RIDGE_VS_DOTS: dict[tuple[float, str], dict] = {}
+# ("peak") and span ("span", results.span), signed, keyed by (thickness, material, dot
+# pattern) with the pattern as Unicode braille ("\u2801": one dot, the paper's section;
+# "\u283f": the full cell); a key without pattern means the single dot. The planner's cost
+# is |peak|. Filled from benchmarks/results/braille_2d_vs_3d.md (see there for meshes and
+# caveats).
+MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {}
+
+SINGLE_DOT = "\u2801"
+
+
+def dot_pattern(text: str) -> str:
+    """The Unicode braille pattern of a Braille text ("" is the paper's single dot)."""
+    from tactileskin.geometry.braille import cells_to_unicode, text_to_cells
+
+    return SINGLE_DOT if text == "" else cells_to_unicode(text_to_cells(text))
+
+
+def measured_ridge_vs_dots(scene: Scene) -> dict | None:
+    """The stored 2D-ridge vs 3D-dots difference for the scene's thickness, material and
+    dot pattern (None when not measured)."""
+    t, mat, pat = float(scene.thickness), scene.material, dot_pattern(scene.braille_text)
+    meas = MEASURED_RIDGE_VS_DOTS.get((t, mat, pat))
+    if meas is None and pat == SINGLE_DOT:
+        meas = MEASURED_RIDGE_VS_DOTS.get((t, mat))
+    return meas
 
 # Measured truncation errors (relative L2 of P(s) on s <= 6 mm, relative to the peak; and
 # the relative peak change), keyed by (thickness, material, indenter): `check_truncation`
@@ -232,20 +254,20 @@ def plan(scene: Scene, tolerance: float = 0.01, *, braille: str = "dots", verify
         choices.append(Choice("dimension", "2D plane strain",
                               f"the {scene.indenter.value} indenter is uniform along the finger", 0.0))
     else:
-        meas = MEASURED_RIDGE_VS_DOTS.get((float(scene.thickness), scene.material))
+        meas = measured_ridge_vs_dots(scene)
         if braille == "ridge":
             out = out.replace(dim=2)
-            cost = None if meas is None else meas["peak"]
+            cost = None if meas is None else abs(meas["peak"])
             choices.append(Choice("dimension", "2D plane strain, dot row as a ridge (the paper's model)",
                                   "asked for the ridge model; " + (
                                       "2D vs 3D difference not measured for this thickness and material"
                                       if meas is None else f"measured 2D vs 3D: {_meas_text(meas)}"),
                                   cost, "unknown" if meas is None else "measured"))
-        elif meas is not None and meas["peak"] <= budget:
+        elif meas is not None and abs(meas["peak"]) <= budget:
             out = out.replace(dim=2)
             choices.append(Choice("dimension", "2D plane strain, dot row as a ridge",
                                   f"measured 2D vs 3D difference within tolerance: {_meas_text(meas)}",
-                                  meas["peak"], "measured"))
+                                  abs(meas["peak"]), "measured"))
         else:
             out = out.replace(dim=3)
             why = ("2D vs 3D difference not measured for this thickness and material" if meas is None
@@ -282,9 +304,9 @@ def plan(scene: Scene, tolerance: float = 0.01, *, braille: str = "dots", verify
 
 
 def _meas_text(meas: dict) -> str:
-    parts = [f"peak {meas['peak']:.1%}"]
+    parts = [f"peak {meas['peak']:+.1%}"]
     if "span" in meas:
-        parts.append(f"span {meas['span']:.1%}")
+        parts.append(f"span {meas['span']:+.1%}")
     if "note" in meas:
         parts.append(meas["note"])
     return ", ".join(parts)
