@@ -128,3 +128,10 @@ def test_absurd_3d_request_is_refused_before_gmsh():
     # refined size 0.02 mm over a 10 mm slab: ~1e9 tetrahedra; must fail fast, naming the knob
     with pytest.raises(ParameterError, match=r"mesh_size.*5e\+06 cells in 3D"):
         build_mesh(Scene(thickness=5.0, dim=3), mesh_size=0.1, refinement=5.0)
+
+
+def test_cell_estimate_is_upper_side_3d(slab_t3):
+    # the slab uses the same graded plan; its estimate (checked before gmsh) must not fall
+    # below the actual count nor exceed it 2x (measured 1.0-1.5x for sizes <= the thickness)
+    r = slab_t3.sizes["estimate"] / slab_t3.mesh.nelements
+    assert 1.0 <= r <= 2.0, r

@@ -90,7 +90,7 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
         for name in ("outer_surface", "nail_edge", "bone_interface", "symmetry"):
             gmsh.model.addPhysicalGroup(1, tags[name], name=name)
         gmsh.model.addPhysicalGroup(2, tags["surface"], name="skin")
-        sizing.apply_fields(gmsh, plan, tags["interface_roi"], dim=2)
+        sizing.apply_fields(gmsh, plan, tags["outer_surface"], tags["interface_roi"], dim=2)
         if cell == "quad":
             gmsh.option.setNumber("Mesh.Algorithm", 8)  # Frontal-Delaunay for quads
             gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)  # full-quad: no triangle left

@@ -85,7 +85,7 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
         for name in names:
             gmsh.model.addPhysicalGroup(2, faces[name], name=name)
         gmsh.model.addPhysicalGroup(3, vol, name="skin")
-        sizing.apply_fields(gmsh, plan, faces["interface_roi"], dim=3)
+        sizing.apply_fields(gmsh, plan, faces["outer_surface"], faces["interface_roi"], dim=3)
         gmsh.option.setNumber("Mesh.Algorithm", 6)
         gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fastest here, best min SICN
         gmsh.model.mesh.generate(3)
