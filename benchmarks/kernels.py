@@ -10,18 +10,17 @@ kernels.residual and kernels.tangent, mixed formulation, on
 The trial state is a homogeneous 5 % deformation plus small random nodal noise (J > 0).
 
 Options: --repeat N (default 15); --no-scene (2D on a structured 31 x 31 x 2 triangle mesh,
-no gmsh); --baseline REV: also time the source tree of git revision REV (extracted to a
-temporary folder), alternating baseline and current runs --rounds times (default 2) and
-printing the median per row, so that both see the same load on a shared machine (the 2D
-mesh is then the structured one unless --scene: the scene's mesh depends on the tree);
+no gmsh); --baseline REV: fe/kernels.py and materials/hyperfoam.py of git revision REV
+against this tree's, on the same models and states, calls alternating so that both see
+the same load on a shared machine (2D: the structured mesh, or the scene's with --scene);
 --solve: also the median of 3 fe.solve calls of the 2D scene.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
-import os
 import subprocess
 import sys
 import tempfile
@@ -112,26 +111,84 @@ def solve_median():
             f"{r.stats['newton_iterations']} Newton iterations, peak {r.peak:.10g} MPa)")
 
 
+def _load(name, path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def paired_ms(fa, fb, repeat):
+    """Median CPU ms of fa and of fb, called alternately (both see the same machine load)."""
+    fa(), fb()
+    ta, tb = [], []
+    for _ in range(repeat):
+        for fn, t in ((fa, ta), (fb, tb)):
+            t0 = time.process_time()
+            fn()
+            t.append(time.process_time() - t0)
+    return 1e3 * float(np.median(ta)), 1e3 * float(np.median(tb))
+
+
 def compare(a):
-    """Alternate subprocess runs of the baseline tree and of this tree; print medians."""
+    """The element kernels and the hyperfoam law of git revision REV (fe/kernels.py and
+    materials/hyperfoam.py loaded from it) against this tree's, call by call on the same
+    models (this tree's Model, meshes and states)."""
+    from skfem import MeshTet, MeshTri
+
+    from tactileskin.fe import Dirichlet, Model, kernels, material_law
+    from tactileskin.materials import get_material
+
+    root = Path(__file__).resolve().parents[1]
     with tempfile.TemporaryDirectory() as tmp:
-        root = Path(__file__).resolve().parents[1]
-        arch = subprocess.run(["git", "-C", str(root), "archive", a.baseline, "src", "geometry"],
-                              check=True, capture_output=True).stdout
-        subprocess.run(["tar", "-x", "-C", tmp], input=arch, check=True)
-        base_env = dict(os.environ, PYTHONPATH=str(Path(tmp) / "src"))
-        cmd = [sys.executable, __file__, "--json", "--repeat", str(a.repeat)] + ([] if a.scene else ["--no-scene"])
-        runs = {"base": [], "new": []}
-        for _ in range(a.rounds):
-            for key, env in (("base", base_env), ("new", None)):
-                out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
-                runs[key].append(json.loads(out.strip().splitlines()[-1]))
-    print(f"CPU ms, median of {a.rounds} alternating runs x {a.repeat} calls")
-    print(f"{'mesh':<11}{'elements x points':>18}  {'call':<24}{a.baseline[:10]:>11}{'now':>9}{'speed-up':>10}")
-    for i, row in enumerate(runs["new"][0]):
-        tb = float(np.median([r[i][3] for r in runs["base"]]))
-        tn = float(np.median([r[i][3] for r in runs["new"]]))
-        print(f"{row[0]:<11}{row[1]:>18}  {row[2]:<24}{tb:>9.2f}ms{tn:>7.2f}ms{tb / tn:>9.1f}x")
+        mods = {}
+        for key, rel in (("kernels", "src/tactileskin/fe/kernels.py"),
+                         ("hyperfoam", "src/tactileskin/materials/hyperfoam.py")):
+            text = subprocess.run(["git", "-C", str(root), "show", f"{a.baseline}:{rel}"],
+                                  check=True, capture_output=True, text=True).stdout
+            path = Path(tmp) / f"baseline_{key}.py"
+            path.write_text(text)
+            mods[key] = _load(f"baseline_{key}", path)
+    kb, hb = mods["kernels"], mods["hyperfoam"]
+    hf = get_material("silicone").hyperfoam
+    hf_b = hb.Hyperfoam(hf.mu, hf.alpha, hf.nu)
+    law_b = lambda C: hb.pk2_tangent(hf_b, C)  # noqa: E731 (the baseline's material_law)
+    if a.scene:
+        from tactileskin.fe import model_for_scene
+        from tactileskin.scene import Scene
+        model2 = model_for_scene(Scene(thickness=1, material="silicone", indenter="flat"))[0]
+    else:
+        mesh = MeshTri.init_tensor(np.linspace(0, 1, 32), np.linspace(0, 1, 32))
+        model2 = Model(mesh, {"l": mesh.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
+                       [Dirichlet("l", (0,))])
+    mesh3 = MeshTet.init_tensor(*(np.linspace(0, 1, 13),) * 3)
+    model3 = Model(mesh3, {"l": mesh3.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
+                   [Dirichlet("l", (0,))])
+    print(f"CPU ms, medians of {a.repeat} alternating calls; baseline = {a.baseline}")
+    print(f"{'mesh':<11}{'elements x points':>18}  {'call':<18}{'baseline':>10}{'now':>9}{'speed-up':>10}")
+    for label, model in (("2D P2 tri", model2), ("3D P2 tet", model3)):
+        m = model.m
+        ue = trial_state(model).reshape(-1, m)[model.sdofs]
+        law = material_law(hf)
+        kin = kernels.Kinematics(ue, model.G, model.w, model.mixed)
+        kin_b = kb.Kinematics(ue, model.G, model.w, model.mixed)
+        S3, D, _ = law(kin.C)
+        S, Dm = S3[..., :m, :m], np.ascontiguousarray(D[..., :m, :m, :m, :m])
+        rows = [
+            ("Kinematics", lambda: kb.Kinematics(ue, model.G, model.w, model.mixed),
+             lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed)),
+            ("material law", lambda: law_b(kin.C), lambda: law(kin.C)),
+            ("kernels.residual", lambda: kb.residual(kin_b, S), lambda: kernels.residual(kin, S)),
+            ("kernels.tangent", lambda: kb.tangent(kin_b, S, Dm), lambda: kernels.tangent(kin, S, Dm)),
+        ]
+        tot_b = tot_n = 0.0
+        E, Q = model.w.shape
+        for name, fb, fn in rows:
+            tb, tn = paired_ms(fb, fn, a.repeat)
+            tot_b, tot_n = tot_b + tb, tot_n + tn
+            print(f"{label:<11}{f'{E} x {Q}':>18}  {name:<18}{tb:>8.2f}ms{tn:>7.2f}ms{tb / tn:>9.1f}x")
+        print(f"{label:<11}{f'{E} x {Q}':>18}  {'sum':<18}{tot_b:>8.2f}ms{tot_n:>7.2f}ms{tot_b / tot_n:>9.1f}x")
 
 
 def main():
@@ -140,7 +197,6 @@ def main():
     ap.add_argument("--no-scene", action="store_true")
     ap.add_argument("--solve", action="store_true")
     ap.add_argument("--baseline", default=None, help="git revision to compare with")
-    ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--scene", action="store_true", help="with --baseline: the scene's 2D mesh")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
