@@ -184,11 +184,12 @@ def compare(a):
         ]
         tot_b = tot_n = 0.0
         E, Q = model.w.shape
+        size = f"{E} x {Q}"
         for name, fb, fn in rows:
             tb, tn = paired_ms(fb, fn, a.repeat)
             tot_b, tot_n = tot_b + tb, tot_n + tn
-            print(f"{label:<11}{f'{E} x {Q}':>18}  {name:<18}{tb:>8.2f}ms{tn:>7.2f}ms{tb / tn:>9.1f}x")
-        print(f"{label:<11}{f'{E} x {Q}':>18}  {'sum':<18}{tot_b:>8.2f}ms{tot_n:>7.2f}ms{tot_b / tot_n:>9.1f}x")
+            print(f"{label:<11}{size:>18}  {name:<18}{tb:>8.2f}ms{tn:>7.2f}ms{tb / tn:>9.1f}x")
+        print(f"{label:<11}{size:>18}  {'sum':<18}{tot_b:>8.2f}ms{tot_n:>7.2f}ms{tot_b / tot_n:>9.1f}x")
 
 
 def main():

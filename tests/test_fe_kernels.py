@@ -123,8 +123,7 @@ def _reference_kernels(kin_ue, G, w, mixed, S, D):
     # tau (dphi dphi + d2phi), m d2phi = d2theta/theta - dtheta^2/theta^2 + tr(F^-1 dF F^-1 dF)
     # with d2theta = avg_q J [tr(F^-1 dF)^2 - tr(F^-1 dF F^-1 dF)]
     K += np.einsum("eq,eqd,eqf->edf", w * tau, dphi, dphi)
-    hh = np.einsum("eqak,eqbi->eaibk", h, h).reshape(E, nd, nd)   # tr(F^-1 dF F^-1 dF)
-    hh_q = np.einsum("eqak,eqbi->eqaibk", h, h).reshape(E, Q, nd, nd)
+    hh_q = np.einsum("eqak,eqbi->eqaibk", h, h).reshape(E, Q, nd, nd)   # tr(F^-1 dF F^-1 dF)
     LL_q = np.einsum("eqd,eqf->eqdf", L, L)
     d2theta = np.einsum("eq,eqdf->edf", w * J, LL_q - hh_q) / V[:, None, None]
     trace2 = np.einsum("eq,eqdf->edf", w * tau, hh_q)
@@ -132,7 +131,6 @@ def _reference_kernels(kin_ue, G, w, mixed, S, D):
     K += (wt[:, None, None] * (d2theta / theta[:, None, None]
                                 - v2[:, :, None] * v2[:, None, :] / theta[:, None, None] ** 2)
           + trace2) / m
-    del hh
     return f, K
 
 

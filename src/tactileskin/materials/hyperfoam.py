@@ -53,7 +53,8 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "cauchy_principal",
+           "EXP_CAP", "LOG_C_CAP"]
 
 
 def _as_float_tuple(name, value) -> tuple[float, ...]:
