@@ -140,7 +140,10 @@ class _Pardiso:
                 pass
 
     def __del__(self):
-        self.close()
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: ctypes/numpy may already be gone
+            pass
 
 
 # -- the solver a Model uses --------------------------------------------------------------------

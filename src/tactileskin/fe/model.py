@@ -74,6 +74,7 @@ class Contact:
     rate: float = 1.0
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
     tol_penetration: float = 1e-4  # mm
+    smooth_gap: float = 0.0        # mm; width over which the contact kink is rounded (fe.contact.ramp)
     max_uzawa: int = 30
 
 
@@ -179,7 +180,7 @@ class Model:
 
     # -- evaluation ---------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, t: float, dt: float, lam_k: np.ndarray | None = None,
-                 tangent: bool = True) -> Evaluation:
+                 tangent: bool = True, sticky: np.ndarray | None = None) -> Evaluation:
         """Residual at a trial state; with tangent=True also the tangent (else `tangent(ev)` later)."""
         m = self.m
         ue = u.reshape(-1, m)[self.sdofs]
@@ -200,13 +201,15 @@ class Model:
         if self.surface is not None:
             c = self.contact
             lam = self.surface.lam if lam_k is None else lam_k
-            fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False)
+            fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False,
+                                                 c.smooth_gap, sticky)
             R += assemble_vector(self.ndof, self.surface.vdofs, fc)
         if not np.all(np.isfinite(R)):
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="non-finite residual")
         ev = Evaluation(R=R, ok=True, contact=cinfo, S0=S0, kin=kin, fint=fint)
         ev.S, ev._D, ev._gamma, ev._u, ev._t, ev._lam = S, D0, gamma, u, t, (
             None if self.surface is None else lam)
+        ev._sticky = sticky
         if tangent:
             self.tangent(ev)
         return ev
@@ -220,7 +223,8 @@ class Model:
         Kd = self.pattern.data(kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm))
         if self.surface is not None:
             c = self.contact
-            _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True)
+            _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True,
+                                             c.smooth_gap, ev._sticky)
             self.pattern.add(Kd, self.surface.vdofs, Kc)
         if not np.all(np.isfinite(Kd)):
             raise FloatingPointError("non-finite tangent")
@@ -235,7 +239,7 @@ class Model:
         self.u = u.copy()
         self.t = t
         if self.surface is not None and ev.contact is not None:
-            self.surface.lam = ev.contact[1].copy()
+            self.surface.lam = np.maximum(ev.contact[1], 0.0)  # no adhesion carried over
 
     # -- output -------------------------------------------------------------------------------
     def stress(self, ev: Evaluation) -> np.ndarray:
