@@ -72,3 +72,18 @@ def test_profile_plane_is_the_2d_section_row(text, z):
     assert profile_plane_z(model) == pytest.approx(z)
     flat = SimpleNamespace(contact=SimpleNamespace(indenter=indenter_for_scene(sc.replace(indenter="flat"))))
     assert profile_plane_z(flat) == 0.0
+
+
+def test_make_result_3d_takes_the_section_plane(slabs):
+    # unloaded state (zero pressure): what is checked is the 3D path of make_result, i.e. the
+    # profile comes from plane_profile on the default plane and the plane is recorded
+    from tactileskin.fe import make_result
+    from tactileskin.fe.solver import Stats
+
+    _, model, section = slabs[0]
+    ev = model.evaluate(model.u, 0.0, 0.0)
+    res = make_result(model, ev, Stats(), s_of_point=section.s_of_point)
+    s_ref, _ = plane_profile(model, model.basis.doflocs[0], "bone_interface", section.s_of_point, 0.0)
+    np.testing.assert_array_equal(res.s, s_ref)
+    assert res.stats["profile_plane_z"] == 0.0 and res.summary()["profile_plane_z"] == 0.0
+    assert np.all(res.pressure == 0.0)

@@ -72,7 +72,8 @@ class Result:
 
     s, pressure: mean pressure P = -(sx+sy+sz)/3 (positive in compression) at the nodes of
       the bone interface, L2-projected from the quadrature points, sorted by curvilinear
-      distance s from the symmetry line.
+      distance s from the symmetry line. 3D: on the section plane z = stats["profile_plane_z"],
+      sampled along the cut of each bone-interface facet (fe.output.plane_profile).
     contact_x, contact_pressure: contact pressure (per current area) at the contact points
       of the outer surface, sorted by the current x.
     reaction: vertical force the fixed boundaries exert on the modelled (half) domain.
@@ -128,6 +129,8 @@ class Result:
             "newton_iterations": int(self.stats.get("newton_iterations", 0)),
             "increments": int(self.stats.get("increments", 0)),
             "wall_s": float(self.stats.get("wall_s", 0.0)),
+            # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
+            **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
             **({"scene": self.scene} if self.scene else {}),
         }
 

@@ -29,7 +29,11 @@ def command(out, elastic, **kw):
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
     t.add_row("span (P >= 10 % of peak)", f"{s['span_mm']:.3g} mm")
     t.add_row("area under P(s)", f"{s['auc']:.4g} MPa mm")
-    t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
+    if scene.dim == 3:
+        t.add_row("bone profile on plane", f"z = {res.stats.get('profile_plane_z', 0.0):g} mm")
+        t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
+    else:
+        t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
     Console().print(t)
