@@ -45,6 +45,7 @@ class SolverOptions:
     max_increments: int = 2000
     linear_solver: str = "auto"   # fe.linsolve backend: auto | pardiso | superlu
     sticky_contact: bool = True   # contact points stay active within a Newton solve (no cycling)
+    stick_after: int = 1          # ... once active at an iterate after this many iterations
 
 
 PULL_FRACTION = 1.0  # of penalty * tol_penetration: the largest pull a sticky point may keep
@@ -161,11 +162,15 @@ def _line_search(model: Model, u, du, ev, t, dt, lam, opts: SolverOptions, stick
     return e, float(np.linalg.norm(tr.R[free])), tr
 
 
-def _stick(model: Model, ev, sticky):
-    """Add the points active at `ev` to the sticky set (same law value there: no re-evaluation)."""
+def _stick(model: Model, ev, sticky, released=None):
+    """Add the points active at `ev` to the sticky set (same law value there: no re-evaluation);
+    points released earlier in this solve keep the plain law (else they cycle: stick, pull,
+    release, stick)."""
     if sticky is None or ev.contact is None:
         return sticky
     grow = ev.contact[1] > 0.0
+    if released is not None:
+        grow &= ~released
     if np.any(grow & ~sticky):
         sticky = sticky | grow
         ev._sticky = sticky
@@ -196,10 +201,10 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
     sticky = None
     if model.surface is not None and opts.sticky_contact:
         sticky = np.zeros(model.surface.shape, bool)
+    released = None if sticky is None else np.zeros_like(sticky)
     ev = model.evaluate(u, t, dt, lam, tangent=False, sticky=sticky)
     if not ev.ok:
         raise _Failure(f"start state inadmissible ({ev.why})", {"history": []})
-    sticky = _stick(model, ev, sticky)
     hist = []
     lu, chord_ok = None, True
     releases = 0
@@ -218,6 +223,7 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             if releases > 3:
                 raise _Failure("contact points keep pulling after release", {"history": hist})
             log.debug("  releasing %d pulling contact points", int(np.sum(sticky & ~reduced)))
+            released |= sticky & ~reduced
             sticky = reduced
             ev = model.evaluate(u, t, dt, lam, tangent=False, sticky=sticky)
             continue
@@ -245,7 +251,8 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             chord_ok = False  # the chord step contracted poorly: refactorise from now on
         u = u + eta * du
         ev = trial
-        sticky = _stick(model, ev, sticky)
+        if it >= opts.stick_after:  # the first iterates overshoot: they would stick points that then pull
+            sticky = _stick(model, ev, sticky, released)
         stats.newton_iterations += 1
         it += 1
     raise _Failure("Newton did not converge", {"history": hist, **_worst(model, ev.R)})
