@@ -19,16 +19,20 @@ logger = logging.getLogger(__name__)
 
 ROI_S = 6.0  # mm: the paper reports bone pressure within 6 mm of s = 0; refine the interface there
 MAX_ELEMENTS = {2: 2_000_000, 3: 5_000_000}
-# Grading (issue #7, measured in benchmarks/mesh_grading.py): the size is `fine` within
+# Grading (issue #7, benchmarks/results/mesh_grading.md): the size is `fine` within
 # OUTER_LAYER fine cells of the contact surface and ROI_LAYER of the bone ROI, and grows by
 # GROWTH mm per mm of distance (each cell ~GROWTH larger than its neighbour) up to coarse.
+# The peak (at s = 0) is most sensitive to the ROI layer: t1 silicone flat, peak change
+# from the former box mesh -0.37 / -0.28 / -0.11 / -0.03 % with 1 / 2 / 3 / 4 cells
+# (GROWTH 0.1 with 1 cell: -0.11 %; OUTER_LAYER 6: -0.20 %).
 GROWTH = 0.2
 OUTER_LAYER = 2.0
 ROI_LAYER = 3.0
 # cells per (size^dim) of area/volume for gmsh's Frontal-Delaunay / HXT meshes (a uniform
 # 2D mesh has ~2.5, an equilateral tiling 2.31); with the strip integrals below and sizes
 # clipped at the skin thickness (a cell cannot be thicker than the skin) the estimate is
-# 1-2x the actual count (tests/test_mesh2d.py, tests/test_mesh3d.py).
+# 1-2x the actual count (tests/test_mesh2d.py, tests/test_mesh3d.py; in 3D with
+# mesh_size > thickness it can be ~20 % low: gmsh then fills the thin slab more densely).
 _CELLS_PER_UNIT = {2: 2.6, 3: 5.0}
 
 
