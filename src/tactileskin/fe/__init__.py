@@ -82,18 +82,48 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     return model, mesh
 
 
+def phases(model: Model, **extra: float) -> dict:
+    """Wall time (s) per phase of a solve: the model's residual / tangent / contact
+    accumulators (contact is part of both), the linear solver's factor / solve, and
+    `extra` (mesh, setup, recovery, total); 'other' is the remainder of total."""
+    t = dict(model.timing)
+    ls = getattr(model, "_linsolve", None)
+    out = {k: round(float(v), 4) for k, v in {**extra}.items()}
+    for k in ("residual", "tangent", "contact"):
+        out[k] = round(float(t.get(k, 0.0)), 4)
+    for k in ("factor", "solve"):
+        out[k] = round(float(ls.timing[k]) if ls is not None else 0.0, 4)
+    if "total" in extra:
+        known = sum(out[k] for k in ("mesh", "setup", "recovery", "residual", "tangent", "factor", "solve")
+                    if k in out)
+        out["other"] = round(max(0.0, extra["total"] - known), 4)
+    return out
+
+
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result."""
     t0 = time.perf_counter()
+    t_mesh = 0.0
+    if mesh is None:
+        from tactileskin.mesh import build_mesh
+
+        mesh = build_mesh(scene)
+        t_mesh = time.perf_counter() - t0
+    t1 = time.perf_counter()
     model, sm = model_for_scene(scene, mesh)
     section = scene.section()
+    t_setup = time.perf_counter() - t1
 
     def record(model, ev):
         return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1])}
 
     ev, stats = run(model, scene.duration, options, history=history, record=record)
-    stats.wall_s = time.perf_counter() - t0
+    t2 = time.perf_counter()
     res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
+    stats.wall_s = time.perf_counter() - t0
+    res.stats["wall_s"] = stats.wall_s
+    res.stats["phases_s"] = phases(model, mesh=t_mesh, setup=t_setup,
+                                   recovery=time.perf_counter() - t2, total=stats.wall_s)
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)

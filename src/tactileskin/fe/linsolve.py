@@ -12,7 +12,7 @@ Backends:
 `backend="auto"` takes PARDISO when mkl_rt loads. Measured (benchmarks/linsolve.py):
 numerical refactorisation 3-10x faster than SuperLU on the fingertip tangents, more on 3D.
 
-Threads: MKL uses MKL_NUM_THREADS (default: all cores); the sweep sets 1 per Dask worker.
+Threads: one, unless MKL_NUM_THREADS is set (Dask workers set it to 1 anyway).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import glob
 import logging
 import os
 import sys
+import time
 from ctypes.util import find_library
 
 import numpy as np
@@ -63,6 +64,13 @@ def _load_mkl():
                                 ctypes.c_void_p, i32p, i32p, i32p, i32p, i32p, i32p,
                                 ctypes.c_void_p, ctypes.c_void_p, i32p]
         lib.pardiso.restype = None
+        if "MKL_NUM_THREADS" not in os.environ:
+            # one thread unless asked: the 2D systems gain little from more, and on a busy
+            # machine (sweep workers, shared CI) OpenMP spinning made the solves 3-10x slower
+            try:
+                lib.MKL_Set_Num_Threads(ctypes.c_int(1))
+            except AttributeError:
+                pass
         log.debug("MKL PARDISO from %s", path)
         _MKL = lib
         return lib
@@ -170,6 +178,7 @@ class SymmetricSolver:
         self.backend = backend
         self.n = structure.shape[0]
         self.factorizations = 0
+        self.timing = {"factor": 0.0, "solve": 0.0}  # s
         self._lu = None
         if backend == "pardiso":
             A = structure.tocsr()
@@ -181,22 +190,30 @@ class SymmetricSolver:
 
     def factor(self, A: sp.csr_matrix) -> "SymmetricSolver":
         self.factorizations += 1
-        if self.backend == "pardiso":
-            self._pardiso.factor(A.data[self._upper])
-            if self._pardiso.perturbed:
-                log.debug("PARDISO: %d perturbed pivots", self._pardiso.perturbed)
+        t0 = time.perf_counter()
+        try:
+            if self.backend == "pardiso":
+                self._pardiso.factor(A.data[self._upper])
+                if self._pardiso.perturbed:
+                    log.debug("PARDISO: %d perturbed pivots", self._pardiso.perturbed)
+                return self
+            # symmetric ordering, diagonal pivots preferred (less fill)
+            self._lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
+                                 options={"SymmetricMode": True})
             return self
-        # symmetric ordering, diagonal pivots preferred (less fill)
-        self._lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.01,
-                             options={"SymmetricMode": True})
-        return self
+        finally:
+            self.timing["factor"] += time.perf_counter() - t0
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        if self.backend == "pardiso":
-            return self._pardiso.solve(b)
-        if self._lu is None:
-            raise SingularMatrix("solve before factor")
-        return self._lu.solve(b)
+        t0 = time.perf_counter()
+        try:
+            if self.backend == "pardiso":
+                return self._pardiso.solve(b)
+            if self._lu is None:
+                raise SingularMatrix("solve before factor")
+            return self._lu.solve(b)
+        finally:
+            self.timing["solve"] += time.perf_counter() - t0
 
     def close(self) -> None:
         if self.backend == "pardiso":

@@ -8,6 +8,8 @@ accepts a converged increment (QLV internal variables).
 from __future__ import annotations
 
 import logging
+import time
+from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -114,6 +116,7 @@ class Model:
         self.sdofs = b.element_dofs.T                                   # (E, A)
         self.edofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)
         self.stiffness = stiffness  # a modulus (MPa) for scaling penalties and tolerances
+        self.timing = defaultdict(float)  # s spent per phase (residual, tangent, contact)
 
         # Dirichlet dofs
         self.dirichlet = list(dirichlet)
@@ -182,6 +185,13 @@ class Model:
     def evaluate(self, u: np.ndarray, t: float, dt: float, lam_k: np.ndarray | None = None,
                  tangent: bool = True, sticky: np.ndarray | None = None) -> Evaluation:
         """Residual at a trial state; with tangent=True also the tangent (else `tangent(ev)` later)."""
+        t0 = time.perf_counter()
+        try:
+            return self._evaluate(u, t, dt, lam_k, tangent, sticky)
+        finally:
+            self.timing["residual"] += time.perf_counter() - t0
+
+    def _evaluate(self, u, t, dt, lam_k, tangent, sticky) -> Evaluation:
         m = self.m
         ue = u.reshape(-1, m)[self.sdofs]
         kin = kernels.Kinematics(ue, self.G, self.w, self.mixed)
@@ -201,8 +211,10 @@ class Model:
         if self.surface is not None:
             c = self.contact
             lam = self.surface.lam if lam_k is None else lam_k
+            tc = time.perf_counter()
             fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False,
                                                  c.smooth_gap, sticky)
+            self.timing["contact"] += time.perf_counter() - tc
             R += assemble_vector(self.ndof, self.surface.vdofs, fc)
         if not np.all(np.isfinite(R)):
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="non-finite residual")
@@ -211,21 +223,27 @@ class Model:
             None if self.surface is None else lam)
         ev._sticky = sticky
         if tangent:
+            tt = time.perf_counter()
             self.tangent(ev)
+            self.timing["residual"] -= time.perf_counter() - tt  # counted as tangent
         return ev
 
     def tangent(self, ev: Evaluation) -> np.ndarray:
         """CSR data of the consistent tangent at an admissible evaluation (cached on it)."""
         if ev.K is not None:
             return ev.K
+        t0 = time.perf_counter()
         m = self.m
         Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
         Kd = self.pattern.data(kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm))
         if self.surface is not None:
             c = self.contact
+            tc = time.perf_counter()
             _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True,
                                              c.smooth_gap, ev._sticky)
             self.pattern.add(Kd, self.surface.vdofs, Kc)
+            self.timing["contact"] += time.perf_counter() - tc
+        self.timing["tangent"] += time.perf_counter() - t0
         if not np.all(np.isfinite(Kd)):
             raise FloatingPointError("non-finite tangent")
         ev.K = Kd
