@@ -41,3 +41,42 @@ def test_contact_tolerance_does_not_change_the_answer(hertz):
     x = g.X + g.displacement(tight["model"].u)
     gap, _ = Cylinder(20.0).gap(x, 0.012)
     assert -gap.min() < 1e-7
+
+
+@pytest.mark.parametrize("curvature", [True, False])
+def test_contact_tangent_against_finite_differences(curvature):
+    """With the curvature term the contact tangent is the exact derivative of the contact
+    residual (central differences, error ~ h^2 * third derivative ~ 1e-9 here); without it
+    the difference is exactly that term, of size lambda / R relative to eps."""
+    from skfem import MeshTri
+    from tactileskin.fe.contact import ContactSurface
+    from tactileskin.fe.model import scalar_element
+
+    m = MeshTri.init_tensor(np.linspace(0, 1, 5), np.linspace(-0.5, 0, 3))
+    top = m.facets_satisfying(lambda p: p[1] > -1e-9)
+    cs = ContactSurface(m, scalar_element(m, 1), top, 2)
+    ind = Cylinder(2.0)
+    rng = np.random.default_rng(3)
+    u = 1e-3 * rng.standard_normal(2 * m.p.shape[1])
+    d, eps = 0.3, 50.0  # every point penetrates (the arc rises 0.27 mm at x = 1): smooth law
+    lam = np.full(cs.shape, 1.0)
+    f0, K, (g, lamN, _, _) = cs.evaluate(u, ind, d, eps, lam, True, curvature=curvature)
+    assert np.all(lamN > 0)
+    dofs = cs.vdofs
+    fd = np.zeros_like(K)
+    h = 1e-6
+    for f in range(len(dofs)):
+        for j, dof in enumerate(dofs[f]):
+            up, um = u.copy(), u.copy()
+            up[dof] += h
+            um[dof] -= h
+            fp = cs.evaluate(up, ind, d, eps, lam, False)[0][f]
+            fm = cs.evaluate(um, ind, d, eps, lam, False)[0][f]
+            fd[f, :, j] = (fp - fm) / (2 * h)
+    err = np.abs(K - fd).max() / np.abs(fd).max()
+    if curvature:
+        assert err < 1e-6
+    else:
+        # the omitted term: lambda (I - n n) / R relative to eps n n: lambda_N = 2.5-16 here,
+        # so 2.5e-2 to 0.16 of eps
+        assert 1e-2 < err < 0.5

@@ -6,13 +6,13 @@ a point is lambda_N = ramp(lambda_k - eps g) with the Uzawa multiplier lambda_k 
 during a Newton solve; after it, lambda_k <- lambda_N until the penetration is below the
 tolerance and the multipliers settle.
 
-ramp is max(0, x) with its kink rounded over |x| < delta/2 (a quadratic, C1), delta =
-eps * smooth_gap. Why: at the edge of the contact zone points graze the indenter; with the
-bare kink they toggled between "free at g ~ +1e-5 mm" and "active at g ~ -3e-4 mm" from one
-Newton iteration to the next, so Newton stalled for 5-8 iterations per increment (measured
-on the t = 3 mm flat case). Points with x >= delta/2 see the exact law, so a converged
-multiplier is unchanged; a grazing point carries at most eps * smooth_gap / 2 of pressure. The tangent includes the curvature of the indenter
-surface (dn/dx, by central differences of the normal, since `gap` gives only g and n).
+ramp is max(0, x), optionally with its kink rounded over |x| < delta/2 (a C1 quadratic,
+delta = eps * smooth_gap; off by default: at smooth_gap = 1e-4 mm it did not stop the
+active-set cycling at the contact edge, the solver's sticky set does). `sticky` points
+keep the linear law lambda_k - eps g within a Newton solve (see fe.solver.newton).
+The tangent may include the curvature of the indenter surface (dn/dx, by central
+differences of the normal, since `gap` gives only g and n); fe.model.Contact says why
+it is off by default.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ class ContactSurface:
         return np.einsum("fqa,fai->fqi", self.N, U[self.sdofs])
 
     def evaluate(self, u, indenter, d: float, eps: float, lam_k: np.ndarray, tangent: bool,
-                 smooth_gap: float = 0.0, sticky: np.ndarray | None = None):
+                 smooth_gap: float = 0.0, sticky: np.ndarray | None = None, curvature: bool = False):
         """Residual contribution (Fc, A*m), tangent blocks (Fc, A*m, A*m) or None, and the
         point data (g, lambda_N, x, n).
 
@@ -74,7 +74,7 @@ class ContactSurface:
         Kc = None
         if tangent:
             Kpt = (eps * slope)[..., None, None] * np.einsum("fqi,fqk->fqik", n, n)
-            if np.any(active):
+            if curvature and np.any(active):
                 dn = self._dn_dx(x, indenter, d, active)
                 Kpt = Kpt - lamN[..., None, None] * dn
             Kc = np.einsum("fq,fqa,fqb,fqik->faibk", self.w, self.N, self.N, Kpt).reshape(Fc, A * m, A * m)

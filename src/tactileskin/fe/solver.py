@@ -45,6 +45,7 @@ class SolverOptions:
     max_increments: int = 2000
     linear_solver: str = "auto"   # fe.linsolve backend: auto | pardiso | superlu
     sticky_contact: bool = True   # contact points stay active within a Newton solve (no cycling)
+    max_residual_growth: float = 100.0  # a step raising |R| more than this fails the increment
     stick_after: int = 1          # ... once active at an iterate after this many iterations
 
 
@@ -245,6 +246,12 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         eta, tn, trial = _line_search(model, u, du, ev, t, dt, lam, opts, sticky)
         if trial is None:
             raise _Failure("line search found no admissible state", {"history": hist, **_worst(model, ev.R)})
+        if tn > opts.max_residual_growth * rn:
+            # measured (t = 1 silicone, curved): an ascent direction (indefinite tangent)
+            # taken at eta = 1/32 raised |R| 2400x into the lock-up; Newton then spent its
+            # budget unwinding it. A smaller increment converges in 4-6 iterations.
+            raise _Failure(f"Newton step raised the residual {tn / max(rn, 1e-300):.3g}x",
+                           {"history": hist + [tn], **_worst(model, trial.R)})
         if eta < 1.0:
             log.debug("  line search eta = %.4g", eta)
         if chord and tn > opts.chord_contraction * rn:
