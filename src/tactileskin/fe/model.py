@@ -77,11 +77,12 @@ class Contact:
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
     tol_penetration: float = 1e-4  # mm
     smooth_gap: float = 0.0        # mm; width over which the contact kink is rounded (fe.contact.ramp)
-    # The indenter-curvature term -lambda dn/dx of the consistent tangent. Off: it is negative
+    # The indenter-curvature term -lambda dn/dx of the consistent tangent. The solver adds it
+    # only after its first iterates (SolverOptions.curvature_after): it is negative
     # semi-definite, and early iterates with overshooting multipliers made the tangent
-    # indefinite (ascent directions, cutbacks). Measured without it: t1 silicone curved
-    # 166 -> 54 Newton iterations, t3 silicone curved 85; the converged state is the same
-    # (the residual is unchanged; peaks within 0.02 %).
+    # indefinite (ascent directions, cutbacks: t1 silicone curved 166 Newton iterations with
+    # it throughout, 54 without); without it at all the tail converges linearly (x16 per
+    # iteration on the Braille dots) instead of quadratically.
     curvature_tangent: bool = False
     max_uzawa: int = 30
 
@@ -144,7 +145,11 @@ class Model:
         if contact is not None:
             if contact.boundary not in self.boundaries:
                 raise ParameterError("contact boundary", contact.boundary, "one of " + ", ".join(sorted(self.boundaries)))
-            self.surface = ContactSurface(mesh, self.element, self.boundaries[contact.boundary], m)
+            # 2 points per P2 edge (2D), 3 per P2 triangle (3D): with 6 per triangle the
+            # multipliers over-constrain the facet and Newton cycled (3D flat plate: failed
+            # at 5.7 um of travel; with 3: 10 increments, no cutback)
+            self.surface = ContactSurface(mesh, self.element, self.boundaries[contact.boundary], m,
+                                          intorder=3 if m == 2 else 2)
             if contact.penalty is None:
                 h = self.surface_size()
                 contact.penalty = PENALTY_FACTOR * stiffness / h
@@ -234,9 +239,10 @@ class Model:
             self.timing["residual"] -= time.perf_counter() - tt  # counted as tangent
         return ev
 
-    def tangent(self, ev: Evaluation) -> np.ndarray:
-        """CSR data of the consistent tangent at an admissible evaluation (cached on it)."""
-        if ev.K is not None:
+    def tangent(self, ev: Evaluation, curvature: bool | None = None) -> np.ndarray:
+        """CSR data of the tangent at an admissible evaluation (cached on it); curvature:
+        include the indenter-curvature term (None: Contact.curvature_tangent)."""
+        if ev.K is not None and (curvature is None or getattr(ev, "_curv", None) == curvature):
             return ev.K
         t0 = time.perf_counter()
         m = self.m
@@ -246,13 +252,14 @@ class Model:
             c = self.contact
             tc = time.perf_counter()
             _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True,
-                                             c.smooth_gap, ev._sticky, c.curvature_tangent)
+                                             c.smooth_gap, ev._sticky,
+                                             c.curvature_tangent if curvature is None else curvature)
             self.pattern.add(Kd, self.surface.vdofs, Kc)
             self.timing["contact"] += time.perf_counter() - tc
         self.timing["tangent"] += time.perf_counter() - t0
         if not np.all(np.isfinite(Kd)):
             raise FloatingPointError("non-finite tangent")
-        ev.K = Kd
+        ev.K, ev._curv = Kd, curvature
         return Kd
 
     def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
