@@ -25,7 +25,7 @@ def test_mesh_command_3d(tmp_path, capsys):
 
 
 def test_mesh_command_rejects_bad_requests(tmp_path, capsys):
-    assert main(["mesh", "--mesh-size", "0.01", "--refinement", "20", "--out", str(tmp_path / "m.vtu")]) == 2
+    assert main(["mesh", "--mesh-size", "0.002", "--refinement", "20", "--out", str(tmp_path / "m.vtu")]) == 2
     err = capsys.readouterr().err
     assert "mesh_size" in err and "Traceback" not in err
     assert main(["mesh", "--out", str(tmp_path / "m.stl")]) == 2
