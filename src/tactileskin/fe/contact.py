@@ -2,15 +2,13 @@
 
 The indenter is any object with `gap(points, d) -> (g, n)` (signed distance, g < 0
 penetrating; unit normal out of the indenter). The contact pressure per reference area at
-a point is lambda_N = ramp(lambda_k - eps g) with the Uzawa multiplier lambda_k held fixed
+a point is lambda_N = max(0, lambda_k - eps g) with the Uzawa multiplier lambda_k held fixed
 during a Newton solve; after it, lambda_k <- lambda_N until the penetration is below the
 tolerance and the multipliers settle.
 
-ramp is max(0, x), optionally with its kink rounded over |x| < delta/2 (a C1 quadratic,
-delta = eps * smooth_gap; off by default: at smooth_gap = 1e-4 mm it did not stop the
-active-set cycling at the contact edge, the solver's sticky set does). `sticky` points
-keep the linear law lambda_k - eps g within a Newton solve (see fe.solver.newton).
-The tangent may include the curvature of the indenter surface (dn/dx, by central
+Points in `sticky` keep the linear law lambda_k - eps g within a Newton solve (see
+fe.solver.newton: a kink rounded over 1e-4 mm of gap did not stop the active-set cycling
+at the contact edge; holding points active did). The tangent may include the curvature of the indenter surface (dn/dx, by central
 differences of the normal, since `gap` gives only g and n); fe.model.Contact says why
 it is off by default.
 """
@@ -23,17 +21,6 @@ from skfem import FacetBasis
 from tactileskin.fe.assembly import vector_dofs
 
 _FD_STEP = 1e-6  # mm; central difference of the unit normal (error ~ h^2 kappa^3, negligible)
-
-
-def ramp(x: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
-    """max(0, x) rounded by a quadratic over |x| < delta/2 (C1), and its slope."""
-    if delta <= 0.0:
-        return np.maximum(0.0, x), (x > 0.0).astype(float)
-    h = 0.5 * delta
-    inner = np.abs(x) < h
-    y = np.where(x >= h, x, np.where(inner, (x + h) ** 2 / (2.0 * delta), 0.0))
-    slope = np.where(x >= h, 1.0, np.where(inner, (x + h) / delta, 0.0))
-    return y, slope
 
 
 class ContactSurface:
@@ -54,7 +41,7 @@ class ContactSurface:
         return np.einsum("fqa,fai->fqi", self.N, U[self.sdofs])
 
     def evaluate(self, u, indenter, d: float, eps: float, lam_k: np.ndarray, tangent: bool,
-                 smooth_gap: float = 0.0, sticky: np.ndarray | None = None, curvature: bool = False):
+                 sticky: np.ndarray | None = None, curvature: bool = False):
         """Residual contribution (Fc, A*m), tangent blocks (Fc, A*m, A*m) or None, and the
         point data (g, lambda_N, x, n).
 
@@ -62,9 +49,10 @@ class ContactSurface:
         turn slightly tensile) — the solver's guard against active-set cycling."""
         x = self.X + self.displacement(u)
         g, n = indenter.gap(x, d)
-        lamN, slope = ramp(lam_k - eps * g, eps * smooth_gap)
+        xN = lam_k - eps * g
+        lamN, slope = np.maximum(0.0, xN), (xN > 0.0).astype(float)
         if sticky is not None:
-            lamN = np.where(sticky, lam_k - eps * g, lamN)
+            lamN = np.where(sticky, xN, lamN)
             slope = np.where(sticky, 1.0, slope)
         active = slope > 0.0
         Fc, Qc, A = self.N.shape

@@ -76,7 +76,6 @@ class Contact:
     rate: float = 1.0
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
     tol_penetration: float = 1e-4  # mm
-    smooth_gap: float = 0.0        # mm; width over which the contact kink is rounded (fe.contact.ramp)
     # The indenter-curvature term -lambda dn/dx of the consistent tangent. The solver adds it
     # only after its first iterates (SolverOptions.curvature_after): it is negative
     # semi-definite, and early iterates with overshooting multipliers made the tangent
@@ -224,7 +223,7 @@ class Model:
             lam = self.surface.lam if lam_k is None else lam_k
             tc = time.perf_counter()
             fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False,
-                                                 c.smooth_gap, sticky)
+                                                 sticky)
             self.timing["contact"] += time.perf_counter() - tc
             R += assemble_vector(self.ndof, self.surface.vdofs, fc)
         if not np.all(np.isfinite(R)):
@@ -252,7 +251,7 @@ class Model:
             c = self.contact
             tc = time.perf_counter()
             _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True,
-                                             c.smooth_gap, ev._sticky,
+                                             ev._sticky,
                                              c.curvature_tangent if curvature is None else curvature)
             self.pattern.add(Kd, self.surface.vdofs, Kc)
             self.timing["contact"] += time.perf_counter() - tc
