@@ -12,7 +12,10 @@ from tactileskin.cli._common import scene_from_options, scene_options
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
               help="Output folder (profile.csv, contact.csv, summary.json, result.vtu).")
 @click.option("--elastic", is_flag=True, default=False, help="Ignore viscoelasticity (Prony series).")
-def command(out, elastic, **kw):
+@click.option("--compare-2d", is_flag=True, default=False,
+              help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
+                   "the default 2D mesh, write it to OUT/section_2d and report the differences.")
+def command(out, elastic, compare_2d, **kw):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.table import Table
@@ -22,6 +25,8 @@ def command(out, elastic, **kw):
     scene = scene_from_options(**kw)
     if elastic:
         scene = scene.replace(viscoelastic=False)
+    if compare_2d and scene.dim != 3:
+        raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     res = solve(scene)
     path = res.write(out)
     s = res.summary()
@@ -37,4 +42,38 @@ def command(out, elastic, **kw):
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
     Console().print(t)
+    if compare_2d:
+        _compare_2d(scene, s, out)
     return 0
+
+
+def _compare_2d(scene, s3, out) -> None:
+    """Solve the 2D section of a 3D scene; print and write (compare_2d.json) the differences."""
+    import json
+    import os
+    import tempfile
+
+    from rich.console import Console
+    from rich.table import Table
+
+    from tactileskin.fe import solve
+
+    sc2 = scene.replace(dim=2)  # default 2D mesh sizes are re-derived on the dim change
+    r2 = solve(sc2)
+    r2.write(os.path.join(out, "section_2d"))
+    s2 = r2.summary()
+    # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN
+    rows = {k: (s2[k], s3[k], (s2[k] - s3[k]) / s3[k] if s3[k] > 0 else None)
+            for k in ("peak_mpa", "span_mm")}
+    t = Table(title=f"2D section ({sc2.label()}) against 3D; difference = (2D - 3D) / 3D")
+    for c in ("", "2D", "3D", "difference"):
+        t.add_column(c)
+    for k, (a, b, d) in rows.items():
+        t.add_row(k, f"{a:.4g}", f"{b:.4g}", "n/a (3D is 0)" if d is None else f"{100 * d:+.1f} %")
+    Console().print(t)
+    doc = {"scene_3d": scene.label(), "scene_2d": sc2.label(),
+           **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
+    fd, tmp = tempfile.mkstemp(dir=out, suffix=".json.partial")
+    with os.fdopen(fd, "w") as f:
+        json.dump(doc, f, indent=2)
+    os.replace(tmp, os.path.join(out, "compare_2d.json"))
