@@ -90,7 +90,7 @@ def phases(model: Model, **extra: float) -> dict:
     `extra` (mesh, setup, recovery, total); 'other' is the remainder of total."""
     t = dict(model.timing)
     ls = getattr(model, "_linsolve", None)
-    out = {k: round(float(v), 4) for k, v in {**extra}.items()}
+    out = {k: round(float(v), 4) for k, v in extra.items()}
     for k in ("residual", "tangent", "contact"):
         out[k] = round(float(t.get(k, 0.0)), 4)
     for k in ("factor", "solve"):
