@@ -68,6 +68,9 @@ MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
                                   "note": "coarse 3D; vs 2D default quality: peak +168%, span -2.3%"},
     (3.0, "silicone", "\u2801"): {"peak": 1.787, "span": -0.056,
                                   "note": "coarse 3D; vs 2D default quality: peak +207%, span -9.3%"},
+    # 2026-11-22 18:21 UTC rerun on the library contact rule (braille_2d_vs_3d.md, last table)
+    (3.0, "silicone", "\u283f"): {"peak": 1.178, "span": 0.013,
+                                  "note": "coarse 3D; vs 2D default quality: peak +132%, span -0.6%"},
 }
 
 SINGLE_DOT = "\u2801"
