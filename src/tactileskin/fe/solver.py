@@ -186,8 +186,13 @@ def _release(model: Model, ev, sticky):
     (a pull of eps * gap is a gap error like a penetration): returns the reduced set, or
     None when none pulls."""
     c = model.contact
-    pull = sticky & (ev.contact[1] < -PULL_FRACTION * c.penalty * c.tol_penetration)
-    return (sticky & ~pull) if np.any(pull) else None
+    lim = PULL_FRACTION * c.penalty * c.tol_penetration
+    pull = sticky & (ev.contact[1] < -lim)
+    if not np.any(pull):
+        return None
+    # with them, the barely pressed points next to them (they would pull next: one peel
+    # per Newton restart otherwise)
+    return sticky & ~(ev.contact[1] < lim)
 
 
 def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverOptions, stats: Stats):
