@@ -19,7 +19,7 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
   over-constrain the multipliers), penalty 20 K0 / h with Uzawa updates to a penetration
   below 1e-4 mm; points stay active within a Newton solve (no active-set cycling);
 - Newton with a Crisfield line search on s(eta) = du.R, inadmissible states halve the
-  step; increments grow x1.5 after <= 5 iterations, cut back x0.35 on failure;
+  step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure;
 - nodal pressure by L2 projection onto P1 (exact mass matrix for the 3-point rule).
 """
 

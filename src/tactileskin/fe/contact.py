@@ -8,9 +8,9 @@ tolerance and the multipliers settle.
 
 Points in `sticky` keep the linear law lambda_k - eps g within a Newton solve (see
 fe.solver.newton: a kink rounded over 1e-4 mm of gap did not stop the active-set cycling
-at the contact edge; holding points active did). The tangent may include the curvature of the indenter surface (dn/dx, by central
-differences of the normal, since `gap` gives only g and n); fe.model.Contact says why
-it is off by default.
+at the contact edge; holding points active did). The tangent may include the curvature
+of the indenter surface (dn/dx, by central differences of the normal, since `gap` gives
+only g and n); fe.model.Contact says why it is off by default.
 """
 
 from __future__ import annotations

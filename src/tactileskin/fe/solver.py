@@ -33,9 +33,6 @@ class SolverOptions:
     atol: float = 1e-12           # absolute residual floor (N)
     max_newton: int = 10           # healthy increments converge in <= 8; failing fast is cheaper
     max_halvings: int = 8
-    chord_below: float = 0.0      # (off: measured slower on the fingertip) reuse the factorisation once |R| < this * |R| at the start
-    chord_contraction: float = 0.05  # ... as long as each chord step cuts |R| by this factor
-    full_step_growth: float = 1.0  # accept a full Newton step raising |R| by up to this factor
     dt0_fraction: float = 0.1     # first increment as a fraction of the total time
     dt_min_fraction: float = 1e-5
     dt_max_fraction: float = 0.25
@@ -166,15 +163,13 @@ def _line_search(model: Model, u, du, ev, t, dt, lam, opts: SolverOptions, stick
     return e, float(np.linalg.norm(tr.R[free])), tr
 
 
-def _stick(model: Model, ev, sticky, released=None):
+def _stick(ev, sticky, released):
     """Add the points active at `ev` to the sticky set (same law value there: no re-evaluation);
     points released earlier in this solve keep the plain law (else they cycle: stick, pull,
     release, stick)."""
     if sticky is None or ev.contact is None:
         return sticky
-    grow = ev.contact[1] > 0.0
-    if released is not None:
-        grow &= ~released
+    grow = (ev.contact[1] > 0.0) & ~released
     if np.any(grow & ~sticky):
         sticky = sticky | grow
         ev._sticky = sticky
@@ -215,7 +210,6 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
     if not ev.ok:
         raise _Failure(f"start state inadmissible ({ev.why})", {"history": []})
     hist = []
-    lu, chord_ok = None, True
     releases = 0
     it = 0
     while True:
@@ -238,16 +232,12 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             continue
         if it >= opts.max_newton * (1 + releases):  # a release starts a fresh budget
             break
-        # In the quadratic tail the tangent hardly changes: a chord step with the last
-        # factorization (one triangular solve) then contracts about as well as a new one.
-        chord = lu is not None and chord_ok and rn < opts.chord_below * hist[0]
-        if not chord:
-            try:
-                K = model.tangent(ev, curvature=it >= opts.curvature_after if model.surface else None)
-                lu = _factor(model, model.pattern.free_matrix(K), opts)
-            except (RuntimeError, FloatingPointError) as e:  # singular factor
-                raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
-            stats.factorizations += 1
+        try:
+            K = model.tangent(ev, curvature=it >= opts.curvature_after if model.surface else None)
+            lu = _factor(model, model.pattern.free_matrix(K), opts)
+        except (RuntimeError, FloatingPointError) as e:  # singular factor
+            raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
+        stats.factorizations += 1
         du = np.zeros_like(u)
         du[free] = -lu.solve(Rf)
         if not np.all(np.isfinite(du)):
@@ -263,12 +253,10 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
                            {"history": hist + [tn], **_worst(model, trial.R)})
         if eta < 1.0:
             log.debug("  line search eta = %.4g", eta)
-        if chord and tn > opts.chord_contraction * rn:
-            chord_ok = False  # the chord step contracted poorly: refactorise from now on
         u = u + eta * du
         ev = trial
         if it >= opts.stick_after:  # the first iterates overshoot: they would stick points that then pull
-            sticky = _stick(model, ev, sticky, released)
+            sticky = _stick(ev, sticky, released)
         stats.newton_iterations += 1
         it += 1
     raise _Failure("Newton did not converge", {"history": hist, **_worst(model, ev.R)})
