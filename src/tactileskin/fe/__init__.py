@@ -46,15 +46,16 @@ def material_law(hyperfoam):
     A plane-strain C (C33 = 1, C13 = C23 = 0 exactly, as the 2D kinematics build it) takes
     the closed-form 2x2 path (same values to rounding, ~3x cheaper than the 3x3 eigh);
     D is still the full (..., 3, 3, 3, 3), so a 3D state that happens to be plane is
-    served correctly too.
+    served correctly too. law(C, tangent=False) skips D on the plane path and returns
+    (S, None, ok) (residual-only evaluations); the 3D path returns its D regardless.
     """
     from tactileskin.materials.hyperfoam import pk2_tangent, pk2_tangent_plane
 
-    def law(C):
+    def law(C, tangent=True):
         C = np.asarray(C, dtype=float)
         if (C.ndim >= 2 and C.shape[-2:] == (3, 3) and np.all(C[..., 2, 2] == 1.0)
                 and not np.any(C[..., 2, :2]) and not np.any(C[..., :2, 2])):
-            return pk2_tangent_plane(hyperfoam, C[..., :2, :2], out_of_plane=True)
+            return pk2_tangent_plane(hyperfoam, C[..., :2, :2], out_of_plane=True, tangent=tangent)
         return pk2_tangent(hyperfoam, C)
 
     return law

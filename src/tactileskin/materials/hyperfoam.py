@@ -33,8 +33,11 @@ Numerical care (see docs/architecture.md, "hard cases"):
 
 Speed (benchmarks/kernels.py): plane strain has a closed-form 2x2 path, `pk2_tangent_plane`
 (e_z is a principal direction with c_3 = 1), evaluating the same formulas ~2.5x faster
-than the 3x3 eigh path; per-term arrays put the term axis first; large inputs are
-evaluated in blocks of _BLOCK points written straight into the outputs.
+than the 3x3 eigh path in numpy (`pk2_tangent_plane_numpy`), and several times faster
+again as the compiled point loop of `_hyperfoam_nb` (benchmarks/hyperfoam_law.py), which
+`pk2_tangent_plane` uses; tangent=False skips D. In numpy, per-term arrays put the term
+axis first; large inputs are evaluated in blocks of _BLOCK points written straight into
+the outputs.
 """
 
 from __future__ import annotations
@@ -53,8 +56,8 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "cauchy_principal",
-           "EXP_CAP", "LOG_C_CAP"]
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2_tangent_plane_numpy", "pk2",
+           "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
 def _as_float_tuple(name, value) -> tuple[float, ...]:
@@ -419,14 +422,68 @@ def _plane_tables():
 _T1, _T2, _C1, _C2, _S9, _D81 = _plane_tables()
 
 
-def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False):
+def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False,
+                      tangent: bool = True):
     """Plane-strain `pk2_tangent` from the in-plane block C2 (..., 2, 2) of C (C33 = 1).
 
     Same formulas and guards as `pk2_tangent`, with the 2x2 eigenproblem solved in closed
     form (the third principal direction is e_z, c_3 = 1). Returns S (..., 3, 3) (S33 is the
     out-of-plane stress, S13 = S23 = 0), D = 2 dS/dC (..., 2, 2, 2, 2), the in-plane block,
     and ok (...). out_of_plane=True returns the full D (..., 3, 3, 3, 3) instead.
+    tangent=False skips D and returns (S, None, ok) (residual-only evaluations).
+
+    Evaluated by the compiled point loop of `_hyperfoam_nb` (same values as the numpy
+    implementation `pk2_tangent_plane_numpy` to rounding, identical ok flags).
     """
+    C2 = np.asarray(C2, dtype=float)
+    _check_shape("C2", C2, 2)
+    nb = _compiled()
+    if nb is None:
+        S, D, ok = pk2_tangent_plane_numpy(mat, C2, detF=detF, out_of_plane=out_of_plane)
+        return S, (D if tangent else None), ok
+    lead = C2.shape[:-2]
+    n = math.prod(lead)
+    Ck = nb.as_kernel_input(C2, (n, 2, 2))
+    if detF is None:
+        dk, has_detF = np.empty(0), False
+    else:
+        dk, has_detF = nb.as_kernel_input(np.broadcast_to(np.asarray(detF, dtype=float), lead), (n,)), True
+    if not tangent:
+        mode, D = nb.MODE_S, np.empty((0, 0))
+    elif out_of_plane:
+        mode, D = nb.MODE_D3, np.empty((n, 81))
+    else:
+        mode, D = nb.MODE_D2, np.empty((n, 16))
+    S = np.empty((n, 3, 3))
+    ok = np.empty(n, dtype=bool)
+    nb.plane_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
+                    float(mat.beta), S, D, ok, mode)
+    ok = ok.reshape(lead)
+    _log_debug_inadmissible(ok)
+    if tangent:
+        D = D.reshape(lead + ((3, 3, 3, 3) if out_of_plane else (2, 2, 2, 2)))
+    else:
+        D = None
+    return S.reshape(lead + (3, 3)), D, ok
+
+
+_NB = []   # [module or None] once tried: numba is imported on first use, not at import
+
+
+def _compiled():
+    """The compiled kernel module, or None (numpy fallback) if numba cannot be loaded."""
+    if not _NB:
+        try:
+            from tactileskin.materials import _hyperfoam_nb
+        except ImportError as exc:  # numba is a dependency; a broken install still computes
+            log.warning("hyperfoam: compiled plane-strain law unavailable (%s); using numpy", exc)
+            _hyperfoam_nb = None
+        _NB.append(_hyperfoam_nb)
+    return _NB[0]
+
+
+def pk2_tangent_plane_numpy(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False):
+    """The numpy implementation of `pk2_tangent_plane` (reference for the compiled one)."""
     C2 = np.asarray(C2, dtype=float)
     _check_shape("C2", C2, 2)
     S, D, ok = _blocked(lambda Cb, db, out: _pk2_tangent_plane(mat, Cb, db, out_of_plane, out), C2,

@@ -1,0 +1,233 @@
+"""Compiled (numba) point loop of the plane-strain hyperfoam law, `hyperfoam.pk2_tangent_plane`.
+
+Same formulas and the same numerical care as the numpy path (see the docstring of
+tactileskin.materials.hyperfoam): ln c_a = log1p(e_a) from the eigenvalues of C - I, the
+exp * expm1 form of c^(alpha/2) - J^(-alpha beta) and of the divided differences (exact down
+to coincident stretches, g' at zero gap), the EXP_CAP / LOG_C_CAP guard with finite values
+from clipped exponents at inadmissible points.
+
+Cost: one pass over the points with scalar math. The transcendental calls are the cost,
+so the exponentials are shared: per term i and in-plane direction a only
+c_a^(alpha_i/2) = exp(alpha_i/2 ln c_a), J^(-alpha_i beta) and 1/c_a = exp(-ln c_a) are
+evaluated, and every other power (c^(alpha/2 - 1), J^(-alpha beta)/c^2, ...) is a product
+of them (a few ulp from the numpy path's single exp of the summed exponent). The
+differences keep their own expm1 calls. The third principal direction (e_z, c_3 = 1,
+ln c_3 = 0) needs no exp at all.
+
+The signature is explicit (one compiled specialisation for any input layout; the cache in
+__pycache__ makes later imports load it instead of compiling).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from tactileskin.materials.hyperfoam import _CLIP, EXP_CAP, LOG_C_CAP
+
+__all__ = ["plane_kernel", "MODE_S", "MODE_D2", "MODE_D3"]
+
+MODE_S, MODE_D2, MODE_D3 = 0, 1, 2   # S only; S + in-plane D (16); S + full D (81)
+
+_SIG = ("void(float64[:, :, :], float64[:], boolean, float64[:], float64[:], float64, "
+        "float64[:, :, ::1], float64[:, ::1], boolean[::1], int64)")
+
+
+@numba.njit(inline="always")
+def _pos(x):
+    """exp(x) with the numpy path's clip (finite for any exponent of an inadmissible point)."""
+    return math.exp(min(x, _CLIP))
+
+
+@numba.njit(inline="always")
+def _diff(ex1, ex2, d):
+    """exp(x1) - exp(x2) from ex1 = exp(x1), ex2 = exp(x2) and d = x1 - x2 (no cancellation)."""
+    if d <= 0.0:
+        return ex2 * math.expm1(max(d, -_CLIP))
+    return -(ex1 * math.expm1(max(-d, -_CLIP)))
+
+
+@numba.njit(inline="always")
+def _log_c(e):
+    """(ln c, e, admissible) of one eigenvalue e of C - I, with the numpy path's guard/clip."""
+    lc_raw = math.log1p(e) if e > -1.0 else -2.0 * LOG_C_CAP
+    ok = e > -1.0 and abs(lc_raw) <= LOG_C_CAP
+    lc = min(max(lc_raw, -LOG_C_CAP), LOG_C_CAP)
+    if lc_raw != lc:
+        e = math.expm1(lc)   # e consistent with the clipped log: divided differences stay finite
+    return lc, e, ok
+
+
+@numba.njit(inline="always")
+def _pair(k, q, cqa, cqb, ea, eb, la, lb, ell, evab):
+    """k (g[c_a, c_b] + J^(-alpha beta) / (c_a c_b)): one term of gamma_ab, a != b.
+    cqa = c_a^q, ell = ln(c_a / c_b), evab = J^(-alpha beta) / (c_a c_b)."""
+    gap = ea - eb
+    if abs(gap) <= 1e-14 * max(1.0 + ea, 1.0 + eb):
+        dd = q * _pos((q - 1.0) * 0.5 * (la + lb))           # g' at the mean
+    else:
+        dd = _diff(cqa, cqb, q * ell) / gap
+    return k * (dd + evab)
+
+
+@numba.njit(_SIG, cache=True, nogil=True, error_model="numpy")
+def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
+    """Plane-strain S (n, 3, 3), D (n, 16) or (n, 81) (mode MODE_D2 / MODE_D3; untouched for
+    MODE_S) and ok (n,) of the points C2 (n, 2, 2), written into S, D, ok."""
+    n = C2.shape[0]
+    m = mu.shape[0]
+    for p in range(n):
+        c00, c01, c10, c11 = C2[p, 0, 0], C2[p, 0, 1], C2[p, 1, 0], C2[p, 1, 1]
+        finite = (math.isfinite(c00) and math.isfinite(c01) and math.isfinite(c10)
+                  and math.isfinite(c11))
+        if not finite:                                       # as np.where(finite, C2, 1.0)
+            c00 = c01 = c10 = c11 = 1.0
+        # closed-form eigenvalues of the in-plane block of C - I (see _spectral_plane)
+        a = c00 - 1.0
+        b = c11 - 1.0
+        c = 0.5 * (c01 + c10)
+        h = 0.5 * (a - b)
+        r = math.hypot(h, c)
+        mid = 0.5 * (a + b)
+        big = mid + r if mid >= 0.0 else mid - r
+        det = a * b - c * c
+        small = det / big if big != 0.0 else 0.0
+        if mid >= 0.0:
+            e0, e1 = small, big
+        else:
+            e0, e1 = big, small
+        if r == 0.0:
+            cos2, sin2 = 1.0, 0.0
+        else:
+            cos2, sin2 = h / r, c / r
+        p11 = 0.5 * (1.0 + cos2)
+        p12 = 0.5 * sin2
+        # projectors n_a n_a as (11, 12, 22): direction 1 (larger e) and 0
+        P1_0, P1_1, P1_2 = p11, p12, 1.0 - p11
+        P0_0, P0_1, P0_2 = 1.0 - p11, -p12, p11
+        lc0, e0, ok0 = _log_c(e0)
+        lc1, e1, ok1 = _log_c(e1)
+        okp = finite and ok0 and ok1
+        if has_detF:
+            okp = okp and detF[p] > 0.0
+        lJ = 0.5 * (lc0 + lc1 + 0.0)
+        ic0 = math.exp(-lc0)                                 # 1 / c_a
+        ic1 = math.exp(-lc1)
+        tangent = mode != MODE_S
+        ell01 = math.log1p((e0 - e1) / (1.0 + e1)) if tangent else 0.0   # ln(c_0 / c_1)
+        f0 = f1 = f2 = 0.0
+        g00 = g11 = g22 = g01 = g02 = g12 = 0.0
+        qv = 0.0
+        for i in range(m):
+            al = alpha[i]
+            k = 2.0 * mu[i] / al
+            xv = -al * beta * lJ
+            h0 = 0.5 * al * lc0
+            h1 = 0.5 * al * lc1
+            if xv > EXP_CAP or h0 > EXP_CAP or h1 > EXP_CAP:
+                okp = False
+            ev = _pos(xv)                                    # J^(-alpha beta)
+            pw0 = _pos(h0)                                   # c_a^(alpha/2)
+            pw1 = _pos(h1)
+            bl = beta * lJ
+            # f(c_a) term: k (c^(alpha/2) - J^(-alpha beta)) / c = k (exp(x1) - exp(x2)),
+            # x1 = (alpha/2 - 1) ln c, x2 = -alpha beta ln J - ln c, x1 - x2 = alpha (ln c/2 + beta ln J)
+            f0 += k * _diff(pw0 * ic0, ev * ic0, al * (0.5 * lc0 + bl))
+            f1 += k * _diff(pw1 * ic1, ev * ic1, al * (0.5 * lc1 + bl))
+            f2 += k * _diff(1.0, ev, al * (0.0 + bl))
+            if tangent:
+                q = 0.5 * al - 1.0
+                cq0 = pw0 * ic0                              # c^q, q = alpha/2 - 1
+                cq1 = pw1 * ic1
+                # diagonal: g'(c_a) + J^(-alpha beta) / c_a^2
+                g00 += k * (q * cq0 * ic0 + ev * ic0 * ic0)
+                g11 += k * (q * cq1 * ic1 + ev * ic1 * ic1)
+                g22 += k * (q + ev)
+                # pairs (0,1), (0,2), (1,2); c_3 = 1: ln(c_a / c_3) = ln c_a
+                g01 += _pair(k, q, cq0, cq1, e0, e1, lc0, lc1, ell01, ev * ic0 * ic1)
+                g02 += _pair(k, q, cq0, 1.0, e0, 0.0, lc0, 0.0, lc0, ev * ic0)
+                g12 += _pair(k, q, cq1, 1.0, e1, 0.0, lc1, 0.0, lc1, ev * ic1)
+                qv += 2.0 * mu[i] * beta * ev                # J dp/dJ
+        ok[p] = okp
+        S[p, 0, 0] = f0 * P0_0 + f1 * P1_0
+        S[p, 0, 1] = S[p, 1, 0] = f0 * P0_1 + f1 * P1_1
+        S[p, 1, 1] = f0 * P0_2 + f1 * P1_2
+        S[p, 2, 2] = f2
+        S[p, 0, 2] = S[p, 1, 2] = S[p, 2, 0] = S[p, 2, 1] = 0.0
+        if not tangent:
+            continue
+        # T = P^T gamma P over the in-plane directions, P[a] = (11, 12, 22) of n_a n_a
+        X00 = g00 * P0_0 + g01 * P1_0
+        X01 = g00 * P0_1 + g01 * P1_1
+        X02 = g00 * P0_2 + g01 * P1_2
+        X10 = g01 * P0_0 + g11 * P1_0
+        X11 = g01 * P0_1 + g11 * P1_1
+        X12 = g01 * P0_2 + g11 * P1_2
+        T00 = P0_0 * X00 + P1_0 * X10
+        T01 = P0_0 * X01 + P1_0 * X11
+        T02 = P0_0 * X02 + P1_0 * X12
+        T10 = P0_1 * X00 + P1_1 * X10
+        T11 = P0_1 * X01 + P1_1 * X11
+        T12 = P0_1 * X02 + P1_1 * X12
+        T20 = P0_2 * X00 + P1_2 * X10
+        T21 = P0_2 * X01 + P1_2 * X11
+        T22 = P0_2 * X02 + P1_2 * X12
+        Ci0 = ic0 * P0_0 + ic1 * P1_0                        # C^-1 in-plane (11, 12, 22)
+        Ci1 = ic0 * P0_1 + ic1 * P1_1
+        Ci2 = ic0 * P0_2 + ic1 * P1_2
+        qC0, qC1, qC2 = qv * Ci0, qv * Ci1, qv * Ci2
+        # D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd, (ab) -> 0 (11), 1 (12), 2 (22)
+        d0000 = T00 + T00 + qC0 * Ci0
+        d0001 = T01 + T10 + qC0 * Ci1
+        d0010 = T10 + T01 + qC0 * Ci1
+        d0011 = T11 + T11 + qC0 * Ci2
+        d0100 = T01 + T01 + qC1 * Ci0
+        d0101 = T02 + T11 + qC1 * Ci1
+        d0110 = T11 + T02 + qC1 * Ci1
+        d0111 = T12 + T12 + qC1 * Ci2
+        d1000 = T10 + T10 + qC1 * Ci0
+        d1001 = T11 + T20 + qC1 * Ci1
+        d1010 = T20 + T11 + qC1 * Ci1
+        d1011 = T21 + T21 + qC1 * Ci2
+        d1100 = T11 + T11 + qC2 * Ci0
+        d1101 = T12 + T21 + qC2 * Ci1
+        d1110 = T21 + T12 + qC2 * Ci1
+        d1111 = T22 + T22 + qC2 * Ci2
+        if mode == MODE_D2:
+            Dp = D[p]
+            Dp[0], Dp[1], Dp[2], Dp[3] = d0000, d0001, d0010, d0011
+            Dp[4], Dp[5], Dp[6], Dp[7] = d0100, d0101, d0110, d0111
+            Dp[8], Dp[9], Dp[10], Dp[11] = d1000, d1001, d1010, d1011
+            Dp[12], Dp[13], Dp[14], Dp[15] = d1100, d1101, d1110, d1111
+            continue
+        Dp = D[p]
+        for j in range(81):
+            Dp[j] = 0.0
+        # in-plane block: index 27 i + 9 j + 3 k + l
+        Dp[0], Dp[1], Dp[3], Dp[4] = d0000, d0001, d0010, d0011
+        Dp[9], Dp[10], Dp[12], Dp[13] = d0100, d0101, d0110, d0111
+        Dp[27], Dp[28], Dp[30], Dp[31] = d1000, d1001, d1010, d1011
+        Dp[36], Dp[37], Dp[39], Dp[40] = d1100, d1101, d1110, d1111
+        # D_ab33 = D_33ab = qv Cinv_ab; D_3333 = 2 gamma_33 + qv
+        Dp[8], Dp[17], Dp[35], Dp[44] = qC0, qC1, qC1, qC2
+        Dp[72], Dp[73], Dp[75], Dp[76] = qC0, qC1, qC1, qC2
+        Dp[80] = 2.0 * g22 + qv
+        # D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab
+        G0 = g02 * P0_0 + g12 * P1_0
+        G1 = g02 * P0_1 + g12 * P1_1
+        G2 = g02 * P0_2 + g12 * P1_2
+        Dp[20], Dp[23], Dp[47], Dp[50] = G0, G1, G1, G2        # D_a3b3
+        Dp[24], Dp[25], Dp[51], Dp[52] = G0, G1, G1, G2        # D_a33b
+        Dp[56], Dp[59], Dp[65], Dp[68] = G0, G1, G1, G2        # D_3ab3
+        Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
+
+
+def as_kernel_input(x, shape):
+    """x as a float64 array of `shape` the compiled kernel accepts (writable: numba rejects
+    read-only arrays such as np.broadcast_to views); a view where possible."""
+    x = np.asarray(x, dtype=float).reshape(shape)
+    if not x.flags.writeable:
+        x = np.array(x)
+    return x

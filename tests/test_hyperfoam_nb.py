@@ -1,0 +1,169 @@
+"""Compiled plane-strain hyperfoam law (materials._hyperfoam_nb) against the numpy implementation.
+
+Both evaluate the same formulas; the compiled loop forms some powers as products of shared
+exponentials (c^(alpha/2 - 1) = c^(alpha/2) / c, ...), a few ulp from the numpy path's single
+exp. Differences therefore stay at rounding level, ~1e-15 of the point's largest entry;
+1e-12 leaves a 1000x margin for the amplification by the spread of the principal values
+(the same bound as the plane-vs-3D test in test_materials_hyperfoam.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tactileskin.fe import material_law
+from tactileskin.materials import EXP_CAP, LOG_C_CAP, Hyperfoam, get_material
+from tactileskin.materials.hyperfoam import pk2_tangent_plane, pk2_tangent_plane_numpy
+
+MATERIALS = {name: get_material(name).hyperfoam for name in ("silicone", "polyurethane")}
+# ln J range keeping J^(-alpha beta) within ~e^10 (as in test_materials_hyperfoam.py)
+LNJ_RANGE = {"silicone": 0.025, "polyurethane": 0.15}
+TOL = 1e-12
+
+
+def _rot2(theta, d1, d2):
+    c, s = np.cos(theta), np.sin(theta)
+    R = np.array([[c, -s], [s, c]])
+    return R @ np.diag([d1, d2]) @ R.T
+
+
+def _lnj_cap(mat):
+    """ln J at which the largest volumetric exponent alpha_i beta |ln J| reaches EXP_CAP."""
+    return -EXP_CAP / (max(mat.alpha) * mat.beta)
+
+
+def ordinary_states(name, n=200, seed=3):
+    """Random rotated plane states of moderate J, plus the hard admissible cases: exact
+    C = I, strains of 1e-8, equal and nearly equal in-plane stretches (relative gaps down
+    to 1e-16, 1e-10 among them), an in-plane stretch equal to c_3 = 1 (to rounding), and a
+    compression just inside the overflow guard."""
+    mat = MATERIALS[name]
+    rng = np.random.default_rng(seed)
+    l1 = rng.uniform(0.7, 1.4, n)
+    l2 = np.exp(rng.uniform(-1, 1, n) * LNJ_RANGE[name]) / l1
+    th = rng.uniform(0, np.pi, n)
+    Cs = [_rot2(t, a * a, b * b) for t, a, b in zip(th, l1, l2)]
+    Cs += [np.eye(2), np.diag([1 + 2e-8, 1 - 1e-8]), _rot2(0.4, 1 + 1e-8, 1 - 3e-8),
+           np.array([[1.0, 1e-8], [1e-8, 1.0]]), np.diag([1.0, 1 + 1e-8])]
+    for g in (0.0, 1e-16, 1e-14, 1e-12, 1e-10, 1e-8):
+        Cs += [_rot2(0.9, 0.97 * (1 + g), 0.97), _rot2(2.1, 1.03, 1.03 * (1 - g)),
+               np.diag([1.0 + g, 1.0]), _rot2(0.3, 1.0, 1.0 + g)]
+    cap = _lnj_cap(mat)
+    for lnj in (cap + 1e-3, cap + 0.05):       # large compression, just inside the guard
+        Cs += [np.diag([np.exp(2 * lnj), 1.0]), _rot2(0.7, np.exp(lnj), np.exp(lnj))]
+    return np.array(Cs)
+
+
+def inadmissible_states(mat):
+    """Just beyond every guard, plus garbage."""
+    cap = _lnj_cap(mat)
+    return np.array([
+        np.diag([np.exp(2 * (cap - 1e-3)), 1.0]),       # volumetric exponent above EXP_CAP
+        _rot2(0.2, np.exp(cap - 0.5), np.exp(cap - 0.5)),
+        np.diag([np.exp(LOG_C_CAP + 0.01), 1.0]),       # |ln c| beyond LOG_C_CAP
+        np.diag([np.exp(-LOG_C_CAP - 0.01), 1.0]),
+        np.diag([1e300, 1e300]),
+        np.diag([-0.1, 1.0]),                           # not positive definite
+        np.zeros((2, 2)),
+        np.full((2, 2), np.nan),
+        np.diag([np.inf, 1.0]),
+        np.array([[1.0, np.nan], [0.0, 1.0]]),
+    ])
+
+
+def _max_rel(a, b):
+    """Worst per-point difference relative to the point's largest entry (b = 0 must be exact)."""
+    a = a.reshape(a.shape[0], -1)
+    b = b.reshape(b.shape[0], -1)
+    return np.max(np.abs(a - b).max(axis=1) / np.maximum(np.abs(b).max(axis=1), np.finfo(float).tiny))
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+@pytest.mark.parametrize("out_of_plane", [False, True])
+def test_compiled_equals_numpy_on_admissible_states(name, out_of_plane):
+    mat = MATERIALS[name]
+    C2 = ordinary_states(name)
+    S, D, ok = pk2_tangent_plane(mat, C2, out_of_plane=out_of_plane)
+    S0, D0, ok0 = pk2_tangent_plane_numpy(mat, C2, out_of_plane=out_of_plane)
+    assert ok0.all() and np.array_equal(ok, ok0)
+    assert D.shape == D0.shape and S.shape == S0.shape
+    assert _max_rel(S, S0) < TOL
+    assert _max_rel(D, D0) < TOL
+    # the undeformed state: S = 0 exactly; plane strain: S13 = S23 = 0 exactly
+    i0 = 200
+    assert np.array_equal(C2[i0], np.eye(2)) and not np.any(S[i0])
+    assert not np.any(S[..., 2, :2]) and not np.any(S[..., :2, 2])
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # numpy reference, C = 1e300
+@pytest.mark.parametrize("name", MATERIALS)
+def test_compiled_guard_flags_equal_numpy_and_values_are_finite(name):
+    mat = MATERIALS[name]
+    bad = inadmissible_states(mat)
+    C2 = np.concatenate([bad, ordinary_states(name, n=5)])
+    detF = np.ones(len(C2))
+    detF[-1] = -1.0                                     # admissible C, flagged by det F only
+    S, D, ok = pk2_tangent_plane(mat, C2, detF=detF, out_of_plane=True)
+    S0, D0, ok0 = pk2_tangent_plane_numpy(mat, C2, detF=detF, out_of_plane=True)
+    assert np.array_equal(ok, ok0)
+    assert not ok[:len(bad)].any() and not ok[-1] and ok[len(bad):-1].all()
+    assert np.isfinite(S).all() and np.isfinite(D).all()
+    adm = ok | (np.arange(len(C2)) == len(C2) - 1)      # the det F-flagged point has ordinary values
+    assert _max_rel(S[adm], S0[adm]) < TOL and _max_rel(D[adm], D0[adm]) < TOL
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+def test_tangent_false_gives_the_same_stress_without_D(name):
+    mat = MATERIALS[name]
+    C2 = np.concatenate([ordinary_states(name, n=20), inadmissible_states(mat)])
+    S, D, ok = pk2_tangent_plane(mat, C2, out_of_plane=True)
+    S1, D1, ok1 = pk2_tangent_plane(mat, C2, out_of_plane=True, tangent=False)
+    assert D1 is None and np.array_equal(ok1, ok) and np.array_equal(S1, S)
+    _, D2, _ = pk2_tangent_plane(mat, C2)
+    assert np.array_equal(D[..., :2, :2, :2, :2], D2)   # in-plane block of the full D
+
+
+@pytest.mark.parametrize("mu,alpha,nu", [((0.2,), (3.0,), 0.3),
+                                         ((0.05, 0.1, -0.01), (0.01, 4.0, -2.0), 0.45)])
+def test_any_number_of_terms(mu, alpha, nu):
+    mat = Hyperfoam(mu, alpha, nu)
+    rng = np.random.default_rng(7)
+    C2 = np.array([_rot2(t, a, b) for t, a, b in rng.uniform([0, 0.6, 0.6], [np.pi, 1.5, 1.5], (50, 3))])
+    S, D, ok = pk2_tangent_plane(mat, C2, out_of_plane=True)
+    S0, D0, ok0 = pk2_tangent_plane_numpy(mat, C2, out_of_plane=True)
+    assert ok.all() and np.array_equal(ok, ok0)
+    assert _max_rel(S, S0) < TOL and _max_rel(D, D0) < TOL
+
+
+def test_shapes_layouts_and_detF_broadcast():
+    mat = MATERIALS["polyurethane"]
+    C2 = np.broadcast_to(_rot2(0.3, 1.1, 0.95), (4, 5, 2, 2))   # read-only view
+    S, D, ok = pk2_tangent_plane(mat, C2, detF=2.0)
+    assert S.shape == (4, 5, 3, 3) and D.shape == (4, 5, 2, 2, 2, 2) and ok.shape == (4, 5) and ok.all()
+    S1, D1, ok1 = pk2_tangent_plane(mat, C2[1, 2])
+    assert S1.shape == (3, 3) and D1.shape == (2, 2, 2, 2) and ok1.shape == ()
+    assert np.array_equal(S[1, 2], S1) and np.array_equal(D[1, 2], D1)
+    # a strided in-plane block, as material_law passes it
+    C = np.zeros((3, 4, 3, 3))
+    C[..., :2, :2] = ordinary_states("polyurethane", n=12)[:12].reshape(3, 4, 2, 2)
+    C[..., 2, 2] = 1.0
+    S2, D2, _ = pk2_tangent_plane(mat, C[..., :2, :2], out_of_plane=True)
+    S3, D3, _ = pk2_tangent_plane(mat, np.ascontiguousarray(C[..., :2, :2]), out_of_plane=True)
+    assert np.array_equal(S2, S3) and np.array_equal(D2, D3)
+    assert pk2_tangent_plane(mat, np.empty((0, 2, 2)))[0].shape == (0, 3, 3)
+
+
+def test_material_law_passes_tangent_through():
+    mat = MATERIALS["silicone"]
+    law = material_law(mat)
+    C = np.zeros((6, 3, 3))
+    C[:, :2, :2] = ordinary_states("silicone", n=6)[:6]
+    C[:, 2, 2] = 1.0
+    S, D, ok = law(C)
+    S1, D1, ok1 = law(C, tangent=False)
+    assert D.shape == (6, 3, 3, 3, 3) and D1 is None
+    assert np.array_equal(S, S1) and np.array_equal(ok, ok1)
+    C[0, 2, 2] = 1.01                                    # not plane: the 3x3 path keeps its D
+    S3, D3, _ = law(C, tangent=False)
+    assert D3 is not None and D3.shape == (6, 3, 3, 3, 3)
