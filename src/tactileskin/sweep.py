@@ -178,6 +178,13 @@ def solve_case(scene: Scene):
     return solve(scene)
 
 
+def _cost_rank(scene: Scene) -> float:
+    """A rough relative cost of solving a scene, for scheduling only: 3D far above 2D, then
+    the skin thickness (dofs and Newton iterations grow with it: benchmarks/paper_sweep.py,
+    t = 5 mm cases 3-10x the t = 1 mm ones), Braille (more increments) above the rest."""
+    return (100.0 if scene.dim == 3 else 0.0) + scene.thickness + (0.5 if scene.indenter == IndenterKind.BRAILLE else 0.0)
+
+
 def _run_one_safely(scene: Scene):
     """Runs on a worker: never raises, so one failure cannot stop the sweep."""
     t0 = time.perf_counter()
@@ -250,7 +257,9 @@ def run_sweep(
                                    dashboard_address=None, silence_logs=logging.ERROR)
             client = Client(cluster)
         try:
-            futs = {client.submit(_run_one_safely, sc, pure=False, key=f"case-{sc.key()}"): sc
+            # longest cases first, so that no long case starts last and runs alone
+            futs = {client.submit(_run_one_safely, sc, pure=False, key=f"case-{sc.key()}",
+                                  priority=_cost_rank(sc)): sc
                     for sc in todo}
             for fut in as_completed(futs):
                 sc = futs[fut]

@@ -7,6 +7,7 @@ accepts a converged increment (QLV internal variables).
 
 from __future__ import annotations
 
+import inspect
 import logging
 import time
 from collections import defaultdict
@@ -26,7 +27,7 @@ from tactileskin.fe.contact import ContactSurface
 log = logging.getLogger(__name__)
 
 PENALTY_FACTOR = 20.0  # penalty = factor * modulus / facet size (MPa/mm)
-Law = Callable[[np.ndarray], tuple]  # C (...,3,3) -> (S, D, ok)
+Law = Callable[..., tuple]  # law(C (...,3,3), tangent=True) -> (S, D or None, ok)
 
 
 def scalar_element(mesh, order: int):
@@ -105,6 +106,7 @@ class Model:
         if formulation not in ("mixed", "displacement"):
             raise ParameterError("formulation", formulation, "'mixed' or 'displacement'")
         self.mesh, self.boundaries, self.law, self.prony = mesh, dict(boundaries), law, prony
+        self._law_tangent_kw = "tangent" in inspect.signature(law).parameters
         self.mixed = formulation == "mixed"
         self.formulation = formulation
         self.element = scalar_element(mesh, order)
@@ -163,6 +165,13 @@ class Model:
         self.t = 0.0
 
     # -- helpers ------------------------------------------------------------------------------
+    def _law(self, C: np.ndarray, tangent: bool) -> tuple:
+        """The material law at C; D may be None when not asked for (a law without the
+        `tangent` keyword always returns it)."""
+        if self._law_tangent_kw:
+            return self.law(C, tangent=tangent)
+        return self.law(C)
+
     def facet_scalar_dofs(self, name: str) -> np.ndarray:
         return np.unique(self.basis.get_dofs(self.boundaries[name]).all())
 
@@ -207,7 +216,9 @@ class Model:
         kin = kernels.Kinematics(ue, self.G, self.w, self.mixed)
         if not kin.admissible:
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="J <= 0")
-        S0, D0, ok = self.law(kin.C)
+        # residual-only evaluations (line-search trials) skip D: the accepted iterate's
+        # tangent computes it then (fe.material_law: S alone costs ~60 % of S and D)
+        S0, D0, ok = self._law(kin.C, tangent)
         if not np.all(ok) or not np.all(np.isfinite(S0)):
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="material state inadmissible")
         gamma, decay, gain = self.qlv(dt)
@@ -245,6 +256,8 @@ class Model:
             return ev.K
         t0 = time.perf_counter()
         m = self.m
+        if ev._D is None:
+            ev._D = self._law(ev.kin.C, True)[1]
         Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
         Kd = self.pattern.data(kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm))
         if self.surface is not None:

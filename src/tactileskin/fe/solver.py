@@ -45,6 +45,9 @@ class SolverOptions:
     max_residual_growth: float = 100.0  # a step raising |R| more than this fails the increment
     curvature_after: int = 2      # iterations before the indenter-curvature tangent term is added
     stick_after: int = 1          # ... once active at an iterate after this many iterations
+    # check for pulling sticky points once |R| <= this * scale, not only at convergence (the
+    # pulls are settled by then; t5 polyurethane curved: 180 -> 157 Newton iterations)
+    release_rtol: float = 1e-3
 
 
 # of penalty * tol_penetration: the largest pull a sticky point may keep. 0.1 released so
@@ -217,19 +220,26 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         rn = float(np.linalg.norm(Rf))
         scale = float(np.linalg.norm(ev.fint))
         hist.append(rn)
-        log.debug("  newton %2d  |R| = %.3e  (scale %.3e)", it, rn, scale)
-        if rn <= opts.rtol * scale + opts.atol:
-            reduced = None if sticky is None else _release(model, ev, sticky)
-            if reduced is None:
-                return u, ev, it, hist
-            releases += 1
-            if releases > 3:
-                raise _Failure("contact points keep pulling after release", {"history": hist})
-            log.debug("  releasing %d pulling contact points", int(np.sum(sticky & ~reduced)))
-            released |= sticky & ~reduced
-            sticky = reduced
-            ev = model.evaluate(u, t, dt, lam, tangent=False, sticky=sticky)
-            continue
+        if ev.contact is not None and log.isEnabledFor(logging.DEBUG):
+            log.debug("  newton %2d  |R| = %.3e  (scale %.3e), %d contact points active, %d sticky, %d pulling",
+                      it, rn, scale, int(np.sum(ev.contact[1] > 0)), -1 if sticky is None else int(sticky.sum()),
+                      int(np.sum(ev.contact[1] < 0)))
+        else:
+            log.debug("  newton %2d  |R| = %.3e  (scale %.3e)", it, rn, scale)
+        converged = rn <= opts.rtol * scale + opts.atol
+        if sticky is not None and (converged or rn <= opts.release_rtol * scale + opts.atol):
+            reduced = _release(model, ev, sticky)
+            if reduced is not None:
+                releases += 1
+                if releases > 3:
+                    raise _Failure("contact points keep pulling after release", {"history": hist})
+                log.debug("  releasing %d pulling contact points", int(np.sum(sticky & ~reduced)))
+                released |= sticky & ~reduced
+                sticky = reduced
+                ev = model.evaluate(u, t, dt, lam, tangent=False, sticky=sticky)
+                continue
+        if converged:
+            return u, ev, it, hist
         if it >= opts.max_newton * (1 + releases):  # a release starts a fresh budget
             break
         try:
