@@ -23,11 +23,27 @@ Two formulations share one code path:
       d2theta = avg_q J [tr(F^-1 dF)^2 - tr(F^-1 dF F^-1 dF)]
 
   The same formulas hold with a stress that has a constant (history) part, as in QLV.
+
+Kinematics, residual and tangent run compiled element loops (fe._kernels_nb, numba) when
+COMPILED is true (the default); the numpy implementations stay as the reference
+(residual_numpy, tangent_numpy, Kinematics with COMPILED false) that the tests compare with.
 """
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
+
+from tactileskin.fe import _kernels_nb
+
+# compiled element loops (the numpy code below is the reference they are tested against)
+COMPILED = True
+
+
+def _c(x: np.ndarray) -> np.ndarray:
+    """C-contiguous float64 (the compiled loops take no strided views)."""
+    return np.ascontiguousarray(x, dtype=np.float64)
 
 
 def deformation_gradient(ue: np.ndarray, G: np.ndarray) -> np.ndarray:
@@ -79,9 +95,40 @@ class Kinematics:
     """Kinematic quantities of one trial displacement, shared by residual, tangent and output."""
 
     def __init__(self, ue: np.ndarray, G: np.ndarray, w: np.ndarray, mixed: bool):
-        self.m = m = ue.shape[-1]
+        self.m = ue.shape[-1]
         self.mixed = mixed
         self.G, self.w = G, w
+        if COMPILED:
+            self._init_compiled(ue)
+        else:
+            self._init_numpy(ue)
+
+    def _init_compiled(self, ue):
+        G, w, m = _c(self.G), _c(self.w), self.m
+        self.G, self.w = G, w
+        E, Q = w.shape
+        self.F = np.empty((E, Q, m, m))
+        self.J = np.empty((E, Q))
+        Finv, alpha, C = np.empty((E, Q, m, m)), np.empty((E, Q)), np.empty((E, Q, 3, 3))
+        Fbar, theta = (np.empty((E, Q, m, m)), np.empty(E)) if self.mixed else (self.F, np.empty(0))
+        loop = _kernels_nb.entry("kinematics", G)
+        self.admissible = bool(loop(_c(ue), G, w, self.mixed, self.F, self.J, Finv, alpha, Fbar, C, theta))
+        if not self.admissible:
+            return
+        self.Finv, self.alpha, self.Fbar, self.C = Finv, alpha, Fbar, C
+        if self.mixed:
+            self.theta = theta
+            self.Jbar = np.broadcast_to(theta[:, None], self.J.shape)
+        else:
+            self.Jbar = self.J
+
+    @cached_property
+    def h(self) -> np.ndarray:
+        """Spatial gradients h_a = G_a F^-1, (E, Q, A, m) (the numpy reference uses them)."""
+        return self.G @ self.Finv
+
+    def _init_numpy(self, ue):
+        G, w, m, mixed = self.G, self.w, self.m, self.mixed
         self.F = deformation_gradient(ue, G)
         with np.errstate(over="ignore", invalid="ignore"):   # a wild trial state: caught below
             self.J = _det(self.F)
@@ -124,6 +171,17 @@ def _nodal(kin: Kinematics, P: np.ndarray) -> np.ndarray:
 
 def residual(kin: Kinematics, S: np.ndarray) -> np.ndarray:
     """Internal force element vectors (E, A*m) from the in-plane PK2 stress S (E, Q, m, m)."""
+    if not COMPILED:
+        return residual_numpy(kin, S)
+    E, Q, A, m = kin.G.shape
+    theta = kin.theta if kin.mixed else np.empty(0)
+    loop = _kernels_nb.entry("residual", kin.G)
+    return loop(_c(kin.G), _c(kin.w), _c(kin.Fbar), _c(kin.Finv), _c(kin.alpha), _c(kin.J), _c(theta),
+                _c(S), kin.mixed, np.empty((E, A * m)))
+
+
+def residual_numpy(kin: Kinematics, S: np.ndarray) -> np.ndarray:
+    """The numpy reference of `residual`."""
     P = kin.Fbar @ S                                                         # P_bar
     p = _nodal(kin, P)
     if kin.mixed:
@@ -147,6 +205,19 @@ _TANGENT_BLOCK_DOUBLES = 1 << 17
 
 
 def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m),
+    D with minor symmetry. Compiled (fe._kernels_nb) unless COMPILED is false; the same
+    algebra as `tangent_numpy`, which documents it."""
+    if not COMPILED:
+        return tangent_numpy(kin, S, D)
+    E, Q, A, m = kin.G.shape
+    theta = kin.theta if kin.mixed else np.empty(0)
+    loop = _kernels_nb.entry("tangent", kin.G)
+    return loop(_c(kin.G), _c(kin.w), _c(kin.F), _c(kin.Fbar), _c(kin.Finv), _c(kin.alpha), _c(kin.J),
+                _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)))
+
+
+def tangent_numpy(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
     """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m).
 
     D must have minor symmetry (any D = 2 dS/dC of a symmetric S has). With B the map from
