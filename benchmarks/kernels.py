@@ -10,8 +10,11 @@ kernels.residual and kernels.tangent, mixed formulation, on
 The trial state is a homogeneous 5 % deformation plus small random nodal noise (J > 0).
 
 Options: --repeat N (default 15); --no-scene (2D on a structured 31 x 31 x 2 triangle mesh,
-no gmsh); --baseline REV: fe/kernels.py and materials/hyperfoam.py of git revision REV
-against this tree's, on the same models and states, calls alternating so that both see
+no gmsh); --thickness T (the 2D scene's skin thickness, default 1); --compiled: the numpy
+reference (kernels.COMPILED = False) against the compiled loops (fe._kernels_nb), calls
+alternating, plus the one-off JIT compile time (fresh NUMBA_CACHE_DIR) and the cached-load
+time of the compiled loops, each measured in a new process; --baseline REV: fe/kernels.py
+and materials/hyperfoam.py of git revision REV against this tree's, on the same models and states, calls alternating so that both see
 the same load on a shared machine (2D: the structured mesh, or the scene's with --scene);
 --solve: also the median of 3 fe.solve calls of the 2D scene.
 """
@@ -21,6 +24,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -74,25 +78,111 @@ def rows_for(label, model, hf, repeat):
     return [[label, f"{E} x {Q}", name, t] for name, t in out]
 
 
-def measure(repeat, no_scene):
-    from skfem import MeshTet, MeshTri
+def _model2(no_scene, thickness, hf):
+    from skfem import MeshTri
 
     from tactileskin.fe import Dirichlet, Model, material_law
+    if no_scene:
+        mesh = MeshTri.init_tensor(np.linspace(0, 1, 32), np.linspace(0, 1, 32))
+        return Model(mesh, {"l": mesh.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
+                     [Dirichlet("l", (0,))])
+    from tactileskin.fe import model_for_scene
+    from tactileskin.scene import Scene
+    return model_for_scene(Scene(thickness=thickness, material="silicone", indenter="flat"))[0]
+
+
+def _model3(hf):
+    from skfem import MeshTet
+
+    from tactileskin.fe import Dirichlet, Model, material_law
+    mesh3 = MeshTet.init_tensor(*(np.linspace(0, 1, 13),) * 3)
+    return Model(mesh3, {"l": mesh3.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
+                 [Dirichlet("l", (0,))])
+
+
+def compiled_vs_numpy(a):
+    """kernels.COMPILED False (numpy reference) vs True, same models and states, alternating."""
+    from tactileskin.fe import kernels, material_law
     from tactileskin.materials import get_material
 
     hf = get_material("silicone").hyperfoam
-    if no_scene:
-        mesh = MeshTri.init_tensor(np.linspace(0, 1, 32), np.linspace(0, 1, 32))
-        model2 = Model(mesh, {"l": mesh.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
-                       [Dirichlet("l", (0,))])
-    else:
-        from tactileskin.fe import model_for_scene
-        from tactileskin.scene import Scene
-        model2 = model_for_scene(Scene(thickness=1, material="silicone", indenter="flat"))[0]
-    mesh3 = MeshTet.init_tensor(*(np.linspace(0, 1, 13),) * 3)
-    model3 = Model(mesh3, {"l": mesh3.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
-                   [Dirichlet("l", (0,))])
-    return rows_for("2D P2 tri", model2, hf, repeat) + rows_for("3D P2 tet", model3, hf, repeat)
+    law = material_law(hf)
+    print(f"CPU ms, medians of {a.repeat} alternating calls; numpy reference vs compiled (numba)")
+    print(f"{'mesh':<11}{'elements x points':>18}  {'call':<18}{'numpy':>10}{'compiled':>10}"
+          f"{'speed-up':>10}{'max rel diff':>14}")
+    for label, model in (("2D P2 tri", _model2(a.no_scene, a.thickness, hf)), ("3D P2 tet", _model3(hf))):
+        m = model.m
+        ue = trial_state(model).reshape(-1, m)[model.sdofs]
+        kin = kernels.Kinematics(ue, model.G, model.w, model.mixed)
+        S3, D, _ = law(kin.C)
+        # as Model.tangent passes them: S a strided view, D a contiguous product
+        S, Dm = S3[..., :m, :m], 1.0 * D[..., :m, :m, :m, :m]
+
+        def flag(on, fn):
+            def call():
+                kernels.COMPILED = on
+                return fn()
+            return call
+
+        kin_n = flag(False, lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed))()
+        kin_c = flag(True, lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed))()
+        rows = [("Kinematics", lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed),
+                 lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed), None),
+                ("kernels.residual", lambda: kernels.residual(kin_n, S), lambda: kernels.residual(kin_c, S),
+                 lambda r: r),
+                ("kernels.tangent", lambda: kernels.tangent(kin_n, S, Dm), lambda: kernels.tangent(kin_c, S, Dm),
+                 lambda r: r)]
+        E, Q = model.w.shape
+        size = f"{E} x {Q}"
+        tot_n = tot_c = 0.0
+        for name, fn, fc, val in rows:
+            fn, fc = flag(False, fn), flag(True, fc)
+            diff = ""
+            if val is not None:
+                rn, rc = fn(), fc()
+                diff = f"{np.abs(rc - rn).max() / np.abs(rn).max():.1e}"
+            tn, tc = paired_ms(fn, fc, a.repeat)
+            tot_n, tot_c = tot_n + tn, tot_c + tc
+            print(f"{label:<11}{size:>18}  {name:<18}{tn:>8.2f}ms{tc:>8.2f}ms{tn / tc:>9.1f}x{diff:>14}")
+        print(f"{label:<11}{size:>18}  {'sum':<18}{tot_n:>8.2f}ms{tot_c:>8.2f}ms{tot_n / tot_c:>9.1f}x")
+        kernels.COMPILED = True
+    with tempfile.TemporaryDirectory() as cache:
+        for what in ("first call, empty cache (JIT compile)", "first call, cache written above (load)"):
+            out = subprocess.run([sys.executable, __file__, "--jit-probe"], check=True, capture_output=True,
+                                 text=True, env={**os.environ, "NUMBA_CACHE_DIR": cache}).stdout
+            t = json.loads(out)
+            print(f"{what}: " + ", ".join(f"{k} {v:.2f} s" for k, v in t.items()))
+
+
+def jit_probe():
+    """Wall time of the first Kinematics/residual/tangent call per element kind in this
+    process (numba import excluded), printed as JSON."""
+    import numba  # noqa: F401  (imported before the clock starts)
+
+    from tactileskin.fe import kernels
+    out = {}
+    for m, A, Q in ((2, 6, 3), (3, 10, 4)):
+        rng = np.random.default_rng(0)
+        G = rng.standard_normal((4, Q, A, m))
+        w, ue = np.ones((4, Q)), 0.01 * rng.standard_normal((4, A, m))
+        S, D = np.zeros((4, Q, m, m)), np.zeros((4, Q) + (m,) * 4)
+        t0 = time.perf_counter()
+        kin = kernels.Kinematics(ue, G, w, True)
+        t1 = time.perf_counter()
+        kernels.residual(kin, S)
+        t2 = time.perf_counter()
+        kernels.tangent(kin, S, D)
+        t3 = time.perf_counter()
+        out.update({f"{m}D kinematics": t1 - t0, f"{m}D residual": t2 - t1, f"{m}D tangent": t3 - t2})
+    print(json.dumps(out))
+
+
+def measure(repeat, no_scene, thickness=1):
+    from tactileskin.materials import get_material
+
+    hf = get_material("silicone").hyperfoam
+    return (rows_for("2D P2 tri", _model2(no_scene, thickness, hf), hf, repeat)
+            + rows_for("3D P2 tet", _model3(hf), hf, repeat))
 
 
 def solve_median():
@@ -135,9 +225,7 @@ def compare(a):
     """The element kernels and the hyperfoam law of git revision REV (fe/kernels.py and
     materials/hyperfoam.py loaded from it) against this tree's, call by call on the same
     models (this tree's Model, meshes and states)."""
-    from skfem import MeshTet, MeshTri
-
-    from tactileskin.fe import Dirichlet, Model, kernels, material_law
+    from tactileskin.fe import kernels, material_law
     from tactileskin.materials import get_material
 
     root = Path(__file__).resolve().parents[1]
@@ -154,17 +242,7 @@ def compare(a):
     hf = get_material("silicone").hyperfoam
     hf_b = hb.Hyperfoam(hf.mu, hf.alpha, hf.nu)
     law_b = lambda C: hb.pk2_tangent(hf_b, C)  # noqa: E731 (the baseline's material_law)
-    if a.scene:
-        from tactileskin.fe import model_for_scene
-        from tactileskin.scene import Scene
-        model2 = model_for_scene(Scene(thickness=1, material="silicone", indenter="flat"))[0]
-    else:
-        mesh = MeshTri.init_tensor(np.linspace(0, 1, 32), np.linspace(0, 1, 32))
-        model2 = Model(mesh, {"l": mesh.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
-                       [Dirichlet("l", (0,))])
-    mesh3 = MeshTet.init_tensor(*(np.linspace(0, 1, 13),) * 3)
-    model3 = Model(mesh3, {"l": mesh3.facets_satisfying(lambda x: x[0] < 1e-9)}, material_law(hf),
-                   [Dirichlet("l", (0,))])
+    model2, model3 = _model2(not a.scene, a.thickness, hf), _model3(hf)
     print(f"CPU ms, medians of {a.repeat} alternating calls; baseline = {a.baseline}")
     print(f"{'mesh':<11}{'elements x points':>18}  {'call':<18}{'baseline':>10}{'now':>9}{'speed-up':>10}")
     for label, model in (("2D P2 tri", model2), ("3D P2 tet", model3)):
@@ -199,12 +277,20 @@ def main():
     ap.add_argument("--solve", action="store_true")
     ap.add_argument("--baseline", default=None, help="git revision to compare with")
     ap.add_argument("--scene", action="store_true", help="with --baseline: the scene's 2D mesh")
+    ap.add_argument("--thickness", type=float, default=1, help="the 2D scene's skin thickness (mm)")
+    ap.add_argument("--compiled", action="store_true", help="numpy reference vs compiled kernels")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--jit-probe", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
-    if a.baseline:
+    if a.jit_probe:
+        jit_probe()
+        return
+    if a.compiled:
+        compiled_vs_numpy(a)
+    elif a.baseline:
         compare(a)
     else:
-        rows = measure(a.repeat, a.no_scene)
+        rows = measure(a.repeat, a.no_scene, a.thickness)
         if a.json:
             print(json.dumps(rows))
             return
