@@ -7,7 +7,7 @@ import numpy as np
 from tactileskin.errors import ConvergenceError, ParameterError
 from tactileskin.fe import kernels
 from tactileskin.fe.model import Evaluation, Model
-from tactileskin.fe.recovery import Projector
+from tactileskin.fe.recovery import PointFit, Projector
 from tactileskin.results import Result
 
 _VTK_CELL = {(2, 6): "triangle6", (2, 3): "triangle", (3, 10): "tetra10", (3, 4): "tetra",
@@ -183,6 +183,13 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
         s, p = plane_profile(model, fields["pressure"], path, s_of_point, plane_z)
     else:
         s, p = path_profile(model, fields["pressure"], path, s_of_point)
+        # the profile itself from the local fit (second order at the boundary; the projected
+        # nodal field, first order there, stays in the VTK output): see recovery.PointFit
+        sd = model.facet_scalar_dofs(path)
+        X = model.basis.doflocs[:, sd].T
+        order = np.argsort(np.asarray(s_of_point(X), float), kind="stable")
+        p = PointFit(model, X[order]).values(kernels.mean_pressure(model.stress(ev)))
+        fields["pressure"][sd[order]] = p  # the VTK field agrees with the profile on the path
     if model.surface is not None and ev.contact is not None:
         g, lamN, x, n = ev.contact
         pc = model.surface.current_pressure(model.u, lamN)
