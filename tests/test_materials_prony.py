@@ -154,3 +154,23 @@ def test_elastic_prony_is_identity():
     S, H = p.update(p.initial_state((3, 3)), np.zeros((3, 3)), np.eye(3), 0.5)
     assert np.array_equal(S, np.eye(3)) and H.shape == (0, 3, 3)
     assert math.isclose(p.relaxation(3.0), 1.0)
+
+
+@pytest.mark.parametrize("dt,dt_prev", [(1e-4, 2e-4), (0.01, 0.01), (0.1, 0.05), (0.3, 0.2), (5.0, 1.0)])
+def test_quadratic_step_factors_match_quadrature(dt, dt_prev):
+    """gain/back of the parabola update against adaptive quadrature of
+    int_0^dt sum_i g_i exp(-(dt - x)/tau_i) p'(x) dx, p the parabola through
+    (-dt_prev, S_{n-1}), (0, S_n), (dt, S_{n+1}); covers the series branch (dt/tau < 0.02)
+    and dt >> tau. quad's error is ~1e-14 here: 1e-9 relative is a wide margin."""
+    from scipy.integrate import quad
+
+    pr = Prony((0.167, 0.158, 0.113), (0.100, 1.380, 25.472))
+    decay, gain, back = pr.step_factors_quadratic(dt, dt_prev)
+    Sm, S0, S1 = 0.3, 1.0, 2.2
+    c2 = ((S1 - S0) / dt - (S0 - Sm) / dt_prev) / (dt + dt_prev)
+    c1 = (S1 - S0) / dt - c2 * dt
+    for i, (g, tau) in enumerate(zip(pr.g, pr.tau)):
+        ref = g * quad(lambda x: np.exp(-(dt - x) / tau) * (c1 + 2 * c2 * x), 0.0, dt, epsabs=0, epsrel=1e-13)[0]
+        got = gain[i] * (S1 - S0) - back[i] * (S0 - Sm)
+        assert got == pytest.approx(ref, rel=1e-9, abs=1e-15)
+    assert np.allclose(decay, np.exp(-dt / np.asarray(pr.tau)))
