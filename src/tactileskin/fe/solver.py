@@ -33,7 +33,11 @@ class SolverOptions:
     atol: float = 1e-12           # absolute residual floor (N)
     max_newton: int = 10           # healthy increments converge in <= 8; failing fast is cheaper
     max_halvings: int = 8
-    dt0_fraction: float = 0.1     # first increment as a fraction of the total time
+    # first increment as a fraction of the total time. 0.25 (was 0.1): with the second-order
+    # QLV update the time error of 4 increments is 0.07-0.14 % of the peak (preview meshes,
+    # against dt = 0.02), and every increment costs ~6-15 Newton iterations of contact
+    # settling however short; 18 paper cases 1919 -> 1648 iterations, 97 -> 77 s CPU
+    dt0_fraction: float = 0.25
     dt_min_fraction: float = 1e-5
     dt_max_fraction: float = 0.25
     growth: float = 1.5
