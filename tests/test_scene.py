@@ -65,3 +65,15 @@ def test_mesh_defaults_follow_dimension():
     assert (Scene(dim=3).mesh_size, Scene(dim=3).refinement) == DEFAULT_MESH[3]
     assert Scene().replace(dim=3) == Scene(dim=3)            # defaults re-derived
     assert Scene(mesh_size=0.4).replace(dim=3).mesh_size == 0.4  # explicit choices kept
+
+
+def test_braille_2d_default_mesh_is_finer():
+    from tactileskin.scene import DEFAULT_MESH, DEFAULT_MESH_BRAILLE_2D
+
+    b = Scene(indenter="braille")
+    assert (b.mesh_size, b.refinement) == DEFAULT_MESH_BRAILLE_2D
+    assert DEFAULT_MESH_BRAILLE_2D[0] / DEFAULT_MESH_BRAILLE_2D[1] < DEFAULT_MESH[2][0] / DEFAULT_MESH[2][1]
+    assert Scene().replace(indenter="braille") == b              # defaults re-derived
+    assert b.replace(indenter="flat") == Scene()
+    assert Scene(mesh_size=0.4).replace(indenter="braille").mesh_size == 0.4
+    assert Scene(indenter="braille", dim=3).mesh_size == DEFAULT_MESH[3][0]

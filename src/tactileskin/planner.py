@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
-from tactileskin.scene import DEFAULT_MESH, IndenterKind, Scene
+from tactileskin.scene import DEFAULT_MESH, DEFAULT_MESH_BRAILLE_2D, IndenterKind, Scene
 
 log = logging.getLogger(__name__)
 
@@ -147,28 +147,32 @@ class Plan:
         return "\n".join([head] + ["  - " + str(c) for c in self.choices])
 
 
-# Quality presets for 2D solves (mesh_size mm, refinement), chosen from the Pareto fronts
-# of benchmarks/speed_vs_error.py (docs/speed_vs_error.md), with the relative peak error
-# expected from them (first-order convergence of the peak; measured or extrapolated there).
+# Quality presets for 2D solves: (mesh_size mm, refinement) for flat / curved indenters and
+# for Braille (the dot needs the finer size), with the relative peak error expected from
+# them, measured against Richardson-extrapolated references of the 18 paper cases
+# (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy.md). `default` is the
+# Scene default (scene.default_mesh).
 QUALITY: dict[str, dict] = {
-    # refined size 0.2 mm: with 0.5 mm (refinement 2) the Braille dot (base radius 0.72 mm)
-    # was unresolved, -27.5 % peak at t = 1 silicone; at 0.2 mm the 18 paper cases are
-    # within -0.5..-2.6 % of `default`, except t1 silicone Braille at -5.6 %
-    # (docs/speed_vs_error.md, "Presets re-measured").
-    "preview": {"mesh_size": 1.0, "refinement": 5.0, "peak_error": 0.05},
-    "default": {"mesh_size": DEFAULT_MESH[2][0], "refinement": DEFAULT_MESH[2][1], "peak_error": 0.01},
-    "fine": {"mesh_size": 0.177, "refinement": 3.0, "peak_error": 0.007},
+    "preview": {"mesh": (1.0, 5.0), "braille_mesh": (1.0, 5.0), "peak_error": 0.05},
+    "default": {"mesh": DEFAULT_MESH[2], "braille_mesh": DEFAULT_MESH_BRAILLE_2D, "peak_error": 0.01},
+    "fine": {"mesh": (0.25, 3.0), "braille_mesh": (0.177, 3.0), "peak_error": 0.005},
 }
+
+
+def quality_mesh(quality: str, indenter) -> tuple[float, float]:
+    """(mesh_size, refinement) of a 2D quality preset for an indenter kind."""
+    if quality not in QUALITY:
+        raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
+    q = QUALITY[quality]
+    return q["braille_mesh"] if IndenterKind(indenter) is IndenterKind.BRAILLE else q["mesh"]
 
 
 def with_quality(scene: Scene, quality: str) -> Scene:
     """The scene meshed at a quality preset (2D; a 3D scene keeps its own sizes)."""
-    if quality not in QUALITY:
-        raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
+    size, ref = quality_mesh(quality, scene.indenter)
     if scene.dim == 3:
         return scene
-    q = QUALITY[quality]
-    return scene.replace(mesh_size=q["mesh_size"], refinement=q["refinement"])
+    return scene.replace(mesh_size=size, refinement=ref)
 
 
 # --- individual estimates (pure) ----------------------------------------------------------

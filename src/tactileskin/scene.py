@@ -15,12 +15,25 @@ from pathlib import Path
 
 from tactileskin.errors import ParameterError, check_range
 
-SCHEMA_VERSION = 1  # bump when a field's meaning changes, so cached results are not reused
+# bump when a field's meaning or the solver's answer for it changes, so cached results are
+# not reused (2: bone pressure from the boundary fit, second-order QLV update)
+SCHEMA_VERSION = 2
 
 
-# Element size and refinement defaults per dimension: 0.25 mm in 2D resolves the bone
-# pressure (benchmarks/speed_vs_error.py); the same size in 3D would be ~1e6 P2 tetrahedra.
-DEFAULT_MESH = {2: (0.25, 3.0), 3: (0.6, 2.0)}
+# Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
+# 2D: with the boundary fit of the bone pressure (fe.recovery.PointFit) 0.5 / 3 keeps the
+# flat and curved peaks within 0.4 % of the mesh-converged value and Braille needs 0.25 / 3
+# (the dot, base radius 0.72 mm: 0.5 / 3 reads -1.7 % at t = 1 silicone); see
+# benchmarks/results/preset_accuracy.md. The same sizes in 3D would be ~1e6 P2 tetrahedra.
+DEFAULT_MESH = {2: (0.5, 3.0), 3: (0.6, 2.0)}
+DEFAULT_MESH_BRAILLE_2D = (0.25, 3.0)
+
+
+def default_mesh(dim: int, indenter) -> tuple[float, float]:
+    """(mesh_size, refinement) a scene of this dimension and indenter gets by default."""
+    if dim == 2 and IndenterKind(indenter) is IndenterKind.BRAILLE:
+        return DEFAULT_MESH_BRAILLE_2D
+    return DEFAULT_MESH[dim]
 
 
 class IndenterKind(str, Enum):
@@ -80,7 +93,7 @@ class Scene:
             # of the mixed formulation equals J: it silently becomes the locking displacement one.
             raise ParameterError("order", 1, "2 with the mixed formulation",
                                  "order 1 locks; use formulation='displacement' to study it")
-        size0, ref0 = DEFAULT_MESH[self.dim]
+        size0, ref0 = default_mesh(self.dim, self.indenter)
         set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
                                       0.01, 5.0, unit="mm"))
         set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
@@ -114,10 +127,11 @@ class Scene:
         return self.fingertip_model().section(self.thickness)
 
     def replace(self, **changes) -> "Scene":
-        """A changed copy. Changing `dim` re-derives mesh defaults that were left at default."""
+        """A changed copy. Changing `dim` or `indenter` re-derives mesh defaults left at default."""
         new_dim = changes.get("dim", self.dim)
-        if new_dim != self.dim and new_dim in DEFAULT_MESH:
-            size0, ref0 = DEFAULT_MESH.get(self.dim, (None, None))
+        new_ind = changes.get("indenter", self.indenter)
+        if (new_dim != self.dim or new_ind != self.indenter) and new_dim in DEFAULT_MESH:
+            size0, ref0 = default_mesh(self.dim, self.indenter)
             if "mesh_size" not in changes and self.mesh_size == size0:
                 changes["mesh_size"] = None
             if "refinement" not in changes and self.refinement == ref0:
