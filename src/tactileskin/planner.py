@@ -155,7 +155,7 @@ class Plan:
 QUALITY: dict[str, dict] = {
     "preview": {"mesh": (1.0, 5.0), "braille_mesh": (1.0, 5.0), "peak_error": 0.05},
     "default": {"mesh": DEFAULT_MESH[2], "braille_mesh": DEFAULT_MESH_BRAILLE_2D, "peak_error": 0.01},
-    "fine": {"mesh": (0.25, 3.0), "braille_mesh": (0.177, 3.0), "peak_error": 0.005},
+    "fine": {"mesh": (0.25, 3.0), "braille_mesh": (0.25, 6.0), "peak_error": 0.005},
 }
 
 

@@ -22,11 +22,13 @@ SCHEMA_VERSION = 2
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
 # 2D: with the boundary fit of the bone pressure (fe.recovery.PointFit) 0.5 / 3 keeps the
-# flat and curved peaks within 0.4 % of the mesh-converged value and Braille needs 0.25 / 3
-# (the dot, base radius 0.72 mm: 0.5 / 3 reads -1.7 % at t = 1 silicone); see
-# benchmarks/results/preset_accuracy.md. The same sizes in 3D would be ~1e6 P2 tetrahedra.
+# flat and curved peaks within 0.4 % of the mesh-converged value; Braille needs the refined
+# size 0.083 mm at the dot (base radius 0.72 mm; 0.5 / 3 reads -1.7 % at t = 1 silicone),
+# which 0.5 / 6 gives with 25 % fewer dofs than 0.25 / 3 at t = 5 for the same peak (within
+# 0.1 %); see benchmarks/results/preset_accuracy_fit.md. In 3D the same sizes would be ~1e6
+# P2 tetrahedra.
 DEFAULT_MESH = {2: (0.5, 3.0), 3: (0.6, 2.0)}
-DEFAULT_MESH_BRAILLE_2D = (0.25, 3.0)
+DEFAULT_MESH_BRAILLE_2D = (0.5, 6.0)
 
 
 def default_mesh(dim: int, indenter) -> tuple[float, float]:
