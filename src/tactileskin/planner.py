@@ -154,10 +154,11 @@ class Plan:
 # Scene default (scene.default_mesh).
 # Measured (commit e355ae2 code, 18 cases): preview -0.12..-3.18 % (t1 silicone Braille),
 # default -0.10..-0.47 %, fine (= the series' 0.177 / 3 level) +0.03..-0.17 %; every preset
-# reads low (the meshes converge from below).
+# reads low (the meshes converge from below). Against 5-level series the t = 1 cases read
+# lower still: preview down to -3.54 %, default -0.67 % (preset_accuracy_fit_t1.md).
 QUALITY: dict[str, dict] = {
-    "preview": {"mesh": (1.0, 5.0), "braille_mesh": (1.0, 5.0), "peak_error": 0.035},
-    "default": {"mesh": DEFAULT_MESH[2], "braille_mesh": DEFAULT_MESH_BRAILLE_2D, "peak_error": 0.005},
+    "preview": {"mesh": (1.0, 5.0), "braille_mesh": (1.0, 5.0), "peak_error": 0.04},
+    "default": {"mesh": DEFAULT_MESH[2], "braille_mesh": DEFAULT_MESH_BRAILLE_2D, "peak_error": 0.007},
     "fine": {"mesh": (0.177, 3.0), "braille_mesh": (0.177, 3.0), "peak_error": 0.002},
 }
 
