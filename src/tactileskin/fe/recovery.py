@@ -107,8 +107,9 @@ class PointFit:
         M = np.einsum("nk,nki,nkj->nij", wt, A, A)
         e0 = np.zeros((len(pts), m + 1))
         e0[:, 0] = 1.0
-        # first row of (A^T W A)^-1 A^T W: the fitted value at the point
-        y = np.linalg.solve(M, e0[..., None])[..., 0]                                   # (n, m+1)
+        # first row of (A^T W A)^-1 A^T W: the fitted value at the point (pinv: a degenerate
+        # patch, e.g. a mesh of a few cells, gives the least-norm fit instead of an error)
+        y = (np.linalg.pinv(M) @ e0[..., None])[..., 0]                                 # (n, m+1)
         self.coef = np.einsum("ni,nki,nk->nk", y, A, wt)
         self.idx = idx
         self.w, self.vol = w, vol
