@@ -150,7 +150,7 @@ class Plan:
 # Quality presets for 2D solves: (mesh_size mm, refinement) for flat / curved indenters and
 # for Braille (the dot needs the finer size), with the relative peak error expected from
 # them, measured against Richardson-extrapolated references of the 18 paper cases
-# (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy.md). `default` is the
+# (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md). `default` is the
 # Scene default (scene.default_mesh).
 # Measured (commit e355ae2 code, 18 cases): preview -0.12..-3.18 % (t1 silicone Braille),
 # default -0.10..-0.47 %, fine (= the series' 0.177 / 3 level) +0.03..-0.17 %; every preset

@@ -6,21 +6,23 @@ Low level (any mesh + named boundaries + BCs + indenter): `Model`, `Dirichlet`, 
 
 Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
 - total Lagrangian, P2 displacements (plane strain F33 = 1, or tets), scikit-fem for the
-  basis and quadrature, element kernels vectorised in numpy, assembly into a fixed CSR
+  basis and quadrature, compiled (numba) element kernels (fe.kernels; the numpy versions
+  are the test references), assembly into a fixed CSR
   pattern, MKL PARDISO on the free block with the ordering analysed once per model
   (fe.linsolve; SuperLU where MKL is not installed);
 - 3-point (triangle) / 4-point (tet) rule, as Abaqus CPE6 / C3D10;
 - default 'mixed': three-field Hu-Washizu with element-constant dilatation and pressure,
   condensed (mean dilatation, F_bar = (theta/J)^(1/m) F): on the Lame cylinder the nodal
   pressure converges O(h^2) while the displacement formulation's is 20-100x worse;
-- QLV Prony update on the PK2 stress at the quadrature points (tangent factor
-  g_inf + sum gain_i);
+- QLV Prony update on the PK2 stress at the quadrature points, S0 interpolated in time
+  by the parabola through the last three states (tangent factor g_inf + sum gain_i);
 - rigid frictionless contact on 2 Gauss points per P2 edge / 3 per P2 triangle (more
   over-constrain the multipliers), penalty 20 K0 / h with Uzawa updates to a penetration
   below 1e-4 mm; points stay active within a Newton solve (no active-set cycling);
 - Newton with a Crisfield line search on s(eta) = du.R, inadmissible states halve the
   step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure;
-- nodal pressure by L2 projection onto P1 (exact mass matrix for the 3-point rule).
+- nodal pressure by L2 projection onto P1 (exact mass matrix for the 3-point rule); the
+  2D bone profile by a local linear fit to element averages (fe.recovery.PointFit).
 """
 
 from __future__ import annotations

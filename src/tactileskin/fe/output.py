@@ -23,10 +23,12 @@ def reaction(model: Model, ev: Evaluation, names=None) -> np.ndarray:
     return np.bincount(comp, weights=ev.fint[dofs], minlength=model.m)
 
 
-def nodal_fields(model: Model, ev: Evaluation, projector: Projector | None = None) -> dict:
-    """Nodal (projected) mean pressure and Cauchy stress components; displacement."""
+def nodal_fields(model: Model, ev: Evaluation, projector: Projector | None = None,
+                 sig: np.ndarray | None = None) -> dict:
+    """Nodal (projected) mean pressure and Cauchy stress components; displacement. `sig`:
+    the Cauchy stress at the quadrature points when the caller has it already."""
     pj = projector or Projector(model)
-    sig = model.stress(ev)
+    sig = model.stress(ev) if sig is None else sig
     P = kernels.mean_pressure(sig)
     out = {"pressure": pj.project(P)}
     names = ["sxx", "syy", "szz", "sxy", "syz", "sxz"]
@@ -39,13 +41,12 @@ def nodal_fields(model: Model, ev: Evaluation, projector: Projector | None = Non
     return out
 
 
-def path_profile(model: Model, nodal: np.ndarray, boundary: str, s_of_point) -> tuple[np.ndarray, np.ndarray]:
-    """(s, values) at the scalar dofs of a named boundary, sorted by s = s_of_point(reference xy)."""
+def path_nodes(model: Model, boundary: str, s_of_point) -> tuple[np.ndarray, np.ndarray]:
+    """(scalar dofs, s) of a named boundary's nodes, sorted by s = s_of_point(reference xy)."""
     sd = model.facet_scalar_dofs(boundary)
-    X = model.basis.doflocs[:, sd].T
-    s = np.asarray(s_of_point(X), float)
+    s = np.asarray(s_of_point(model.basis.doflocs[:, sd].T), float)
     order = np.argsort(s, kind="stable")
-    return s[order], nodal[sd][order]
+    return sd[order], s[order]
 
 
 def _facet_nodes(model: Model, boundary: str) -> np.ndarray:
@@ -175,21 +176,19 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     """Result of a converged state. 2D: the profile at the path's nodes. 3D: the profile on
     the section plane z = plane_z (default `profile_plane_z(model)`), see `plane_profile`."""
     pj = Projector(model)
-    fields = nodal_fields(model, ev, pj)
+    sig = model.stress(ev)
+    fields = nodal_fields(model, ev, pj, sig)
     if s_of_point is None:
         s_of_point = arc_length
     if model.m == 3:
         plane_z = profile_plane_z(model) if plane_z is None else float(plane_z)
         s, p = plane_profile(model, fields["pressure"], path, s_of_point, plane_z)
     else:
-        s, p = path_profile(model, fields["pressure"], path, s_of_point)
-        # the profile itself from the local fit (second order at the boundary; the projected
-        # nodal field, first order there, stays in the VTK output): see recovery.PointFit
-        sd = model.facet_scalar_dofs(path)
-        X = model.basis.doflocs[:, sd].T
-        order = np.argsort(np.asarray(s_of_point(X), float), kind="stable")
-        p = PointFit(model, X[order]).values(kernels.mean_pressure(model.stress(ev)))
-        fields["pressure"][sd[order]] = p  # the VTK field agrees with the profile on the path
+        # the profile from the local fit (second order at the boundary; the projected nodal
+        # field, first order there, stays in the VTK output elsewhere): see recovery.PointFit
+        sd, s = path_nodes(model, path, s_of_point)
+        p = PointFit(model, model.basis.doflocs[:, sd].T).values(kernels.mean_pressure(sig))
+        fields["pressure"][sd] = p  # the VTK field agrees with the profile on the path
     if model.surface is not None and ev.contact is not None:
         g, lamN, x, n = ev.contact
         pc = model.surface.current_pressure(model.u, lamN)
