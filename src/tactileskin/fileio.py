@@ -1,0 +1,263 @@
+"""Safe file output: every file and folder the toolkit writes goes through here.
+
+Rules (issue #12, "never destroy user data"):
+- A file is written to a temporary sibling and renamed over its target (atomic on one
+  filesystem), so a crash leaves either the old file or the new one, never a partial one.
+- Files get mode 0o666 and folders 0o777, less the user's umask (mkstemp and mkdtemp
+  would leave 0600 / 0700).
+- A temporary name carries the writer's pid (`.NAME.tsk<pid>-XXXX.tmp`), so that the next
+  run can remove the leftovers of a killed one (`clean_stale`) without touching the files
+  of a writer that is still alive.
+- An output folder is written into only if it is new, empty, or marked as the toolkit's
+  (`claim_dir` writes the marker `.tactileskin`); a folder holding files we did not write
+  is refused, never emptied.
+- An OSError becomes an `OutputError` that names the path and the cause in one line.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Iterable, Iterator
+
+from tactileskin.errors import TactileSkinError
+
+MARKER = ".tactileskin"
+_TMP_RE = re.compile(r"^\..+\.tsk(\d+)-[A-Za-z0-9_]+\.(tmp|partial)$")
+
+
+class OutputError(TactileSkinError):
+    """An output could not be written (permissions, no space, a file in the way, ...)."""
+
+    def __init__(self, path, cause: str):
+        self.path = str(path)
+        super().__init__(f"cannot write {self.path}: {cause}")
+
+
+def umask() -> int:
+    """The process umask, read without changing it where the OS allows."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    old = os.umask(0o022)  # not thread-safe, hence the /proc read above
+    os.umask(old)
+    return old
+
+
+def file_mode() -> int:
+    return 0o666 & ~umask()
+
+
+def dir_mode() -> int:
+    return 0o777 & ~umask()
+
+
+def _cause(e: OSError) -> str:
+    if e.errno == errno.ENOSPC:
+        return "no space left on the device"
+    if e.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return "permission denied (read-only folder?)"
+    if e.errno == errno.ENOTDIR:
+        return "a part of the path is a file, not a folder"
+    if e.errno == errno.EISDIR:
+        return "it is a folder"
+    return e.strerror or type(e).__name__
+
+
+@contextlib.contextmanager
+def os_errors(path) -> Iterator[None]:
+    """Turn an OSError raised inside into an OutputError naming `path` (or the error's own file)."""
+    try:
+        yield
+    except OutputError:
+        raise
+    except OSError as e:
+        raise OutputError(e.filename or path, _cause(e)) from e
+
+
+def _tmp_prefix(path: Path) -> str:
+    return f".{path.name}.tsk{os.getpid()}-"
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_stale(folder) -> list[Path]:
+    """Remove our temporary files/folders in `folder` whose writer process is gone."""
+    folder = Path(folder)
+    removed = []
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return removed
+    for p in entries:
+        m = _TMP_RE.match(p.name)
+        if m and not _pid_alive(int(m.group(1))):
+            with contextlib.suppress(OSError):
+                if p.is_dir() and not p.is_symlink():
+                    shutil.rmtree(p)
+                else:
+                    p.unlink()
+                removed.append(p)
+    return removed
+
+
+def make_dirs(path) -> Path:
+    """mkdir -p under the umask; a file in the way is an OutputError."""
+    path = Path(path)
+    with os_errors(path):
+        path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path, *, suffix: str = ".tmp") -> Iterator[Path]:
+    """Yield a temporary path beside `path`; on success it is renamed over `path` with
+    normal permissions. For writers that want a file name (meshio, savefig, OCP)."""
+    path = Path(path)
+    make_dirs(path.parent)
+    clean_stale(path.parent)
+    with os_errors(path):
+        fd, tmp = tempfile.mkstemp(prefix=_tmp_prefix(path), suffix=suffix, dir=path.parent)
+        os.close(fd)
+    tmp = Path(tmp)
+    try:
+        yield tmp
+        with os_errors(path):
+            os.chmod(tmp, file_mode())
+            os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+
+
+def atomic_write_bytes(path, data: bytes) -> Path:
+    path = Path(path)
+    with atomic_path(path) as tmp, os_errors(path):
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+    return path
+
+
+def atomic_write_text(path, text: str) -> Path:
+    """Write `text` (UTF-8, newlines as given) to `path` atomically."""
+    return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_json(path, obj) -> Path:
+    """Strict JSON (NaN and infinity are refused, not written as invalid tokens)."""
+    try:
+        text = json.dumps(obj, indent=2, allow_nan=False)
+    except ValueError as e:
+        raise OutputError(path, f"non-finite number in the data ({e})") from None
+    return atomic_write_text(path, text + "\n")
+
+
+# --- output folders -------------------------------------------------------------------
+
+def _is_ours(folder: Path, kind: str | None, own_names: Iterable[str]) -> bool:
+    marker = folder / MARKER
+    if marker.is_file():
+        if kind is None:
+            return True
+        try:
+            return json.loads(marker.read_text()).get("kind") in (kind, None)
+        except (OSError, ValueError, AttributeError):
+            return False
+    # a folder written before the marker existed: only names this command writes
+    own = set(own_names)
+    names = [p.name for p in folder.iterdir() if not _TMP_RE.match(p.name)]
+    return bool(own) and bool(names) and all(n in own for n in names)
+
+
+def claim_dir(folder, kind: str, *, own_names: Iterable[str] = (), what: str = "out") -> Path:
+    """Make `folder` the toolkit's output folder of `kind`, or refuse it.
+
+    Accepted: a missing or empty folder, a folder with our marker of the same kind, or one
+    holding only `own_names` (outputs of an earlier version). Anything else raises
+    OutputError and nothing is written. Stale temporaries of killed runs are removed.
+    """
+    folder = Path(folder)
+    if folder.is_symlink() and not folder.is_dir():
+        raise OutputError(folder, "it is a broken symbolic link")
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(folder, f"{what} must be a folder, and this is a file")
+    if folder.is_dir():
+        with os_errors(folder):
+            entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)]
+        if entries and not _is_ours(folder, kind, own_names):
+            shown = ", ".join(sorted(p.name for p in entries)[:3]) + (", ..." if len(entries) > 3 else "")
+            raise OutputError(folder, f"the folder holds files tactileskin did not write ({shown}); "
+                                      f"refusing to write into it: give {what} a new or empty folder")
+    make_dirs(folder)
+    clean_stale(folder)
+    if not (folder / MARKER).is_file():
+        atomic_write_json(folder / MARKER, {"kind": kind, "note": "written by tactileskin; "
+                                            "its commands may replace their own files here"})
+    return folder
+
+
+@contextlib.contextmanager
+def staged_dir(final) -> Iterator[Path]:
+    """Yield a new, empty staging folder beside `final`; on success it replaces `final`.
+
+    For folders the toolkit owns entirely (a cache entry, a result folder inside one).
+    `final`, if it exists, must be ours: callers check (claim_dir, or a cache layout).
+    The old folder is moved aside and removed only after the new one is in place.
+    """
+    final = Path(final)
+    make_dirs(final.parent)
+    clean_stale(final.parent)
+    with os_errors(final):
+        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(final), suffix=".partial", dir=final.parent))
+        os.chmod(tmp, dir_mode())
+    try:
+        yield tmp
+        with os_errors(final):
+            if final.exists():
+                old = Path(tempfile.mkdtemp(prefix=_tmp_prefix(final), suffix=".partial", dir=final.parent))
+                os.replace(final, old / "old")
+                try:
+                    os.replace(tmp, final)
+                except BaseException:
+                    os.replace(old / "old", final)
+                    raise
+                finally:
+                    shutil.rmtree(old, ignore_errors=True)
+            else:
+                os.replace(tmp, final)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def fix_tree_modes(root) -> None:
+    """Give files written by third-party code inside a staging folder normal permissions."""
+    fm, dm = file_mode(), dir_mode()
+    for dirpath, dirnames, filenames in os.walk(root):
+        os.chmod(dirpath, dm)
+        for f in filenames:
+            p = os.path.join(dirpath, f)
+            if not os.path.islink(p):
+                os.chmod(p, fm)
