@@ -127,3 +127,14 @@ def test_full_disk_and_denied_write_name_the_path_and_keep_the_old_file(tmp_path
     monkeypatch.undo()
     assert p.read_text() == "old"
     assert sorted(x.name for x in tmp_path.iterdir()) == ["r.csv"]
+
+
+def test_a_temporary_with_its_own_suffix_is_also_cleaned(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    stale = tmp_path / f".m.vtu.tsk{dead}-k2j_9.vtu"
+    stale.write_text("half")
+    with fileio.atomic_path(tmp_path / "m.vtu", suffix=".vtu") as tmp:
+        assert fileio._TMP_RE.match(tmp.name)
+        tmp.write_text("whole")
+    assert not stale.exists() and (tmp_path / "m.vtu").read_text() == "whole"

@@ -29,7 +29,7 @@ from typing import Iterable, Iterator
 from tactileskin.errors import TactileSkinError
 
 MARKER = ".tactileskin"
-_TMP_RE = re.compile(r"^\..+\.tsk(\d+)-[A-Za-z0-9_]+\.(tmp|partial)$")
+_TMP_RE = re.compile(r"^\..+\.tsk(\d+)-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
 
 
 class OutputError(TactileSkinError):
