@@ -175,6 +175,6 @@ def _write_vtu(path: Path, fields: dict) -> None:
         if v.ndim == 2 and v.shape[1] == 2:
             v = np.column_stack([v, np.zeros(len(v))])
         pdata[k] = v
-    with fileio.atomic_path(path, suffix=".vtu") as tmp, fileio.os_errors(path):
+    with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
         meshio.Mesh(pts, [(fields["cell_type"], np.asarray(fields["cells"]))], point_data=pdata).write(
             tmp, file_format="vtu")

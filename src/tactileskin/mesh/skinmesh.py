@@ -96,7 +96,7 @@ class SkinMesh:
         out = self.to_meshio()
         if fmt == "vtu":
             out.cell_sets, out.point_sets, out.field_data = {}, {}, {}
-        with fileio.atomic_path(path, suffix=path.suffix) as tmp, fileio.os_errors(path):
+        with fileio.atomic_path(path) as tmp, fileio.os_errors(path):  # a .tmp name, known to clean_stale
             try:
                 if fmt == "abaqus":
                     from tactileskin.mesh.abaqus import inp_text

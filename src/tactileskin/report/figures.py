@@ -5,11 +5,12 @@ Each figure is written as PNG and SVG. matplotlib runs on the Agg backend (no di
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
-from tactileskin.fileio import atomic_path, make_dirs, os_errors
+from tactileskin.fileio import atomic_write_bytes, make_dirs
 
 INDENTER_ORDER = ("flat", "curved", "braille")
 COLOURS = {"flat": "#1f77b4", "curved": "#d62728", "braille": "#2ca02c"}
@@ -28,8 +29,9 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
     for ext in ("png", "svg"):
         p = out / f"{stem}.{ext}"
-        with atomic_path(p, suffix=f".{ext}") as tmp, os_errors(p):
-            fig.savefig(tmp, format=ext, dpi=150, bbox_inches="tight")
+        buf = io.BytesIO()
+        fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")
+        atomic_write_bytes(p, buf.getvalue())
         paths.append(p)
     _plt().close(fig)
     return paths

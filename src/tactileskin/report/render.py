@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import io
 import logging
 from pathlib import Path
 
-from tactileskin.fileio import atomic_path, os_errors
+from tactileskin.fileio import atomic_write_bytes
 
 log = logging.getLogger(__name__)
 
@@ -34,8 +35,9 @@ def render_case(vtu: Path, png: Path, title: str = "") -> Path:
         if title:
             p.add_text(title, font_size=10)
         p.view_xy()
-        with atomic_path(png, suffix=".png") as tmp, os_errors(png):
-            p.screenshot(str(tmp))
+        buf = io.BytesIO()
+        p.screenshot(buf)  # PNG bytes; the file is written atomically below
     finally:
         p.close()
+    atomic_write_bytes(png, buf.getvalue())
     return png
