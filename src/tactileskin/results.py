@@ -6,15 +6,13 @@ two compare like for like. Pure numpy.
 
 from __future__ import annotations
 
-import json
-import os
-import shutil
-import tempfile
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from tactileskin import fileio
 from tactileskin.errors import ConvergenceError, ParameterError
 
 
@@ -135,31 +133,34 @@ class Result:
         }
 
     def write(self, directory) -> Path:
-        """Write profile.csv, summary.json, contact.csv and result.vtu into `directory`
-        atomically (a temporary sibling directory renamed into place)."""
-        directory = Path(directory)
-        directory.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", dir=directory.parent))
-        try:
-            s, p = self._profile()
-            np.savetxt(tmp / "profile.csv", np.column_stack([s, p]), delimiter=",",
-                       header="s_mm,pressure_mpa", comments="", fmt="%.10g")
-            np.savetxt(tmp / "contact.csv", np.column_stack([self.contact_x, self.contact_pressure]),
-                       delimiter=",", header="x_mm,contact_pressure_mpa", comments="", fmt="%.10g")
-            (tmp / "summary.json").write_text(json.dumps(self.summary(), indent=2))
-            if self.fields is not None:
-                _write_vtu(tmp / "result.vtu", self.fields)
-            if directory.exists():
-                old = Path(tempfile.mkdtemp(prefix=f".{directory.name}.old.", dir=directory.parent))
-                os.replace(directory, old / "d")
-                os.replace(tmp, directory)
-                shutil.rmtree(old, ignore_errors=True)
-            else:
-                os.replace(tmp, directory)
-        except BaseException:
-            shutil.rmtree(tmp, ignore_errors=True)
-            raise
+        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu) into
+        `directory`, creating it; each file is written atomically and only these names are
+        touched (a result.vtu of an earlier write is removed when there are no fields).
+        Callers writing into a user's folder claim it first (fileio.claim_dir)."""
+        directory = fileio.make_dirs(directory)
+        s, p = self._profile()
+        fileio.atomic_write_text(directory / "profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
+        fileio.atomic_write_text(directory / "contact.csv",
+                                 _csv(["x_mm", "contact_pressure_mpa"], self.contact_x, self.contact_pressure))
+        vtu = directory / "result.vtu"
+        if self.fields is not None:
+            _write_vtu(vtu, self.fields)
+        elif vtu.is_file():  # a stale field file would not match the new profile
+            with fileio.os_errors(vtu):
+                vtu.unlink()
+        # last: a folder with a summary.json holds a complete result
+        fileio.atomic_write_json(directory / "summary.json", self.summary())
         return directory
+
+
+# the file names Result.write owns in a folder
+OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu")
+
+
+def _csv(header: list[str], *cols) -> str:
+    buf = io.StringIO()
+    np.savetxt(buf, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+    return buf.getvalue()
 
 
 def _write_vtu(path: Path, fields: dict) -> None:
@@ -174,5 +175,6 @@ def _write_vtu(path: Path, fields: dict) -> None:
         if v.ndim == 2 and v.shape[1] == 2:
             v = np.column_stack([v, np.zeros(len(v))])
         pdata[k] = v
-    meshio.Mesh(pts, [(fields["cell_type"], np.asarray(fields["cells"]))], point_data=pdata).write(
-        path, file_format="vtu")
+    with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
+        meshio.Mesh(pts, [(fields["cell_type"], np.asarray(fields["cells"]))], point_data=pdata).write(
+            tmp, file_format="vtu")

@@ -175,7 +175,9 @@ class Scene:
     def to_toml(self, path: str | Path) -> None:
         import tomli_w
 
-        Path(path).write_text(tomli_w.dumps(self.to_dict()))
+        from tactileskin import fileio
+
+        fileio.atomic_write_text(path, tomli_w.dumps(self.to_dict()))
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "Scene":

@@ -20,8 +20,6 @@ import itertools
 import json
 import logging
 import os
-import shutil
-import tempfile
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -30,6 +28,7 @@ from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
+from tactileskin import fileio
 from tactileskin.errors import ParameterError, TactileSkinError
 from tactileskin.scene import IndenterKind, Scene
 
@@ -136,19 +135,14 @@ class ResultCache:
         return CaseRecord(scene, s, pr, summary, p)
 
     def store(self, scene: Scene, result) -> Path:
-        """Write `result` (has .write(dir)) under the scene key, atomically."""
-        self.root.mkdir(parents=True, exist_ok=True)
+        """Write `result` (has .write(dir)) under the scene key, atomically: the entry is
+        staged whole beside its final name and renamed into place (fileio.staged_dir)."""
         final = self.path(scene)
-        staging_root = Path(tempfile.mkdtemp(prefix=".staging-", dir=self.root))
-        try:
-            staging = staging_root / "case"
+        if final.exists():  # a concurrent writer finished first: identical content by key
+            return final
+        with fileio.staged_dir(final) as staging:
             result.write(staging)
             scene.to_toml(staging / "scene.toml")
-            if final.exists():  # a concurrent writer finished first: identical content by key
-                return final
-            os.replace(staging, final)
-        finally:
-            shutil.rmtree(staging_root, ignore_errors=True)
         return final
 
 

@@ -6,11 +6,14 @@ for build123d or pyvista imports.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import importlib.util
 import logging
 import os
+import signal
 import sys
+import threading
 
 # One BLAS/OpenMP thread per process unless the user says otherwise (before numpy loads):
 # the solver's vectors are small, and threaded BLAS spinning on a busy 2-core machine made
@@ -57,15 +60,34 @@ def cli(verbose: int) -> None:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
 
 
+def _on_sigterm(signum, frame):
+    # an exception, so that `finally` blocks remove temporaries and staging folders
+    raise SystemExit(128 + signum)
+
+
+@contextlib.contextmanager
+def _sigterm_raises():
+    """SIGTERM (a scheduler's kill, `timeout`) unwinds like Ctrl-C instead of dying in place."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI in-process; returns the exit code (tests call this directly)."""
     from rich.console import Console
 
     err = Console(stderr=True)
     try:
-        rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
+        with _sigterm_raises():
+            rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
     except TactileSkinError as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)  # one line, unwrapped
         return 2
     except click.exceptions.Exit as e:
         return e.exit_code
@@ -75,6 +97,12 @@ def main(argv: list[str] | None = None) -> int:
     except click.exceptions.Abort:
         err.print("aborted")
         return 1
+    except OSError as e:  # last resort: a file error that no writer turned into an OutputError
+        from rich.markup import escape
+
+        where = f"{e.filename}: " if e.filename else ""
+        err.print(f"[bold red]error:[/] {escape(where + str(e.strerror or e))}", highlight=False, soft_wrap=True)
+        return 2
     return rv if isinstance(rv, int) else 0
 
 

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+from pathlib import Path
+
 import click
 
 from tactileskin.scene import Formulation, IndenterKind
@@ -37,3 +40,24 @@ def scene_from_options(scene_file=None, **kw):
     if "dim" in changes:
         changes["dim"] = int(changes["dim"])
     return base.replace(**changes) if changes else base
+
+
+@contextlib.contextmanager
+def claimed_output(out, kind: str, own_names=(), what: str = "--out"):
+    """Claim the output folder `out` (fileio.claim_dir) for the body; if the body fails and the
+    folder was created here and holds nothing but our marker, remove it again (no empty
+    leftovers from a refused or failed run)."""
+    from tactileskin import fileio
+
+    out = Path(out)
+    existed = out.exists()
+    fileio.claim_dir(out, kind, own_names=own_names, what=what)
+    try:
+        yield out
+    except BaseException:
+        if not existed:
+            with contextlib.suppress(OSError):
+                if [p.name for p in out.iterdir()] == [fileio.MARKER]:
+                    (out / fileio.MARKER).unlink()
+                    out.rmdir()
+        raise

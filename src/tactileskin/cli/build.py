@@ -10,14 +10,14 @@ import click
 
 @click.command("build")
 @click.option("--thickness", "-t", type=float, default=None,
-              help="Skin thickness (mm); default from geometry/fingertip.toml.")
+              help="Skin thickness (mm); default from data/geometry/fingertip.toml.")
 @click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
               help="Output folder (replaced only if empty or a previous build).")
 @click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "all", "none"]), default="all",
               show_default=True, help="Which indenter(s) to make.")
 @click.option("--braille-text", type=str, default="", help="Text for the Braille indenter (default: one dot).")
 @click.option("--braille-standard", type=str, default="standard_american", show_default=True,
-              help="Braille standard name (geometry/braille.toml).")
+              help="Braille standard name (data/geometry/braille.toml).")
 @click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import click
 
-from tactileskin.cli._common import scene_from_options, scene_options
+from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
+
+# every name `solve` writes into its folder (also how a folder of an earlier version is recognised)
+OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "section_2d", "compare_2d.json")
 
 
 @click.command("solve")
 @scene_options
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
-              help="Output folder (profile.csv, contact.csv, summary.json, result.vtu).")
+              help="Output folder (profile.csv, contact.csv, summary.json, result.vtu): a new or "
+                   "empty folder, or one written by `solve`; only these files are replaced.")
 @click.option("--elastic", is_flag=True, default=False, help="Ignore viscoelasticity (Prony series).")
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
@@ -27,8 +31,9 @@ def command(out, elastic, compare_2d, **kw):
         scene = scene.replace(viscoelastic=False)
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
-    res = solve(scene)
-    path = res.write(out)
+    with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
+        res = solve(scene)
+        path = res.write(out)
     s = res.summary()
     t = Table(title=f"{scene.label()} -> {path}", show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
@@ -49,14 +54,13 @@ def command(out, elastic, compare_2d, **kw):
 
 def _compare_2d(scene, s3, out) -> None:
     """Solve the 2D section of a 3D scene; print and write (compare_2d.json) the differences."""
-    import json
     import os
-    import tempfile
 
     from rich.console import Console
     from rich.table import Table
 
     from tactileskin.fe import solve
+    from tactileskin.fileio import atomic_write_json
 
     sc2 = scene.replace(dim=2)  # default 2D mesh sizes are re-derived on the dim change
     r2 = solve(sc2)
@@ -73,7 +77,4 @@ def _compare_2d(scene, s3, out) -> None:
     Console().print(t)
     doc = {"scene_3d": scene.label(), "scene_2d": sc2.label(),
            **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
-    fd, tmp = tempfile.mkstemp(dir=out, suffix=".json.partial")
-    with os.fdopen(fd, "w") as f:
-        json.dump(doc, f, indent=2)
-    os.replace(tmp, os.path.join(out, "compare_2d.json"))
+    atomic_write_json(os.path.join(out, "compare_2d.json"), doc)

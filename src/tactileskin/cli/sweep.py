@@ -2,17 +2,26 @@
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
 import click
 
+from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
+
+# the names a sweep writes into OUT (a folder of an earlier version holding only these is ours)
+OWN_NAMES = ("results.csv", "profiles.csv", "report.md", "cache",
+             *(f"{stem}.{ext}" for stem in ("fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
+               for ext in ("png", "svg")))
+_RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
 
 @click.command("sweep")
 @click.option("--out", "out", type=click.Path(file_okay=False), default="out", show_default=True,
-              help="Output folder: results.csv, profiles.csv, figures, report.md.")
+              help="Output folder: results.csv, profiles.csv, figures, report.md (a new or empty "
+                   "folder, or one written by `sweep`; other files are never touched).")
 @click.option("--config", type=click.Path(dir_okay=False), default=None,
               help="Sweep TOML ([sweep] lists, optional [scene] base); flags override it.")
 @click.option("--thickness", "-t", default=None, help="Thicknesses (mm): '1,3,5' or '1:5:0.5'. Default 1,3,5.")
@@ -63,23 +72,24 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     scenes = expand_grid(base=base, **grid)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
-    console.print(f"sweep: {len(scenes)} cases → {out}")
+    with claimed_output(out, "sweep", _own_names(out)):  # before any solving
+        console.print(f"sweep: {len(scenes)} cases → {out}")
 
-    t0 = time.perf_counter()
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=console, transient=False) as bar:
-        task = bar.add_task("solving", total=len(scenes))
+        t0 = time.perf_counter()
+        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                      TimeElapsedColumn(), console=console, transient=False) as bar:
+            task = bar.add_task("solving", total=len(scenes))
 
-        def on_event(oc):
-            style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
-            extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
-            bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
-            bar.advance(task)
+            def on_event(oc):
+                style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
+                extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
+                bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
+                bar.advance(task)
 
-        outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
-                             on_event=on_event)
-    wall = time.perf_counter() - t0
-    paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
+            outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
+                                 on_event=on_event)
+        wall = time.perf_counter() - t0
+        paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
     console.print(f"report: {paths['report']}  ({len(scenes) - nfail}/{len(scenes)} ok, {wall:.1f} s)")
     return 1 if nfail else 0
@@ -90,3 +100,13 @@ def _names(text: str, name: str) -> tuple[str, ...]:
     if not items:
         raise ParameterError(name, text, "a comma-separated list of names")
     return items
+
+
+def _own_names(out: Path) -> set[str]:
+    names = set(OWN_NAMES)
+    if out.is_dir():
+        from tactileskin.fileio import os_errors
+
+        with os_errors(out):
+            names |= {p.name for p in out.iterdir() if _RENDER_RE.fullmatch(p.name)}
+    return names

@@ -1,6 +1,6 @@
 """Braille standards, text -> cells (6-bit dot masks) and dot centres on the indenter face.
 
-Pure python/numpy. The standards table lives in geometry/braille.toml (one source of truth);
+Pure python/numpy. The standards table lives in data/geometry/braille.toml (one source of truth);
 the CAD solids (build123d) and the analytic indenter surface (indenters.py) both place their
 dots with `dot_centres`.
 
@@ -82,7 +82,7 @@ def standard_names() -> list[str]:
 
 
 def get_standard(name: str) -> BrailleStandard:
-    """The named standard from geometry/braille.toml; unknown name -> ParameterError."""
+    """The named standard from data/geometry/braille.toml; unknown name -> ParameterError."""
     table = params.load("braille")
     if not isinstance(name, str) or name not in table:
         raise ParameterError("braille_standard", name, "one of " + ", ".join(sorted(table)))

@@ -1,8 +1,9 @@
 """Write parts as binary STL + STEP, check every STL is a valid volume, write manifest.json.
 
-All output goes into a temporary folder beside the target and is renamed into place only
-once every file is written and checked: a failed build leaves nothing behind (an existing
-previous build in the target stays untouched until the new one is complete).
+All output goes into a staging folder beside the target (fileio.staged_dir) and is renamed
+into place only once every file is written and checked: a failed build leaves nothing behind
+(an existing previous build in the target stays untouched until the new one is complete).
+Only a new or empty folder or a previous build (our manifest) is ever replaced.
 """
 
 from __future__ import annotations
@@ -10,8 +11,6 @@ from __future__ import annotations
 import json
 import logging
 import math
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -19,6 +18,7 @@ import build123d as bd
 import numpy as np
 import trimesh
 
+from tactileskin import fileio
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import format_params, occ_guard
@@ -107,12 +107,22 @@ def _is_previous_build(out: Path) -> bool:
 
 
 def check_target(out: Path) -> None:
-    """Only a new or empty folder, or a previous parts build (our manifest), may be replaced."""
+    """Only a new or empty folder, or a previous parts build (our manifest), may be replaced.
+
+    The build replaces the folder whole, so the current folder (or one holding it) is refused
+    too: the shell would be left in the removed folder."""
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
-    if out.is_dir() and any(out.iterdir()) and not _is_previous_build(out):
-        raise ParameterError("out", str(out), "a new or empty folder, or the folder of a previous `tactileskin build`",
-                             hint="refusing to replace a folder holding other files")
+    if out.is_dir():
+        with fileio.os_errors(out):
+            entries = list(out.iterdir())
+        if entries and not _is_previous_build(out):
+            raise ParameterError("out", str(out), "a new or empty folder, or the folder of a previous `tactileskin build`",
+                                 hint="refusing to replace a folder holding other files")
+        cwd = Path.cwd().resolve()
+        if cwd == out.resolve() or out.resolve() in cwd.parents:
+            raise ParameterError("out", str(out), "a folder that does not hold the current folder",
+                                 hint="the build replaces the folder whole; give a subfolder such as parts/")
 
 
 def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE,
@@ -123,14 +133,13 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ParameterError("parts", names, "unique part names")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".partial", dir=out.parent))
-    try:
+    with fileio.staged_dir(out) as tmp:
         t0 = time.perf_counter()
         entries = []
         for part in parts:
             t1 = time.perf_counter()
-            entries.append(_write_part(part, tmp, tolerance, angular_tolerance))
+            with fileio.os_errors(out):  # OCP writes the files itself
+                entries.append(_write_part(part, tmp, tolerance, angular_tolerance))
             log.info("exported %s in %.2f s", part.name, time.perf_counter() - t1)
         manifest = {
             "kind": MANIFEST_KIND,
@@ -140,25 +149,7 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
             "parameters": {k: _json_safe(v) for k, v in (meta or {}).items()},
             "parts": entries,
         }
-        (tmp / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n")
+        fileio.atomic_write_json(tmp / MANIFEST, manifest)
+        fileio.fix_tree_modes(tmp)  # OCP and trimesh write with their own modes
         log.info("exported %d parts in %.2f s", len(parts), time.perf_counter() - t0)
-        _swap_into_place(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return manifest
-
-
-def _swap_into_place(tmp: Path, out: Path) -> None:
-    if out.exists():
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
-        old.rmdir()
-        out.rename(old)
-        try:
-            tmp.rename(out)
-        except BaseException:
-            old.rename(out)  # put the previous build back
-            raise
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        tmp.rename(out)

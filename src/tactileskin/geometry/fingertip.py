@@ -1,7 +1,7 @@
 """Fingertip half cross-section: analytic contour, bone interface and its arc length.
 
 Pure numpy/scipy: the CAD solids (build123d), the gmsh model and the solver all derive
-from these functions, so they share one set of numbers (geometry/fingertip.toml).
+from these functions, so they share one set of numbers (data/geometry/fingertip.toml).
 
 Coordinates (mm): x lateral (x = 0 is the symmetry line), y towards the pulp (the
 indenter moves in -y), z along the finger. The outer contour is the ellipse
@@ -38,7 +38,7 @@ class Fingertip:
 
     @classmethod
     def from_params(cls, **overrides) -> "Fingertip":
-        """Defaults from geometry/fingertip.toml, with keyword overrides."""
+        """Defaults from data/geometry/fingertip.toml, with keyword overrides."""
         p = params.load("fingertip")
         kw = dict(
             half_width=p["section"]["half_width"],

@@ -1,6 +1,6 @@
 """Rigid indenters as exact analytic surfaces: signed gap and normal, 2D section and 3D.
 
-Pure numpy. The dimensions come from geometry/indenters.toml and geometry/braille.toml,
+Pure numpy. The dimensions come from data/geometry/indenters.toml and data/geometry/braille.toml,
 the same numbers the CAD solids are built from.
 
 Conventions (mm): x lateral, y towards the pulp, z along the finger. The indenter sits above

@@ -1,6 +1,6 @@
 """Two-part casting mold for the skin; the printed rigid base is its core.
 
-Layout (dimensions in geometry/molds.toml, frame as in solids.py):
+Layout (dimensions in data/geometry/molds.toml, frame as in solids.py):
 - The cavity is the full-width outer contour (the ellipse) extruded over the sample length,
   z in [-L/2, L/2]; the end walls close it.
 - The rigid base sits in the lower half: below the nail edges it fills the contour exactly,

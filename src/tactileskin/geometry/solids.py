@@ -2,7 +2,7 @@
 
 This module (with molds.py, parts.py and export.py) is the only place that imports
 build123d; the solver never does. Every dimension comes from the analytic geometry
-(fingertip.Section, indenters.Indenter), which in turn reads geometry/*.toml.
+(fingertip.Section, indenters.Indenter), which in turn reads data/geometry/*.toml.
 
 Frame (mm): x lateral, y towards the pulp, z along the finger. The fingertip prism spans
 z in [-L/2, L/2] (L = Fingertip.sample_length) so that it lines up with the indenters,

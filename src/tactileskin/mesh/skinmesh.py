@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import logging
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from tactileskin import fileio
 from tactileskin.errors import MeshError, ParameterError
 
 logger = logging.getLogger(__name__)
@@ -88,7 +88,7 @@ class SkinMesh:
                            field_data=field_data, cell_sets=cell_sets, point_sets=point_sets)
 
     def write(self, path: str | os.PathLike) -> Path:
-        """Write by suffix (.msh, .vtu, .inp) atomically: temp file in the target folder, then rename."""
+        """Write by suffix (.msh, .vtu, .inp) atomically (fileio.atomic_path)."""
         path = Path(path)
         fmt = FORMATS.get(path.suffix.lower())
         if fmt is None:
@@ -96,23 +96,21 @@ class SkinMesh:
         out = self.to_meshio()
         if fmt == "vtu":
             out.cell_sets, out.point_sets, out.field_data = {}, {}, {}
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-        os.close(fd)
-        try:
-            if fmt == "abaqus":
-                from tactileskin.mesh.abaqus import inp_text
+        with fileio.atomic_path(path) as tmp, fileio.os_errors(path):  # a .tmp name, known to clean_stale
+            try:
+                if fmt == "abaqus":
+                    from tactileskin.mesh.abaqus import inp_text
 
-                Path(tmp).write_text(inp_text(out.points[:, : self.dim], out.cells[0].type,
-                                              out.cells[0].data, out.point_sets))
-            elif fmt == "gmsh":
-                out.write(tmp, file_format="gmsh22", binary=False)
-            else:
-                out.write(tmp, file_format=fmt)
-            os.replace(tmp, path)
-        except Exception as e:
-            Path(tmp).unlink(missing_ok=True)
-            raise MeshError(f"could not write {path} ({fmt}): {e}") from e
+                    tmp.write_text(inp_text(out.points[:, : self.dim], out.cells[0].type,
+                                            out.cells[0].data, out.point_sets))
+                elif fmt == "gmsh":
+                    out.write(tmp, file_format="gmsh22", binary=False)
+                else:
+                    out.write(tmp, file_format=fmt)
+            except OSError:
+                raise  # an OutputError naming the path (os_errors)
+            except Exception as e:
+                raise MeshError(f"could not write {path} ({fmt}): {e}") from e
         logger.info("wrote %s", path)
         return path
 

@@ -5,7 +5,7 @@ the indenter is mirror-symmetric about z = 0 (flat plate, cylinder, Braille dots
 z) only the half z in [0, L/2] is meshed and `end_back` is the mid-plane z = 0 (a symmetry
 plane, u_z = 0; SkinMesh.z_symmetric = True); otherwise z in [-L/2, L/2] and `end_back` is
 the free end z = -L/2. `end_front` is always the free end z = +L/2. L = sample length
-(geometry/fingertip.toml).
+(data/geometry/fingertip.toml).
 """
 
 from __future__ import annotations

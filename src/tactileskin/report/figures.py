@@ -5,9 +5,12 @@ Each figure is written as PNG and SVG. matplotlib runs on the Agg backend (no di
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
+
+from tactileskin.fileio import atomic_write_bytes, make_dirs
 
 INDENTER_ORDER = ("flat", "curved", "braille")
 COLOURS = {"flat": "#1f77b4", "curved": "#d62728", "braille": "#2ca02c"}
@@ -26,7 +29,9 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
     for ext in ("png", "svg"):
         p = out / f"{stem}.{ext}"
-        fig.savefig(p, dpi=150, bbox_inches="tight")
+        buf = io.BytesIO()
+        fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")
+        atomic_write_bytes(p, buf.getvalue())
         paths.append(p)
     _plt().close(fig)
     return paths
@@ -93,7 +98,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
 
 
 def all_figures(records, rows, out: Path) -> list[Path]:
-    out.mkdir(parents=True, exist_ok=True)
+    make_dirs(out)
     paths = profiles_figure(records, out)
     paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
     paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)

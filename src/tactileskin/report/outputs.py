@@ -6,30 +6,16 @@ import csv
 import io
 import logging
 import math
-import os
-import tempfile
 from pathlib import Path
 
 from tactileskin.errors import TactileSkinError
+from tactileskin.fileio import atomic_write_text, make_dirs
 
 log = logging.getLogger(__name__)
 
 RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter", "braille_text",
                   "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc", "reaction_n_per_mm",
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def collect(outcomes, cache):
@@ -61,8 +47,7 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     from tactileskin.report.figures import all_figures
     from tactileskin.report.markdown import build_report
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = make_dirs(out)  # the CLI has claimed it (fileio.claim_dir)
     records, rows, failures = collect(outcomes, cache)
 
     buf = io.StringIO()

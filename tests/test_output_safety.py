@@ -1,0 +1,287 @@
+"""Never destroy user data: output folders are claimed or refused, files are written
+atomically under the umask, killed writers leave nothing behind, file errors are one line.
+The CLI runs in-process; solves are faked where the test is about files, not numbers."""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import signal
+import stat
+import subprocess
+import sys
+import textwrap
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tactileskin
+import tactileskin.fe
+import tactileskin.sweep as sw
+from tactileskin import fileio, params
+from tactileskin.cli import main
+from tactileskin.results import Result
+
+CHEAP = ["--mesh-size", "1", "--refinement", "2", "-t", "1", "--elastic"]
+REPO = Path(__file__).resolve().parents[1]
+
+
+def fake_result(scene=None) -> Result:
+    """A tiny complete Result (with fields, so result.vtu is written)."""
+    return Result(s=np.array([0.0, 1.0, 2.0]), pressure=np.array([0.1, 0.3, 0.0]),
+                  contact_x=np.array([0.0, 0.5]), contact_pressure=np.array([0.2, 0.1]), reaction=0.4,
+                  stats={"dofs": 6}, fields={"points": [[0, 0], [1, 0], [0, 1]], "cells": [[0, 1, 2]],
+                                             "cell_type": "triangle", "point_data": {"pressure": [0, 1, 2]}})
+
+
+@pytest.fixture
+def fake_solve(monkeypatch):
+    calls = []
+
+    def solve(scene, **kw):
+        calls.append(scene)
+        return fake_result()
+
+    monkeypatch.setattr(tactileskin.fe, "solve", solve)
+    return calls
+
+
+def _err(capsys) -> str:
+    cap = capsys.readouterr()
+    assert "Traceback" not in cap.err + cap.out
+    return cap.err
+
+
+def _temporaries(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.rglob("*") if ".tsk" in p.name or ".old" in p.name
+                  or p.name.endswith(".partial"))
+
+
+# --- solve --out ------------------------------------------------------------------------
+
+def test_solve_refuses_a_folder_holding_a_user_file_and_keeps_it(tmp_path, capsys, fake_solve):
+    d = tmp_path / "d"
+    d.mkdir()
+    (d / "notes.txt").write_text("mine")
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert str(d) in err and "notes.txt" in err and len(err.strip().splitlines()) == 1
+    assert fake_solve == []  # refused before solving
+    assert [p.name for p in d.iterdir()] == ["notes.txt"] and (d / "notes.txt").read_text() == "mine"
+
+
+def test_solve_rewrites_its_own_folder_and_accepts_an_earlier_versions(tmp_path, capsys, fake_solve):
+    d = tmp_path / "d"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # marked as ours: rewritten
+    assert sorted(p.name for p in d.iterdir()) == [".tactileskin", "contact.csv", "profile.csv",
+                                                  "result.vtu", "summary.json"]
+    old = tmp_path / "old"  # written before the marker existed: only solve's own names
+    old.mkdir()
+    (old / "summary.json").write_text("{}")
+    (old / "profile.csv").write_text("s_mm,pressure_mpa\n")
+    assert main(["solve", *CHEAP, "--out", str(old)]) == 0
+    assert (old / "result.vtu").is_file() and "peak_mpa" in (old / "summary.json").read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "old"]  # no staging siblings
+
+
+def test_solve_out_dot_works_when_empty_and_refuses_cleanly_otherwise(tmp_path, capsys, monkeypatch, fake_solve):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    monkeypatch.chdir(empty)
+    assert main(["solve", *CHEAP, "--out", "."]) == 0
+    assert (empty / "summary.json").is_file()
+    user = tmp_path / "user"
+    user.mkdir()
+    (user / "thesis.tex").write_text("x")
+    monkeypatch.chdir(user)
+    assert main(["solve", *CHEAP, "--out", "."]) == 2
+    assert "thesis.tex" in _err(capsys)
+    assert [p.name for p in user.iterdir()] == ["thesis.tex"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "user"]  # no `..old.*` left
+
+
+def test_a_path_under_a_file_is_a_one_line_error(tmp_path, capsys, fake_solve):
+    f = tmp_path / "file.txt"
+    f.write_text("x")
+    assert main(["solve", *CHEAP, "--out", str(f / "sub")]) == 2
+    err = _err(capsys)
+    assert str(f) in err and "is a file" in err and len(err.strip().splitlines()) == 1
+    assert main(["mesh", "-t", "1", "--mesh-size", "1", "--refinement", "2", "--out", str(f / "m.vtu")]) == 2
+    assert str(f) in _err(capsys)
+    assert main(["sweep", "-t", "1", "--out", str(f / "sweep"), "--serial"]) == 2
+    assert str(f) in _err(capsys)
+    assert f.read_text() == "x"
+
+
+def test_a_full_disk_is_a_one_line_error_without_leftovers(tmp_path, capsys, monkeypatch, fake_solve):
+    def full(fd):
+        raise OSError(28, os.strerror(28))
+
+    monkeypatch.setattr(os, "fsync", full)
+    d = tmp_path / "d"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert "no space left" in err and str(d) in err and len(err.strip().splitlines()) == 1
+    assert _temporaries(tmp_path) == []
+
+
+def test_a_stray_os_error_is_one_line(tmp_path, capsys, monkeypatch):
+    def boom(scene, **kw):
+        raise PermissionError(13, "Permission denied", "/some/place")
+
+    monkeypatch.setattr(tactileskin.fe, "solve", boom)
+    assert main(["solve", *CHEAP, "--out", str(tmp_path / "d")]) == 2
+    err = _err(capsys)
+    assert "/some/place" in err and "Permission denied" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "d").exists()  # the folder it created for nothing is removed again
+
+
+def test_solve_outputs_have_umask_permissions(tmp_path, capsys):
+    old = os.umask(0o022)
+    try:
+        d = tmp_path / "d"
+        assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(d.stat().st_mode) == 0o755
+    files = [p for p in d.iterdir()]
+    assert {p.name for p in files} >= {"profile.csv", "contact.csv", "summary.json", "result.vtu"}
+    assert {p.name: stat.S_IMODE(p.stat().st_mode) for p in files} == {p.name: 0o644 for p in files}
+
+
+# --- killed writers ----------------------------------------------------------------------
+
+_KILLED = textwrap.dedent("""
+    import os, signal, sys, time
+    import numpy as np
+    import tactileskin.fe, tactileskin.results as r
+    from tactileskin import fileio
+    from tactileskin.cli import main
+    sys.path.insert(0, {tests!r})
+    from test_output_safety import fake_result
+
+    def dying_vtu(path, fields):
+        with fileio.atomic_path(path) as tmp:
+            tmp.write_text("half a file")
+            os.kill(os.getpid(), signal.{sig})
+            time.sleep(30)
+
+    tactileskin.fe.solve = lambda scene, **kw: fake_result()
+    r._write_vtu = dying_vtu
+    sys.exit(main(["solve", "-t", "1", "--out", {out!r}]))
+""")
+
+
+def _run_killed(out: Path, sig: str) -> int:
+    code = _KILLED.format(tests=str(Path(__file__).parent), out=str(out), sig=sig)
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120).returncode
+
+
+def test_sigterm_unwinds_and_removes_the_temporary(tmp_path):
+    out = tmp_path / "d"
+    assert _run_killed(out, "SIGTERM") == 128 + signal.SIGTERM
+    assert _temporaries(tmp_path) == [] and not (out / "result.vtu").exists()
+
+
+def test_a_killed_writers_temporary_is_removed_by_the_next_run(tmp_path, capsys, fake_solve):
+    out = tmp_path / "d"
+    assert _run_killed(out, "SIGKILL") == -signal.SIGKILL
+    assert any(".tsk" in p.name for p in out.iterdir())  # the kill left its temporary
+    assert main(["solve", *CHEAP, "--out", str(out)]) == 0
+    assert _temporaries(tmp_path) == [] and (out / "result.vtu").is_file()
+
+
+# --- sweep --out -------------------------------------------------------------------------
+
+@pytest.fixture
+def counted_cases(monkeypatch):
+    """Every case fails at once (no solving); the list records which were attempted."""
+    from tactileskin.errors import ConvergenceError
+
+    calls = []
+
+    def fail(scene):
+        calls.append(scene)
+        raise ConvergenceError("not solved in this test", {})
+
+    monkeypatch.setattr(sw, "solve_case", fail)
+    return calls
+
+
+def test_sweep_refuses_a_foreign_folder_before_solving(tmp_path, capsys, counted_cases):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.csv").write_text("mine")
+    (out / "data.xlsx").write_text("mine too")
+    assert main(["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render",
+                 "--out", str(out)]) == 2
+    assert "data.xlsx" in _err(capsys)
+    assert counted_cases == []
+    assert sorted(p.name for p in out.iterdir()) == ["data.xlsx", "results.csv"]
+    assert (out / "results.csv").read_text() == "mine"
+
+
+def test_sweep_accepts_the_folder_of_an_earlier_version(tmp_path, capsys, counted_cases):
+    out = tmp_path / "out"
+    (out / "cache").mkdir(parents=True)
+    for name in ("results.csv", "profiles.csv", "report.md", "fig11_peak.svg", "fig9_t1-silicone-flat-2d.png"):
+        (out / name).write_text("old")
+    argv = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
+    assert main(argv) == 1  # accepted and run; the (faked) case failed
+    assert len(counted_cases) == 1 and "failed" in (out / "results.csv").read_text()
+    assert (out / fileio.MARKER).is_file()
+    assert main(argv) == 1  # now marked as ours
+
+
+# --- build --------------------------------------------------------------------------------
+
+def test_build_output_has_umask_permissions_and_refuses_the_current_folder(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "parts"
+    old = os.umask(0o022)
+    try:
+        assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]) == 0
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(out.stat().st_mode) == 0o755
+    modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()}
+    assert "manifest.json" in modes and "skin.stl" in modes
+    assert modes == {n: 0o644 for n in modes}
+    assert [p.name for p in tmp_path.iterdir()] == ["parts"]
+    capsys.readouterr()
+    monkeypatch.chdir(out)  # a previous build, but replacing it would pull the shell's folder away
+    assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", "."]) == 2
+    assert "current folder" in _err(capsys)
+    assert set(p.name for p in out.iterdir()) == set(modes)
+
+
+# --- install --------------------------------------------------------------------------------
+
+def test_geometry_files_are_package_data_and_read_from_the_package(monkeypatch):
+    monkeypatch.delenv("TACTILESKIN_GEOMETRY", raising=False)
+    names = {"fingertip.toml", "indenters.toml", "braille.toml", "molds.toml"}
+    pkg = Path(tactileskin.__file__).parent
+    assert params.geometry_dir().resolve() == (pkg / "data" / "geometry").resolve()
+    assert names <= {p.name for p in params.geometry_dir().iterdir()}
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        pytest.skip("not a source checkout")
+    # every TOML file inside the package is matched by a package-data glob, so the wheel ships it
+    data = tomllib.loads(pyproject.read_text())["tool"]["setuptools"]["package-data"]
+    src = REPO / "src"
+    for f in (src / "tactileskin").rglob("*.toml"):
+        rel = f.relative_to(src)
+        owners = [(pkg_name, globs) for pkg_name, globs in data.items()
+                  if rel.parent.as_posix().startswith(pkg_name.replace(".", "/"))]
+        assert any(fnmatch.fnmatch(rel.relative_to(Path(*n.split("."))).as_posix(), g)
+                   for n, globs in owners for g in globs), f"{rel} is not package data"
+    assert not list(REPO.glob("geometry/*.toml"))  # one source of truth
+
+
+def test_geometry_override_still_works(tmp_path, monkeypatch):
+    (tmp_path / "fingertip.toml").write_text("[x]\ny = 1\n")
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(tmp_path))
+    assert params.geometry_dir() == tmp_path
+    assert params.read_toml(params.geometry_dir() / "fingertip.toml", "p") == {"x": {"y": 1}}
