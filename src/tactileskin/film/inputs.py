@@ -16,8 +16,10 @@ from tactileskin.errors import ParameterError
 MAX_TEXT_BYTES = 16 * 2**20
 
 
-def read_text(path, what: str, valid: str, *, limit: int = MAX_TEXT_BYTES) -> str:
-    """UTF-8 text of `path`, or ParameterError(what) naming the file and the problem."""
+def read_text(path, what: str, valid: str, *, limit: int | None = None) -> str:
+    """UTF-8 text of `path` (at most `limit` bytes, default MAX_TEXT_BYTES), or
+    ParameterError(what) naming the file and the problem."""
+    limit = MAX_TEXT_BYTES if limit is None else limit
     path = Path(path)
     try:
         with path.open("rb") as fh:
