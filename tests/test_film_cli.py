@@ -72,7 +72,7 @@ def test_cli_calibrate_analyze_compare(tmp_path, capsys):
                "--cmap", "jet", "--out", str(tmp_path / "film")])
     assert rc == 0, capsys.readouterr().err
     assert sorted(p.name for p in (tmp_path / "film").iterdir()) == [
-        "pressure_map.png", "profile.csv", "summary.json"]
+        ".tactileskin", "pressure_map.png", "profile.csv", "summary.json"]
     summ = json.loads((tmp_path / "film" / "summary.json").read_text())
     assert summ["unit"] == "MPa/mm" and summ["calibration"]["name"] == "paper_eq8"
     assert summ["metrics_folded"]["peak"] == pytest.approx(0.4, abs=0.0025)  # 8-bit rounding

@@ -19,7 +19,7 @@ def command() -> None:
 @click.option("--model", type=click.Choice(["auto", *models.MODELS]), default="auto",
               show_default=True, help="Fitting function; auto selects by AICc.")
 @click.option("--activation-range", nargs=2, type=float, default=None,
-              help="Clip range LO HI of the readings (default 0 .. darkest press).")
+              help="Clip range LO HI of the readings, LO < HI (default 0 .. darkest press).")
 @click.option("--plot", type=click.Path(dir_okay=False), default=None,
               help="Also write a PNG of the fit, its 90 % band and residuals.")
 def calibrate(cal_csv, out, model, activation_range, plot):
@@ -55,7 +55,9 @@ def calibrate(cal_csv, out, model, activation_range, plot):
 @click.option("--calibration", "-c", default="paper_eq8", show_default=True,
               help="Calibration JSON, or paper_eq8 (the paper's Eq. 8).")
 @click.option("--px-per-mm", type=float, default=8.0, show_default=True, help="Scan scale.")
-@click.option("--box-px", nargs=4, type=int, default=None, help="Region X0 Y0 X1 Y1 (pixels).")
+@click.option("--box-px", nargs=4, type=int, default=None,
+              help="Region X0 Y0 X1 Y1 (pixels). Default: the activated strip, found on the "
+                   "scan (refused if ambiguous); the region used is printed and saved.")
 @click.option("--box-mm", nargs=4, type=float, default=None, help="Region X0 Y0 X1 Y1 (mm).")
 @click.option("--axis", type=click.Choice(["x", "y"]), default="x", show_default=True,
               help="Direction of the strip in the image.")
@@ -80,6 +82,10 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
     fp = analyze_scan(scan, cal, px_per_mm=px_per_mm, box_px=box_px or None,
                       box_mm=box_mm or None, axis=axis, centre=centre)
     fp.write(out, cmap=cmap)
+    x0, y0, x1, y1 = fp.box_px
+    how = ("found automatically (the activated strip; --box-px/--box-mm to override)"
+           if fp.region.get("method") == "auto" else f"given ({fp.region.get('method')})")
+    click.echo(f"region x {x0}-{x1}, y {y0}-{y1} px {how}")
     m, f = fp.metrics, fp.folded["metrics"]
     click.echo(f"origin {fp.origin_mm:.3f} mm; two-sided: peak {m['peak']:.4g} {fp.unit}, "
                f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g}; folded: peak "

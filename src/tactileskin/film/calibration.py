@@ -24,6 +24,7 @@ numbers with the simulation's MPa the same way, flagging the unit in the compari
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
 import math
@@ -32,9 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
+from tactileskin import fileio
 from tactileskin.errors import ParameterError
 from tactileskin.film import models
-from tactileskin.film._io import atomic_write_text
+from tactileskin.film.inputs import finite, read_text
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +51,7 @@ CRITERION = ("AICc (small-sample corrected Akaike information criterion, k = par
 AICC_TIE = 2.0
 MIN_POINTS = 3
 _MONO_GRID = 1001
+MAX_PRESSES = 10_000    # a calibration is tens of presses; more is a wrong file
 
 
 @dataclass(frozen=True)
@@ -64,6 +67,42 @@ class Calibration:
     cov: tuple[tuple[float, ...], ...] | None = None   # parameter covariance, if fitted
     dof: int | None = None
     report: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self):
+        """Refuse a calibration that cannot be evaluated (or written as strict JSON)."""
+        if self.model not in models.MODELS:
+            raise ParameterError("calibration model", self.model, ", ".join(models.MODELS))
+        n_p = models.MODELS[self.model].n_params
+        params = _floats("calibration params", self.params, n_p)
+        g0, g1 = _floats("calibration gs_range", self.gs_range, 2)
+        if not 0 <= g0 < g1 <= 255:
+            raise ParameterError("calibration gs_range", list(self.gs_range),
+                                 "lo < hi within [0, 255]",
+                                 hint="inverted" if g0 >= g1 else "outside the grayscale scale")
+        p0, p1 = _floats("calibration activation range", self.p_range, 2)
+        if not 0 <= p0 < p1:
+            raise ParameterError("calibration activation range", list(self.p_range),
+                                 "0 <= lo < hi", hint="inverted" if p0 >= p1 else "negative")
+        cov = self.cov
+        if cov is not None:
+            try:
+                rows = [tuple(r) for r in cov]
+            except TypeError:
+                rows = None
+            if rows is None or len(rows) != n_p:
+                raise ParameterError("calibration cov", cov, f"a {n_p} x {n_p} matrix or null")
+            cov = tuple(_floats("calibration cov", r, n_p) for r in rows)
+        dof = self.dof
+        if dof is not None and (isinstance(dof, bool) or not isinstance(dof, int) or dof < 1):
+            raise ParameterError("calibration dof", dof, "an integer >= 1 or null")
+        if not isinstance(self.name, str) or not isinstance(self.unit, str):
+            raise ParameterError("calibration name/unit", (self.name, self.unit), "text")
+        if not isinstance(self.report, dict):
+            raise ParameterError("calibration report", type(self.report).__name__, "a table")
+        object.__setattr__(self, "params", params)
+        object.__setattr__(self, "gs_range", (g0, g1))
+        object.__setattr__(self, "p_range", (p0, p1))
+        object.__setattr__(self, "cov", cov)
 
     # -- evaluation -------------------------------------------------------------------
     def _f(self, g):
@@ -137,34 +176,61 @@ class Calibration:
             "params": list(self.params), "gs_range": list(self.gs_range),
             "p_range": list(self.p_range), "unit": self.unit,
             "cov": [list(r) for r in self.cov] if self.cov is not None else None,
-            "dof": self.dof, "confidence": models.CONFIDENCE, "report": self.report,
+            "dof": self.dof, "confidence": models.CONFIDENCE, "report": _plain(self.report),
         }
 
     @classmethod
     def from_dict(cls, d: dict) -> "Calibration":
+        """Build from ``to_dict`` output; every field is type-checked (ParameterError)."""
+        if not isinstance(d, dict):
+            raise ParameterError("calibration", type(d).__name__, "a JSON object (table)")
         if d.get("format") != FORMAT:
             raise ParameterError("calibration format", d.get("format"), FORMAT)
-        if d.get("model") not in models.MODELS:
-            raise ParameterError("calibration model", d.get("model"), ", ".join(models.MODELS))
-        cov = d.get("cov")
-        return cls(name=d["name"], model=d["model"], params=tuple(map(float, d["params"])),
-                   gs_range=tuple(map(float, d["gs_range"])),
-                   p_range=tuple(map(float, d["p_range"])), unit=d.get("unit", "MPa"),
-                   cov=tuple(tuple(map(float, r)) for r in cov) if cov is not None else None,
-                   dof=d.get("dof"), report=d.get("report", {}))
+        missing = [k for k in ("name", "model", "params", "gs_range", "p_range") if k not in d]
+        if missing:
+            raise ParameterError("calibration keys", ", ".join(missing), "present",
+                                 hint="required: name, model, params, gs_range, p_range")
+        if d["model"] not in models.MODELS:
+            raise ParameterError("calibration model", d["model"], ", ".join(models.MODELS))
+        return cls(name=d["name"], model=d["model"], params=d["params"],
+                   gs_range=d["gs_range"], p_range=d["p_range"], unit=d.get("unit", "MPa"),
+                   cov=d.get("cov"), dof=d.get("dof"), report=d.get("report", {}))
 
     def save(self, path) -> Path:
-        path = Path(path)
-        atomic_write_text(path, json.dumps(self.to_dict(), indent=2, default=_json_default))
-        return path
+        """Strict JSON (no NaN/Infinity tokens), written atomically."""
+        return fileio.atomic_write_json(path, self.to_dict())
 
 
-def _json_default(o):
+def _floats(name: str, values, n: int) -> tuple[float, ...]:
+    """n finite numbers (not booleans, not text) as floats, else ParameterError(name)."""
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__len__") \
+            or len(values) != n:
+        raise ParameterError(name, values, f"a list of {n} finite numbers")
+    out = []
+    for v in values:
+        if isinstance(v, (bool, str, bytes)) or not isinstance(v, (int, float, np.number)) \
+                or not math.isfinite(float(v)):
+            raise ParameterError(name, list(values), f"a list of {n} finite numbers")
+        out.append(float(v))
+    return tuple(out)
+
+
+def _plain(o):
+    """Report data as strict-JSON values: numpy -> Python; NaN/inf (a statistic undefined
+    for these points, e.g. adjusted R^2 with no degrees of freedom left) -> None."""
+    if isinstance(o, dict):
+        return {str(k): _plain(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple, np.ndarray)):
+        return [_plain(v) for v in o]
     if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(type(o))
+        o = o.item()
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    return o
+
+
+def _reject_constant(token: str):
+    raise ValueError(f"{token} is not a number in strict JSON")
 
 
 def load_calibration(path) -> Calibration:
@@ -172,13 +238,16 @@ def load_calibration(path) -> Calibration:
     if str(path) == "paper_eq8":
         return paper_eq8()
     path = Path(path)
+    valid = "a calibration JSON written by `film calibrate`, or 'paper_eq8'"
+    text = read_text(path, "calibration", valid)
     try:
-        d = json.loads(path.read_text())
-    except (OSError, ValueError) as e:
-        raise ParameterError("calibration", str(path),
-                             "a calibration JSON written by `film calibrate`, or 'paper_eq8'",
-                             hint=str(e)) from None
-    return Calibration.from_dict(d)
+        d = json.loads(text, parse_constant=_reject_constant)
+    except ValueError as e:
+        raise ParameterError("calibration", str(path), valid, hint=f"not JSON: {e}") from None
+    try:
+        return Calibration.from_dict(d)
+    except ParameterError as e:
+        raise ParameterError("calibration", str(path), valid, hint=str(e)) from None
 
 
 def paper_eq8() -> Calibration:
@@ -219,6 +288,8 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
     Raises ParameterError for < 3 points, non-finite data, a trend indistinguishable from
     zero, or a selected fit that is not strictly monotonic over the calibrated range.
     """
+    if activation_range is not None:
+        activation_range = _activation_range(activation_range)
     x = np.asarray(gray, float).ravel()
     y = np.asarray(pressure, float).ravel()
     n = x.size
@@ -233,7 +304,12 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
     if np.any((x < 0) | (x > 255)):
         raise ParameterError("calibration gray", f"[{x.min():g}, {x.max():g}]", "[0, 255]")
     if np.ptp(x) == 0:
-        raise ParameterError("calibration gray", f"all {x[0]:g}", "at least two distinct values")
+        raise ParameterError("calibration gray", f"all {x[0]:g}", "at least two distinct values",
+                             hint="every press has the same grayscale")
+    if np.ptp(y) == 0:
+        raise ParameterError("calibration pressure", f"all {y[0]:g} {unit}",
+                             "at least two distinct pressures",
+                             hint="every press has the same force per area")
     if model != "auto" and model not in models.MODELS:
         raise ParameterError("model", model, "auto, " + ", ".join(models.MODELS))
     gs_range = (float(x.min()), float(x.max()))
@@ -286,10 +362,16 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
 
     p_ends = models.MODELS[chosen].f(np.asarray(gs_range), fr.params)
     if activation_range is None:
-        activation_range = (0.0, float(np.max(p_ends)))
-    lo, hi = map(float, activation_range)
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
-        raise ParameterError("activation_range", activation_range, "0 <= lo < hi, finite")
+        top = float(np.max(p_ends))
+        if not (math.isfinite(top) and top > 0):
+            raise ParameterError("calibration", f"{chosen} fit reads {top:g} at the darkest "
+                                 "press", "a positive pressure there",
+                                 hint="give --activation-range LO HI")
+        activation_range = (0.0, top)
+    lo, hi = activation_range
+    if not all(np.all(np.isfinite(a)) for a in (fr.params, fr.cov if fr.cov is not None else 0)):
+        raise ParameterError("calibration", f"{chosen} fit", "finite parameters and covariance",
+                             hint="the presses are degenerate for this model")
 
     lin_ci = lin.param_ci()
     report = {
@@ -316,6 +398,19 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
 
 # -- CSV input ------------------------------------------------------------------------
 
+def _activation_range(r) -> tuple[float, float]:
+    try:
+        lo, hi = r
+    except (TypeError, ValueError):
+        raise ParameterError("activation_range", r, "two numbers LO HI") from None
+    lo = finite("activation_range LO", lo, 0, unit="(pressure unit)")
+    hi = finite("activation_range HI", hi, 0, unit="(pressure unit)")
+    if not lo < hi:
+        raise ParameterError("activation_range", (lo, hi), "LO < HI, both finite and >= 0",
+                             hint="inverted: give LO first" if lo > hi else "empty range")
+    return lo, hi
+
+
 def read_calibration_csv(path) -> dict[str, np.ndarray]:
     """Read presses: columns force_n, area_mm2 and gray, or image (path relative to the CSV).
 
@@ -323,56 +418,76 @@ def read_calibration_csv(path) -> dict[str, np.ndarray]:
     whole image is averaged, so each image should show the pressed area only.
     Returns arrays force_n, area_mm2, pressure (Eq. 7, MPa) and gray.
     """
-    from tactileskin.film.scan import load_grayscale  # local: keeps Pillow off this path
+    from tactileskin.film.image import load_grayscale  # local: keeps Pillow off this path
+    from tactileskin.film.scan import select_region
 
     path = Path(path)
+    valid = "a CSV with columns force_n, area_mm2 and gray or image"
+    text = read_text(path, "calibration CSV", valid)
     try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except (OSError, UnicodeDecodeError, csv.Error) as e:
-        raise ParameterError("calibration CSV", str(path), "a readable CSV file",
-                             hint=str(e)) from None
-    if not rows:
-        raise ParameterError("calibration CSV", str(path), f">= {MIN_POINTS} data rows")
-    rows = [{(k or "").strip().lower(): (v or "").strip() for k, v in r.items()} for r in rows]
-    cols = set(rows[0])
+        raw = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as e:
+        raise ParameterError("calibration CSV", str(path), valid, hint=str(e)) from None
+    raw = [(i, r) for i, r in enumerate(raw, start=1) if any(c.strip() for c in r)]
+    if len(raw) < 2:
+        raise ParameterError("calibration CSV", str(path), f"a header and >= {MIN_POINTS} data rows")
+    if len(raw) - 1 > MAX_PRESSES:
+        raise ParameterError("calibration CSV", str(path), f"at most {MAX_PRESSES} presses",
+                             hint=f"{len(raw) - 1} rows")
+    header = [c.strip().lower() for c in raw[0][1]]
+    cols = set(header)
     for c in ("force_n", "area_mm2"):
         if c not in cols:
             raise ParameterError("calibration CSV column", c, "present (columns: force_n, "
-                                 "area_mm2 and gray or image)", hint=f"found {sorted(cols)}")
+                                 "area_mm2 and gray or image)", hint=f"{path}: found {sorted(cols)}")
     if "gray" not in cols and "image" not in cols:
         raise ParameterError("calibration CSV column", "gray|image", "one of them present",
-                             hint=f"found {sorted(cols)}")
+                             hint=f"{path}: found {sorted(cols)}")
     force, area, gray = [], [], []
-    for i, r in enumerate(rows, start=2):  # line numbers as an editor shows them
-        try:
-            f_n, a = float(r["force_n"]), float(r["area_mm2"])
-        except ValueError:
-            raise ParameterError(f"calibration CSV line {i}", r, "numeric force_n, area_mm2") from None
-        if not (f_n > 0 and math.isfinite(f_n)):
-            raise ParameterError(f"force_n (line {i})", f_n, "> 0 N")
-        if not (a > 0 and math.isfinite(a)):
-            raise ParameterError(f"area_mm2 (line {i})", a, "> 0 mm^2")
+    for i, cells in raw[1:]:  # line numbers as an editor shows them
+        where = f"{path.name} line {i}"
+        if len(cells) > len(header):
+            raise ParameterError(f"calibration CSV ({where})", ",".join(cells),
+                                 f"at most {len(header)} fields, as in the header")
+        r = dict(zip(header, (c.strip() for c in cells)))
+        f_n = _csv_number(f"force_n ({where})", r.get("force_n"), "> 0 N")
+        a = _csv_number(f"area_mm2 ({where})", r.get("area_mm2"), "> 0 mm^2")
+        if not f_n > 0:
+            raise ParameterError(f"force_n ({where})", f_n, "> 0 N")
+        if not a > 0:
+            raise ParameterError(f"area_mm2 ({where})", a, "> 0 mm^2")
         if r.get("gray"):
-            try:
-                g = float(r["gray"])
-            except ValueError:
-                raise ParameterError(f"gray (line {i})", r["gray"], "a number in [0, 255]") from None
+            g = _csv_number(f"gray ({where})", r["gray"], "a number in [0, 255]")
+            if not 0 <= g <= 255:
+                raise ParameterError(f"gray ({where})", g, "a number in [0, 255]")
         elif r.get("image"):
             img = load_grayscale(path.parent / r["image"])
             box = [r.get(k) for k in ("x0", "y0", "x1", "y1")]
-            if all(box):
-                from tactileskin.film.scan import select_region
-                img, _ = select_region(img, box_px=tuple(int(float(b)) for b in box))
+            if any(box):
+                img, _ = select_region(img, box_px=tuple(
+                    _csv_number(f"crop x0,y0,x1,y1 ({where})", b, "whole pixel numbers")
+                    for b in box))
             g = float(img.mean())
         else:
-            raise ParameterError(f"calibration CSV line {i}", "no gray and no image",
+            raise ParameterError(f"calibration CSV ({where})", "no gray and no image",
                                  "a gray value or an image path")
         force.append(f_n)
         area.append(a)
         gray.append(g)
     force, area = np.array(force), np.array(area)
     return {"force_n": force, "area_mm2": area, "pressure": force / area, "gray": np.array(gray)}
+
+
+def _csv_number(name: str, cell, valid: str) -> float:
+    if cell is None or cell == "":
+        raise ParameterError(name, "missing", valid)
+    try:
+        v = float(cell)
+    except ValueError:
+        raise ParameterError(name, cell, valid) from None
+    if not math.isfinite(v):
+        raise ParameterError(name, cell, valid)
+    return v
 
 
 def calibrate_csv(path, *, model: str = "auto", activation_range=None,

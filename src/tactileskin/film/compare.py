@@ -16,16 +16,20 @@ the paper does (see calibration module docstring).
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from tactileskin import fileio
 from tactileskin.errors import ParameterError
-from tactileskin.film._io import staged_dir
-from tactileskin.film.scan import FilmProfile, fold_profile, profile_metrics
+from tactileskin.film.inputs import read_text
+from tactileskin.film.scan import (ANALYZE_NAMES, COMPARE_NAMES, FilmProfile, fold_profile,
+                                   profile_metrics)
 
 log = logging.getLogger(__name__)
 
@@ -34,18 +38,19 @@ METRICS = ("peak", "span_mm", "auc")
 
 def read_profile_csv(path, s_col: str, p_col: str) -> tuple[np.ndarray, np.ndarray]:
     path = Path(path)
+    text = read_text(path, "profile", "a readable profile.csv")
     try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as e:
-        raise ParameterError("profile", str(path), "a readable profile.csv", hint=str(e)) from None
+        rows = list(csv.DictReader(io.StringIO(text, newline="")))
+    except csv.Error as e:
+        raise ParameterError("profile", str(path), "a CSV file", hint=str(e)) from None
     if not rows or s_col not in rows[0] or p_col not in rows[0]:
         raise ParameterError("profile", str(path), f"CSV with columns {s_col}, {p_col} and >= 2 rows")
     try:
         s = np.array([float(r[s_col]) for r in rows])
         p = np.array([float(r[p_col]) for r in rows])
-    except ValueError as e:
-        raise ParameterError("profile", str(path), "numeric columns", hint=str(e)) from None
+    except (TypeError, ValueError) as e:
+        raise ParameterError("profile", str(path), "numeric columns, every row complete",
+                             hint=str(e)) from None
     if s.size < 2 or not (np.all(np.isfinite(s)) and np.all(np.isfinite(p))):
         raise ParameterError("profile", str(path), ">= 2 finite rows")
     order = np.argsort(s)
@@ -58,23 +63,34 @@ def load_simulation(sim_dir) -> tuple[np.ndarray, np.ndarray, dict]:
     s, p = read_profile_csv(sim_dir / "profile.csv", "s_mm", "pressure_mpa")
     meta = {}
     if (sim_dir / "summary.json").exists():
-        try:
-            meta = json.loads((sim_dir / "summary.json").read_text())
-        except ValueError as e:
-            raise ParameterError("simulation summary", str(sim_dir / "summary.json"),
-                                 "valid JSON", hint=str(e)) from None
+        meta = _read_json(sim_dir / "summary.json", "simulation summary", "valid JSON")
     return s, p, meta
+
+
+def _reject_constant(token: str):
+    raise ValueError(f"{token} is not a number in strict JSON")
+
+
+def _read_json(path, what: str, valid: str) -> dict:
+    text = read_text(path, what, valid)
+    try:
+        d = json.loads(text, parse_constant=_reject_constant)
+    except ValueError as e:
+        raise ParameterError(what, str(path), valid, hint=str(e)) from None
+    if not isinstance(d, dict):
+        raise ParameterError(what, str(path), valid, hint="not a JSON object")
+    return d
 
 
 def load_film(film_dir) -> tuple[np.ndarray, np.ndarray, dict]:
     """profile.csv (s_mm, pressure) and summary.json written by ``FilmProfile.write``."""
     film_dir = Path(film_dir)
     s, p = read_profile_csv(film_dir / "profile.csv", "s_mm", "pressure")
-    try:
-        meta = json.loads((film_dir / "summary.json").read_text())
-    except (OSError, ValueError) as e:
-        raise ParameterError("film result", str(film_dir), "a directory written by `film analyze`",
-                             hint=str(e)) from None
+    meta = _read_json(film_dir / "summary.json", "film result",
+                      "a directory written by `film analyze`")
+    if not isinstance(meta.get("unit", "MPa"), str):
+        raise ParameterError("film result unit", meta.get("unit"), "text, e.g. MPa",
+                             hint=str(film_dir / "summary.json"))
     return s, p, meta
 
 
@@ -105,14 +121,44 @@ class Comparison:
         }
 
     def write(self, out) -> dict[str, Path]:
-        """comparison.json and overlay.png into ``out`` (atomically)."""
+        """comparison.json and overlay.png into ``out``, each atomically.
+
+        ``out`` is claimed with fileio.claim_dir: a new or empty folder, a `film compare`
+        folder, or a `film analyze` folder (the default of the CLI: the film's own folder).
+        """
         from tactileskin.film import plots
 
         out = Path(out)
-        with staged_dir(out) as tmp:
-            (tmp / "comparison.json").write_text(json.dumps(self.to_dict(), indent=2, default=str))
-            plots.overlay(self, tmp / "overlay.png")
+        if _is_analyze_folder(out):
+            fileio.claim_dir(out, "film-analyze", own_names=ANALYZE_NAMES + COMPARE_NAMES)
+        else:
+            fileio.claim_dir(out, "film-compare", own_names=COMPARE_NAMES)
+        doc = json.loads(json.dumps(self.to_dict(), default=str))
+        fileio.atomic_write_json(out / "comparison.json", _finite_or_none(doc))
+        plots.overlay(self, out / "overlay.png")
         return {"comparison": out / "comparison.json", "overlay": out / "overlay.png"}
+
+
+def _is_analyze_folder(out: Path) -> bool:
+    """A folder `film analyze` wrote: its marker says so, or (written before markers) it
+    holds profile.csv and summary.json (claim_dir still checks every name is ours)."""
+    marker = out / fileio.MARKER
+    if marker.is_file():
+        try:
+            return json.loads(marker.read_text()).get("kind") == "film-analyze"
+        except (OSError, ValueError, AttributeError):
+            return False
+    return (out / "profile.csv").is_file() and (out / "summary.json").is_file()
+
+
+def _finite_or_none(o):
+    if isinstance(o, dict):
+        return {k: _finite_or_none(v) for k, v in o.items()}
+    if isinstance(o, list):
+        return [_finite_or_none(v) for v in o]
+    if isinstance(o, float) and not math.isfinite(o):
+        return None
+    return o
 
 
 def compare(film, sim) -> Comparison:

@@ -7,8 +7,6 @@ MATLAB figures (Sec. IV-D), which is why it is offered.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -36,17 +34,15 @@ def _check_cmap(cmap: str) -> str:
 
 
 def _save(fig, path) -> Path:
+    """Render to a temporary sibling and rename (fileio.atomic_path): no partial PNG."""
+    from tactileskin import fileio
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=120)
-        os.replace(tmp, path)
+        with fileio.atomic_path(path, suffix=".png") as tmp, fileio.os_errors(path):
+            fig.savefig(tmp, dpi=120, format="png")
     finally:
         _plt().close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 

@@ -1,20 +1,18 @@
 """Scanned pressure film -> pressure image -> profile along the strip.
 
-Grayscale convention: 0 = black, 255 = white (the paper's). Colour scans are converted
-to luminance with ITU-R BT.601 luma, Y = 0.299 R + 0.587 G + 0.114 B (the weights
-Pillow's "L" mode uses), computed in floating point without rounding; alpha is ignored.
-16-bit images are scaled by 255/65535.
+Grayscale convention: 0 = black, 255 = white (the paper's). Image reading (pixel scale of
+8/16/32-bit and float images, BT.601 luma for colour, the pixel cap) is in ``film.image``.
 
 The strip runs along image x (columns) by default (``axis="x"``); the profile is the mean
 pressure across the strip width (rows of the region) at each column, against the distance
 s in mm from an origin: the peak (sub-pixel), the middle of the half-maximum extent, or a
 position given in mm from the image's left (or top) edge. Pixel j's centre sits at
-(j + 0.5) / px_per_mm mm.
+(j + 0.5) / px_per_mm mm. Without a box the activated strip is found on the scan
+(``film.region``) and the box used is logged and written to summary.json.
 """
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 from dataclasses import dataclass, field
@@ -22,82 +20,67 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin.errors import ParameterError, check_range
-from tactileskin.film._io import staged_dir
+from tactileskin import fileio
+from tactileskin.errors import ParameterError
+from tactileskin.film import region as strip_region
 from tactileskin.film.calibration import Calibration, paper_eq8
+from tactileskin.film.image import LUMINANCE_NOTE, load_grayscale, luminance, read_scan  # noqa: F401
+from tactileskin.film.inputs import finite
 from tactileskin.results import auc, peak, span
 
 log = logging.getLogger(__name__)
 
 PX_PER_MM = 8.0          # the paper's scans (Sec. IV-B: 160 x 80 px for 20 x 10 mm)
-LUMA_BT601 = (0.299, 0.587, 0.114)
-LUMINANCE_NOTE = "ITU-R BT.601 luma Y = 0.299 R + 0.587 G + 0.114 B (float, alpha ignored)"
+# 0.01 px/mm (a pixel per 10 cm) to 10^4 px/mm (0.1 um pixels) spans every scanner and
+# microscope by far; outside it a typo is likelier than a scale.
+PX_PER_MM_RANGE = (0.01, 1e4)
 PEAK_WINDOW = 0.8        # parabola fitted to the samples >= 80 % of the maximum around it
+ANALYZE_NAMES = ("profile.csv", "summary.json", "pressure_map.png")
+COMPARE_NAMES = ("comparison.json", "overlay.png")
 
 
-def luminance(rgb: np.ndarray) -> np.ndarray:
-    """BT.601 luma of an (..., 3) RGB array, in the array's own scale."""
-    return np.asarray(rgb, float)[..., :3] @ np.asarray(LUMA_BT601)
-
-
-def load_grayscale(path) -> np.ndarray:
-    """Read a PNG/TIFF (any Pillow mode) as a float (H, W) array on the 0-255 scale."""
-    from PIL import Image, UnidentifiedImageError
-
-    path = Path(path)
-    valid = "a readable, non-empty PNG or TIFF image"
+def _box_numbers(name: str, box, px_per_mm: float | None) -> tuple[int, int, int, int]:
+    """Four finite numbers -> pixel box; mm are rounded to pixel edges, pixels must be whole."""
     try:
-        with Image.open(path) as im:
-            im.load()
-            if getattr(im, "n_frames", 1) > 1:
-                log.warning("%s has %d frames; using the first", path, im.n_frames)
-            mode = im.mode
-            if mode == "L":
-                arr = np.asarray(im, float)
-            elif mode.startswith("I"):           # 16/32-bit integer grayscale
-                arr = np.asarray(im, float) * (255.0 / 65535.0)
-            elif mode == "F":
-                arr = np.asarray(im, float)
-            elif mode in ("LA", "La"):
-                arr = np.asarray(im.getchannel(0), float)
-            else:                                # 1, P, RGB, RGBA, CMYK, YCbCr, ...
-                arr = luminance(np.asarray(im.convert("RGB"), float))
-    except FileNotFoundError:
-        raise ParameterError("scan", str(path), valid, hint="file not found") from None
-    except (UnidentifiedImageError, OSError, ValueError, SyntaxError) as e:
-        raise ParameterError("scan", str(path), valid, hint=f"unreadable: {e}") from None
-    if arr.ndim != 2 or arr.size == 0:
-        raise ParameterError("scan", str(path), valid, hint=f"image shape {arr.shape}")
-    if not np.all(np.isfinite(arr)) or arr.min() < 0 or arr.max() > 255:
-        raise ParameterError("scan", str(path), valid,
-                             hint=f"values must be finite on 0-255, got [{arr.min()}, {arr.max()}]")
-    return arr
+        vals = list(box)
+    except TypeError:
+        raise ParameterError(name, box, "four numbers x0, y0, x1, y1") from None
+    if len(vals) != 4:
+        raise ParameterError(name, tuple(vals), "four numbers x0, y0, x1, y1")
+    out = []
+    for v in vals:
+        f = finite(name, v)
+        if px_per_mm is not None:
+            f = round(f * px_per_mm)
+        elif f != int(f):
+            raise ParameterError(name, tuple(vals), "whole pixel numbers x0, y0, x1, y1")
+        out.append(int(f))
+    return tuple(out)
 
 
 def select_region(gray: np.ndarray, *, box_px=None, box_mm=None, px_per_mm: float = PX_PER_MM):
     """Crop to a box (x0, y0, x1, y1): pixels (half-open) or mm (rounded to pixel edges).
 
     x runs along columns from the left edge, y along rows from the top. Returns the crop
-    and the box in pixels.
+    and the box in pixels. No box: the whole image.
     """
     h, w = gray.shape
     if box_px is not None and box_mm is not None:
         raise ParameterError("box", "both box_px and box_mm", "one of them")
-    name = "box_px"
+    name = "box_mm" if box_mm is not None else "box_px"
     if box_mm is not None:
-        name = "box_mm"
-        box_px = tuple(int(round(float(v) * px_per_mm)) for v in box_mm)
-    if box_px is None:
+        box_px = _box_numbers(name, box_mm, px_per_mm)
+    elif box_px is not None:
+        box_px = _box_numbers(name, box_px, None)
+    else:
         box_px = (0, 0, w, h)
-    if len(box_px) != 4:
-        raise ParameterError(name, box_px, "four numbers x0, y0, x1, y1")
-    x0, y0, x1, y1 = (int(v) for v in box_px)
+    x0, y0, x1, y1 = box_px
     if not (0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h):
         given = box_mm if box_mm is not None else box_px
         unit = f" mm at {px_per_mm:g} px/mm" if box_mm is not None else " px"
+        why = ("x1 <= x0 or y1 <= y0" if (x1 <= x0 or y1 <= y0) else "region outside the image")
         raise ParameterError(name, tuple(given), f"0 <= x0 < x1 <= {w}, 0 <= y0 < y1 <= {h} px "
-                             f"(the image is {w} x {h} px)",
-                             hint=f"region outside the image; box given in{unit}")
+                             f"(the image is {w} x {h} px)", hint=f"{why}; box given in{unit}")
     return gray[y0:y1, x0:x1], (x0, y0, x1, y1)
 
 
@@ -184,13 +167,16 @@ class FilmProfile:
     source: str = ""
     metrics: dict = field(default_factory=dict)
     folded: dict = field(default_factory=dict)
+    region: dict = field(default_factory=dict)   # how box_px was chosen
+    image_note: str = ""                           # pixel scale applied when reading
 
     def summary(self) -> dict:
         cal = self.calibration
         return {
             "source": self.source, "unit": self.unit, "px_per_mm": self.px_per_mm,
-            "box_px": list(self.box_px), "axis": self.axis, "centre": self.centre,
-            "origin_mm": self.origin_mm, "luminance": LUMINANCE_NOTE,
+            "box_px": list(self.box_px), "region": self.region, "axis": self.axis,
+            "centre": self.centre, "origin_mm": self.origin_mm, "luminance": LUMINANCE_NOTE,
+            "pixel_scale": self.image_note,
             "calibration": {"name": cal.name, "model": cal.model, "params": list(cal.params),
                             "gs_range": list(cal.gs_range), "activation_range": list(cal.p_range),
                             "unit": cal.unit},
@@ -207,44 +193,88 @@ class FilmProfile:
         }
 
     def write(self, out, *, cmap: str = "viridis") -> dict[str, Path]:
-        """Write profile.csv, summary.json and pressure_map.png into ``out`` (atomically)."""
+        """Write profile.csv, summary.json and pressure_map.png into ``out``.
+
+        ``out`` must be new, empty or a `film analyze` folder (fileio.claim_dir); each file
+        is written atomically. A comparison left there by an earlier `film compare` is
+        removed: it describes the previous profile.
+        """
         from tactileskin.film import plots
 
-        out = Path(out)
+        plots._check_cmap(cmap)
+        out = fileio.claim_dir(out, "film-analyze", own_names=ANALYZE_NAMES + COMPARE_NAMES)
         names = {"profile": "profile.csv", "summary": "summary.json", "map": "pressure_map.png"}
-        with staged_dir(out) as tmp:
-            lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
-            for k in range(self.s_mm.size):
-                lo = f"{self.band_lo[k]:.6g}" if self.band_lo is not None else ""
-                hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
-                lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},"
-                             f"{self.pressure_sd[k]:.6g},{lo},{hi}")
-            (tmp / names["profile"]).write_text("\n".join(lines) + "\n")
-            (tmp / names["summary"]).write_text(json.dumps(self.summary(), indent=2))
-            plots.pressure_map(self, tmp / names["map"], cmap=cmap)
+        lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
+        for k in range(self.s_mm.size):
+            lo = f"{self.band_lo[k]:.6g}" if self.band_lo is not None else ""
+            hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
+            lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},"
+                         f"{self.pressure_sd[k]:.6g},{lo},{hi}")
+        for stale in COMPARE_NAMES:
+            with fileio.os_errors(out / stale):
+                (out / stale).unlink(missing_ok=True)
+        fileio.atomic_write_text(out / names["profile"], "\n".join(lines) + "\n")
+        fileio.atomic_write_json(out / names["summary"], self.summary())
+        plots.pressure_map(self, out / names["map"], cmap=cmap)
         return {k: out / v for k, v in names.items()}
+
+
+def _scan_array(scan) -> tuple[str, np.ndarray, str]:
+    if isinstance(scan, (str, Path)):
+        gray, note = read_scan(scan)
+        return str(scan), gray, note
+    gray = np.asarray(scan, float)
+    if gray.ndim == 3:
+        gray = luminance(gray)
+    if gray.ndim != 2 or gray.size == 0 or not np.all(np.isfinite(gray)):
+        raise ParameterError("scan", f"array {gray.shape}", "a finite, non-empty 2-D array")
+    if gray.min() < 0 or gray.max() > 255:
+        raise ParameterError("scan", f"array [{gray.min():g}, {gray.max():g}]",
+                             "grayscale values in [0, 255]")
+    return "<array>", gray, "array: read as 0-255"
 
 
 def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: float = PX_PER_MM,
                  box_px=None, box_mm=None, axis: str = "x", centre="peak") -> FilmProfile:
     """Scan (path or (H, W) grayscale array) -> FilmProfile.
 
-    calibration: default ``paper_eq8``. centre: "peak", "midspan" or a number (origin in
-    mm from the image's left edge for axis "x", top edge for "y").
+    calibration: default ``paper_eq8``. box_px / box_mm: the region (x0, y0, x1, y1);
+    neither: the activated strip is found automatically (``film.region``; refused if
+    ambiguous). centre: "peak", "midspan" or a number (origin in mm from the image's left
+    edge for axis "x", top edge for "y", inside the image).
     """
     cal = calibration or paper_eq8()
-    px_per_mm = check_range("px_per_mm", px_per_mm, 0, None, lo_open=True, unit="px/mm")
+    lo_s, hi_s = PX_PER_MM_RANGE
+    px_per_mm = finite("px_per_mm", px_per_mm, 0, lo_open=True, unit="px/mm")
+    if not lo_s <= px_per_mm <= hi_s:
+        raise ParameterError("px_per_mm", px_per_mm, f"[{lo_s:g}, {hi_s:g}] px/mm")
     if axis not in ("x", "y"):
         raise ParameterError("axis", axis, "'x' (strip along columns) or 'y' (along rows)")
-    if isinstance(scan, (str, Path)):
-        source, gray = str(scan), load_grayscale(scan)
+    if isinstance(centre, str):
+        if centre not in ("peak", "midspan"):
+            raise ParameterError("centre", centre, "'peak', 'midspan' or an origin in mm")
     else:
-        source, gray = "<array>", np.asarray(scan, float)
-        if gray.ndim == 3:
-            gray = luminance(gray)
-        if gray.ndim != 2 or gray.size == 0 or not np.all(np.isfinite(gray)):
-            raise ParameterError("scan", f"array {gray.shape}", "a finite, non-empty 2-D array")
-    region, box = select_region(gray, box_px=box_px, box_mm=box_mm, px_per_mm=px_per_mm)
+        centre = finite("centre", centre, unit="mm")
+    source, gray, note = _scan_array(scan)
+    length_mm = gray.shape[1 if axis == "x" else 0] / px_per_mm
+    if not isinstance(centre, str) and not 0 <= centre <= length_mm:
+        raise ParameterError("centre", centre, f"[0, {length_mm:g}] mm (inside the image, "
+                             f"{'left' if axis == 'x' else 'top'} edge = 0)")
+    if box_px is None and box_mm is None:
+        oriented = gray if axis == "x" else gray.T
+        c0, r0, c1, r1 = strip_region.find_strip(cal.pressure(oriented), cal.p_range[0],
+                                                 px_per_mm)
+        box = (c0, r0, c1, r1) if axis == "x" else (r0, c0, r1, c1)
+        region_info = {"method": "auto", "rule": strip_region.RULE}
+        log.info("no region given: analysing the activated strip found at x %d-%d, "
+                 "y %d-%d px (pass --box-px/--box-mm to choose another)",
+                 box[0], box[2], box[1], box[3])
+    else:
+        _, box = select_region(gray, box_px=box_px, box_mm=box_mm, px_per_mm=px_per_mm)
+        region_info = {"method": "box_mm" if box_mm is not None else "box_px",
+                       "given": [float(v) for v in (box_mm if box_mm is not None else box_px)]}
+    x0, y0, x1, y1 = box
+    region = gray[y0:y1, x0:x1]
     start = box[0] if axis == "x" else box[1]
     if axis == "y":
         region = region.T
@@ -272,26 +302,24 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     sd = pmap.std(axis=0)
     band = cal.band(region.mean(axis=0))
     x_mm = (start + np.arange(region.shape[1]) + 0.5) / px_per_mm   # pixel centres
-    if isinstance(centre, str):
-        if centre == "peak":
-            origin = _peak_position(x_mm, prof)
-        elif centre == "midspan":
-            origin = _midspan_position(x_mm, prof)
-        else:
-            raise ParameterError("centre", centre, "'peak', 'midspan' or an origin in mm")
+    if centre == "peak":
+        origin = _peak_position(x_mm, prof)
+    elif centre == "midspan":
+        origin = _midspan_position(x_mm, prof)
     else:
-        origin = check_range("centre", centre, unit="mm")
+        origin = centre
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
     fp = FilmProfile(
         s_mm=s, pressure=prof, pressure_sd=sd,
         band_lo=band[0] if band else None, band_hi=band[1] if band else None,
-        pressure_map=pmap, gray=region, box_px=box, px_per_mm=px_per_mm, axis=axis,
+        pressure_map=pmap, gray=region, box_px=tuple(int(v) for v in box),
+        px_per_mm=px_per_mm, axis=axis,
         origin_mm=float(origin), centre=str(centre), unit=cal.unit, calibration=cal,
         saturated_fraction=sat, inactive_fraction=inactive, source=source,
         metrics=profile_metrics(s, prof),
         folded={"s_mm": sh, "pressure": ph, "asymmetry": asym,
-                "metrics": profile_metrics(sh, ph)})
+                "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note)
     for k, v in fp.metrics.items():
         if not math.isfinite(v):  # pragma: no cover - inputs are checked finite above
             raise ParameterError(f"metric {k}", v, "finite")

@@ -17,6 +17,8 @@ from scipy import ndimage
 
 from tactileskin.errors import ParameterError, check_range
 from tactileskin.film.calibration import Calibration, paper_eq8
+from tactileskin.film.image import MAX_PIXELS
+from tactileskin.film.inputs import finite
 
 
 def gaussian_profile(peak: float, width_mm: float) -> Callable[[np.ndarray], np.ndarray]:
@@ -52,14 +54,18 @@ def render_scan(profile: Callable[[np.ndarray], np.ndarray], calibration: Calibr
     """
     cal = calibration or paper_eq8()
     for name, v in (("length_mm", length_mm), ("width_mm", width_mm)):
-        check_range(name, v, 0, None, lo_open=True, unit="mm")
-    check_range("margin_mm", margin_mm, 0, None, unit="mm")
-    check_range("px_per_mm", px_per_mm, 0, None, lo_open=True, unit="px/mm")
-    check_range("blur_px", blur_px, 0, None, unit="px")
-    check_range("noise_gs", noise_gs, 0, None, unit="gray levels")
-    nx = int(round(length_mm * px_per_mm))
-    nw = int(round(width_mm * px_per_mm))
-    nm = int(round(margin_mm * px_per_mm))
+        finite(name, v, 0, lo_open=True, unit="mm")
+    finite("margin_mm", margin_mm, 0, unit="mm")
+    finite("px_per_mm", px_per_mm, 0, lo_open=True, unit="px/mm")
+    finite("blur_px", blur_px, 0, unit="px")
+    finite("noise_gs", noise_gs, 0, unit="gray levels")
+    nx = length_mm * px_per_mm
+    nw = width_mm * px_per_mm
+    nm = margin_mm * px_per_mm
+    if not nx * (nw + 2 * nm) <= MAX_PIXELS:
+        raise ParameterError("length_mm/width_mm/margin_mm", (length_mm, width_mm, margin_mm),
+                             f"at most {MAX_PIXELS / 1e6:g} Mpx at {px_per_mm:g} px/mm")
+    nx, nw, nm = int(round(nx)), int(round(nw)), int(round(nm))
     if nx < 3 or nw < 1:
         raise ParameterError("length_mm/width_mm", (length_mm, width_mm),
                              f">= 3 px long and 1 px wide at {px_per_mm:g} px/mm")
@@ -85,19 +91,14 @@ def render_scan(profile: Callable[[np.ndarray], np.ndarray], calibration: Calibr
 
 def save_scan(img: np.ndarray, path) -> Path:
     """Write a uint8 array as PNG/TIFF (by suffix), atomically."""
-    import os
-    import tempfile
-
     from PIL import Image
 
+    from tactileskin import fileio
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        Image.fromarray(np.asarray(img)).save(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    fmt = {".png": "PNG", ".tif": "TIFF", ".tiff": "TIFF"}.get(path.suffix.lower())
+    if fmt is None:
+        raise ParameterError("scan path", str(path), "a .png, .tif or .tiff file name")
+    with fileio.atomic_path(path, suffix=path.suffix) as tmp, fileio.os_errors(path):
+        Image.fromarray(np.asarray(img)).save(tmp, format=fmt)
     return path

@@ -1,0 +1,88 @@
+"""Film output folders and files go through fileio: a folder holding user files is refused
+and left intact, `film compare` may write into the `film analyze` folder (its default), a
+re-analysis removes the stale comparison, files get normal permissions."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from tactileskin import fileio
+from tactileskin.cli import main
+from tactileskin.film.synthetic import gaussian_profile, render_scan, save_scan
+
+S = np.linspace(0, 6, 121)
+
+
+@pytest.fixture
+def scan(tmp_path):
+    return save_scan(render_scan(gaussian_profile(0.4, 1.0), background_gs=245), tmp_path / "s.png")
+
+
+@pytest.fixture
+def sim(tmp_path):
+    d = tmp_path / "sim"
+    d.mkdir()
+    np.savetxt(d / "profile.csv", np.column_stack([S, gaussian_profile(0.4, 1.0)(S)]),
+               delimiter=",", header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+    return d
+
+
+def test_analyze_refuses_a_folder_with_user_files(tmp_path, capsys, scan):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("x")
+    assert main(["film", "analyze", str(scan), "--out", str(out)]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+    assert (out / "notes.txt").read_text() == "x"
+
+
+def test_compare_into_the_film_folder_and_stale_comparison_removed(tmp_path, capsys, scan, sim):
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    assert main(["film", "compare", str(film), str(sim)]) == 0          # default: FILM_DIR
+    assert (film / "comparison.json").exists() and (film / "overlay.png").exists()
+    json.loads((film / "comparison.json").read_text(),
+               parse_constant=lambda t: pytest.fail(f"non-strict token {t}"))
+    mode = fileio.file_mode()
+    assert all(os.stat(film / n).st_mode & 0o777 == mode
+               for n in ("profile.csv", "summary.json", "pressure_map.png", "comparison.json"))
+    # a new analysis in the same folder: the comparison of the old profile is gone
+    assert main(["film", "analyze", str(scan), "--centre", "midspan", "--out", str(film)]) == 0
+    assert not (film / "comparison.json").exists() and not (film / "overlay.png").exists()
+    assert [p.name for p in tmp_path.iterdir() if ".tsk" in p.name] == []
+
+
+def test_compare_into_a_foreign_folder_is_refused(tmp_path, capsys, scan, sim):
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "data.csv").write_text("1")
+    assert main(["film", "compare", str(film), str(sim), "--out", str(other)]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert sorted(p.name for p in other.iterdir()) == ["data.csv"]
+    # a new folder becomes a compare folder, and can be written again
+    for _ in range(2):
+        assert main(["film", "compare", str(film), str(sim), "--out", str(tmp_path / "cmp")]) == 0
+    assert json.loads((tmp_path / "cmp" / fileio.MARKER).read_text())["kind"] == "film-compare"
+
+
+def test_compare_into_a_folder_written_before_markers(tmp_path, scan, sim):
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    (film / fileio.MARKER).unlink()
+    assert main(["film", "compare", str(film), str(sim)]) == 0
+    assert json.loads((film / fileio.MARKER).read_text())["kind"] == "film-analyze"
+
+
+def test_calibrate_out_under_a_file(tmp_path, capsys):
+    (tmp_path / "cal.csv").write_text("force_n,area_mm2,gray\n30,100,40\n17,100,120\n2,100,220\n")
+    (tmp_path / "f").write_text("a file")
+    assert main(["film", "calibrate", str(tmp_path / "cal.csv"), "--out",
+                 str(tmp_path / "f" / "c.json")]) == 2
+    err = capsys.readouterr().err.replace("\n", "")
+    assert "cannot write" in err and "Traceback" not in err
+    assert (tmp_path / "f").read_text() == "a file"

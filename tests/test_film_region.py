@@ -1,0 +1,110 @@
+"""`film analyze` without a region: the activated strip is found on synthetic scans with a
+white margin (sharp, blurred, all-film, axis y), ambiguity is refused, and the region used
+is printed and written to summary.json."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tactileskin.cli import main
+from tactileskin.errors import ParameterError
+from tactileskin.film import analyze_scan
+from tactileskin.film.calibration import Calibration
+from tactileskin.film.synthetic import gaussian_profile, mirrored, render_scan, save_scan
+
+PPM = 8.0
+# the film of examples/film_roundtrip.py, where a whole-image average read 0.110 for 0.199
+TRUE = Calibration(name="true film", model="linear", params=(-0.0015, 0.345),
+                   gs_range=(0.0, 255.0), p_range=(0.0, 0.345))
+S = np.linspace(0, 6, 121)
+PROFILE = mirrored(S, gaussian_profile(0.2, 1.2)(S))
+STRIP = (16, 56)        # rows of the strip: 2 mm margin, 5 mm wide, at 8 px/mm
+CORE = (0, 26, 128, 46)  # rows 10 px (> 3 blur sd) inside the strip: the reference
+
+
+def _scan(blur=0.0, background=245.0, **kw):
+    return render_scan(PROFILE, TRUE, length_mm=16, blur_px=blur, noise_gs=2.0,
+                       background_gs=background, seed=1, **kw)
+
+
+@pytest.mark.parametrize("background", [245.0, None])
+def test_sharp_strip_is_found_exactly(background):
+    img = _scan(background=background)
+    fp = analyze_scan(img, TRUE)
+    assert fp.box_px[1::2] == STRIP                     # rows: exactly the strip
+    assert fp.region["method"] == "auto"
+    # along the strip: the activated extent plus 1 mm, inside the image
+    assert 0 <= fp.box_px[0] and fp.box_px[2] <= img.shape[1]
+    act = np.flatnonzero(TRUE.pressure(img[STRIP[0]:STRIP[1]]).mean(axis=0) > 0.01)
+    assert fp.box_px[0] <= act[0] and fp.box_px[2] > act[-1]
+    ref = analyze_scan(img, TRUE, box_px=CORE)
+    # the same pixels per column within the strip: only the noise of the different
+    # row count differs; 2 gray levels x 0.0015 / sqrt(20 rows) = 0.0007 per column
+    assert fp.metrics["peak"] == pytest.approx(ref.metrics["peak"], abs=5 * 0.0007)
+    whole = analyze_scan(img, TRUE, box_px=(0, 0, img.shape[1], img.shape[0]))
+    assert whole.metrics["peak"] < 0.6 * fp.metrics["peak"]   # what the margin did
+
+
+@pytest.mark.parametrize("blur", [1.0, 1.5, 3.0])
+def test_blurred_edges_are_dropped(blur):
+    img = _scan(blur=blur)
+    fp = analyze_scan(img, TRUE)
+    r0, r1 = fp.box_px[1::2]
+    assert STRIP[0] <= r0 and r1 <= STRIP[1]
+    # kept rows are >= 2.5 blur sd inside the edges (so they read within 0.6 %), and the
+    # band keeps most of the strip
+    assert r0 + 0.5 - STRIP[0] >= 2.5 * blur - 1 and STRIP[1] - (r1 - 0.5) >= 2.5 * blur - 1
+    assert r1 - r0 >= 40 - 2 * (2.5 * blur + 2)
+    ref = analyze_scan(img, TRUE, box_px=CORE)
+    # blur bias of the kept rows (<= 0.6 %) plus five sd of the column-noise difference
+    # (2 gray levels x 0.0015 / sqrt(20) = 0.0007 MPa)
+    assert fp.metrics["peak"] == pytest.approx(ref.metrics["peak"],
+                                               abs=0.006 * ref.metrics["peak"] + 5 * 0.0007)
+
+
+def test_all_film_scan_and_axis_y():
+    img = _scan(margin_mm=0.0)
+    fp = analyze_scan(img, TRUE)
+    assert fp.box_px[1::2] == (0, img.shape[0])
+    ref = analyze_scan(img, TRUE, box_px=(0, 0, img.shape[1], img.shape[0]))
+    assert fp.metrics["peak"] == pytest.approx(ref.metrics["peak"], abs=1e-12)
+    # strip along rows: the same answer on the transposed scan
+    img = _scan()
+    fx, fy = analyze_scan(img, TRUE), analyze_scan(img.T.copy(), TRUE, axis="y")
+    assert fy.box_px == (fx.box_px[1], fx.box_px[0], fx.box_px[3], fx.box_px[2])
+    assert fy.pressure == pytest.approx(fx.pressure, abs=1e-12)
+
+
+def test_a_small_dark_mark_does_not_capture_the_region():
+    img = _scan()
+    img[0:2, :] = 0             # a black scanner edge along the top: saturated, but thin
+    img[66:70, 2:6] = 20        # an ink dot in the margin
+    fp = analyze_scan(img, TRUE)
+    assert fp.box_px[1::2] == STRIP
+
+
+def test_two_similar_strips_are_refused_with_a_hint():
+    img = np.vstack([_scan(), _scan()])
+    with pytest.raises(ParameterError, match=r"region.*--box-px.*2 separate activated regions"):
+        analyze_scan(img, TRUE)
+
+
+def test_blank_scan_is_still_reported_as_blank():
+    with pytest.raises(ParameterError, match="blank"):
+        analyze_scan(np.full((30, 60), 245.0), TRUE)
+
+
+def test_cli_without_region_reports_and_saves_it(tmp_path, capsys):
+    scan = save_scan(_scan(blur=1.0), tmp_path / "scan.png")
+    TRUE.save(tmp_path / "cal.json")
+    assert main(["film", "analyze", str(scan), "-c", str(tmp_path / "cal.json"),
+                 "--out", str(tmp_path / "film")]) == 0
+    out = capsys.readouterr().out
+    assert "found automatically" in out
+    summ = json.loads((tmp_path / "film" / "summary.json").read_text())
+    assert summ["region"]["method"] == "auto" and "50 %" in summ["region"]["rule"]
+    x0, y0, x1, y1 = summ["box_px"]
+    assert f"region x {x0}-{x1}, y {y0}-{y1} px" in out
+    # the issue's numbers: 0.199 with a hand-picked region (blur 1 px lowers it to 0.1985)
+    assert summ["metrics_two_sided"]["peak"] == pytest.approx(0.199, abs=0.003)
