@@ -45,7 +45,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.text import Text
 
-    from tactileskin import quality
+    from tactileskin import quality as result_quality  # `quality` is the mesh preset option
 
     from tactileskin.report.outputs import write_outputs
     from tactileskin.scene import Scene
@@ -97,7 +97,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     wall = time.perf_counter() - t0
     paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
-    nsus = sum(1 for r in paths.get("rows", []) if quality.kind(r.get("status", "")) == "suspect")
+    nsus = sum(1 for r in paths.get("rows", []) if result_quality.kind(r.get("status", "")) == "suspect")
     console.print(f"report: {paths['report']}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
                   f"{nsus} suspect, {nfail} failed, {wall:.1f} s)", highlight=False)
     return EXIT_FAILED if nfail else (EXIT_SUSPECT if nsus else 0)
