@@ -165,8 +165,12 @@ def jacobian_ratio(mesh) -> float:
 
     Xq, _ = get_quadrature(mesh.elem.refdom, 4)
     X = np.concatenate([Xq, _lattice(mesh.dim(), 4)], axis=1)
-    J = [[mesh._mapping().J(i, j, X) for j in range(mesh.dim())] for i in range(mesh.dim())]
-    d = np.linalg.det(np.moveaxis(np.array(J), (0, 1), (-2, -1)))  # (cells, points)
+    mapping = mesh._mapping()
+    if hasattr(mapping, "J"):  # isoparametric (curved) cells
+        J = [[mapping.J(i, j, X) for j in range(mesh.dim())] for i in range(mesh.dim())]
+        d = np.linalg.det(np.moveaxis(np.array(J), (0, 1), (-2, -1)))  # (cells, points)
+    else:  # affine (straight) cells: det J is constant per cell
+        d = np.asarray(mapping.detDF(X))
     dmax = d.max(axis=1)
     ratio = np.where(dmax > 0, d.min(axis=1) / np.where(dmax > 0, dmax, 1.0), -1.0)
     return float(np.min(ratio))
