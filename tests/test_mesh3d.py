@@ -100,7 +100,10 @@ def test_facet_export_ordering(slab_t3):
 def test_no_inverted_cells(t):
     sm = build_mesh(Scene(thickness=t, dim=3), **COARSE)
     assert sm.min_jacobian() > 0.0
-    assert sm.quality["min_scaled_jacobian"] > 0.3
+    # min over quadrature points and the cell's lattice points (vertices included, where a
+    # P2 cell's det J is often smallest): t = 5 gives 0.254 here, 0.425 at the quadrature
+    # points alone; the refusal threshold (skinmesh.MIN_SCALED_JACOBIAN) is 0.05
+    assert sm.quality["min_scaled_jacobian"] > 0.25
     assert sm.quality["min_sicn"] > 0.1
 
 

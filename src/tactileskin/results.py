@@ -118,11 +118,19 @@ class Result:
         return s, p
 
     def summary(self) -> dict:
-        return {
+        """The result's numbers, with its status ("ok" or "suspect: reasons") and flags
+        (tactileskin.quality: no contact, material law outside its range)."""
+        from tactileskin import quality
+
+        out = {
             "peak_mpa": self.peak,
             "span_mm": self.span,
             "auc": self.auc,
             "reaction_n_per_mm": float(self.reaction),
+            "contact_points": int(len(self.contact_x)),
+            # extremes of the material law's state (fe.output.law_state)
+            **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa")
+               if k in self.stats},
             "dofs": int(self.stats.get("dofs", 0)),
             "newton_iterations": int(self.stats.get("newton_iterations", 0)),
             "increments": int(self.stats.get("increments", 0)),
@@ -131,6 +139,15 @@ class Result:
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
             **({"scene": self.scene} if self.scene else {}),
         }
+        found = quality.flags(out)
+        out["status"] = quality.status_of(found)
+        out["flags"] = [f.to_dict() for f in found]
+        return out
+
+    @property
+    def status(self) -> str:
+        """'ok' or 'suspect: <reasons>' (tactileskin.quality)."""
+        return self.summary()["status"]
 
     def write(self, directory) -> Path:
         """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu) into

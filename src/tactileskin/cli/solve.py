@@ -10,7 +10,13 @@ from tactileskin.cli._common import claimed_output, scene_from_options, scene_op
 OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "section_2d", "compare_2d.json")
 
 
-@click.command("solve")
+EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see the help text)
+
+
+@click.command("solve", epilog=(
+    "Exit status: 0 the result is ok; 3 the result was written but is suspect (no contact, or "
+    "the material law outside its range: see 'status' and 'flags' in summary.json); 2 an "
+    "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
               help="Output folder (profile.csv, contact.csv, summary.json, result.vtu): a new or "
@@ -23,6 +29,7 @@ def command(out, elastic, compare_2d, **kw):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.table import Table
+    from rich.text import Text
 
     from tactileskin.fe import solve
 
@@ -46,10 +53,21 @@ def command(out, elastic, compare_2d, **kw):
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
-    Console().print(t)
+    if "min_J" in s:
+        t.add_row("min volume ratio J / max |stress|",
+                  f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")
+    t.add_row("status", Text("ok", style="green") if s["status"] == "ok"
+              else Text(s["status"], style="bold yellow"))
+    console = Console()
+    console.print(t)
+    rc = 0
+    if s["status"] != "ok":
+        console.print(Text("warning: suspect result (exit status 3): ", style="bold yellow")
+                      + Text(s["status"].split(": ", 1)[-1]), highlight=False)
+        rc = EXIT_SUSPECT
     if compare_2d:
         _compare_2d(scene, s, out)
-    return 0
+    return rc
 
 
 def _compare_2d(scene, s3, out) -> None:
@@ -58,6 +76,7 @@ def _compare_2d(scene, s3, out) -> None:
 
     from rich.console import Console
     from rich.table import Table
+    from rich.text import Text
 
     from tactileskin.fe import solve
     from tactileskin.fileio import atomic_write_json
@@ -75,6 +94,9 @@ def _compare_2d(scene, s3, out) -> None:
     for k, (a, b, d) in rows.items():
         t.add_row(k, f"{a:.4g}", f"{b:.4g}", "n/a (3D is 0)" if d is None else f"{100 * d:+.1f} %")
     Console().print(t)
+    if s2.get("status", "ok") != "ok":
+        Console().print(Text(f"warning: the 2D section is suspect: {s2['status']}", style="bold yellow"),
+                        highlight=False)
     doc = {"scene_3d": scene.label(), "scene_2d": sc2.label(),
            **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
     atomic_write_json(os.path.join(out, "compare_2d.json"), doc)

@@ -18,7 +18,14 @@ OWN_NAMES = ("results.csv", "profiles.csv", "report.md", "cache",
 _RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
 
-@click.command("sweep")
+EXIT_FAILED, EXIT_SUSPECT = 1, 3
+
+
+@click.command("sweep", epilog=(
+    "Exit status: 0 every case ok; 1 some case failed (the others are reported); 3 no case "
+    "failed but some result is suspect (no contact, or the material law outside its range: "
+    "the 'status' column of results.csv and the top of report.md say why); 2 an error "
+    "before any case ran (bad parameter, output folder)."))
 @click.option("--out", "out", type=click.Path(file_okay=False), default="out", show_default=True,
               help="Output folder: results.csv, profiles.csv, figures, report.md (a new or empty "
                    "folder, or one written by `sweep`; other files are never touched).")
@@ -45,6 +52,9 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.text import Text
+
+    from tactileskin import quality as result_quality  # `quality` is the mesh preset option
 
     from tactileskin.report.outputs import write_outputs
     from tactileskin.scene import Scene
@@ -83,7 +93,13 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
             def on_event(oc):
                 style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
                 extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
-                bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
+                word, why = oc.status, ""
+                if oc.status != "failed":
+                    st = _case_status(cache, oc.scene)
+                    if st != "ok":
+                        word, style, why = "suspect", "bold yellow", f" - {st.split(': ', 1)[-1]}"
+                line = Text.assemble((f"{word:>7}", style), f" {oc.scene.label()}{extra}{why}")
+                bar.console.print(line, highlight=False)
                 bar.advance(task)
 
             outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
@@ -91,8 +107,20 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         wall = time.perf_counter() - t0
         paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
-    console.print(f"report: {paths['report']}  ({len(scenes) - nfail}/{len(scenes)} ok, {wall:.1f} s)")
-    return 1 if nfail else 0
+    nsus = sum(1 for r in paths.get("rows", []) if result_quality.kind(r.get("status", "")) == "suspect")
+    console.print(f"report: {paths['report']}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
+                  f"{nsus} suspect, {nfail} failed, {wall:.1f} s)", highlight=False)
+    return EXIT_FAILED if nfail else (EXIT_SUSPECT if nsus else 0)
+
+
+def _case_status(cache, scene) -> str:
+    """Status of a finished case from its cached numbers (tactileskin.quality)."""
+    from tactileskin import quality
+
+    try:
+        return quality.status(cache.load(scene).summary)
+    except Exception as e:  # noqa: BLE001 - the report step reports an unreadable entry
+        return f"suspect: cached entry unreadable ({e})"
 
 
 def _names(text: str, name: str) -> tuple[str, ...]:

@@ -106,7 +106,11 @@ def phases(model: Model, **extra: float) -> dict:
 
 
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None):
-    """Indent the scene's skin from first touch to its full depth at its rate; return a Result."""
+    """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
+    Raises ParameterError before meshing if the indenter cannot reach the skin (no contact)."""
+    from tactileskin.geometry.indenters import require_contact
+
+    require_contact(scene)
     t0 = time.perf_counter()
     t_mesh = 0.0
     if mesh is None:

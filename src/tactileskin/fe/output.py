@@ -171,6 +171,17 @@ def arc_length(points: np.ndarray) -> np.ndarray:
     return s
 
 
+def law_state(ev: Evaluation, sig: np.ndarray) -> dict:
+    """Extremes of the state the material law saw, for tactileskin.quality: `min_J` (the
+    smallest volume ratio at a quadrature point; the mixed formulation's law sees the
+    element dilatation, so its J), `max_abs_stress_mpa` (largest |principal Cauchy
+    stress|) and `max_pressure_mpa` (largest mean pressure, positive in compression)."""
+    J = np.asarray(ev.kin.Jbar, float)
+    principal = np.linalg.eigvalsh(0.5 * (sig + np.swapaxes(sig, -1, -2)))
+    return {"min_J": float(np.min(J)), "max_abs_stress_mpa": float(np.max(np.abs(principal))),
+            "max_pressure_mpa": float(np.max(kernels.mean_pressure(sig)))}
+
+
 def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: str = "bone_interface",
                 vertical: int = 1, scene: dict | None = None, plane_z: float | None = None) -> Result:
     """Result of a converged state. 2D: the profile at the path's nodes. 3D: the profile on
@@ -199,6 +210,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     else:
         cx, cp = np.zeros(0), np.zeros(0)
     r = reaction(model, ev)
+    law = law_state(ev, sig)
     for name, v in fields.items():
         if not np.all(np.isfinite(v)):
             raise ConvergenceError(f"non-finite nodal field {name!r}", {"field": name})
@@ -214,7 +226,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     st = {"dofs": int(model.ndof), "free_dofs": int(len(model.free)), "elements": int(len(cells)),
           "increments": stats.increments, "newton_iterations": stats.newton_iterations,
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
-          "wall_s": stats.wall_s, "formulation": model.formulation,
+          "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           "reaction_vector": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, reaction=float(r[vertical]),

@@ -310,3 +310,48 @@ def indenter_symmetry(scene) -> tuple[bool, bool]:
     xz = _braille.dot_centres(scene.braille_text, _braille.get_standard(scene.braille_standard))
     key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
     return tuple(key(xz * np.where(np.arange(2) == ax, -1.0, 1.0)) == key(xz) for ax in (0, 1))
+
+
+def first_contact_travel(scene, samples: int = 4000) -> float:
+    """Travel (mm) after which the scene's indenter first touches the skin, as the model
+    sees it: the smallest analytic gap at the start over the outer contour x >= 0 (the half
+    model), sampled every ~0.01 mm, in 3D on the planes of the Braille dot rows (the slab is
+    uniform along z, so a dot's gap is smallest in its own row's plane). 0 for plates and
+    cylinders (they touch at x = 0 at the start); a Braille text without a dot near the
+    centre touches later, or only with its base plate (dot height)."""
+    ind = indenter_for_scene(scene)
+    sec = scene.section()
+    pts = sec.fingertip.outer(np.linspace(0.0, sec.u_outer_end, samples))
+    if scene.dim == 3:
+        rows = ind.rows if isinstance(ind, BrailleIndenter) else np.zeros(1)
+        pts = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in rows])
+    g, _ = ind.gap(pts, 0.0)
+    return max(0.0, float(np.min(g)))
+
+
+def require_contact(scene) -> None:
+    """Raise ParameterError if the scene's indenter cannot touch the skin within its depth
+    (a solve would return zero pressure everywhere: no contact)."""
+    travel = first_contact_travel(scene)
+    depth = scene.indentation
+    if depth > travel + 1e-9:
+        return
+    why = f"the {scene.indenter.value} indenter first touches the skin after {travel:.3g} mm of travel"
+    if isinstance(ind := indenter_for_scene(scene), BrailleIndenter):
+        x = ind.section_x if scene.dim == 2 else ind.dots[:, 0]
+        seen = x[x >= -1e-9]  # the half model (x >= 0)
+        why += f": the pattern of {scene.braille_text!r} is centred on x = 0"
+        if seen.size:
+            why += (f"; its nearest modelled dot is at x = {seen.min():.3g} mm, where the fingertip has "
+                    f"curved away{'' if scene.dim == 3 else ' (a 3D model has the same contour)'}")
+        symmetric = ind.section_symmetric if scene.dim == 2 else indenter_symmetry(scene)[0]
+        if not symmetric:
+            why += "; the half model (x >= 0) does not see the dots at x < 0"
+    dmax = 0.6 * scene.thickness
+    if travel < dmax:
+        raise ParameterError("depth", depth, f"> {travel:.3g} mm for this indenter, at most {dmax:g} mm",
+                             f"no contact: {why}; use a larger --depth or a text with a dot on the centre line")
+    raise ParameterError("braille_text" if scene.indenter.value == "braille" else "indenter",
+                         scene.braille_text if scene.indenter.value == "braille" else scene.indenter.value,
+                         "an indenter that reaches the skin within the depth",
+                         f"no contact: {why}; use a text with a dot on the centre line")

@@ -17,7 +17,7 @@ import numpy as np
 
 from tactileskin.errors import ParameterError
 from tactileskin.mesh import _gmsh, sizing
-from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
+from tactileskin.mesh.skinmesh import SkinMesh, check_quality, jacobian_ratio
 
 logger = logging.getLogger(__name__)
 
@@ -110,5 +110,6 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
     mesh = mesh.with_boundaries(boundaries)
     logger.info("2D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, "
                 "min scaled Jacobian %(min_scaled_jacobian).3f", quality)
+    check_quality(quality, plan.as_dict())
     return SkinMesh(mesh=mesh, boundaries=boundaries, dim=2, quality=quality, section=section,
                     sizes=plan.as_dict())

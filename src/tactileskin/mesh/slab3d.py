@@ -19,7 +19,7 @@ import numpy as np
 from tactileskin.geometry.indenters import indenter_symmetry
 from tactileskin.mesh import _gmsh, sizing
 from tactileskin.mesh.section2d import add_section_curves
-from tactileskin.mesh.skinmesh import SkinMesh, jacobian_ratio
+from tactileskin.mesh.skinmesh import SkinMesh, check_quality, jacobian_ratio
 from tactileskin.mesh.snap import snap_boundary_nodes
 
 logger = logging.getLogger(__name__)
@@ -103,5 +103,6 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
                    wall_s=time.perf_counter() - t0)
     logger.info("3D mesh: %(elements)d cells, %(nodes)d nodes, min SICN %(min_sicn).3f, "
                 "min scaled Jacobian %(min_scaled_jacobian).3f", quality)
+    check_quality(quality, plan.as_dict())
     return SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality, section=section,
                     z_symmetric=zsym, length=length, sizes=plan.as_dict())

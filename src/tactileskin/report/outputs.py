@@ -8,6 +8,7 @@ import logging
 import math
 from pathlib import Path
 
+from tactileskin import quality
 from tactileskin.errors import TactileSkinError
 from tactileskin.fileio import atomic_write_text, make_dirs
 
@@ -15,6 +16,7 @@ log = logging.getLogger(__name__)
 
 RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter", "braille_text",
                   "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc", "reaction_n_per_mm",
+                  "min_J", "max_abs_stress_mpa",
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
 
 
@@ -27,14 +29,16 @@ def collect(outcomes, cache):
                    indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
                    rate_mm_s=sc.rate)
         if oc.status == "failed":
-            row.update(status="failed", error=oc.error)
+            row.update(status=quality.failed_status(oc.error), error=oc.error)
             failures.append(oc)
         else:
             rec = cache.load(sc)
             records.append(rec)
-            row.update(status="ok", **{k: rec.summary.get(k) for k in
-                                       ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "dofs",
-                                        "increments", "newton_iterations", "wall_s")})
+            # recomputed from the numbers (not the stored string): the ranges are quality's
+            row.update(status=quality.status(rec.summary), **{k: rec.summary.get(k) for k in
+                                       ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "min_J",
+                                        "max_abs_stress_mpa", "dofs", "increments",
+                                        "newton_iterations", "wall_s")})
             for k in ("peak_mpa", "span_mm", "auc"):
                 v = row[k]
                 if v is None or not math.isfinite(float(v)):
@@ -83,4 +87,4 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     report = build_report(rows, records, failures, figures, renders, wall_s)
     atomic_write_text(out / "report.md", report)
     return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",
-                figures=figures, renders=renders, failures=failures)
+                figures=figures, renders=renders, failures=failures, rows=rows)

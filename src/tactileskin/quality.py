@@ -1,0 +1,101 @@
+"""Whether a solve's result is a normal result: flags computed from the result's own numbers.
+
+`flags(summary)` takes the numbers of `Result.summary()` (or a cached summary.json) and
+returns one `Flag` per reason to distrust them; `status(summary)` is "ok" or
+"suspect: <reason>; <reason>". A failed case (no result) is "failed: <error>"
+(`failed_status`). The ranges are stated once, here; docs/hard_cases.md explains them.
+Pure Python, no solver import.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+# Largest |principal Cauchy stress| (MPa) at any quadrature point of a trusted result. Soft
+# skin elastomers fail in tension at 1-10 MPa (cast silicones) and a few tens of MPa at most
+# (polyurethane elastomers); the paper's cases stay below 1 MPa, the hardest converged one
+# (3 mm silicone at 40 % strain) reaches 5 MPa. Above 50 MPa the stress comes from the
+# hyperfoam's volumetric term J^(-alpha*beta) (alpha*beta = 379.75 for Table I silicone term
+# 2: 4e5 MPa at J = 0.95), i.e. the lock-up of the law, not from the skin's response.
+MAX_ABS_STRESS_MPA = 50.0
+
+# Volume ratio J (current / reference volume) range the material law may visit. Table I's
+# elastomers have nu = 0.47-0.49, i.e. a small-strain bulk modulus of only 2.7-4.5 MPa,
+# three orders below a real elastomer's (1-3 GPa); the paper's cases (20 % strain) stay at
+# J = 0.96-0.99, 3 mm silicone at 40 % at 0.98. A volume change beyond 10 % is outside anything a solid
+# elastomer undergoes, so there the result reflects the law's volumetric term, not the skin.
+J_RANGE = (0.9, 1.1)
+
+
+@dataclass(frozen=True)
+class Flag:
+    code: str      # "no_contact" | "stress_range" | "volume_range"
+    reason: str
+
+    def to_dict(self) -> dict:
+        return {"code": self.code, "reason": self.reason}
+
+
+def _num(summary: dict, key: str):
+    v = summary.get(key)
+    try:
+        return None if v is None else float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def flags(summary: dict) -> list[Flag]:
+    """Reasons not to trust a result, from its summary numbers (empty: a normal result).
+
+    Keys read: peak_mpa, reaction_n_per_mm, contact_points, min_J, max_abs_stress_mpa (a
+    key that is missing is not checked; a non-finite value is flagged).
+    """
+    out = []
+    peak, reaction = _num(summary, "peak_mpa"), _num(summary, "reaction_n_per_mm")
+    npts = _num(summary, "contact_points")
+    none = []
+    if npts is not None and npts <= 0:
+        none.append("no contact point")
+    if reaction is not None and reaction == 0.0:
+        none.append("reaction 0")
+    if peak is not None and peak <= 0.0:
+        none.append(f"peak {peak:g} MPa")
+    if none:
+        out.append(Flag("no_contact", "no contact (" + ", ".join(none) + "): the indenter never "
+                        "pressed the skin within the indentation depth"))
+    stress = _num(summary, "max_abs_stress_mpa")
+    if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
+        out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "
+                        "(material law outside its range: hyperfoam volumetric lock-up)"))
+    J = _num(summary, "min_J")
+    lo, hi = J_RANGE
+    if J is not None and not (lo <= J <= hi):
+        out.append(Flag("volume_range", f"volume ratio J = {J:.4g} outside [{lo:g}, {hi:g}] "
+                        "(material law outside its range)"))
+    for key in ("peak_mpa", "reaction_n_per_mm"):
+        v = _num(summary, key)
+        if v is not None and not math.isfinite(v):
+            out.append(Flag("non_finite", f"{key} is {v}"))
+    return out
+
+
+def status(summary: dict) -> str:
+    """'ok', or 'suspect: <reason>; <reason>' (see `flags`)."""
+    return status_of(flags(summary))
+
+
+def status_of(found: list[Flag]) -> str:
+    return "ok" if not found else "suspect: " + "; ".join(f.reason for f in found)
+
+
+def failed_status(error) -> str:
+    """Status of a case without a result: 'failed: <first line of the error>'."""
+    text = str(error or "").strip().splitlines()
+    return "failed: " + (text[0] if text else "unknown error")
+
+
+def kind(status_text: str) -> str:
+    """'ok', 'suspect' or 'failed' of a status string."""
+    k = str(status_text).split(":", 1)[0].strip()
+    return k if k in ("ok", "suspect", "failed") else "failed"

@@ -1,0 +1,220 @@
+"""Suspect results are flagged, never reported as 'ok': the status function's ranges, a
+no-contact request refused, a lock-up solve flagged in summary.json / results.csv /
+report.md with exit status 3, an inverted mesh refused."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tactileskin import quality
+from tactileskin.cli import main
+from tactileskin.errors import MeshError, ParameterError
+from tactileskin.results import Result
+from tactileskin.scene import Scene
+
+NORMAL = dict(peak_mpa=0.3, reaction_n_per_mm=0.5, contact_points=8, min_J=0.986, max_abs_stress_mpa=0.33)
+# 1 mm silicone pressed 60 %: the Table I lock-up (coarse mesh: peak ~3e4 MPa, J 0.957)
+LOCKUP = ["-t", "1", "--depth", "0.6", "--mesh-size", "1"]
+
+
+# --- the status function --------------------------------------------------------------------
+
+def test_normal_numbers_are_ok():
+    assert quality.flags(NORMAL) == [] and quality.status(NORMAL) == "ok"
+
+
+@pytest.mark.parametrize("change", [dict(contact_points=0), dict(peak_mpa=0.0), dict(reaction_n_per_mm=0.0)])
+def test_no_contact_is_suspect(change):
+    st = quality.status({**NORMAL, **change})
+    assert st.startswith("suspect: no contact")
+    assert [f.code for f in quality.flags({**NORMAL, **change})] == ["no_contact"]
+
+
+def test_stress_threshold_on_both_sides():
+    lim = quality.MAX_ABS_STRESS_MPA
+    assert quality.status({**NORMAL, "max_abs_stress_mpa": 0.999 * lim}) == "ok"
+    st = quality.status({**NORMAL, "max_abs_stress_mpa": 1.001 * lim})
+    assert st.startswith("suspect: stress") and f"{lim:g} MPa" in st
+    assert quality.flags({**NORMAL, "max_abs_stress_mpa": float("nan")})[0].code == "stress_range"
+
+
+def test_volume_ratio_range_on_both_sides():
+    lo, hi = quality.J_RANGE
+    for J in (lo, 1.0, hi):
+        assert quality.status({**NORMAL, "min_J": J}) == "ok"
+    for J in (lo - 1e-3, hi + 1e-3):
+        (f,) = quality.flags({**NORMAL, "min_J": J})
+        assert f.code == "volume_range" and f"{J:.4g}" in f.reason
+
+
+def test_several_reasons_are_all_given():
+    st = quality.status({**NORMAL, "min_J": 0.8, "max_abs_stress_mpa": 1e5})
+    assert st.startswith("suspect: ") and "stress" in st and "volume ratio" in st
+
+
+def test_status_kinds():
+    assert quality.kind("ok") == "ok"
+    assert quality.kind("suspect: no contact") == "suspect"
+    assert quality.kind(quality.failed_status("did not converge\ndetails")) == "failed"
+    assert quality.failed_status("did not converge\ndetails") == "failed: did not converge"
+
+
+def test_result_without_contact_is_not_ok():
+    s = np.linspace(0.0, 5.0, 11)
+    r = Result(s=s, pressure=np.zeros_like(s), contact_x=np.zeros(0), contact_pressure=np.zeros(0),
+               reaction=0.0, stats={"min_J": 1.0, "max_abs_stress_mpa": 0.0})
+    summ = r.summary()
+    assert summ["status"].startswith("suspect: no contact") and r.status == summ["status"]
+    assert summ["flags"][0]["code"] == "no_contact"
+
+
+# --- no contact: refused before solving -------------------------------------------------------
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_braille_text_without_central_dot_is_refused(dim):
+    from tactileskin.geometry.indenters import first_contact_travel, require_contact
+
+    sc = Scene(thickness=1, indenter="braille", braille_text="ab", dim=dim)
+    # 'ab' has its dots at |x| = 3.1 mm: only the base plate (dot height 0.48) reaches x = 0
+    assert 0.4 < first_contact_travel(sc) <= 0.48 + 1e-9
+    with pytest.raises(ParameterError, match="no contact") as e:
+        require_contact(sc)
+    assert e.value.name == "depth" and "x = 3.1 mm" in str(e.value)
+    require_contact(sc.replace(depth=0.55))  # past the first touch: a normal request
+
+
+def test_indenters_touching_at_the_centre_pass():
+    from tactileskin.geometry.indenters import first_contact_travel, require_contact
+
+    for kw in (dict(indenter="flat"), dict(indenter="curved"), dict(indenter="braille"),
+               dict(indenter="braille", braille_text="l", dim=3)):
+        sc = Scene(thickness=1, **kw)
+        assert first_contact_travel(sc) < 1e-9
+        require_contact(sc)
+
+
+def test_cli_solve_refuses_no_contact_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "ab"
+    rc = main(["solve", "-i", "braille", "--braille-text", "ab", "-t", "1", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 2 and "no contact" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+# --- lock-up: flagged everywhere ---------------------------------------------------------------
+
+def test_cli_solve_lockup_is_flagged_with_exit_3(tmp_path, capsys):
+    out = tmp_path / "lock"
+    rc = main(["solve", *LOCKUP, "--refinement", "2", "--out", str(out)])
+    text = capsys.readouterr().out
+    summ = json.loads((out / "summary.json").read_text())
+    assert rc == 3
+    assert summ["status"].startswith("suspect: stress") and summ["max_abs_stress_mpa"] > quality.MAX_ABS_STRESS_MPA
+    assert summ["flags"][0]["code"] == "stress_range" and 0.9 < summ["min_J"] < 1.0
+    assert "suspect" in text and "warning" in text
+
+
+def test_cli_sweep_lockup_in_results_csv_and_report(tmp_path, capsys):
+    out = tmp_path / "sw"
+    # polyurethane pressed 60 % (coarse: ~100 MPa, J 0.88): both ranges left, a fast solve
+    rc = main(["sweep", "--serial", "--no-render", "-m", "polyurethane", "-i", "flat", *LOCKUP, "--out", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 3
+    with open(out / "results.csv") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["status"].startswith("suspect: stress") and "volume ratio J" in row["status"]
+    assert float(row["max_abs_stress_mpa"]) > quality.MAX_ABS_STRESS_MPA and float(row["min_J"]) < quality.J_RANGE[0]
+    report = (out / "report.md").read_text()
+    assert "## Failed and suspect cases" in report
+    assert report.index("suspect: stress") < report.index("## Cases")
+    assert "suspect" in text
+
+
+def _help(cmd):
+    from click.testing import CliRunner
+
+    from tactileskin.cli import cli
+
+    return CliRunner().invoke(cli, [cmd, "--help"]).output
+
+
+def test_help_states_exit_codes():
+    for cmd in ("solve", "sweep"):
+        h = _help(cmd)
+        assert "Exit status" in h and "3" in h and "suspect" in h
+
+
+# --- report ordering (synthetic rows) ---------------------------------------------------------
+
+def test_report_lists_failed_and_suspect_first_and_keeps_suspect_out_of_checks():
+    from tactileskin.report.markdown import build_report, paper_checks
+    from tactileskin.sweep import CaseRecord
+
+    s = np.linspace(0, 8, 81)
+    recs, rows = [], []
+    for ind, peak, extra in (("flat", 9e4, {"max_abs_stress_mpa": 9e4}), ("curved", 0.2, {}), ("braille", 0.1, {})):
+        sc = Scene(thickness=1.0, material="silicone", indenter=ind)
+        summ = {**NORMAL, "peak_mpa": peak, **extra}
+        recs.append(CaseRecord(sc, s, peak * np.exp(-s ** 2), summ, Path(".")))
+        rows.append(dict(case=sc.label(), status=quality.status(summ), material="silicone", thickness_mm=1.0,
+                         indenter=ind, braille_text="", depth_mm=0.2, peak_mpa=peak, span_mm=1.0, auc=0.1,
+                         reaction_n_per_mm=0.1))
+    rows.append(dict(case="t3-x", status=quality.failed_status("did not converge"), material="silicone",
+                     thickness_mm=3.0, indenter="flat", braille_text=""))
+    checks = {c["claim"]: c for c in paper_checks(rows, recs)}
+    flat = checks["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm"]
+    assert flat["verdict"] == "untested" and flat["ours"] == "suspect result"
+    assert not any("distinguishable" in c for c in checks)  # 2 trusted profiles only: no verdict
+    md = build_report(rows, recs, [], [], [], 1.0)
+    top = md[: md.index("## Cases")]
+    assert "t3-x: failed: did not converge" in top and "t1-silicone-flat-2d: suspect: stress" in top
+    table = md[md.index("## Cases"):]
+    assert table.index("t3-x") < table.index("t1-silicone-flat") < table.index("t1-silicone-curved")
+    assert "Left out as suspect: t1-silicone-flat-2d." in md
+
+
+# --- inverted mesh: refused --------------------------------------------------------------------
+
+def test_inverted_mesh_is_refused():
+    from tactileskin.mesh import build_mesh
+
+    with pytest.raises(MeshError, match="min scaled Jacobian -0.2") as e:
+        build_mesh(Scene(thickness=1, mesh_size=5, refinement=1))
+    assert "--mesh-size" in str(e.value)
+
+
+def test_cli_solve_inverted_mesh_exit_2(tmp_path, capsys):
+    rc = main(["solve", "-t", "1", "--mesh-size", "5", "--refinement", "1", "--out", str(tmp_path / "m")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "inverted" in err and not (tmp_path / "m").exists()
+
+
+def test_jacobian_ratio_sees_a_fold_between_quadrature_points():
+    """One P2 triangle whose hypotenuse mid-node is pulled towards the right-angle vertex:
+    det J turns negative at the other two vertices while it is still positive at every
+    degree-4 quadrature point (what the check looked at before)."""
+    import dataclasses
+
+    from skfem import MeshTri1, MeshTri2
+    from skfem.quadrature import get_quadrature
+
+    from tactileskin.mesh.skinmesh import MIN_SCALED_JACOBIAN, check_quality, jacobian_ratio
+
+    m = MeshTri2.from_mesh(MeshTri1(np.array([[0.0, 1, 0], [0, 0, 1]]), np.array([[0], [1], [2]])))
+    assert jacobian_ratio(m) == pytest.approx(1.0)
+    dl = m.doflocs.copy()
+    k = int(np.argmin(np.linalg.norm(dl.T - [0.5, 0.5], axis=1)))
+    dl[:, k] = (1 - 0.53) * np.array([0.5, 0.5])
+    bent = dataclasses.replace(m, doflocs=dl)
+    Xq, _ = get_quadrature(bent.elem.refdom, 4)
+    assert bent._mapping().detDF(Xq).min() > 0
+    q = jacobian_ratio(bent)
+    assert q == pytest.approx(-0.06, abs=1e-9)
+    with pytest.raises(MeshError, match="inverted"):
+        check_quality({"min_scaled_jacobian": q}, {"coarse": 2.0})
+    with pytest.raises(MeshError, match="nearly folded"):
+        check_quality({"min_scaled_jacobian": 0.5 * MIN_SCALED_JACOBIAN}, {})
+    check_quality({"min_scaled_jacobian": MIN_SCALED_JACOBIAN}, {})
