@@ -35,6 +35,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
             formulation, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from tactileskin.report.outputs import write_outputs
@@ -73,7 +74,8 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         def on_event(oc):
             style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
             extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
-            bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
+            bar.console.print(f"[{style}]{oc.status:>6}[/] {escape(oc.case or oc.scene.label())}{escape(extra)}",
+                              highlight=False)
             bar.advance(task)
 
         outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
