@@ -128,27 +128,25 @@ _ID_FIELDS = (
     (lambda s: s.viscoelastic, lambda s: "visco" if s.viscoelastic else "elastic"),
     (lambda s: s.braille_standard, lambda s: s.braille_standard),
     (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
-    (lambda s: s.material, lambda s: s.material),  # two material files with one name
+    (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name),  # two files, one name
 )
 
 
 def case_variants(scenes: Sequence[Scene]) -> list[str]:
-    """Per scene, the suffix that tells it apart from the other scenes with the same base id
-    (thickness, material, indenter, Braille text, dim): "" when the base id is unique, else
-    e.g. "d0.2" or "d0.2-r2", naming only the fields that differ within that group."""
+    """Per scene, the suffix that tells it apart from scenes with the same base id (thickness,
+    material, indenter, Braille text, dim): "" for a scene whose base id is unique, else the
+    values of every field that differs within some group of equal base ids, e.g. "d0.2" or
+    "d0.2-r2" (the same fields for all such scenes, so their ids read alike)."""
     scenes = list(scenes)
-    base = [_base_id(s) for s in scenes]
-    parts: list[list[str]] = [[] for _ in scenes]
-    for value, text in _ID_FIELDS:
-        groups = defaultdict(list)
-        for i, b in enumerate(base):
-            groups[(b, *parts[i])].append(i)
-        for members in groups.values():
-            if len(members) > 1 and len({value(scenes[i]) for i in members}) > 1:
-                for i in members:
-                    parts[i].append(text(scenes[i]))
-    variants = ["-".join(p) for p in parts]
-    ids = [b + (f"-{v}" if v else "") for b, v in zip(base, variants)]
+    groups = defaultdict(list)
+    for i, s in enumerate(scenes):
+        groups[_base_id(s)].append(i)
+    shared = [g for g in groups.values() if len(g) > 1]
+    named = [text for value, text in _ID_FIELDS
+             if any(len({value(scenes[i]) for i in g}) > 1 for g in shared)]
+    in_shared = {i for g in shared for i in g}
+    variants = ["-".join(text(s) for text in named) if i in in_shared else "" for i, s in enumerate(scenes)]
+    ids = [_base_id(s) + (f"-{v}" if v else "") for s, v in zip(scenes, variants)]
     n = Counter(ids)
     # still equal: the scenes differ in a field not named above (or are the same scene)
     return [v + (("-" if v else "") + f"k{s.key()[:6]}" if n[i] > 1 else "")
