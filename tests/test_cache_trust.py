@@ -287,3 +287,31 @@ def test_dask_sweep_waits_for_a_locked_case_then_reuses_it(tmp_path, caplog):
     th.join(120)
     assert [o.status for o in out["r"]] == ["done", "cached"]
     assert out["r"][1].record.summary["peak_mpa"] == pytest.approx(0.321)
+
+
+def test_geometry_edited_during_a_solve_is_not_stored(tmp_path, geometry, monkeypatch):
+    import tactileskin.sweep as sw
+
+    real = sw.solve_case
+
+    def edit_then_solve(scene):
+        _set_radius(geometry, 20)   # the user edits the file while the case is being solved
+        return real(scene)
+
+    monkeypatch.setattr(sw, "solve_case", edit_then_solve)
+    sc = Scene(material="polyurethane", indenter="curved", **COARSE)
+    cache = ResultCache(tmp_path / "cache")
+    (oc,) = run_sweep([sc], cache, serial=True)
+    assert oc.status == "failed" and "changed during the solve" in oc.error
+    assert not [p for p in cache.root.iterdir() if p.is_dir()]   # stored under neither key
+
+
+def test_one_entry_shared_by_equal_cases_is_solved_once(tmp_path, monkeypatch):
+    calls = _counting_solver(monkeypatch)
+    cache = ResultCache(tmp_path / "cache")
+    mat = _material_file(tmp_path / "pu_copy.toml")   # the preset's numbers under another name
+    a = Scene(material="polyurethane", **COARSE)
+    b = a.replace(material=str(mat))
+    outcomes = run_sweep([a, b], cache, serial=True)
+    assert [o.status for o in outcomes] == ["done", "cached"] and calls == [a]
+    assert outcomes[1].record.summary == outcomes[0].record.summary

@@ -187,11 +187,19 @@ def _cost_rank(scene: Scene) -> float:
     return (100.0 if scene.dim == 3 else 0.0) + scene.thickness + (0.5 if scene.indenter == IndenterKind.BRAILLE else 0.0)
 
 
-def _run_one_safely(scene: Scene):
-    """Runs on a worker: never raises, so one failure cannot stop the sweep."""
+def _run_one_safely(scene: Scene, key: str | None = None):
+    """Runs on a worker: never raises, so one failure cannot stop the sweep. With `key` (the
+    client's cache key), a worker whose material/geometry files or version differ, or whose
+    files change during the solve, fails the case rather than store it under a wrong key."""
     t0 = time.perf_counter()
     try:
-        return ("done", solve_case(scene), time.perf_counter() - t0, "", {})
+        if key is not None and cache_key(scene) != key:
+            raise TactileSkinError("the material or geometry files (or the package version) seen by the "
+                                   "worker differ from the sweep's; not solved")
+        result = solve_case(scene)
+        if key is not None and cache_key(scene) != key:
+            raise TactileSkinError("the material or geometry files changed during the solve; rerun the sweep")
+        return ("done", result, time.perf_counter() - t0, "", {})
     except TactileSkinError as e:
         return ("failed", None, time.perf_counter() - t0, str(e), getattr(e, "diagnosis", {}) or {})
     except Exception as e:  # noqa: BLE001 - a bug in one case is reported, the rest go on
@@ -202,8 +210,9 @@ def _run_one_safely(scene: Scene):
 class _Runner:
     """Runs batches of cases serially or on Dask; the cluster starts with the first batch."""
 
-    def __init__(self, scenes, *, serial, scheduler, workers):
-        self.scenes, self.serial, self.scheduler, self.workers = scenes, serial, scheduler, workers
+    def __init__(self, scenes, keys, *, serial, scheduler, workers):
+        self.scenes, self.keys = scenes, keys
+        self.serial, self.scheduler, self.workers = serial, scheduler, workers
         self.client = self.cluster = None
 
     def __call__(self, idx: list[int], finish) -> None:
@@ -211,14 +220,14 @@ class _Runner:
             return
         if self.serial:
             for i in idx:
-                finish(i, _run_one_safely(self.scenes[i]))
+                finish(i, _run_one_safely(self.scenes[i], self.keys[i]))
             return
         from dask.distributed import as_completed
 
         client = self.client or self._start(len(idx))
         # longest cases first, so that no long case starts last and runs alone
-        futs = {client.submit(_run_one_safely, self.scenes[i], pure=False, key=f"case-{i}-{self.scenes[i].key()}",
-                              priority=_cost_rank(self.scenes[i])): i
+        futs = {client.submit(_run_one_safely, self.scenes[i], self.keys[i], pure=False,
+                              key=f"case-{self.keys[i]}-{i}", priority=_cost_rank(self.scenes[i])): i
                 for i in idx}
         for fut in as_completed(futs):
             try:
@@ -332,7 +341,7 @@ def run_sweep(
         emit(CaseOutcome(sc, status, secs, err, diag, case=ids[i], record=rec), i)
 
     _raise_fd_limit(len(scenes))
-    runner = _Runner(scenes, serial=serial, scheduler=scheduler, workers=workers)
+    runner = _Runner(scenes, keys, serial=serial, scheduler=scheduler, workers=workers)
     try:
         todo, busy, held = [], [], set()
         for i, sc in enumerate(scenes):
