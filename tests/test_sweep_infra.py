@@ -7,6 +7,7 @@ import pytest
 
 from tactileskin.discrimination import THRESHOLD, discriminate, profile_distance
 from tactileskin.errors import ParameterError
+from tactileskin.fileio import OutputError
 from tactileskin.scene import Scene
 from tactileskin.sweep import ResultCache, expand_grid, parse_values
 
@@ -48,14 +49,14 @@ class _Written:
         d.mkdir(parents=True, exist_ok=True)  # Result.write creates the folder or writes into it
         (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1.5\n1,0.5\n")
         if self.fail:
-            raise OSError("disk full")
-        (d / "summary.json").write_text(json.dumps({"peak_mpa": 1.5}))
+            raise OSError(28, "No space left on device")
+        (d / "summary.json").write_text(json.dumps({"peak_mpa": 1.5, "span_mm": 1.0, "auc": 1.0}))
 
 
 def test_cache_store_is_atomic(tmp_path):
     cache = ResultCache(tmp_path / "c")
     sc = Scene(thickness=1.0)
-    with pytest.raises(OSError):
+    with pytest.raises(OutputError, match="no space"):
         cache.store(sc, _Written(fail=True))
     assert not cache.has(sc) and not cache.path(sc).exists()
     assert list((tmp_path / "c").iterdir()) == []  # no staging debris

@@ -10,6 +10,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import functools
+import hashlib
 import os
 import tomllib
 from importlib import resources
@@ -50,7 +51,47 @@ def read_toml(path: str | Path, what: str) -> dict:
         raise ParameterError(what, str(path), f"valid TOML ({e})") from None
 
 
-@functools.cache
+# parsed files by content: a file edited during a process is read again, never served stale
+_PARSED: dict[tuple[str, bytes], dict] = {}
+
+
+def _read_bytes(path: Path, what: str) -> bytes:
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise ParameterError(what, str(path), "an existing TOML file") from None
+    except OSError as e:
+        raise ParameterError(what, str(path), "a readable TOML file", e.strerror or type(e).__name__) from None
+
+
 def load(name: str) -> dict:
-    """Parsed <geometry_dir>/<name>.toml (cached; treat as read-only)."""
-    return read_toml(geometry_dir() / f"{name}.toml", "parameter file")
+    """Parsed <geometry_dir>/<name>.toml (memoised by content; treat as read-only)."""
+    path = geometry_dir() / f"{name}.toml"
+    data = _read_bytes(path, "parameter file")
+    hit = _PARSED.get((name, data))
+    if hit is None:
+        try:
+            hit = tomllib.loads(data.decode("utf-8"))
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+            raise ParameterError("parameter file", str(path), f"valid UTF-8 TOML ({e})") from None
+        if len(_PARSED) > 64:  # only edits add entries; keep the memo small
+            _PARSED.clear()
+        _PARSED[(name, data)] = hit
+    return hit
+
+
+def geometry_digest() -> str:
+    """SHA-256 of every geometry parameter file (names and bytes, sorted by name): part of
+    the result cache's key, so that editing a dimension invalidates the cached results."""
+    folder = geometry_dir()
+    try:
+        paths = sorted((p for p in folder.iterdir() if p.name.endswith(".toml") and p.is_file()),
+                       key=lambda p: p.name)
+    except OSError as e:
+        raise ParameterError("geometry folder", str(folder), "a readable folder of TOML files",
+                             e.strerror or type(e).__name__) from None
+    h = hashlib.sha256()
+    for p in paths:
+        data = _read_bytes(p, "parameter file")
+        h.update(p.name.encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
+    return h.hexdigest()

@@ -1,7 +1,9 @@
 """Scene: the single, validated, hashable description that every stage reads.
 
 Units: mm, s, N, MPa. A Scene is immutable; `replace()` returns a changed copy. Its
-`key()` is a stable content hash (SHA-256 of canonical JSON) that keys the result cache.
+`key()` is a stable hash (SHA-256 of canonical JSON) of the scene's own fields; the result
+cache's key (`tactileskin.cache.cache_key`) adds the content of the material and geometry
+files the scene names, and the solver version.
 """
 
 from __future__ import annotations
@@ -163,7 +165,8 @@ class Scene:
         return cls(**d)
 
     def key(self) -> str:
-        """Stable content hash of everything that can change a result."""
+        """Stable hash of the scene's fields (names a scene; the result cache uses
+        cache.cache_key, which adds material and geometry file content and versions)."""
         payload = json.dumps({"schema": SCHEMA_VERSION, **self.to_dict()}, sort_keys=True,
                              separators=(",", ":"))
         return hashlib.sha256(payload.encode()).hexdigest()[:20]

@@ -1,11 +1,14 @@
-"""Sweeps: grid expansion, a crash-safe result cache keyed by Scene hash, Dask execution.
+"""Sweeps: grid expansion, unique case ids, cached Dask execution.
 
-The cache is a folder per case, `<cache>/<scene key>/` holding profile.csv, summary.json,
-result.vtu and scene.toml, i.e. the same files `tactileskin solve` writes, so every cached
-case can be opened by hand. A case is staged in a temporary folder and renamed into place
-only when complete (rename is atomic on one filesystem), so a sweep killed midway leaves
-no half-written case and a rerun recomputes only what is missing. (diskcache or
-joblib.Memory would store opaque pickles and add nothing the atomic rename does not give.)
+The result cache (tactileskin.cache) holds one validated folder per case, keyed by
+`cache_key(scene)`: the scene, the material's numbers, the geometry files and the solver
+version. A case is computed under a per-case lock, so two sweeps into one cache share the
+work: cases another run holds are waited for after our own, then read from the cache (or
+computed, if that run failed). A killed sweep leaves no half-written case; a rerun
+computes only what is missing.
+
+Case ids (`case_ids`) extend `Scene.label()` by the fields that tell cases of one sweep
+apart (depth, rate, mesh, ...), so every row, profile and bar of a report is one case.
 
 Execution uses dask.distributed: an embedded LocalCluster of single-threaded worker
 processes by default (gmsh is not thread-safe), or any running scheduler by address.
@@ -15,20 +18,19 @@ shared filesystem.
 
 from __future__ import annotations
 
-import csv
 import itertools
-import json
 import logging
 import os
 import time
 import traceback
+from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
-from tactileskin import fileio
+from tactileskin.cache import CaseRecord, ResultCache, cache_key, read_profile  # noqa: F401 (API)
 from tactileskin.errors import ParameterError, TactileSkinError
 from tactileskin.scene import IndenterKind, Scene
 
@@ -104,54 +106,58 @@ def load_spec(path: str | Path) -> dict:
     return spec
 
 
-# --- cache -------------------------------------------------------------------------------
+# --- case ids -----------------------------------------------------------------------------
 
-@dataclass
-class CaseRecord:
-    """One finished case as stored in the cache."""
-
-    scene: Scene
-    s: np.ndarray
-    pressure: np.ndarray
-    summary: dict
-    path: Path
+def _material_tag(material: str) -> str:
+    return Path(material).stem if material.endswith(".toml") else material
 
 
-class ResultCache:
-    def __init__(self, root: str | Path):
-        self.root = Path(root)
-
-    def path(self, scene: Scene) -> Path:
-        return self.root / scene.key()
-
-    def has(self, scene: Scene) -> bool:
-        p = self.path(scene)
-        return (p / "summary.json").is_file() and (p / "profile.csv").is_file()
-
-    def load(self, scene: Scene) -> CaseRecord:
-        p = self.path(scene)
-        s, pr = read_profile(p / "profile.csv")
-        summary = json.loads((p / "summary.json").read_text())
-        return CaseRecord(scene, s, pr, summary, p)
-
-    def store(self, scene: Scene, result) -> Path:
-        """Write `result` (has .write(dir)) under the scene key, atomically: the entry is
-        staged whole beside its final name and renamed into place (fileio.staged_dir)."""
-        final = self.path(scene)
-        if final.exists():  # a concurrent writer finished first: identical content by key
-            return final
-        with fileio.staged_dir(final) as staging:
-            result.write(staging)
-            scene.to_toml(staging / "scene.toml")
-        return final
+def _base_id(sc: Scene) -> str:
+    ind = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
+    return f"t{sc.thickness:g}-{_material_tag(sc.material)}-{ind}-{sc.dim}d"
 
 
-def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    s = np.array([float(r["s_mm"]) for r in rows])
-    p = np.array([float(r["pressure_mpa"]) for r in rows])
-    return s, p
+# Fields outside the base id that change a result, with the suffix naming each value.
+_ID_FIELDS = (
+    (lambda s: round(s.indentation, 9), lambda s: f"d{s.indentation:.4g}"),
+    (lambda s: s.rate, lambda s: f"r{s.rate:g}"),
+    (lambda s: s.mesh_size, lambda s: f"h{s.mesh_size:g}"),
+    (lambda s: s.refinement, lambda s: f"ref{s.refinement:g}"),
+    (lambda s: s.order, lambda s: f"p{s.order}"),
+    (lambda s: s.formulation, lambda s: s.formulation.value),
+    (lambda s: s.viscoelastic, lambda s: "visco" if s.viscoelastic else "elastic"),
+    (lambda s: s.braille_standard, lambda s: s.braille_standard),
+    (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
+    (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name),  # two files, one name
+)
+
+
+def case_variants(scenes: Sequence[Scene]) -> list[str]:
+    """Per scene, the suffix that tells it apart from scenes with the same base id (thickness,
+    material, indenter, Braille text, dim): "" for a scene whose base id is unique, else the
+    values of every field that differs within some group of equal base ids, e.g. "d0.2" or
+    "d0.2-r2" (the same fields for all such scenes, so their ids read alike)."""
+    scenes = list(scenes)
+    groups = defaultdict(list)
+    for i, s in enumerate(scenes):
+        groups[_base_id(s)].append(i)
+    shared = [g for g in groups.values() if len(g) > 1]
+    named = [text for value, text in _ID_FIELDS
+             if any(len({value(scenes[i]) for i in g}) > 1 for g in shared)]
+    in_shared = {i for g in shared for i in g}
+    variants = ["-".join(text(s) for text in named) if i in in_shared else "" for i, s in enumerate(scenes)]
+    ids = [_base_id(s) + (f"-{v}" if v else "") for s, v in zip(scenes, variants)]
+    n = Counter(ids)
+    # still equal: the scenes differ in a field not named above (or are the same scene)
+    return [v + (("-" if v else "") + f"k{s.key()[:6]}" if n[i] > 1 else "")
+            for v, i, s in zip(variants, ids, scenes)]
+
+
+def case_ids(scenes: Sequence[Scene]) -> list[str]:
+    """A unique, readable id per scene of a sweep: Scene.label() (a material file by its
+    name) plus "-d0.2"/"-r2"-style suffixes for the fields that differ between cases."""
+    scenes = list(scenes)
+    return [_base_id(s) + (f"-{v}" if v else "") for s, v in zip(scenes, case_variants(scenes))]
 
 
 # --- execution ------------------------------------------------------------------------------
@@ -163,6 +169,8 @@ class CaseOutcome:
     seconds: float = 0.0
     error: str = ""
     diagnosis: dict = field(default_factory=dict)
+    case: str = ""              # the case id within the sweep (case_ids)
+    record: CaseRecord | None = None  # the validated cache entry, unless failed
 
 
 def solve_case(scene: Scene):
@@ -179,16 +187,98 @@ def _cost_rank(scene: Scene) -> float:
     return (100.0 if scene.dim == 3 else 0.0) + scene.thickness + (0.5 if scene.indenter == IndenterKind.BRAILLE else 0.0)
 
 
-def _run_one_safely(scene: Scene):
-    """Runs on a worker: never raises, so one failure cannot stop the sweep."""
+def _run_one_safely(scene: Scene, key: str | None = None):
+    """Runs on a worker: never raises, so one failure cannot stop the sweep. With `key` (the
+    client's cache key), a worker whose material/geometry files or version differ, or whose
+    files change during the solve, fails the case rather than store it under a wrong key."""
     t0 = time.perf_counter()
     try:
-        return ("done", solve_case(scene), time.perf_counter() - t0, "", {})
+        if key is not None and cache_key(scene) != key:
+            raise TactileSkinError("the material or geometry files (or the package version) seen by the "
+                                   "worker differ from the sweep's; not solved")
+        result = solve_case(scene)
+        if key is not None and cache_key(scene) != key:
+            raise TactileSkinError("the material or geometry files changed during the solve; rerun the sweep")
+        return ("done", result, time.perf_counter() - t0, "", {})
     except TactileSkinError as e:
         return ("failed", None, time.perf_counter() - t0, str(e), getattr(e, "diagnosis", {}) or {})
     except Exception as e:  # noqa: BLE001 - a bug in one case is reported, the rest go on
         return ("failed", None, time.perf_counter() - t0, f"{type(e).__name__}: {e}",
                 {"traceback": traceback.format_exc()})
+
+
+class _Runner:
+    """Runs batches of cases serially or on Dask; the cluster starts with the first batch."""
+
+    def __init__(self, scenes, keys, *, serial, scheduler, workers):
+        self.scenes, self.keys = scenes, keys
+        self.serial, self.scheduler, self.workers = serial, scheduler, workers
+        self.client = self.cluster = None
+
+    def __call__(self, idx: list[int], finish) -> None:
+        if not idx:
+            return
+        if self.serial:
+            for i in idx:
+                finish(i, _run_one_safely(self.scenes[i], self.keys[i]))
+            return
+        from dask.distributed import as_completed
+
+        client = self.client or self._start(len(idx))
+        # longest cases first, so that no long case starts last and runs alone
+        futs = {client.submit(_run_one_safely, self.scenes[i], self.keys[i], pure=False,
+                              key=f"case-{self.keys[i]}-{i}", priority=_cost_rank(self.scenes[i])): i
+                for i in idx}
+        for fut in as_completed(futs):
+            try:
+                packed = fut.result()
+            except Exception as e:  # worker died etc.
+                packed = ("failed", None, 0.0, f"{type(e).__name__}: {e}", {})
+            finish(futs[fut], packed)
+
+    def _start(self, ncases: int):
+        from dask.distributed import Client, LocalCluster
+
+        if not log.isEnabledFor(logging.INFO):  # dask's scheduler logs at INFO by default
+            for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
+                         "distributed.http.proxy", "distributed.worker"):
+                logging.getLogger(name).setLevel(logging.ERROR)
+        if self.scheduler:
+            self.client = Client(self.scheduler)
+            return self.client
+        n = max(1, min(self.workers or os.cpu_count() or 1, ncases))
+        import dask
+
+        # dask sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also switches off
+        # glibc's adaptive mmap threshold: every numpy temporary over 128 KiB is then
+        # mmapped and unmapped, and a solve spent ~30 % of its time in the kernel (t1
+        # silicone curved: 2.0 s in a worker, 1.0 s in a plain process; 1.4 s without it).
+        # The statistical profiler samples every 10 ms; nobody reads it here.
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                              "distributed.worker.profile.enabled": False}):
+            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                        dashboard_address=None, silence_logs=logging.ERROR)
+        self.client = Client(self.cluster)
+        return self.client
+
+    def close(self) -> None:
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _raise_fd_limit(n: int) -> None:
+    """Each case being computed holds an open lock file; make room for n of them."""
+    try:
+        import resource
+
+        soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+        want = n + 256
+        if soft != resource.RLIM_INFINITY and soft < want:
+            resource.setrlimit(resource.RLIMIT_NOFILE, (want if hard == resource.RLIM_INFINITY else min(want, hard), hard))
+    except (ImportError, ValueError, OSError):
+        pass
 
 
 def run_sweep(
@@ -200,79 +290,82 @@ def run_sweep(
     serial: bool = False,
     on_event: Callable[[CaseOutcome], None] | None = None,
 ) -> list[CaseOutcome]:
-    """Solve every scene not yet in the cache; returns one outcome per scene, in order.
+    """Solve every scene without a valid cache entry; returns one outcome per scene, in order.
 
     scheduler: address of a running dask scheduler; None starts a LocalCluster.
     workers: LocalCluster worker processes (default: number of cores).
     serial: run in this process without Dask (debugging, profiling).
+    A case is computed while holding its lock; cases locked by another run are waited for
+    after our own, then taken from the cache, or computed if that run did not store them.
     """
     scenes = list(scenes)
-    outcomes: dict[str, CaseOutcome] = {}
-    todo: list[Scene] = []
-    for sc in scenes:
-        if cache.has(sc):
-            outcomes[sc.key()] = CaseOutcome(sc, "cached")
-            on_event and on_event(outcomes[sc.key()])
-        else:
-            todo.append(sc)
+    if workers is not None and workers < 1 and not serial and not scheduler:
+        raise ParameterError("workers", workers, ">= 1 (or use serial)")
+    keys = [cache.key(sc) for sc in scenes]  # reads every material file before any work
+    ids = case_ids(scenes)
+    outcomes: list[CaseOutcome | None] = [None] * len(scenes)
+    locks: dict[int, object] = {}
 
-    def finish(sc: Scene, packed) -> None:
-        status, result, secs, err, diag = packed
-        if status == "done":
-            try:
-                cache.store(sc, result)
-            except TactileSkinError as e:
-                status, err = "failed", str(e)
-        oc = CaseOutcome(sc, status, secs, err, diag)
-        if status == "failed":
-            log.error("case %s failed: %s", sc.label(), err)
-        outcomes[sc.key()] = oc
+    def emit(oc: CaseOutcome, i: int) -> None:
+        outcomes[i] = oc
         on_event and on_event(oc)
 
-    if todo and serial:
-        for sc in todo:
-            finish(sc, _run_one_safely(sc))
-    elif todo:
-        from dask.distributed import Client, LocalCluster, as_completed
+    def claim(i: int, blocking: bool) -> bool:
+        """True: case i is ours to compute (lock held); False: cached, or locked elsewhere."""
+        lock = cache.lock(keys[i], blocking=blocking)
+        if lock is None:
+            return False
+        rec = cache.lookup(scenes[i], keys[i])  # under the lock: a damaged entry is removed
+        if rec is None:
+            locks[i] = lock
+            return True
+        lock.release()
+        emit(CaseOutcome(scenes[i], "cached", case=ids[i], record=rec), i)
+        return False
 
-        cluster = None
-        if not log.isEnabledFor(logging.INFO):  # dask's scheduler logs at INFO by default
-            for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
-                         "distributed.http.proxy", "distributed.worker"):
-                logging.getLogger(name).setLevel(logging.ERROR)
-        if scheduler:
-            client = Client(scheduler)
-        else:
-            if workers is not None and workers < 1:
-                raise ParameterError("workers", workers, ">= 1 (or use serial)")
-            n = workers or os.cpu_count() or 1
-            n = max(1, min(n, len(todo)))
-            import dask
+    def finish(i: int, packed) -> None:
+        sc = scenes[i]
+        status, result, secs, err, diag = packed
+        rec = None
+        if status == "done":
+            try:
+                cache.store(sc, result, keys[i])
+                rec = cache.lookup(sc, keys[i])
+                if rec is None:
+                    status, err = "failed", "the stored result did not pass the cache's validation"
+            except TactileSkinError as e:
+                status, err = "failed", str(e)
+        locks.pop(i).release()
+        if status == "failed":
+            log.error("case %s failed: %s", ids[i], err)
+        emit(CaseOutcome(sc, status, secs, err, diag, case=ids[i], record=rec), i)
 
-            # dask sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also switches off
-            # glibc's adaptive mmap threshold: every numpy temporary over 128 KiB is then
-            # mmapped and unmapped, and a solve spent ~30 % of its time in the kernel (t1
-            # silicone curved: 2.0 s in a worker, 1.0 s in a plain process; 1.4 s without it).
-            # The statistical profiler samples every 10 ms; nobody reads it here.
-            with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-                                  "distributed.worker.profile.enabled": False}):
-                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-            client = Client(cluster)
-        try:
-            # longest cases first, so that no long case starts last and runs alone
-            futs = {client.submit(_run_one_safely, sc, pure=False, key=f"case-{sc.key()}",
-                                  priority=_cost_rank(sc)): sc
-                    for sc in todo}
-            for fut in as_completed(futs):
-                sc = futs[fut]
-                try:
-                    packed = fut.result()
-                except Exception as e:  # worker died etc.
-                    packed = ("failed", None, 0.0, f"{type(e).__name__}: {e}", {})
-                finish(sc, packed)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    return [outcomes[sc.key()] for sc in scenes]
+    _raise_fd_limit(len(scenes))
+    runner = _Runner(scenes, keys, serial=serial, scheduler=scheduler, workers=workers)
+    try:
+        todo, busy, held = [], [], set()
+        for i, sc in enumerate(scenes):
+            if keys[i] in held:
+                busy.append(i)  # the same entry as an earlier case of this sweep
+            elif (rec := cache.lookup(sc, keys[i], repair=False)) is not None:
+                emit(CaseOutcome(sc, "cached", case=ids[i], record=rec), i)
+            elif claim(i, blocking=False):
+                todo.append(i)
+                held.add(keys[i])
+            elif outcomes[i] is None:
+                busy.append(i)  # another run holds it
+        runner(todo, finish)
+        # One lock at a time from here on, so that waiting runs cannot deadlock.
+        for i in busy:
+            ours = claim(i, blocking=False)
+            if not ours and outcomes[i] is None:
+                log.warning("case %s is being computed by another run (lock %s); waiting for it",
+                            ids[i], cache.root / f"{keys[i]}.lock")
+                ours = claim(i, blocking=True)
+            if ours:
+                runner([i], finish)
+    finally:
+        runner.close()
+        for lock in locks.values():
+            lock.release()
+    return outcomes

@@ -51,6 +51,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
             formulation, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.text import Text
 
@@ -98,7 +99,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
                     st = _case_status(cache, oc.scene)
                     if st != "ok":
                         word, style, why = "suspect", "bold yellow", f" - {st.split(': ', 1)[-1]}"
-                line = Text.assemble((f"{word:>7}", style), f" {oc.scene.label()}{extra}{why}")
+                line = Text.assemble((f"{word:>7}", style), f" {oc.case or oc.scene.label()}{extra}{why}")
                 bar.console.print(line, highlight=False)
                 bar.advance(task)
 

@@ -43,8 +43,22 @@ def _axes_keys(records):
     return mats, thick
 
 
+def _series(indenter: str, text: str, variant: str) -> str:
+    """The name of a case within a (material, thickness) panel: indenter, Braille text and
+    the case id's variant suffix (sweep.case_variants), so two depths are two series."""
+    return indenter + (f" '{text}'" if text else "") + (f" {variant}" if variant else "")
+
+
 def _ind_name(r) -> str:
-    return r.scene.indenter.value + (f" '{r.scene.braille_text}'" if r.scene.braille_text else "")
+    return _series(r.scene.indenter.value, r.scene.braille_text, getattr(r, "variant", ""))
+
+
+def _order(indenter: str) -> int:
+    return INDENTER_ORDER.index(indenter) if indenter in INDENTER_ORDER else len(INDENTER_ORDER)
+
+
+_DASHES = ("-", "--", ":", "-.")
+_HATCHES = ("", "//", "..", "xx", "\\\\", "++")
 
 
 def profiles_figure(records, out: Path) -> list[Path]:
@@ -56,9 +70,12 @@ def profiles_figure(records, out: Path) -> list[Path]:
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
             ax = axes[i][j]
+            variants = sorted({getattr(r, "variant", "") for r in records})
             for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t),
-                            key=lambda r: INDENTER_ORDER.index(r.scene.indenter.value)):
-                ax.plot(r.s, r.pressure, color=COLOURS.get(r.scene.indenter.value), label=_ind_name(r))
+                            key=lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,
+                                           getattr(r, "variant", ""))):
+                ls = _DASHES[variants.index(getattr(r, "variant", "")) % len(_DASHES)]
+                ax.plot(r.s, r.pressure, ls, color=COLOURS.get(r.scene.indenter.value), label=_ind_name(r))
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.set_xlim(0, 8)
@@ -72,23 +89,30 @@ def profiles_figure(records, out: Path) -> list[Path]:
 
 
 def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: str, out: Path) -> list[Path]:
-    """Fig. 11-13 style grouped bars: x thickness, bars per indenter, one panel per material."""
+    """Fig. 11-13 style grouped bars: x thickness, one bar per case (indenter, Braille text,
+    variant) at each thickness, one panel per material."""
     plt = _plt()
     mats = sorted({r["material"] for r in rows})
     thick = sorted({r["thickness_mm"] for r in rows})
-    inds = [i for i in INDENTER_ORDER if any(r["indenter"] == i for r in rows)]
+    key = lambda r: (_order(r["indenter"]), r.get("braille_text") or "", r.get("variant") or "",  # noqa: E731
+                     r.get("dim", 2))
+    series = sorted({key(r) + (r["indenter"],) for r in rows})
+    variants = sorted({r.get("variant") or "" for r in rows})
+    dims = {r.get("dim", 2) for r in rows}
     fig, axes = plt.subplots(1, len(mats), figsize=(4.2 * len(mats), 3.2), squeeze=False)
-    w = 0.8 / max(len(inds), 1)
+    w = 0.8 / max(len(series), 1)
     for k, m in enumerate(mats):
         ax = axes[0][k]
-        for q, ind in enumerate(inds):
+        for q, (*sk, ind) in enumerate(series):
             vals = []
             for t in thick:
                 v = [r[metric] for r in rows if r["material"] == m and r["thickness_mm"] == t
-                     and r["indenter"] == ind and r.get("status", "ok") == "ok"]
+                     and list(key(r)) == sk and r.get("status", "ok") == "ok"]
                 vals.append(v[0] if v else np.nan)
-            ax.bar(np.arange(len(thick)) + (q - (len(inds) - 1) / 2) * w, vals, w,
-                   label=ind, color=COLOURS.get(ind))
+            ax.bar(np.arange(len(thick)) + (q - (len(series) - 1) / 2) * w, vals, w,
+                   label=_series(ind, sk[1], sk[2]) + (f" {sk[3]}d" if len(dims) > 1 else ""),
+                   color=COLOURS.get(ind),
+                   hatch=_HATCHES[variants.index(sk[2]) % len(_HATCHES)])
         ax.set_xticks(np.arange(len(thick)), [f"{t:g} mm" for t in thick])
         ax.set_title(m, fontsize=9)
         ax.set_ylabel(ylabel)

@@ -22,11 +22,24 @@ def _fmt(v, nd=3):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{nd}g}"
 
 
+def at_paper_conditions(scene) -> bool:
+    """The paper's loading and geometry: 20 % indentation at the default rate, viscoelastic,
+    the default fingertip and Braille standard. The paper checks use only these cases."""
+    from tactileskin.scene import Scene
+
+    d = Scene()
+    return (math.isclose(scene.indentation, 0.2 * scene.thickness, rel_tol=1e-9)
+            and scene.rate == d.rate and scene.viscoelastic and not scene.fingertip
+            and scene.braille_standard == d.braille_standard)
+
+
 def _index(rows):
+    """{(material, thickness, indenter): row} of the ok rows at the paper's conditions
+    without a Braille text; where several remain (two meshes, ...) the first one listed."""
     idx = {}
     for r in rows:
-        if r.get("status") == "ok" and not r.get("braille_text"):
-            idx[(r["material"], r["thickness_mm"], r["indenter"])] = r
+        if r.get("status") == "ok" and r.get("paper", True) and not r.get("braille_text"):
+            idx.setdefault((r["material"], r["thickness_mm"], r["indenter"]), r)
     return idx
 
 
@@ -35,18 +48,22 @@ def _suspect_records(records) -> list:
     return [rec for rec in records if quality.status(rec.summary) != "ok"]
 
 
-def _profiles_by_group(records, *, with_text: bool):
-    """Sorted ((material, thickness), {indenter name: (s, P)}) groups of the sweep's profiles;
-    Braille cases with a text are named 'braille[text]', or left out when not with_text.
-    Suspect results are left out (a verdict on them would be a verdict on a wrong number)."""
+def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False):
+    """Sorted ((material, thickness, variant), {indenter name: (s, P)}) groups of the sweep's
+    profiles; Braille cases with a text are named 'braille[text]', or left out when not
+    with_text. paper_only: only cases at the paper's conditions, the first per indenter,
+    all in one group per (material, thickness). Suspect results are left out (a verdict on
+    them would be a verdict on a wrong number)."""
     groups = defaultdict(dict)
     suspect = {id(r) for r in _suspect_records(records)}
     for rec in records:
         sc = rec.scene
-        if (sc.braille_text and not with_text) or id(rec) in suspect:
+        if ((sc.braille_text and not with_text) or (paper_only and not at_paper_conditions(sc))
+                or id(rec) in suspect):
             continue
         name = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
-        groups[(sc.material, sc.thickness)][name] = (rec.s, rec.pressure)
+        variant = "" if paper_only else getattr(rec, "variant", "")
+        groups[(sc.material, sc.thickness, variant)].setdefault(name, (rec.s, rec.pressure))
     return sorted(groups.items())
 
 
@@ -109,7 +126,7 @@ def paper_checks(rows, records) -> list[dict]:
                                ours=f"spread {(spread):.0%} of the mean",
                                verdict="agrees" if spread < THRESHOLD else "differs"))
 
-    for (mat, t), profs in _profiles_by_group(records, with_text=False):
+    for (mat, t, _), profs in _profiles_by_group(records, with_text=False, paper_only=True):
         if len(profs) < 3:
             continue
         v = discriminate(profs)
@@ -121,11 +138,12 @@ def paper_checks(rows, records) -> list[dict]:
 
 
 def discrimination_table(records) -> list[str]:
-    lines = ["| material | t (mm) | pairwise distances | verdict |", "|---|---|---|---|"]
-    for (mat, t), profs in _profiles_by_group(records, with_text=True):
+    lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
+    for (mat, t, variant), profs in _profiles_by_group(records, with_text=True):
         v = discriminate(profs)
         d = ", ".join(f"{a}–{b} {x:.2f}" for (a, b), x in v.distances.items())
-        lines.append(f"| {mat} | {t:g} | {d or 'n/a'} | {'distinguishable' if v.distinguishable else 'not distinguishable'} |")
+        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {d or 'n/a'} | "
+                     f"{'distinguishable' if v.distinguishable else 'not distinguishable'} |")
     return lines
 
 
@@ -164,6 +182,9 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
                    f"{'**suspect**' if k == 'suspect' else 'ok'} |")
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
     out += ["## Against the paper", "",
+            "Only the cases at the paper's conditions enter these checks (indentation 20 % of the "
+            "thickness, the default rate, viscoelastic, the default fingertip and Braille standard); "
+            "where several remain for one material, thickness and indenter, the first listed is used.", "",
             "| paper says | ours | verdict |", "|---|---|---|"]
     for c in paper_checks(rows, records):
         out.append(f"| {c['claim']} | {c['ours']} | {c['verdict']} |")
@@ -180,7 +201,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
     out += discrimination_table(records)
     sus = _suspect_records(records)
     if sus:
-        out += ["", "Left out as suspect: " + ", ".join(r.scene.label() for r in sus) + "."]
+        out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]
     out += ["", "## Figures", ""]
     for p in figures:
         if p.suffix == ".png":

@@ -5,11 +5,9 @@ from __future__ import annotations
 import csv
 import io
 import logging
-import math
 from pathlib import Path
 
 from tactileskin import quality
-from tactileskin.errors import TactileSkinError
 from tactileskin.fileio import atomic_write_text, make_dirs
 
 log = logging.getLogger(__name__)
@@ -21,28 +19,33 @@ RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter
 
 
 def collect(outcomes, cache):
-    """(records, rows, failures) from run_sweep outcomes."""
+    """(records, rows, failures) from run_sweep outcomes. Rows and records carry the case id
+    (sweep.case_ids), unique within the sweep. A cached record was validated by the cache
+    (finite metrics and profile), which is the gate against damaged entries."""
+    from tactileskin.report.markdown import at_paper_conditions
+    from tactileskin.sweep import case_ids, case_variants
+
+    scenes = [oc.scene for oc in outcomes]
+    ids, variants = case_ids(scenes), case_variants(scenes)
     records, rows, failures = [], [], []
-    for oc in outcomes:
+    for oc, case, variant in zip(outcomes, ids, variants):
         sc = oc.scene
-        row = dict(case=sc.label(), key=sc.key(), thickness_mm=sc.thickness, material=sc.material,
+        row = dict(case=case, variant=variant, paper=at_paper_conditions(sc), key=cache.key(sc),
+                   thickness_mm=sc.thickness, material=sc.material,
                    indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
-                   rate_mm_s=sc.rate)
+                   rate_mm_s=sc.rate, dim=sc.dim)
         if oc.status == "failed":
             row.update(status=quality.failed_status(oc.error), error=oc.error)
             failures.append(oc)
         else:
-            rec = cache.load(sc)
+            rec = oc.record if oc.record is not None else cache.load(sc)
+            rec.case, rec.variant = case, variant
             records.append(rec)
             # recomputed from the numbers (not the stored string): the ranges are quality's
             row.update(status=quality.status(rec.summary), **{k: rec.summary.get(k) for k in
                                        ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "min_J",
                                         "max_abs_stress_mpa", "dofs", "increments",
                                         "newton_iterations", "wall_s")})
-            for k in ("peak_mpa", "span_mm", "auc"):
-                v = row[k]
-                if v is None or not math.isfinite(float(v)):
-                    raise TactileSkinError(f"cached case {sc.label()} has a non-finite {k}: {v}")
         rows.append(row)
     return records, rows, failures
 
@@ -64,7 +67,7 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     buf.write("case,s_mm,pressure_mpa\n")
     for rec in records:
         for s, p in zip(rec.s, rec.pressure):
-            buf.write(f"{rec.scene.label()},{s:.6g},{p:.6g}\n")
+            buf.write(f"{rec.case},{s:.6g},{p:.6g}\n")
     atomic_write_text(out / "profiles.csv", buf.getvalue())
 
     figures = all_figures(records, rows, out) if records else []
@@ -81,9 +84,10 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
             vtu = rec.path / "result.vtu"
             if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
                 try:
-                    renders.append(render_case(vtu, out / f"fig9_{sc.label()}.png", title=sc.label()))
+                    name = re.sub(r"[^A-Za-z0-9._=,\[\]-]", "_", rec.case)
+                    renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
-                    log.warning("render of %s failed: %s", sc.label(), e)
+                    log.warning("render of %s failed: %s", rec.case, e)
     report = build_report(rows, records, failures, figures, renders, wall_s)
     atomic_write_text(out / "report.md", report)
     return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",

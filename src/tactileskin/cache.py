@@ -1,0 +1,243 @@
+"""The result cache of sweeps: one folder per case, keyed by everything that can change it.
+
+Key. `Scene.key()` hashes the scene's own fields only (it names a scene, e.g. to drop
+duplicates from a grid). A cached result also depends on files and code the scene merely
+names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
+- the scene's fields except the material's name or path;
+- the material's numbers (hyperfoam and Prony terms), read from the preset table or the
+  user's material file: editing the file changes the key, renaming or moving it does not;
+- the bytes of every geometry parameter file (`params.geometry_digest()`: fingertip,
+  indenters, Braille standards, molds);
+- `scene.SCHEMA_VERSION` and the package version.
+Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
+`key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
+time stamp, so an edit within the same second is not missed.
+
+Entry. `<cache>/<key>/` holds the files `tactileskin solve` writes (profile.csv,
+summary.json, contact.csv, result.vtu), scene.toml, and cache.json (schema, key, package
+version). It is staged beside its final name and renamed into place when complete, so a
+killed run leaves no half-written entry. Loading validates it: cache.json names this key
+and schema, summary.json is an object with finite peak/span/auc, profile.csv has >= 2
+finite rows with increasing s, scene.toml describes this scene. A damaged entry (truncated,
+empty, corrupt, non-finite, foreign) is logged as a WARNING naming its path, removed, and
+recomputed; it is never used.
+
+Lock. `<cache>/<key>.lock` is taken with flock by the run computing the case, so two
+sweeps into one cache do not compute the same case twice; the lock goes with the process
+(a killed run leaves no stale lock). Without fcntl (Windows) there is no lock.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import logging
+import math
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin import __version__, fileio, params
+from tactileskin.errors import TactileSkinError
+from tactileskin.scene import SCHEMA_VERSION, Scene
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not POSIX
+    fcntl = None
+
+log = logging.getLogger(__name__)
+
+ENTRY_FILES = ("profile.csv", "summary.json", "contact.csv", "result.vtu", "scene.toml", "cache.json")
+
+
+class CacheError(TactileSkinError):
+    """A cache entry that should be valid is missing or damaged."""
+
+
+def _floats(x):
+    if isinstance(x, dict):
+        return {k: _floats(v) for k, v in sorted(x.items())}
+    if isinstance(x, (list, tuple)):
+        return [_floats(v) for v in x]
+    return float(x)
+
+
+def material_content(material: str) -> dict:
+    """The numbers of a material (preset name or .toml path) that enter a solve."""
+    from tactileskin.materials import get_material
+
+    m = get_material(material)
+    return {"hyperfoam": _floats(m.hyperfoam.to_dict()), "prony": _floats(m.prony.to_dict())}
+
+
+def cache_key(scene: Scene) -> str:
+    """Hash of everything that can change `scene`'s result (see the module docstring)."""
+    fields = scene.to_dict()
+    fields.pop("material")
+    payload = {"scene": fields, "material": material_content(scene.material),
+               "geometry": params.geometry_digest(), "schema": SCHEMA_VERSION, "version": __version__}
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+@dataclass
+class CaseRecord:
+    """One finished case as stored in the cache (validated)."""
+
+    scene: Scene
+    s: np.ndarray
+    pressure: np.ndarray
+    summary: dict
+    path: Path
+    case: str = ""      # the case id within its sweep (sweep.case_ids), set by the report
+    variant: str = ""   # the id's suffix naming the fields that tell it apart ("d0.2-r2")
+
+
+def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    s = np.array([float(r["s_mm"]) for r in rows])
+    p = np.array([float(r["pressure_mpa"]) for r in rows])
+    return s, p
+
+
+def _scene_fields(scene: Scene) -> dict:
+    d = scene.to_dict()
+    d.pop("material")  # its content is in the key; the file may have been renamed
+    return d
+
+
+class CaseLock:
+    """An exclusive flock on `<cache>/<key>.lock`, held until release() or process exit."""
+
+    def __init__(self, path: Path, fd: int | None):
+        self.path, self._fd = path, fd
+
+    def release(self) -> None:
+        if self._fd is not None:
+            try:
+                fcntl.flock(self._fd, fcntl.LOCK_UN)
+            finally:
+                os.close(self._fd)
+                self._fd = None
+
+
+class ResultCache:
+    def __init__(self, root: str | Path):
+        self.root = Path(root)
+
+    def key(self, scene: Scene) -> str:
+        return cache_key(scene)
+
+    def path(self, scene: Scene, key: str | None = None) -> Path:
+        return self.root / (key or self.key(scene))
+
+    # --- reading ------------------------------------------------------------------------
+    def lookup(self, scene: Scene, key: str | None = None, *, repair: bool = True) -> CaseRecord | None:
+        """The validated entry of `scene`, or None when there is none or it is damaged.
+        With repair, a damaged entry is logged (WARNING, naming its path) and removed."""
+        key = key or self.key(scene)
+        p = self.root / key
+        rec, problem = self._check(p, scene, key)
+        if problem and repair:
+            log.warning("cache entry %s is damaged (%s); it is removed and the case recomputed", p, problem)
+            self._discard(p)
+        return rec
+
+    def has(self, scene: Scene) -> bool:
+        return self.lookup(scene) is not None
+
+    def load(self, scene: Scene) -> CaseRecord:
+        rec = self.lookup(scene)
+        if rec is None:
+            raise CacheError(f"no valid cached result for {scene.label()} in {self.root}")
+        return rec
+
+    def _check(self, p: Path, scene: Scene, key: str) -> tuple[CaseRecord | None, str | None]:
+        if not os.path.lexists(p):
+            return None, None
+        if p.is_symlink() or not p.is_dir():
+            return None, "not a folder"
+        name = "cache.json"
+        try:
+            meta = json.loads((p / name).read_text(encoding="utf-8"))
+            if not isinstance(meta, dict):
+                raise ValueError("not a JSON object")
+            if meta.get("schema") != SCHEMA_VERSION:
+                raise ValueError(f"schema {meta.get('schema')!r}, expected {SCHEMA_VERSION}")
+            if meta.get("key") != key:
+                raise ValueError(f"written for key {meta.get('key')!r}")
+            name = "summary.json"
+            summary = json.loads((p / name).read_text(encoding="utf-8"))
+            if not isinstance(summary, dict):
+                raise ValueError("not a JSON object")
+            for k in ("peak_mpa", "span_mm", "auc"):
+                v = summary.get(k)
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise ValueError(f"{k} = {v!r}, expected a finite number")
+            name = "profile.csv"
+            s, pr = read_profile(p / name)
+            if s.size < 2:
+                raise ValueError(f"{s.size} rows, expected at least 2")
+            if not (np.all(np.isfinite(s)) and np.all(np.isfinite(pr))):
+                raise ValueError("non-finite values")
+            if np.any(np.diff(s) <= 0):
+                raise ValueError("s is not increasing")
+            name = "scene.toml"
+            stored = Scene.from_toml(p / name)
+            if _scene_fields(stored) != _scene_fields(scene):
+                raise ValueError("describes another scene")
+        except FileNotFoundError:
+            return None, f"{name} is missing"
+        except (OSError, ValueError, KeyError, TypeError, TactileSkinError) as e:
+            return None, f"{name}: {e}"
+        return CaseRecord(scene, s, pr, summary, p), None
+
+    def _discard(self, p: Path) -> None:
+        """Remove a damaged entry: it is the cache's own folder (named by a key)."""
+        try:
+            if p.is_symlink() or not p.is_dir():
+                p.unlink()
+                return
+            aside = p.parent / f".{p.name}.tsk{os.getpid()}-bad.partial"  # clean_stale finishes it
+            os.replace(p, aside)
+            shutil.rmtree(aside, ignore_errors=True)
+        except OSError as e:
+            log.warning("could not remove the damaged cache entry %s: %s", p, e)
+
+    # --- writing ------------------------------------------------------------------------
+    def store(self, scene: Scene, result, key: str | None = None) -> Path:
+        """Write `result` (has .write(dir)) under the scene's key, atomically."""
+        key = key or self.key(scene)
+        final = self.root / key
+        with fileio.os_errors(final), fileio.staged_dir(final) as tmp:
+            result.write(tmp)
+            scene.to_toml(tmp / "scene.toml")
+            (tmp / "cache.json").write_text(json.dumps(
+                {"schema": SCHEMA_VERSION, "key": key, "version": __version__}, indent=2) + "\n",
+                encoding="utf-8")
+            fileio.fix_tree_modes(tmp)
+        return final
+
+    def lock(self, key: str, *, blocking: bool) -> CaseLock | None:
+        """Take the case's lock; None if another process holds it and not blocking."""
+        path = self.root / f"{key}.lock"
+        if fcntl is None:
+            return CaseLock(path, None)
+        fileio.make_dirs(self.root)
+        with fileio.os_errors(path):
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, fileio.file_mode())
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+        except BlockingIOError:
+            os.close(fd)
+            return None
+        except BaseException:
+            os.close(fd)
+            raise
+        return CaseLock(path, fd)

@@ -1,0 +1,317 @@
+"""The result cache can be trusted: its key covers the material and geometry files, damaged
+entries are recomputed with a warning (never used), and two runs share one case's work."""
+
+import json
+import logging
+import shutil
+import threading
+import time
+
+import numpy as np
+import pytest
+import tomli_w
+
+from tactileskin import params
+from tactileskin.cache import ResultCache, cache_key
+from tactileskin.materials import get_material
+from tactileskin.report.outputs import collect
+from tactileskin.results import Result
+from tactileskin.scene import Scene
+from tactileskin.sweep import run_sweep
+
+COARSE = dict(thickness=1.0, mesh_size=1.0, refinement=2.0)
+
+
+def _material_file(path, mu_scale=1.0):
+    d = get_material("polyurethane").to_dict()
+    d["hyperfoam"]["mu"] = [m * mu_scale for m in d["hyperfoam"]["mu"]]
+    d.pop("name")
+    path.write_text(tomli_w.dumps(d))
+    return path
+
+
+@pytest.fixture
+def geometry(tmp_path, monkeypatch):
+    """A private copy of the geometry parameter files, used by this process."""
+    folder = tmp_path / "geometry"
+    shutil.copytree(params.geometry_dir(), folder)
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(folder))
+    return folder
+
+
+def _set_radius(folder, radius):
+    p = folder / "indenters.toml"
+    text = p.read_text()
+    assert "radius = 12.0" in text
+    p.write_text(text.replace("radius = 12.0", f"radius = {radius}"))
+
+
+# --- the key ---------------------------------------------------------------------------------
+
+def test_key_follows_material_content_not_its_path(tmp_path):
+    a = _material_file(tmp_path / "pu.toml")
+    k = cache_key(Scene(material=str(a)))
+    b = tmp_path / "renamed.toml"
+    a.rename(b)
+    assert cache_key(Scene(material=str(b))) == k            # renaming alone: same result
+    _material_file(b, mu_scale=10.0)
+    assert cache_key(Scene(material=str(b))) != k            # mu x10: another result
+    assert cache_key(Scene(material="polyurethane")) != cache_key(Scene(material="silicone"))
+
+
+def test_key_and_loads_follow_geometry_files_within_a_process(geometry):
+    sc = Scene(indenter="curved")
+    k = cache_key(sc)
+    assert params.load("indenters")["curved"]["radius"] == 12.0
+    _set_radius(geometry, 20)
+    assert params.load("indenters")["curved"]["radius"] == 20.0   # not served from a stale memo
+    assert cache_key(sc) != k
+    f = geometry / "indenters.toml"
+    f.write_text(f.read_text().replace("radius = 20", "radius = 12.0"))  # undone: the old key again
+    assert cache_key(sc) == k
+
+
+def test_key_follows_schema_and_version(monkeypatch):
+    import tactileskin.cache as cache_mod
+
+    sc = Scene()
+    k = cache_key(sc)
+    monkeypatch.setattr(cache_mod, "SCHEMA_VERSION", cache_mod.SCHEMA_VERSION + 1)
+    k2 = cache_key(sc)
+    monkeypatch.setattr(cache_mod, "__version__", "99.0")
+    assert len({k, k2, cache_key(sc)}) == 3
+
+
+def test_edited_material_file_is_recomputed(tmp_path):
+    mat = _material_file(tmp_path / "pu.toml")
+    sc = Scene(material=str(mat), indenter="curved", **COARSE)
+    cache = ResultCache(tmp_path / "cache")
+    first = run_sweep([sc], cache, serial=True)[0]
+    assert first.status == "done"
+    assert run_sweep([sc], cache, serial=True)[0].status == "cached"
+    _material_file(mat, mu_scale=10.0)
+    again = run_sweep([sc], cache, serial=True)[0]
+    assert again.status == "done"
+    assert again.record.summary["peak_mpa"] > 1.5 * first.record.summary["peak_mpa"]
+
+
+def test_edited_curved_radius_is_recomputed(tmp_path, geometry):
+    sc = Scene(material="polyurethane", indenter="curved", **COARSE)
+    cache = ResultCache(tmp_path / "cache")
+    r12 = run_sweep([sc], cache, serial=True)[0]
+    assert r12.status == "done"
+    _set_radius(geometry, 20)
+    r20 = run_sweep([sc], cache, serial=True)[0]
+    assert r20.status == "done"
+    # a flatter cylinder spreads the same indentation: the profile changes
+    assert r20.record.summary["span_mm"] != pytest.approx(r12.record.summary["span_mm"], rel=1e-3)
+
+
+# --- damaged entries -------------------------------------------------------------------------
+
+def _result(peak=0.4):
+    s = np.linspace(0.0, 5.0, 11)
+    p = peak * np.exp(-s ** 2)
+    return Result(s=s, pressure=p, contact_x=s[:3], contact_pressure=p[:3], reaction=0.5,
+                  stats={"dofs": 10, "increments": 1, "newton_iterations": 2, "wall_s": 0.1})
+
+
+def _damage(entry, kind):
+    prof, summ = entry / "profile.csv", entry / "summary.json"
+    if kind == "truncated profile":
+        prof.write_bytes(prof.read_bytes()[:25])
+    elif kind == "empty summary":
+        summ.write_text("")
+    elif kind == "corrupt summary":
+        summ.write_bytes(b"\x00\xff{not json")
+    elif kind == "summary a list":
+        summ.write_text("[1, 2]")
+    elif kind == "NaN peak":
+        d = json.loads(summ.read_text())
+        d["peak_mpa"] = float("nan")
+        summ.write_text(json.dumps(d))
+    elif kind == "NaN in profile":
+        lines = prof.read_text().splitlines()
+        lines[3] = lines[3].split(",")[0] + ",nan"
+        prof.write_text("\n".join(lines) + "\n")
+    elif kind == "s not increasing":
+        lines = prof.read_text().splitlines()
+        lines[2], lines[3] = lines[3], lines[2]
+        prof.write_text("\n".join(lines) + "\n")
+    elif kind == "no cache.json":
+        (entry / "cache.json").unlink()
+    elif kind == "old schema":
+        d = json.loads((entry / "cache.json").read_text())
+        d["schema"] -= 1
+        (entry / "cache.json").write_text(json.dumps(d))
+    elif kind == "foreign scene":
+        Scene(thickness=5.0).to_toml(entry / "scene.toml")
+    elif kind == "entry is a file":
+        shutil.rmtree(entry)
+        entry.write_text("x")
+    else:
+        raise AssertionError(kind)
+
+
+DAMAGE = ["truncated profile", "empty summary", "corrupt summary", "summary a list", "NaN peak",
+          "NaN in profile", "s not increasing", "no cache.json", "old schema", "foreign scene",
+          "entry is a file"]
+
+
+@pytest.mark.parametrize("kind", DAMAGE)
+def test_damaged_entry_is_warned_removed_and_never_used(tmp_path, caplog, kind):
+    cache = ResultCache(tmp_path / "cache")
+    sc = Scene(**COARSE)
+    entry = cache.store(sc, _result())
+    assert cache.lookup(sc) is not None
+    _damage(entry, kind)
+    with caplog.at_level(logging.WARNING, logger="tactileskin.cache"):
+        assert cache.lookup(sc) is None
+    assert any(str(entry) in r.getMessage() and r.levelno == logging.WARNING for r in caplog.records)
+    assert not entry.exists()
+    assert not any(p.name.endswith(".partial") for p in cache.root.iterdir())
+    cache.store(sc, _result(peak=0.7))
+    assert cache.load(sc).summary["peak_mpa"] == pytest.approx(0.7)
+
+
+@pytest.mark.parametrize("kind", ["NaN in profile", "truncated profile", "empty summary"])
+def test_sweep_recomputes_a_damaged_case_and_reports_it(tmp_path, caplog, kind):
+    cache = ResultCache(tmp_path / "cache")
+    sc = Scene(material="polyurethane", **COARSE)
+    good = run_sweep([sc], cache, serial=True)[0]
+    _damage(good.record.path, kind)
+    with caplog.at_level(logging.WARNING):
+        again = run_sweep([sc], cache, serial=True)[0]
+    assert again.status == "done"
+    assert any(str(good.record.path) in r.getMessage() for r in caplog.records if r.levelno == logging.WARNING)
+    records, rows, _ = collect([again], cache)
+    assert rows[0]["peak_mpa"] == pytest.approx(good.record.summary["peak_mpa"], rel=1e-9)
+    assert np.all(np.isfinite(records[0].pressure))
+    assert run_sweep([sc], cache, serial=True)[0].status == "cached"
+
+
+# --- two runs, one cache ---------------------------------------------------------------------
+
+def _counting_solver(monkeypatch):
+    import tactileskin.sweep as sw
+
+    real, calls = sw.solve_case, []
+    one_at_a_time = threading.Lock()  # gmsh is not thread-safe; the runs' threads take turns
+
+    def counted(scene):
+        calls.append(scene)
+        with one_at_a_time:
+            return real(scene)
+
+    monkeypatch.setattr(sw, "solve_case", counted)
+    return calls
+
+
+def _wait_for(pred, timeout=60.0):
+    t0 = time.monotonic()
+    while not pred():
+        assert time.monotonic() - t0 < timeout, "timed out"
+        time.sleep(0.02)
+
+
+@pytest.mark.parametrize("other_run_stores", [True, False])
+def test_case_locked_by_another_run_is_waited_for(tmp_path, monkeypatch, caplog, other_run_stores):
+    """The test holds one case's lock, as another sweep computing it would. The sweep does its
+    other case first, waits, then reuses the other run's result (or computes the case itself
+    when the other run ended without storing it)."""
+    cache = ResultCache(tmp_path / "cache")
+    mine = Scene(material="polyurethane", indenter="flat", **COARSE)
+    theirs = Scene(material="polyurethane", indenter="curved", **COARSE)
+    lock = cache.lock(cache.key(theirs), blocking=False)
+    assert lock is not None
+    calls = _counting_solver(monkeypatch)
+    out = {}
+    caplog.set_level(logging.WARNING, logger="tactileskin.sweep")
+    th = threading.Thread(target=lambda: out.update(r=run_sweep([theirs, mine], cache, serial=True)))
+    th.start()
+    try:
+        _wait_for(lambda: any("waiting" in r.getMessage() for r in caplog.records))
+        assert calls == [mine] and th.is_alive()   # our own case first, then it waits
+        if other_run_stores:
+            cache.store(theirs, _result(peak=0.123))
+    finally:
+        lock.release()
+    th.join(60)
+    assert not th.is_alive()
+    first, second = out["r"]
+    assert second.status == "done"
+    if other_run_stores:
+        assert first.status == "cached" and calls == [mine]
+        assert first.record.summary["peak_mpa"] == pytest.approx(0.123)
+    else:
+        assert first.status == "done" and calls == [mine, theirs]
+
+
+def test_two_concurrent_sweeps_solve_each_case_once(tmp_path, monkeypatch):
+    cache = ResultCache(tmp_path / "cache")
+    scenes = [Scene(material="polyurethane", indenter=i, **COARSE) for i in ("flat", "curved")]
+    calls = _counting_solver(monkeypatch)
+    results = [None, None]
+
+    def run(k):
+        results[k] = run_sweep(scenes if k == 0 else scenes[::-1], cache, serial=True)
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in (0, 1)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join(120)
+    assert sorted(sc.indenter.value for sc in calls) == ["curved", "flat"]  # each solved once
+    for res in results:
+        assert all(o.status in ("done", "cached") for o in res)
+    peaks = [{o.scene.indenter.value: o.record.summary["peak_mpa"] for o in res} for res in results]
+    assert peaks[0] == peaks[1]
+
+
+@pytest.mark.slow
+def test_dask_sweep_waits_for_a_locked_case_then_reuses_it(tmp_path, caplog):
+    cache = ResultCache(tmp_path / "cache")
+    mine = Scene(material="polyurethane", indenter="flat", **COARSE)
+    theirs = Scene(material="polyurethane", indenter="curved", **COARSE)
+    lock = cache.lock(cache.key(theirs), blocking=False)
+    out = {}
+    caplog.set_level(logging.WARNING, logger="tactileskin.sweep")
+    th = threading.Thread(target=lambda: out.update(r=run_sweep([mine, theirs], cache, workers=1)))
+    th.start()
+    try:
+        _wait_for(lambda: any("waiting" in r.getMessage() for r in caplog.records), timeout=120)
+        assert cache.has(mine) and not cache.has(theirs)
+        cache.store(theirs, _result(peak=0.321))
+    finally:
+        lock.release()
+    th.join(120)
+    assert [o.status for o in out["r"]] == ["done", "cached"]
+    assert out["r"][1].record.summary["peak_mpa"] == pytest.approx(0.321)
+
+
+def test_geometry_edited_during_a_solve_is_not_stored(tmp_path, geometry, monkeypatch):
+    import tactileskin.sweep as sw
+
+    real = sw.solve_case
+
+    def edit_then_solve(scene):
+        _set_radius(geometry, 20)   # the user edits the file while the case is being solved
+        return real(scene)
+
+    monkeypatch.setattr(sw, "solve_case", edit_then_solve)
+    sc = Scene(material="polyurethane", indenter="curved", **COARSE)
+    cache = ResultCache(tmp_path / "cache")
+    (oc,) = run_sweep([sc], cache, serial=True)
+    assert oc.status == "failed" and "changed during the solve" in oc.error
+    assert not [p for p in cache.root.iterdir() if p.is_dir()]   # stored under neither key
+
+
+def test_one_entry_shared_by_equal_cases_is_solved_once(tmp_path, monkeypatch):
+    calls = _counting_solver(monkeypatch)
+    cache = ResultCache(tmp_path / "cache")
+    mat = _material_file(tmp_path / "pu_copy.toml")   # the preset's numbers under another name
+    a = Scene(material="polyurethane", **COARSE)
+    b = a.replace(material=str(mat))
+    outcomes = run_sweep([a, b], cache, serial=True)
+    assert [o.status for o in outcomes] == ["done", "cached"] and calls == [a]
+    assert outcomes[1].record.summary == outcomes[0].record.summary
