@@ -60,12 +60,14 @@ def cli(verbose: int) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI in-process; returns the exit code (tests call this directly)."""
     from rich.console import Console
+    from rich.markup import escape
 
     err = Console(stderr=True)
     try:
         rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
     except TactileSkinError as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False)
+        # the message quotes user text (names, Braille text, paths): print it as text, not markup
+        err.print(f"[bold red]error:[/] {escape(str(e))}", highlight=False)
         return 2
     except click.exceptions.Exit as e:
         return e.exit_code

@@ -26,7 +26,8 @@ from tactileskin.errors import ParameterError
 @click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
 @click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
-@click.option("--workers", type=int, default=None, help="Local worker processes (default: all cores).")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Local worker processes (default: all cores).")
 @click.option("--serial", is_flag=True, help="Run in this process, without Dask.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
@@ -35,14 +36,17 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
             formulation, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from tactileskin.report.outputs import write_outputs
     from tactileskin.scene import Scene
     from tactileskin.sweep import (PAPER_INDENTERS, PAPER_MATERIALS, PAPER_THICKNESSES, ResultCache,
-                                   expand_grid, load_spec, parse_values, run_sweep)
+                                   check_scheduler, expand_grid, load_spec, parse_values, run_sweep)
 
     console = Console()
+    if scheduler is not None:
+        check_scheduler(scheduler)
     spec = load_spec(config) if config else {}
     base = spec.pop("base", Scene())
     if quality:
@@ -63,7 +67,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     scenes = expand_grid(base=base, **grid)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
-    console.print(f"sweep: {len(scenes)} cases → {out}")
+    console.print(f"sweep: {len(scenes)} cases → {escape(str(out))}")
 
     t0 = time.perf_counter()
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
@@ -73,7 +77,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         def on_event(oc):
             style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
             extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
-            bar.console.print(f"[{style}]{oc.status:>6}[/] {oc.scene.label()}{extra}", highlight=False)
+            bar.console.print(f"[{style}]{oc.status:>6}[/] {escape(oc.scene.label() + extra)}", highlight=False)
             bar.advance(task)
 
         outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
@@ -81,7 +85,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     wall = time.perf_counter() - t0
     paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
-    console.print(f"report: {paths['report']}  ({len(scenes) - nfail}/{len(scenes)} ok, {wall:.1f} s)")
+    console.print(f"report: {escape(str(paths['report']))}  ({len(scenes) - nfail}/{len(scenes)} ok, {wall:.1f} s)")
     return 1 if nfail else 0
 
 
