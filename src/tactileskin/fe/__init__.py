@@ -107,6 +107,9 @@ def phases(model: Model, **extra: float) -> dict:
 
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result."""
+    from tactileskin.materials import get_material
+
+    get_material(scene.material)  # a bad material (name or file) fails before the mesh is made
     t0 = time.perf_counter()
     t_mesh = 0.0
     if mesh is None:
