@@ -187,6 +187,10 @@ def test_grid_resolves_every_material_before_any_work():
     assert time.perf_counter() - t0 < 1.0
     with pytest.raises(ParameterError, match="not a string"):
         sweep.expand_grid(materials="silicone")
+    t0 = time.perf_counter()
+    with pytest.raises(ParameterError, match="at most 10000 cases"):
+        sweep.expand_grid(thicknesses=sweep.parse_values("1:5:0.005", "t"), depths=(0.1, 0.2, 0.3, 0.4, 0.5))
+    assert time.perf_counter() - t0 < 1.0
 
 
 @pytest.mark.parametrize("args,needle", [

@@ -67,6 +67,11 @@ def parse_values(text: str, name: str) -> list[float]:
     return out
 
 
+# ~30 h of 2D solves at ~10 s each on one core: beyond that a grid is surely a typo (a range
+# step of 0.001), and building its scenes alone would take minutes
+MAX_CASES = 10_000
+
+
 def expand_grid(
     thicknesses: Sequence[float] = PAPER_THICKNESSES,
     materials: Sequence[str] = PAPER_MATERIALS,
@@ -81,6 +86,10 @@ def expand_grid(
                        ("depths", depths), ("braille_texts", braille_texts)):
         if isinstance(axis, (str, bytes)):  # would iterate as one-letter values
             raise ParameterError(name, axis, "a sequence of values, not a string")
+    n = len(thicknesses) * len(materials) * len(indenters) * len(depths) * max(len(braille_texts), 1)
+    if n > MAX_CASES:
+        raise ParameterError("sweep grid", f"{n} cases", f"at most {MAX_CASES} cases",
+                             "split the sweep; every case is a separate solve")
     scenes: list[Scene] = []
     seen: set[str] = set()
     for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
