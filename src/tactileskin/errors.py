@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+import sys
+
 
 class TactileSkinError(Exception):
     """Base class for every error the toolkit raises on purpose."""
@@ -39,27 +42,49 @@ class ConvergenceError(TactileSkinError):
 
 def check_range(name: str, value: float, lo: float | None = None, hi: float | None = None,
                 *, lo_open: bool = False, hi_open: bool = False, unit: str = "") -> float:
-    """Return float(value) if lo <= value <= hi (open ends as flagged), else raise ParameterError."""
+    """Return float(value) if it is a finite number with lo <= value <= hi (open ends as
+    flagged), else raise ParameterError. Booleans and strings are not numbers here (a TOML
+    `thickness = true` or `"3"` is a mistake, not 1.0 or 3.0).
+
+    A closed bound is met within a few ulps: bounds are often computed (0.6 * t) and a value
+    typed as the printed bound (1.8 for 0.6 * 3 = 1.7999999999999998) must pass."""
+    valid = _range_text(lo, hi, lo_open, hi_open, unit)
+    if isinstance(value, (bool, str, bytes)):
+        raise ParameterError(name, value, valid, "a number")
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, _range_text(lo, hi, lo_open, hi_open, unit)) from None
-    ok = v == v  # rejects NaN
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(name, value, valid) from None
+    ok = math.isfinite(v)
     if lo is not None:
-        ok &= v > lo if lo_open else v >= lo
+        ok &= v > lo if lo_open else v >= lo - _slack(lo)
     if hi is not None:
-        ok &= v < hi if hi_open else v <= hi
+        ok &= v < hi if hi_open else v <= hi + _slack(hi)
     if not ok:
-        raise ParameterError(name, value, _range_text(lo, hi, lo_open, hi_open, unit))
+        raise ParameterError(name, value, valid)
     return v
+
+
+def _slack(bound: float) -> float:
+    return 4.0 * sys.float_info.epsilon * abs(bound)
+
+
+def fmt_bound(x: float) -> str:
+    """Shortest text of x that reads back as x to within a few ulps (`:g` drops digits:
+    a bound 0.74074068 would print as 0.740741, which is above it)."""
+    for digits in (6, 10, 15, 17):
+        text = f"{x:.{digits}g}"
+        if abs(float(text) - x) <= _slack(x):
+            return text
+    return repr(x)
 
 
 def _range_text(lo, hi, lo_open, hi_open, unit):
     u = f" {unit}" if unit else ""
     if lo is not None and hi is not None:
-        return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}{u}"
+        return f"{'(' if lo_open else '['}{fmt_bound(lo)}, {fmt_bound(hi)}{')' if hi_open else ']'}{u}"
     if lo is not None:
-        return f"{'>' if lo_open else '>='} {lo:g}{u}"
+        return f"{'>' if lo_open else '>='} {fmt_bound(lo)}{u}"
     if hi is not None:
-        return f"{'<' if hi_open else '<='} {hi:g}{u}"
-    return "a finite number"
+        return f"{'<' if hi_open else '<='} {fmt_bound(hi)}{u}"
+    return "a finite number" + (f" ({unit})" if unit else "")

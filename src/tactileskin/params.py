@@ -40,15 +40,34 @@ def geometry_dir() -> Path:
     return _packaged_dir()
 
 
+# Parameter files are a few kB; a cap keeps a wrong path (a log, an image, /dev/zero) from
+# being read whole. 1 MiB is ~100x the largest file the toolkit writes or ships.
+MAX_TOML_BYTES = 1 << 20
+
+
 def read_toml(path: str | Path, what: str) -> dict:
-    """Parse a user's TOML file; a missing or malformed file is a ParameterError naming `what`."""
+    """Parse a user's TOML file; a missing, unreadable, oversized (> MAX_TOML_BYTES), non-UTF-8
+    or malformed file is a ParameterError naming `what`."""
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh)
+            raw = fh.read(MAX_TOML_BYTES + 1)
     except FileNotFoundError:
         raise ParameterError(what, str(path), "an existing TOML file") from None
+    except OSError as e:
+        raise ParameterError(what, str(path), "a readable TOML file", e.strerror or str(e)) from None
+    if len(raw) > MAX_TOML_BYTES:
+        raise ParameterError(what, str(path), f"a TOML file of at most {MAX_TOML_BYTES // 1024} KiB")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ParameterError(what, str(path), "a UTF-8 text file",
+                             f"byte {e.start} is not UTF-8") from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ParameterError(what, str(path), f"valid TOML ({e})") from None
+    except RecursionError:
+        raise ParameterError(what, str(path), "valid TOML", "nested too deeply") from None
 
 
 # parsed files by content: a file edited during a process is read again, never served stale

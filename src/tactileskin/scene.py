@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
+from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
@@ -54,8 +55,23 @@ class Formulation(str, Enum):
 def _enum(cls, name, value):
     try:
         return cls(value)
-    except ValueError:
+    except (ValueError, TypeError):
         raise ParameterError(name, value, "one of " + ", ".join(m.value for m in cls)) from None
+
+
+def _fingertip_overrides(value) -> tuple[tuple[str, float], ...]:
+    """Fingertip overrides as sorted (name, float) pairs, from a table or pairs; names are
+    checked against the Fingertip parameters (geometry/fingertip.toml)."""
+    from tactileskin.geometry.fingertip import OVERRIDES
+
+    if isinstance(value, dict):
+        items = list(value.items())
+    elif isinstance(value, (list, tuple)) and all(isinstance(p, (list, tuple)) and len(p) == 2 for p in value):
+        items = [tuple(p) for p in value]
+    else:
+        raise ParameterError("fingertip", value, "a table of overrides: " + ", ".join(OVERRIDES))
+    validate.known_keys(dict(items), OVERRIDES, "fingertip")
+    return tuple(sorted((str(k), validate.number(v, f"fingertip.{k}")) for k, v in items))
 
 
 @dataclass(frozen=True)
@@ -80,8 +96,14 @@ class Scene:
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
         set_("indenter", _enum(IndenterKind, "indenter", self.indenter))
         set_("formulation", _enum(Formulation, "formulation", self.formulation))
-        if isinstance(self.fingertip, dict):
-            set_("fingertip", tuple(sorted(self.fingertip.items())))
+        set_("material", validate.string(self.material, "material", "a material preset name"))
+        set_("braille_text", validate.string(self.braille_text, "braille_text"))
+        set_("braille_standard", validate.string(self.braille_standard, "braille_standard",
+                                                 "a Braille standard name"))
+        set_("viscoelastic", validate.boolean(self.viscoelastic, "viscoelastic"))
+        set_("dim", validate.integer(self.dim, "dim", "2 or 3"))
+        set_("order", validate.integer(self.order, "order", "1 or 2"))
+        set_("fingertip", _fingertip_overrides(self.fingertip))
         ft = self.fingertip_model()
         set_("thickness", ft.check_thickness(self.thickness))
         set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, 0.6, lo_open=True))
@@ -102,14 +124,14 @@ class Scene:
                                       0.01, 5.0, unit="mm"))
         set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
                                        1.0, 20.0))
-        if not isinstance(self.material, str) or not self.material:
+        if not self.material:
             raise ParameterError("material", self.material, "a material preset name")
         if self.indenter is IndenterKind.BRAILLE:
             from tactileskin.geometry import braille
 
             braille.get_standard(self.braille_standard)  # raises ParameterError if unknown
             if self.braille_text:
-                braille.text_to_cells(self.braille_text)   # raises on unknown characters
+                braille.check_text(self.braille_text)   # raises on unknown characters, > MAX_CELLS
 
     # --- derived -----------------------------------------------------------------------
     @property
@@ -158,10 +180,12 @@ class Scene:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
+        validate.table(d, "scene")
         names = {f.name for f in dataclasses.fields(cls)}
-        unknown = sorted(set(d) - names)
+        unknown = sorted(str(k) for k in d if k not in names)
         if unknown:
-            raise ParameterError("scene field", unknown[0], "one of " + ", ".join(sorted(names)))
+            raise ParameterError("scene field", unknown[0], "one of " + ", ".join(sorted(names)),
+                                 validate.did_you_mean(unknown[0], names))
         return cls(**d)
 
     def key(self) -> str:

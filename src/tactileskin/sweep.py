@@ -51,7 +51,7 @@ def parse_values(text: str, name: str) -> list[float]:
         try:
             if ":" in part:
                 a, b, c = (float(x) for x in part.split(":"))
-                if c <= 0 or b < a:
+                if not all(np.isfinite((a, b, c))) or c <= 0 or b < a:
                     raise ValueError
                 n = int(np.floor((b - a) / c + 1e-9)) + 1
                 if n > 1000:
@@ -59,11 +59,18 @@ def parse_values(text: str, name: str) -> list[float]:
                 out.extend(round(a + i * c, 10) for i in range(n))
             else:
                 out.append(float(part))
+                if not np.isfinite(out[-1]):
+                    raise ValueError
         except ValueError:
-            raise ParameterError(name, text, "comma-separated numbers or start:stop:step with step > 0") from None
+            raise ParameterError(name, text, "comma-separated finite numbers or start:stop:step with step > 0") from None
     if not out:
         raise ParameterError(name, text, "at least one value")
     return out
+
+
+# ~30 h of 2D solves at ~10 s each on one core: beyond that a grid is surely a typo (a range
+# step of 0.001), and building its scenes alone would take minutes
+MAX_CASES = 10_000
 
 
 def expand_grid(
@@ -76,6 +83,14 @@ def expand_grid(
 ) -> list[Scene]:
     """Cartesian product of the sweep axes; Braille texts apply to Braille indenters only."""
     base = base or Scene()
+    for name, axis in (("thicknesses", thicknesses), ("materials", materials), ("indenters", indenters),
+                       ("depths", depths), ("braille_texts", braille_texts)):
+        if isinstance(axis, (str, bytes)):  # would iterate as one-letter values
+            raise ParameterError(name, axis, "a sequence of values, not a string")
+    n = len(thicknesses) * len(materials) * len(indenters) * len(depths) * max(len(braille_texts), 1)
+    if n > MAX_CASES:
+        raise ParameterError("sweep grid", f"{n} cases", f"at most {MAX_CASES} cases",
+                             "split the sweep; every case is a separate solve")
     scenes: list[Scene] = []
     seen: set[str] = set()
     for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
@@ -86,23 +101,44 @@ def expand_grid(
             if s.key() not in seen:
                 seen.add(s.key())
                 scenes.append(s)
+    check_materials(s.material for s in scenes)
     return scenes
+
+
+def check_materials(names: Iterable[str]) -> None:
+    """Resolve every material (preset name or .toml file) now, so a bad one fails before
+    any worker starts rather than in every case."""
+    from tactileskin.materials import get_material
+
+    for name in sorted(set(names)):
+        get_material(name)
+
+
+MAX_AXIS_VALUES = 1000  # values per sweep axis, as parse_values allows
+_SPEC_LISTS = {"thicknesses": "numbers", "depths": "numbers", "materials": "strings",
+               "indenters": "strings", "braille_texts": "strings"}
 
 
 def load_spec(path: str | Path) -> dict:
     """A sweep TOML: [sweep] thicknesses/materials/indenters/depths/braille_texts lists,
-    optional [scene] base fields."""
+    optional [scene] base fields. Unknown tables or keys and values of the wrong type
+    (`materials = "silicone"`, a string, not a list) are ParameterErrors."""
+    from tactileskin import validate
     from tactileskin.params import read_toml
 
     data = read_toml(path, "sweep file")
-    allowed = {"thicknesses", "materials", "indenters", "depths", "braille_texts"}
-    sw = data.get("sweep", {})
-    bad = sorted(set(sw) - allowed)
-    if bad:
-        raise ParameterError("sweep key", bad[0], "one of " + ", ".join(sorted(allowed)))
-    spec = {k: tuple(v) for k, v in sw.items()}
+    validate.known_keys(data, ("sweep", "scene"), "sweep file table")
+    sw = validate.table(data.get("sweep", {}), "[sweep]")
+    validate.known_keys(sw, _SPEC_LISTS, "sweep")
+    spec: dict = {}
+    for k, v in sw.items():
+        name = f"sweep.{k}"
+        if _SPEC_LISTS[k] == "numbers":
+            spec[k] = validate.number_list(v, name, MAX_AXIS_VALUES, min_len=1)
+        else:
+            spec[k] = validate.string_list(v, name, MAX_AXIS_VALUES, min_len=1)
     if "scene" in data:
-        spec["base"] = Scene.from_dict(data["scene"])
+        spec["base"] = Scene.from_dict(validate.table(data["scene"], "[scene]"))
     return spec
 
 
@@ -161,6 +197,34 @@ def case_ids(scenes: Sequence[Scene]) -> list[str]:
 
 
 # --- execution ------------------------------------------------------------------------------
+
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+SCHEDULER_TIMEOUT_S = 10.0  # a running scheduler answers in well under a second
+
+
+def check_scheduler(address: str) -> str:
+    """A Dask scheduler address [scheme://]host:port, checked for form (not reachability)."""
+    import re
+
+    valid = "an address such as tcp://host:8786 (schemes: " + ", ".join(SCHEDULER_SCHEMES) + ")"
+    m = re.fullmatch(r"(?:([a-z]+)://)?(\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.-]+):([0-9]{1,5})/?", str(address))
+    if not m or (m.group(1) or "tcp") not in SCHEDULER_SCHEMES or not 0 < int(m.group(3)) < 65536:
+        raise ParameterError("--scheduler", address, valid)
+    return str(address)
+
+
+def connect(address: str):
+    """A dask Client on a running scheduler; an unreachable one is a ParameterError after
+    SCHEDULER_TIMEOUT_S, not a traceback."""
+    from dask.distributed import Client
+
+    check_scheduler(address)
+    try:
+        return Client(address, timeout=SCHEDULER_TIMEOUT_S)
+    except (OSError, TimeoutError, ValueError) as e:
+        raise ParameterError("--scheduler", address, "the address of a running Dask scheduler",
+                             f"no connection within {SCHEDULER_TIMEOUT_S:g} s: {type(e).__name__}: "
+                             f"{str(e).splitlines()[0] if str(e) else ''}".rstrip(": ")) from None
 
 @dataclass
 class CaseOutcome:
@@ -244,7 +308,7 @@ class _Runner:
                          "distributed.http.proxy", "distributed.worker"):
                 logging.getLogger(name).setLevel(logging.ERROR)
         if self.scheduler:
-            self.client = Client(self.scheduler)
+            self.client = connect(self.scheduler)
             return self.client
         n = max(1, min(self.workers or os.cpu_count() or 1, ncases))
         import dask

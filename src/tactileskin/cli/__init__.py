@@ -81,13 +81,15 @@ def _sigterm_raises():
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI in-process; returns the exit code (tests call this directly)."""
     from rich.console import Console
+    from rich.markup import escape
 
     err = Console(stderr=True)
     try:
         with _sigterm_raises():
             rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
     except TactileSkinError as e:
-        err.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)  # one line, unwrapped
+        # the message quotes user text (names, Braille text, paths): print it as text, not markup
+        err.print(f"[bold red]error:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
         return 2
     except click.exceptions.Exit as e:
         return e.exit_code

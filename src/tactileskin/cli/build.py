@@ -26,6 +26,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     watertight flag). Every STL is checked to be a closed, consistently wound volume.
     """
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
 
     from tactileskin.geometry.fingertip import Fingertip
@@ -45,12 +46,12 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         parts = build_parts(t, indenters=indenter, braille_text=braille_text,
                             braille_standard=braille_standard, molds=not no_molds)
     t1 = time.perf_counter()
-    with console.status(f"writing {len(parts)} parts to {out_dir}..."):
+    with console.status(f"writing {len(parts)} parts to {escape(str(out_dir))}..."):
         manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
                                                           braille_standard=braille_standard, molds=not no_molds))
     t2 = time.perf_counter()
 
-    table = Table(title=f"t = {t:g} mm -> {out_dir}/<part>.stl, .step")
+    table = Table(title=escape(f"t = {t:g} mm -> {out_dir}/<part>.stl, .step"))
     table.add_column("part", no_wrap=True)
     table.add_column("volume mm³", justify="right", no_wrap=True)
     table.add_column("x × y × z mm", justify="right", no_wrap=True)
@@ -58,7 +59,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     table.add_column("what")
     for e in manifest["parts"]:
         size = "×".join(f"{hi - lo:.1f}" for lo, hi in zip(e["bbox_min"], e["bbox_max"]))
-        table.add_row(e["name"], f"{e['volume_mm3']:.1f}", size,
-                      "yes" if e["is_volume"] else "[red]no[/]", e["description"])
+        table.add_row(escape(e["name"]), f"{e['volume_mm3']:.1f}", size,
+                      "yes" if e["is_volume"] else "[red]no[/]", escape(e["description"]))
     console.print(table)
-    console.print(f"solids {t1 - t0:.1f} s, export {t2 - t1:.1f} s; manifest: {out_dir}/manifest.json")
+    console.print(f"solids {t1 - t0:.1f} s, export {t2 - t1:.1f} s; manifest: {escape(str(out_dir))}/manifest.json")

@@ -17,6 +17,7 @@ from tactileskin.cli._common import scene_from_options, scene_options
 def command(out, order, cell, **scene_kw):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
 
     from tactileskin.mesh import FORMATS, build_mesh
@@ -30,8 +31,8 @@ def command(out, order, cell, **scene_kw):
     sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
 
-    table = Table(title=f"skin mesh {scene.label()} (mesh_size {scene.mesh_size:g} mm, "
-                        f"refinement {scene.refinement:g})")
+    table = Table(title=escape(f"skin mesh {scene.label()} (mesh_size {scene.mesh_size:g} mm, "
+                               f"refinement {scene.refinement:g})"))
     table.add_column("quantity")
     table.add_column("value", justify="right")
     shape = {"tri": {2: "triangles", 3: "tetrahedra"}[sm.dim], "quad": "quadrilaterals"}[sm.cell]
@@ -54,4 +55,4 @@ def command(out, order, cell, **scene_kw):
     console.print(table)
     if out is not None:
         path = sm.write(out)
-        console.print(f"wrote {path}")
+        console.print(f"wrote {escape(str(path))}")

@@ -28,6 +28,7 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
 def command(out, elastic, compare_2d, **kw):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
     from rich.text import Text
 
@@ -42,7 +43,7 @@ def command(out, elastic, compare_2d, **kw):
         res = solve(scene)
         path = res.write(out)
     s = res.summary()
-    t = Table(title=f"{scene.label()} -> {path}", show_header=False)
+    t = Table(title=escape(f"{scene.label()} -> {path}"), show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
     t.add_row("span (P >= 10 % of peak)", f"{s['span_mm']:.3g} mm")
     t.add_row("area under P(s)", f"{s['auc']:.4g} MPa mm")
@@ -75,6 +76,7 @@ def _compare_2d(scene, s3, out) -> None:
     import os
 
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
     from rich.text import Text
 
@@ -88,7 +90,7 @@ def _compare_2d(scene, s3, out) -> None:
     # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN
     rows = {k: (s2[k], s3[k], (s2[k] - s3[k]) / s3[k] if s3[k] > 0 else None)
             for k in ("peak_mpa", "span_mm")}
-    t = Table(title=f"2D section ({sc2.label()}) against 3D; difference = (2D - 3D) / 3D")
+    t = Table(title=escape(f"2D section ({sc2.label()}) against 3D; difference = (2D - 3D) / 3D"))
     for c in ("", "2D", "3D", "difference"):
         t.add_column(c)
     for k, (a, b, d) in rows.items():

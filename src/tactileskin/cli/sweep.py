@@ -42,7 +42,8 @@ EXIT_FAILED, EXIT_SUSPECT = 1, 3
 @click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
 @click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
-@click.option("--workers", type=int, default=None, help="Local worker processes (default: all cores).")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Local worker processes (default: all cores).")
 @click.option("--serial", is_flag=True, help="Run in this process, without Dask.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
@@ -60,9 +61,11 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     from tactileskin.report.outputs import write_outputs
     from tactileskin.scene import Scene
     from tactileskin.sweep import (PAPER_INDENTERS, PAPER_MATERIALS, PAPER_THICKNESSES, ResultCache,
-                                   expand_grid, load_spec, parse_values, run_sweep)
+                                   check_scheduler, expand_grid, load_spec, parse_values, run_sweep)
 
     console = Console()
+    if scheduler is not None:
+        check_scheduler(scheduler)
     spec = load_spec(config) if config else {}
     base = spec.pop("base", Scene())
     if quality:
@@ -84,7 +87,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     with claimed_output(out, "sweep", _own_names(out)):  # before any solving
-        console.print(f"sweep: {len(scenes)} cases → {out}")
+        console.print(f"sweep: {len(scenes)} cases → {escape(str(out))}")
 
         t0 = time.perf_counter()
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
@@ -109,7 +112,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
     nsus = sum(1 for r in paths.get("rows", []) if result_quality.kind(r.get("status", "")) == "suspect")
-    console.print(f"report: {paths['report']}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
+    console.print(f"report: {escape(str(paths['report']))}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
                   f"{nsus} suspect, {nfail} failed, {wall:.1f} s)", highlight=False)
     return EXIT_FAILED if nfail else (EXIT_SUSPECT if nsus else 0)
 

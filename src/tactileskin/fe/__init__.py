@@ -109,7 +109,9 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
     Raises ParameterError before meshing if the indenter cannot reach the skin (no contact)."""
     from tactileskin.geometry.indenters import require_contact
+    from tactileskin.materials import get_material
 
+    get_material(scene.material)  # a bad material (name or file) fails before the mesh is made
     require_contact(scene)
     t0 = time.perf_counter()
     t_mesh = 0.0

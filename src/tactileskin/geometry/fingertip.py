@@ -21,8 +21,14 @@ from scipy.optimize import brentq
 
 from tactileskin import params
 from tactileskin.errors import ParameterError, check_range
+from tactileskin.validate import did_you_mean
 
 _N_DENSE = 20001  # samples for arc-length tables; spacing ~1e-3 mm, error ~1e-9 mm
+
+
+# the Scene.fingertip overrides: the Fingertip fields (fingertip.toml values by default)
+OVERRIDES = ("half_width", "height", "max_fraction_of_min_radius", "nail_angle_deg", "sample_length",
+             "thickness_min")
 
 
 @dataclass(frozen=True)
@@ -48,6 +54,10 @@ class Fingertip:
             thickness_min=p["thickness"]["min"],
             max_fraction_of_min_radius=p["thickness"]["max_fraction_of_min_radius"],
         )
+        unknown = sorted(str(k) for k in overrides if k not in OVERRIDES)
+        if unknown:
+            raise ParameterError("fingertip key", unknown[0], "one of " + ", ".join(OVERRIDES),
+                                 did_you_mean(unknown[0], OVERRIDES))
         kw.update(overrides)
         ft = cls(**kw)
         ft.validate()
@@ -58,6 +68,13 @@ class Fingertip:
         check_range("height", self.height, 2.0, 50.0, unit="mm")
         check_range("nail_angle_deg", self.nail_angle_deg, 45.0, 175.0, unit="deg")
         check_range("sample_length", self.sample_length, 1.0, 500.0, unit="mm")
+        check_range("thickness_min", self.thickness_min, 0.0, 50.0, lo_open=True, unit="mm")
+        # at 1 the interface (the inward offset) reaches the contour's centre of curvature: a cusp
+        check_range("max_fraction_of_min_radius", self.max_fraction_of_min_radius, 0.0, 1.0,
+                    lo_open=True, hi_open=True)
+        if self.thickness_min > self.thickness_max:
+            raise ParameterError("thickness_min", self.thickness_min,
+                                 f"<= {self.thickness_max:.4g} mm (the largest thickness this contour allows)")
 
     @property
     def nail_angle(self) -> float:

@@ -64,7 +64,7 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
     if "braille" in kinds:
         std = _braille.get_standard(braille_standard)
         if braille_text:
-            _braille.text_to_cells(braille_text)
+            _braille.check_text(braille_text)
     mold_params = _molds.MoldParams.from_params() if molds else None
     if mold_params is not None:
         mold_params.check(sec)

@@ -60,6 +60,12 @@ __all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2_tange
            "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
+# Abaqus's hyperfoam takes N <= 6 terms and published fits use 1-3; each term costs an exp()
+# per principal stretch at every quadrature point of every assembly, so 8 leaves headroom
+# while bounding that cost.
+MAX_TERMS = 8
+
+
 def _as_float_tuple(name, value) -> tuple[float, ...]:
     try:
         t = tuple(float(v) for v in np.atleast_1d(np.asarray(value, dtype=float)).ravel())
@@ -81,11 +87,13 @@ class Hyperfoam:
         alpha = _as_float_tuple("alpha", self.alpha)
         if len(mu) == 0:
             raise ParameterError("mu", self.mu, "at least one term")
+        if len(mu) > MAX_TERMS:
+            raise ParameterError("mu", f"{len(mu)} terms", f"at most {MAX_TERMS} terms")
         if len(alpha) != len(mu):
             raise ParameterError("alpha", self.alpha, f"{len(mu)} values (one per mu term)")
         for i, (m, a) in enumerate(zip(mu, alpha)):
-            if not math.isfinite(m):
-                raise ParameterError(f"mu[{i}]", m, "a finite number (MPa)")
+            if not math.isfinite(m) or m == 0.0:
+                raise ParameterError(f"mu[{i}]", m, "a finite non-zero number (MPa)")
             if not math.isfinite(a) or a == 0.0:
                 raise ParameterError(f"alpha[{i}]", a, "a finite non-zero number")
         try:

@@ -12,9 +12,10 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from tactileskin import validate
 from tactileskin.errors import ParameterError
-from tactileskin.materials.hyperfoam import Hyperfoam
-from tactileskin.materials.prony import Prony
+from tactileskin.materials.hyperfoam import MAX_TERMS as HF_TERMS, Hyperfoam
+from tactileskin.materials.prony import MAX_TERMS as PRONY_TERMS, Prony
 from tactileskin.params import read_toml
 
 __all__ = ["Material", "get_material", "list_materials"]
@@ -29,22 +30,35 @@ class Material:
 
     @classmethod
     def from_dict(cls, name: str, d: dict) -> "Material":
-        """Build from {"source": str, "hyperfoam": {mu, alpha, nu}, "prony": {g, tau}} (prony optional)."""
+        """Build from {"name"?: str, "source"?: str, "hyperfoam": {mu, alpha, nu}, "prony"?: {g, tau}}.
+
+        Every table is checked for unknown keys and value types here (a `[prnoy]` typo must
+        not silently make the material elastic); Hyperfoam and Prony check the ranges."""
+        what = f"material {name!r}"
         if not isinstance(d, dict) or "hyperfoam" not in d:
-            raise ParameterError(f"material {name!r}", d, "a table with a [hyperfoam] sub-table (mu, alpha, nu)")
-        hf = d["hyperfoam"]
+            raise ParameterError(what, d if not isinstance(d, dict) else sorted(d),
+                                 "a table with a [hyperfoam] sub-table (mu, alpha, nu)")
+        validate.known_keys(d, ("name", "source", "hyperfoam", "prony"), what)
+        hf = validate.table(d["hyperfoam"], f"{what} hyperfoam")
+        validate.known_keys(hf, ("mu", "alpha", "nu"), f"{what} hyperfoam")
         missing = [k for k in ("mu", "alpha", "nu") if k not in hf]
         if missing:
-            raise ParameterError(f"material {name!r} hyperfoam", sorted(hf), "keys mu, alpha, nu",
+            raise ParameterError(f"{what} hyperfoam", sorted(hf), "keys mu, alpha, nu",
                                  "missing " + ", ".join(missing))
-        pr = d.get("prony", {"g": [], "tau": []})
-        if set(pr) - {"g", "tau"} or ("g" in pr) != ("tau" in pr):
-            raise ParameterError(f"material {name!r} prony", sorted(pr), "keys g and tau")
+        mu = validate.number_list(hf["mu"], "mu", HF_TERMS, min_len=1)
+        alpha = validate.number_list(hf["alpha"], "alpha", HF_TERMS, min_len=1)
+        nu = validate.number(hf["nu"], "nu")
+        pr = validate.table(d.get("prony", {"g": [], "tau": []}), f"{what} prony")
+        validate.known_keys(pr, ("g", "tau"), f"{what} prony")
+        if ("g" in pr) != ("tau" in pr):
+            raise ParameterError(f"{what} prony", sorted(pr), "keys g and tau (both, or an empty table)")
+        g = validate.number_list(pr.get("g", []), "g", PRONY_TERMS)
+        tau = validate.number_list(pr.get("tau", []), "tau", PRONY_TERMS)
         return cls(
-            name=str(d.get("name", name)),
-            hyperfoam=Hyperfoam(tuple(hf["mu"]), tuple(hf["alpha"]), hf["nu"]),
-            prony=Prony(tuple(pr.get("g", ())), tuple(pr.get("tau", ()))),
-            source=str(d.get("source", "")),
+            name=validate.string(d.get("name", name), f"{what} name"),
+            hyperfoam=Hyperfoam(mu, alpha, nu),
+            prony=Prony(g, tau),
+            source=validate.string(d.get("source", ""), f"{what} source"),
         )
 
     @classmethod
@@ -60,7 +74,7 @@ class Material:
         if "hyperfoam" in data:
             return cls.from_dict(str(data.get("name", path.stem)), data)
         tables = {k: v for k, v in data.items() if isinstance(v, dict)}
-        if len(tables) != 1:
+        if len(tables) != 1 or len(data) != 1:
             raise ParameterError("material file", str(path),
                                  "one material: top-level [hyperfoam] table, or exactly one named table")
         (name, d), = tables.items()

@@ -29,6 +29,12 @@ from tactileskin.errors import ParameterError
 __all__ = ["Prony"]
 
 
+# One term per decade of time is the usual fit; 12 cover 1 ms to 1e9 s, far beyond any
+# indentation. Each term keeps a stress history at every quadrature point (memory and one
+# update per increment), so the count is bounded.
+MAX_TERMS = 12
+
+
 @dataclass(frozen=True)
 class Prony:
     """Prony series: relative moduli g (each >= 0, sum < 1) and relaxation times tau (s, > 0)."""
@@ -42,6 +48,8 @@ class Prony:
             tau = tuple(float(v) for v in np.atleast_1d(np.asarray(self.tau, dtype=float)).ravel())
         except (TypeError, ValueError):
             raise ParameterError("prony", (self.g, self.tau), "sequences of finite numbers") from None
+        if len(g) > MAX_TERMS:
+            raise ParameterError("g", f"{len(g)} terms", f"at most {MAX_TERMS} terms")
         if len(tau) != len(g):
             raise ParameterError("tau", self.tau, f"{len(g)} values (one per g term)")
         for i, (gi, ti) in enumerate(zip(g, tau)):

@@ -80,7 +80,7 @@ def build_section_mesh(scene, section=None, *, mesh_size: float | None = None,
         raise ParameterError("cell", cell, "'tri' or 'quad'")
     section = scene.section() if section is None else section
     order = scene.order if order is None else order
-    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=2)
+    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=2, order=order)
     params = {"thickness": section.thickness, "order": order, "cell": cell, **plan.as_dict()}
     logger.info("meshing 2D section: %s", params)
     t0 = time.perf_counter()

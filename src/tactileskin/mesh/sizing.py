@@ -7,6 +7,7 @@ ParameterError, not a hang. `apply_fields` turns a plan into gmsh size fields.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 from dataclasses import dataclass
@@ -18,7 +19,26 @@ from tactileskin.errors import ParameterError, check_range
 logger = logging.getLogger(__name__)
 
 ROI_S = 6.0  # mm: the paper reports bone pressure within 6 mm of s = 0; refine the interface there
-MAX_ELEMENTS = {2: 2_000_000, 3: 5_000_000}
+# Limits on the estimated displacement dofs of a request (the solver's memory and time grow
+# with them; the mesh exists to be solved). A 2D cap of 2e6 cells (~8e6 P2 dofs) let
+# through requests that crashed in scikit-fem after minutes and 4.5 GB, and a 3D request
+# under a 5e6-cell cap meshed for over 5 minutes. 3D P2 element matrices are 30 x 30 (2D:
+# 12 x 12) and the sparse factorisation fills in faster than in 2D: the default 3D slab
+# (~74k dofs) solves in about 2 min, so 3D is capped at ~5x that. The estimate is 1-2x the
+# actual count, so these caps refuse no mesh below about half of them.
+MAX_DOFS = {2: 1_500_000, 3: 400_000}
+# above this a request is allowed but logged as a warning: it takes many minutes (the 3D
+# defaults estimate 0.04-0.2e6 dofs at t = 0.5-5 mm; a 6-character Braille text 0.32e6)
+WARN_DOFS = {2: 300_000, 3: 250_000}
+# mesh nodes per cell for large meshes (Euler: a triangle mesh has V ~ T/2, E ~ 3T/2; a
+# tetrahedral one V ~ T/5.5, E ~ 1.2 T); P2 adds a node per edge
+_NODES_PER_CELL = {(2, 1): 0.5, (2, 2): 2.0, (3, 1): 0.18, (3, 2): 1.38}
+
+
+def estimate_dofs(cells: int, dim: int, order: int = 2) -> int:
+    """Displacement dofs of a mesh of `cells` triangles/tetrahedra of this order."""
+    return int(dim * _NODES_PER_CELL[(dim, order)] * cells)
+
 # Grading (issue #7, benchmarks/results/mesh_grading.md): the size is `fine` within
 # OUTER_LAYER fine cells of the contact surface and ROI_LAYER of the bone ROI, and grows by
 # GROWTH mm per mm of distance (each cell ~GROWTH larger than its neighbour) up to coarse.
@@ -123,13 +143,52 @@ def _strip(p: "SizePlan", layer: float, depth: float, dim: int, cap: bool = Fals
 
 
 def plan(scene, section, *, mesh_size: float | None = None, refinement: float | None = None,
-         dim: int = 2, length: float | None = None, z_symmetric: bool = False) -> SizePlan:
-    """Sizes for `section`; raises ParameterError if a size is not positive or the estimate
-    exceeds MAX_ELEMENTS[dim]."""
+         dim: int = 2, length: float | None = None, z_symmetric: bool = False,
+         order: int | None = None) -> SizePlan:
+    """Sizes for `section`; raises ParameterError if a size is not positive or the estimated
+    dofs (cells of `dim`, element `order`, default the scene's) exceed MAX_DOFS[dim]."""
     coarse = scene.mesh_size if mesh_size is None else mesh_size
     ratio = scene.refinement if refinement is None else refinement
     coarse = check_range("mesh_size", coarse, 0.0, None, lo_open=True, unit="mm")
     ratio = check_range("refinement", ratio, 1.0, None)
+    if dim == 3 and length is None:
+        raise ParameterError("length", length, "> 0 mm (slab length along z)")
+    order = scene.order if order is None else order
+    layout = functools.partial(_layout, scene, section, dim=dim, length=length, z_symmetric=z_symmetric)
+    p = layout(coarse, ratio)
+    dofs = estimate_dofs(p.estimate, dim, order)
+    cap = MAX_DOFS[dim]
+    if dofs > cap:
+        hc = _smallest_size(lambda h: estimate_dofs(layout(h, ratio).estimate, dim, order) <= cap, coarse)
+        hint = (f"keep mesh_size at or above {hc:.3g} mm at refinement {ratio:g}" if hc is not None
+                else f"lower the refinement ({ratio:g})")
+        raise ParameterError(
+            "mesh_size", coarse,
+            f"a mesh of at most {cap:.2g} dofs in {dim}D; mesh_size={coarse:g} mm with "
+            f"refinement={ratio:g} (refined size {p.fine:.3g} mm) needs about {p.estimate:.2e} P{order} "
+            f"cells, {dofs:.2e} dofs", hint=hint)
+    if dofs > WARN_DOFS[dim]:
+        logger.warning("a large mesh: about %.2g P%d cells (%.2g dofs) in %dD for mesh_size=%g mm, "
+                       "refinement=%g; meshing and solving it can take many minutes and GBs",
+                       p.estimate, order, dofs, dim, coarse, ratio)
+    return p
+
+
+def _smallest_size(fits, too_small: float, largest: float = 5.0) -> float | None:
+    """The smallest mesh_size (to 1 %, rounded up) in (too_small, largest] for which fits(size)
+    holds (the estimate falls as the size grows), or None if not even `largest` fits."""
+    if not fits(largest):
+        return None
+    lo, hi = too_small, largest
+    while hi / lo > 1.01:
+        mid = math.sqrt(lo * hi)
+        lo, hi = (lo, mid) if fits(mid) else (mid, hi)
+    return float(f"{hi * 1.005:.3g}") if fits(float(f"{hi * 1.005:.3g}")) else hi
+
+
+def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: float | None,
+            z_symmetric: bool) -> SizePlan:
+    """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
     fine = coarse / ratio
     t = section.thickness
     ft = section.fingertip
@@ -146,8 +205,6 @@ def plan(scene, section, *, mesh_size: float | None = None, refinement: float | 
     kappa = 1.0 / max(ft.min_radius_of_curvature - t, 0.1 * t)
     lz = 1.0
     if dim == 3:
-        if length is None:
-            raise ParameterError("length", length, "> 0 mm (slab length along z)")
         lz = 0.5 * length if z_symmetric else length
         zr = contact_zrange(scene, length, z_symmetric)
         p = dataclasses.replace(p, contact_z=zr)
@@ -158,17 +215,16 @@ def plan(scene, section, *, mesh_size: float | None = None, refinement: float | 
     excess = (l_out * lc * _strip(pe, p.outer_layer, t, dim)
               + lz * (roi * _strip(pe, p.roi_layer, t, dim, kappa=kappa)
                       + (_strip(pe, p.roi_layer, t, dim, cap=True) if roi < section.interface_length else 0.0)))
-    n = int(_CELLS_PER_UNIT[dim] * (section.area() * lz / pe.coarse ** dim + excess))
-    cap = MAX_ELEMENTS[dim]
-    if n > cap:
-        # scaling both sizes by k divides the background by k^dim and the strips by less
-        hc = coarse * (n / cap) ** (1.0 / dim)
-        raise ParameterError(
-            "mesh_size", coarse,
-            f"a size giving at most {cap:.0e} cells in {dim}D; the request (mesh_size={coarse:g} mm, "
-            f"refinement={ratio:g}, refined size {fine:.3g} mm) needs about {n:.2e}",
-            hint=f"keep mesh_size above about {hc:.3g} mm at refinement {ratio:g}")
+    n = int(_CELLS_PER_UNIT[dim] * (_area(section) * lz / pe.coarse ** dim + excess))
     return dataclasses.replace(p, estimate=n)
+
+
+def _area(section) -> float:
+    a = section.__dict__.get("_sizing_area")
+    if a is None:  # Section is frozen; cache the 4000-point shoelace area beside it
+        a = section.area()
+        object.__setattr__(section, "_sizing_area", a)
+    return a
 
 
 def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], dim: int) -> None:

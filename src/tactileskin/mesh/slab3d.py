@@ -47,7 +47,7 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
         logger.warning("the indenter (braille_text=%r) is not symmetric about x = 0, but the slab "
                        "is the half x >= 0 with a symmetry plane there", scene.braille_text)
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3,
-                       length=length, z_symmetric=zsym)
+                       length=length, z_symmetric=zsym, order=order)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"thickness": section.thickness, "order": order, "length": length, "z_symmetric": zsym,
               **plan.as_dict()}
