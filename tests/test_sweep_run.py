@@ -54,3 +54,19 @@ def test_failed_case_is_reported_and_others_go_on(tmp_path, monkeypatch):
     assert [o.status for o in outcomes] == ["done", "failed"]
     assert outcomes[1].diagnosis["residuals"] == [1.0, 0.5]
     assert cache.has(scenes[0]) and not cache.has(scenes[1])
+
+
+def test_sweep_outputs_include_the_fig9_render_of_the_flat_case(tmp_path, caplog):
+    # the render step runs only with render=True (the CLI default); a failure there is only
+    # logged, so assert both the file and the absence of the warning
+    from tactileskin.report.outputs import write_outputs
+
+    scenes = expand_grid(thicknesses=[1.0], materials=["polyurethane"], indenters=["flat"],
+                         base=Scene(**COARSE))
+    cache = ResultCache(tmp_path / "cache")
+    outcomes = run_sweep(scenes, cache, serial=True)
+    with caplog.at_level("WARNING"):
+        paths = write_outputs(tmp_path / "out", outcomes, cache, 1.0, render=True)
+    assert [p.name for p in paths["renders"]] == ["fig9_t1-polyurethane-flat-2d.png"]
+    assert paths["renders"][0].stat().st_size > 1000
+    assert not [r for r in caplog.records if "render" in r.getMessage()]
