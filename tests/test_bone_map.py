@@ -176,3 +176,21 @@ def test_cli_writes_and_lists_the_map_figure(tmp_path, monkeypatch, capsys):
                  "--out", str(out)]) == 0
     names = {p.name for p in out.iterdir()}
     assert not names & {"bone_map.png", "bone_map.csv", "profile_max_z.csv"} and "profile.csv" in names
+
+
+def test_figure_zoom_box_holds_the_loaded_region(tmp_path):
+    # a dot-like load in a corner of a 13 x 10 mm surface: the zoom panel's box holds every
+    # point with P >= 1 % of the peak and is much smaller than the surface
+    from tactileskin.report.bone_map import loaded_box, write_bone_map_figure
+    from tactileskin.results import BoneMap
+
+    s, z = np.linspace(0, 13, 131), np.linspace(0, 10, 41)
+    P = 0.004 * np.exp(-((s[None, :] - 0.3) ** 2 + z[:, None] ** 2) / 0.2)
+    bm = BoneMap(s, z, P, 0.0)
+    s0, s1, z0, z1 = loaded_box(bm)
+    j, i = np.nonzero(P >= 0.01 * P.max())
+    assert s0 <= s[i].min() and s[i].max() <= s1 and z0 <= z[j].min() and z[j].max() <= z1
+    assert (s1 - s0) < 0.3 * 13 and (z1 - z0) < 0.3 * 10
+    assert loaded_box(BoneMap(s, z, -P, 0.0)) is None  # no compression: nothing to zoom on
+    png = write_bone_map_figure(bm, tmp_path / "m.png", "synthetic")
+    assert png.read_bytes()[:4] == b"\x89PNG"
