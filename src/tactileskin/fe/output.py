@@ -159,15 +159,16 @@ def plane_profile(model: Model, nodal: np.ndarray, boundary: str, s_of_point, z:
 def map_planes(model: Model, boundary: str, section_z: float, dz: float | None = None,
                max_planes: int = MAX_MAP_PLANES) -> np.ndarray:
     """Sorted z of the bone map's rows: equally spaced over the boundary's z range at about
-    `dz` (default: the 5th percentile of its facets' edge lengths, i.e. the fine mesh size
-    where the surface is refined, robust to slivers), with at most `max_planes` intervals,
-    plus the section plane `section_z` (so the section profile is a row of the map)."""
+    `dz` (default: a quarter of the 5th percentile of its facets' edge lengths, i.e. of the
+    fine mesh size where the surface is refined, robust to slivers; a quarter as along s,
+    where `plane_profile` samples each facet cut 4 times), with at most `max_planes`
+    intervals, plus the section plane `section_z` (so the section profile is a row)."""
     fn = _facet_nodes(model, boundary)
     V = model.basis.doflocs[:, fn[:, :3]]                        # (3, F, 3) vertex coordinates
     z0, z1 = float(V[2].min()), float(V[2].max())
     if dz is None:
         edges = np.linalg.norm(V - np.roll(V, 1, axis=2), axis=0)  # (F, 3)
-        dz = float(np.percentile(edges, 5))
+        dz = 0.25 * float(np.percentile(edges, 5))
     if not dz > 0:
         raise ParameterError("bone map dz", dz, "> 0 mm")
     n = int(min(max(np.ceil((z1 - z0) / dz), 1), max_planes))
