@@ -13,8 +13,8 @@ Every caller that identifies a cached result (the cache itself, run_sweep, resul
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
 time stamp, so an edit within the same second is not missed.
 
-Entry. `<cache>/<key>/` holds the files `tactileskin solve` writes (profile.csv,
-summary.json, contact.csv, result.vtu), scene.toml, and cache.json (schema, key, package
+Entry. `<cache>/<key>/` holds the files `Result.write` writes (profile.csv,
+summary.json, contact.csv, result.vtu; 3D also bone_map.csv, profile_max_z.csv), scene.toml, and cache.json (schema, key, package
 version). It is staged beside its final name and renamed into place when complete, so a
 killed run leaves no half-written entry. Loading validates it: cache.json names this key
 and schema, summary.json is an object with finite peak/span/auc, profile.csv has >= 2
@@ -52,7 +52,8 @@ except ImportError:  # pragma: no cover - not POSIX
 
 log = logging.getLogger(__name__)
 
-ENTRY_FILES = ("profile.csv", "summary.json", "contact.csv", "result.vtu", "scene.toml", "cache.json")
+ENTRY_FILES = ("profile.csv", "summary.json", "contact.csv", "result.vtu", "bone_map.csv", "profile_max_z.csv",
+               "scene.toml", "cache.json")
 
 
 class CacheError(TactileSkinError):

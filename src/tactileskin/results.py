@@ -65,6 +65,78 @@ def auc(s, p) -> float:
 # --- solver results ------------------------------------------------------------------------
 
 @dataclass
+class BoneMap:
+    """Bone pressure P(s, z) of a 3D result on a tensor grid: pressure[j, i] at (s[i], z[j]).
+
+    s: the section profile's samples (so the row z = section_z is the profile); z: rows over
+    the slab (fe.output.map_planes). Values are the nodal pressure field of result.vtu,
+    interpolated with each bone facet's own shape functions (fe.output.surface_grid).
+    """
+
+    s: np.ndarray
+    z: np.ndarray
+    pressure: np.ndarray
+    section_z: float = 0.0
+
+    def __post_init__(self):
+        self.s = np.asarray(self.s, float)
+        self.z = np.asarray(self.z, float)
+        self.pressure = np.asarray(self.pressure, float)
+        for name in ("s", "z"):
+            v = getattr(self, name)
+            if v.ndim != 1 or v.size < 1 or np.any(np.diff(v) <= 0):
+                raise ParameterError(f"bone map {name}", f"shape {v.shape}", "a strictly increasing 1-D grid")
+        if self.pressure.shape != (self.z.size, self.s.size):
+            raise ParameterError("bone map pressure", f"shape {self.pressure.shape}",
+                                 f"(len(z), len(s)) = ({self.z.size}, {self.s.size})")
+        if not np.all(np.isfinite(self.pressure)):
+            raise ConvergenceError("non-finite values in the bone map", {"field": "bone_map"})
+
+    def max_over_z(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(s, P_max(s) = max over z of P(s, z), the z where it occurs)."""
+        j = np.argmax(self.pressure, axis=0)
+        return self.s, self.pressure[j, np.arange(self.s.size)], self.z[j]
+
+    def peak(self) -> tuple[float, float, float]:
+        """(largest P over the map, its s, its z)."""
+        j, i = np.unravel_index(int(np.argmax(self.pressure)), self.pressure.shape)
+        return float(self.pressure[j, i]), float(self.s[i]), float(self.z[j])
+
+    def row(self, z: float) -> np.ndarray:
+        """P(s) on the map's row nearest z."""
+        return self.pressure[int(np.argmin(np.abs(self.z - z)))]
+
+    def to_csv(self) -> str:
+        """Long (tidy) table s_mm, z_mm, pressure_mpa, one row per grid point, z-major."""
+        S, Z = np.meshgrid(self.s, self.z)
+        return _csv(["s_mm", "z_mm", "pressure_mpa"], S.ravel(), Z.ravel(), self.pressure.ravel())
+
+
+def read_bone_map(path, section_z: float = 0.0) -> BoneMap:
+    """The BoneMap of a bone_map.csv (as Result.write writes it). A file that is not a complete
+    (s, z) grid of finite numbers raises ParameterError naming it."""
+    path = Path(path)
+    valid = "a bone_map.csv written by tactileskin solve (s_mm, z_mm, pressure_mpa on a full grid)"
+    try:
+        with open(path, encoding="utf-8") as fh:
+            header = fh.readline().strip().split(",")
+            data = np.loadtxt(fh, delimiter=",", ndmin=2)
+    except (OSError, ValueError) as e:
+        raise ParameterError("bone map file", str(path), valid, hint=str(e)) from None
+    if header != ["s_mm", "z_mm", "pressure_mpa"] or data.shape[1] != 3 or not np.all(np.isfinite(data)):
+        raise ParameterError("bone map file", str(path), valid)
+    s, z = np.unique(data[:, 0]), np.unique(data[:, 1])
+    if data.shape[0] != s.size * z.size:
+        raise ParameterError("bone map file", str(path), valid, hint=f"{data.shape[0]} rows for "
+                             f"{s.size} s x {z.size} z values")
+    P = np.full((z.size, s.size), np.nan)
+    P[np.searchsorted(z, data[:, 1]), np.searchsorted(s, data[:, 0])] = data[:, 2]
+    if not np.all(np.isfinite(P)):
+        raise ParameterError("bone map file", str(path), valid, hint="repeated (s, z) points")
+    return BoneMap(s, z, P, section_z)
+
+
+@dataclass
 class Result:
     """Output of one solve (units mm, MPa, N; plane-strain forces per mm of depth).
 
@@ -72,6 +144,8 @@ class Result:
       the bone interface, L2-projected from the quadrature points, sorted by curvilinear
       distance s from the symmetry line. 3D: on the section plane z = stats["profile_plane_z"],
       sampled along the cut of each bone-interface facet (fe.output.plane_profile).
+    bone_map: 3D only, P(s, z) over the whole bone surface (BoneMap); its row z =
+      profile_plane_z is the profile.
     contact_x, contact_pressure: contact pressure (per current area) at the contact points
       of the outer surface, sorted by the current x.
     reaction: vertical force the fixed boundaries exert on the modelled (half) domain.
@@ -89,6 +163,7 @@ class Result:
     fields: dict | None = None
     history: list = field(default_factory=list)
     scene: dict | None = None
+    bone_map: BoneMap | None = None
 
     def __post_init__(self):
         for name in ("s", "pressure", "contact_x", "contact_pressure"):
@@ -137,6 +212,7 @@ class Result:
             "wall_s": float(self.stats.get("wall_s", 0.0)),
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
+            **self._map_summary(),
             **({"scene": self.scene} if self.scene else {}),
         }
         found = quality.flags(out)
@@ -144,16 +220,24 @@ class Result:
         out["flags"] = [f.to_dict() for f in found]
         return out
 
+    def _map_summary(self) -> dict:
+        if self.bone_map is None:
+            return {}
+        p, s, z = self.bone_map.peak()
+        return {"peak_map_mpa": p, "peak_map_s_mm": s, "peak_map_z_mm": z}
+
     @property
     def status(self) -> str:
         """'ok' or 'suspect: <reasons>' (tactileskin.quality)."""
         return self.summary()["status"]
 
     def write(self, directory) -> Path:
-        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu) into
-        `directory`, creating it; each file is written atomically and only these names are
-        touched (a result.vtu of an earlier write is removed when there are no fields).
-        Callers writing into a user's folder claim it first (fileio.claim_dir)."""
+        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu; 3D: also
+        bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
+        where it occurs) into `directory`, creating it; each file is written atomically and
+        only these names are touched (a result.vtu or map of an earlier write is removed when
+        this result has none). Callers writing into a user's folder claim it first
+        (fileio.claim_dir)."""
         directory = fileio.make_dirs(directory)
         s, p = self._profile()
         fileio.atomic_write_text(directory / "profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
@@ -162,16 +246,28 @@ class Result:
         vtu = directory / "result.vtu"
         if self.fields is not None:
             _write_vtu(vtu, self.fields)
-        elif vtu.is_file():  # a stale field file would not match the new profile
-            with fileio.os_errors(vtu):
-                vtu.unlink()
+        else:  # a stale field file would not match the new profile
+            _remove(vtu)
+        if self.bone_map is not None:
+            fileio.atomic_write_text(directory / "bone_map.csv", self.bone_map.to_csv())
+            fileio.atomic_write_text(directory / "profile_max_z.csv",
+                                     _csv(["s_mm", "pressure_mpa", "z_mm"], *self.bone_map.max_over_z()))
+        else:
+            _remove(directory / "bone_map.csv")
+            _remove(directory / "profile_max_z.csv")
         # last: a folder with a summary.json holds a complete result
         fileio.atomic_write_json(directory / "summary.json", self.summary())
         return directory
 
 
 # the file names Result.write owns in a folder
-OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu")
+OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv")
+
+
+def _remove(path: Path) -> None:
+    if path.is_file():
+        with fileio.os_errors(path):
+            path.unlink()
 
 
 def _csv(header: list[str], *cols) -> str:

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import click
 
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
 # every name `solve` writes into its folder (also how a folder of an earlier version is recognised)
-OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "section_2d", "compare_2d.json")
+RESULT_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
+                "bone_map.png")
+OWN_NAMES = RESULT_FILES + ("section_2d", "compare_2d.json")
 
 
 EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see the help text)
@@ -19,8 +23,9 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
     "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
 @click.option("--out", "out", type=click.Path(file_okay=False), required=True,
-              help="Output folder (profile.csv, contact.csv, summary.json, result.vtu): a new or "
-                   "empty folder, or one written by `solve`; only these files are replaced.")
+              help="Output folder (profile.csv, contact.csv, summary.json, result.vtu; 3D also "
+                   "bone_map.csv, bone_map.png, profile_max_z.csv): a new or empty folder, or one "
+                   "written by `solve`; only these files are replaced.")
 @click.option("--elastic", is_flag=True, default=False, help="Ignore viscoelasticity (Prony series).")
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
@@ -40,8 +45,10 @@ def command(out, elastic, compare_2d, **kw):
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
-        res = solve(scene)
+        with solve_progress(scene.label()) as show:
+            res = solve(scene, progress=show)
         path = res.write(out)
+        _write_map_figure(res, path, scene.label())
     s = res.summary()
     t = Table(title=escape(f"{scene.label()} -> {path}"), show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
@@ -49,11 +56,15 @@ def command(out, elastic, compare_2d, **kw):
     t.add_row("area under P(s)", f"{s['auc']:.4g} MPa mm")
     if scene.dim == 3:
         t.add_row("bone profile on plane", f"z = {res.stats.get('profile_plane_z', 0.0):g} mm")
+        if "peak_map_mpa" in s:
+            t.add_row("peak of the bone map P(s, z)", f"{s['peak_map_mpa']:.4g} MPa at s = "
+                      f"{s['peak_map_s_mm']:.3g} mm, z = {s['peak_map_z_mm']:.3g} mm")
         t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
     else:
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
+    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).is_file()))
     if "min_J" in s:
         t.add_row("min volume ratio J / max |stress|",
                   f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")
@@ -71,6 +82,42 @@ def command(out, elastic, compare_2d, **kw):
     return rc
 
 
+@contextlib.contextmanager
+def solve_progress(label: str):
+    """A transient progress line on stderr for one solve; yields the callback for
+    fe.solve(progress=) (increment, time, travel and Newton iterations)."""
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    with Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(bar_width=16),
+                  TextColumn("{task.fields[info]}"), TimeElapsedColumn(),
+                  console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(escape(label), total=1.0, info="meshing, setting up")
+
+        def show(i):  # short: it must fit an 80-column terminal beside the label
+            bar.update(task, completed=i.t, total=i.T,
+                       info=f"increment {i.increment}, t {i.t:.3g}/{i.T:.3g} s, d {i.travel:.3g} mm, "
+                            f"Newton {i.newton} ({i.newton_total})")
+
+        yield show
+
+
+def _write_map_figure(res, path, label: str) -> None:
+    """bone_map.png of a 3D result; a 2D result removes one left by an earlier 3D solve."""
+    from tactileskin import fileio
+
+    png = path / "bone_map.png"
+    if res.bone_map is None:
+        if png.is_file():
+            with fileio.os_errors(png):
+                png.unlink()
+        return
+    from tactileskin.report.bone_map import write_bone_map_figure
+
+    write_bone_map_figure(res.bone_map, png, title=f"bone pressure, {label}")
+
+
 def _compare_2d(scene, s3, out) -> None:
     """Solve the 2D section of a 3D scene; print and write (compare_2d.json) the differences."""
     import os
@@ -84,7 +131,8 @@ def _compare_2d(scene, s3, out) -> None:
     from tactileskin.fileio import atomic_write_json
 
     sc2 = scene.replace(dim=2)  # default 2D mesh sizes are re-derived on the dim change
-    r2 = solve(sc2)
+    with solve_progress(sc2.label()) as show:
+        r2 = solve(sc2, progress=show)
     r2.write(os.path.join(out, "section_2d"))
     s2 = r2.summary()
     # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN

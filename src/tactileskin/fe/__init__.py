@@ -1,6 +1,7 @@
 """Finite-strain hyperfoam-viscoelastic contact solver on scikit-fem.
 
-High level: `solve(scene, mesh=None, *, history=False) -> Result`.
+High level: `solve(scene, mesh=None, *, history=False, progress=None) -> Result` (progress:
+called with a `solver.IncrementInfo` after each converged increment).
 Low level (any mesh + named boundaries + BCs + indenter): `Model`, `Dirichlet`, `Contact`,
 `run`, `SolverOptions`, `make_result`.
 
@@ -34,12 +35,12 @@ import numpy as np
 
 from tactileskin.fe.model import Contact, Dirichlet, Model
 from tactileskin.fe.output import make_result, reaction
-from tactileskin.fe.solver import SolverOptions, run
+from tactileskin.fe.solver import IncrementInfo, SolverOptions, run
 
 log = logging.getLogger(__name__)
 
 __all__ = ["solve", "model_for_scene", "material_law", "Model", "Dirichlet", "Contact", "run",
-           "SolverOptions", "make_result", "reaction"]
+           "SolverOptions", "IncrementInfo", "make_result", "reaction"]
 
 
 def material_law(hyperfoam):
@@ -105,9 +106,12 @@ def phases(model: Model, **extra: float) -> dict:
     return out
 
 
-def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None):
+def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None,
+          progress=None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
-    Raises ParameterError before meshing if the indenter cannot reach the skin (no contact)."""
+    Raises ParameterError before meshing if the indenter cannot reach the skin (no contact).
+    progress: optional callable, given an IncrementInfo (increment, t, T, travel, Newton
+    iterations) after each converged increment; nothing is printed either way."""
     from tactileskin.geometry.indenters import require_contact
     from tactileskin.materials import get_material
 
@@ -128,7 +132,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     def record(model, ev):
         return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1])}
 
-    ev, stats = run(model, scene.duration, options, history=history, record=record)
+    ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
     t2 = time.perf_counter()
     res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
     stats.wall_s = time.perf_counter() - t0

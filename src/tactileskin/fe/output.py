@@ -8,7 +8,7 @@ from tactileskin.errors import ConvergenceError, ParameterError
 from tactileskin.fe import kernels
 from tactileskin.fe.model import Evaluation, Model
 from tactileskin.fe.recovery import PointFit, Projector
-from tactileskin.results import Result
+from tactileskin.results import BoneMap, Result
 
 _VTK_CELL = {(2, 6): "triangle6", (2, 3): "triangle", (3, 10): "tetra10", (3, 4): "tetra",
              (2, 9): "quad9", (2, 4): "quad"}
@@ -77,6 +77,8 @@ def _tri_shape(xi: np.ndarray, eta: np.ndarray, n: int) -> np.ndarray:
     return np.stack([l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), l2 * (2 * l2 - 1),
                      4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0], axis=-1)
 
+
+MAX_MAP_PLANES = 400  # bounds the bone map's size (rows x section samples)
 
 _REF_TRI = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
 
@@ -154,6 +156,102 @@ def plane_profile(model: Model, nodal: np.ndarray, boundary: str, s_of_point, z:
     return np.bincount(grp, weights=s) / cnt, np.bincount(grp, weights=vals) / cnt
 
 
+def map_planes(model: Model, boundary: str, section_z: float, dz: float | None = None,
+               max_planes: int = MAX_MAP_PLANES) -> np.ndarray:
+    """Sorted z of the bone map's rows: equally spaced over the boundary's z range at about
+    `dz` (default: a quarter of the 5th percentile of its facets' edge lengths, i.e. of the
+    fine mesh size where the surface is refined, robust to slivers; a quarter as along s,
+    where `plane_profile` samples each facet cut 4 times), with at most `max_planes`
+    intervals, plus the section plane `section_z` (so the section profile is a row)."""
+    fn = _facet_nodes(model, boundary)
+    V = model.basis.doflocs[:, fn[:, :3]]                        # (3, F, 3) vertex coordinates
+    z0, z1 = float(V[2].min()), float(V[2].max())
+    if dz is None:
+        edges = np.linalg.norm(V - np.roll(V, 1, axis=2), axis=0)  # (F, 3)
+        dz = 0.25 * float(np.percentile(edges, 5))
+    if not dz > 0:
+        raise ParameterError("bone map dz", dz, "> 0 mm")
+    n = int(min(max(np.ceil((z1 - z0) / dz), 1), max_planes))
+    z = np.linspace(z0, z1, n + 1)
+    if np.min(np.abs(z - section_z)) > 1e-9 * max(z1 - z0, 1.0):
+        z = np.sort(np.append(z, section_z))
+    return z
+
+
+def surface_grid(model: Model, nodal: np.ndarray, boundary: str, s_of_point, s: np.ndarray,
+                 z: np.ndarray, *, iterations: int = 8) -> np.ndarray:
+    """(len(z), len(s)) values of a nodal field at the points (s_i, z_j) of a 3D boundary that
+    (s, z) parametrise (the bone interface of the extruded slab: s along the section, z along
+    the finger).
+
+    Each grid point is located in the facet whose vertices' (s, z) triangle holds it best
+    (largest smallest barycentric coordinate), then its reference coordinates are corrected
+    by chord iterations (the facet's affine (s, z) Jacobian) until the facet's own P2 geometry
+    maps it to (s_i, z_j); the value is the facet's P1/P2 interpolant there, as in
+    `plane_profile`. Raises ParameterError for a grid point outside the boundary.
+    """
+    if model.m != 3:
+        raise ParameterError("bone map dimension", model.m, "3 (a 2D model has a profile, not a map)")
+    s, z = np.asarray(s, float), np.asarray(z, float)
+    for name, v in (("s", s), ("z", z)):
+        if v.ndim != 1 or v.size < 1 or np.any(np.diff(v) <= 0):
+            raise ParameterError(f"bone map {name}", f"shape {v.shape}", "a strictly increasing 1-D grid")
+    fn = _facet_nodes(model, boundary)
+    X = model.basis.doflocs
+    F, n = fn.shape
+    sv = np.asarray(s_of_point(X[:2, fn[:, :3]].reshape(2, -1).T), float).reshape(F, 3)
+    zv = X[2, fn[:, :3]]
+    tol_s = 1e-7 * max(float(np.ptp(sv)), 1.0)
+    tol_z = 1e-7 * max(float(np.ptp(zv)), 1.0)
+    # candidate (facet, grid point) pairs: the grid points inside each facet's (s, z) box
+    lo_i = np.searchsorted(s, sv.min(axis=1) - tol_s, "left")
+    hi_i = np.searchsorted(s, sv.max(axis=1) + tol_s, "right")
+    lo_j = np.searchsorted(z, zv.min(axis=1) - tol_z, "left")
+    hi_j = np.searchsorted(z, zv.max(axis=1) + tol_z, "right")
+    cs, cz = hi_i - lo_i, hi_j - lo_j
+    cnt = cs * cz
+    fac = np.repeat(np.arange(F), cnt)
+    local = np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    ii = lo_i[fac] + local % cs[fac]
+    jj = lo_j[fac] + local // cs[fac]
+    # affine (s, z) map of each facet: (s, z) = (s0, z0) + A (xi, eta)
+    A = np.stack([np.stack([sv[:, 1] - sv[:, 0], sv[:, 2] - sv[:, 0]], -1),
+                  np.stack([zv[:, 1] - zv[:, 0], zv[:, 2] - zv[:, 0]], -1)], axis=1)  # (F, 2, 2)
+    det = A[:, 0, 0] * A[:, 1, 1] - A[:, 0, 1] * A[:, 1, 0]
+    ok = np.abs(det) > 1e-12 * max(float(np.ptp(sv)), float(np.ptp(zv)), 1.0) ** 2  # not degenerate
+    det = np.where(ok, det, 1.0)
+    Ainv = np.stack([np.stack([A[:, 1, 1], -A[:, 0, 1]], -1),
+                     np.stack([-A[:, 1, 0], A[:, 0, 0]], -1)], axis=1) / det[:, None, None]
+    r = np.stack([s[ii] - sv[fac, 0], z[jj] - zv[fac, 0]], -1)
+    ref = np.einsum("kab,kb->ka", Ainv[fac], r)
+    score = np.minimum(np.minimum(ref[:, 0], ref[:, 1]), 1.0 - ref[:, 0] - ref[:, 1])
+    score = np.where(ok[fac], score, -np.inf)                    # degenerate (s, z) triangles last
+    # the best facet of each grid point: sort by point, then score descending
+    k = jj * len(s) + ii
+    order = np.lexsort((-score, k))
+    first = np.concatenate([[True], np.diff(k[order]) != 0])
+    pick = order[first]
+    missing = np.setdiff1d(np.arange(len(s) * len(z)), k[pick])
+    if missing.size or np.any(score[pick] < -1e-3):
+        bad = missing[0] if missing.size else k[pick][np.argmin(score[pick])]
+        raise ParameterError("bone map point (s, z)", (float(s[bad % len(s)]), float(z[bad // len(s)])),
+                             f"on the {boundary} surface: s in [{sv.min():.6g}, {sv.max():.6g}], "
+                             f"z in [{zv.min():.6g}, {zv.max():.6g}] mm")
+    fac, ref, ii, jj = fac[pick], ref[pick], ii[pick], jj[pick]
+    nodes = fn[fac]
+    P = X[:, nodes]                                              # (3, k, n)
+    Ai = Ainv[fac]
+    for _ in range(iterations):  # chord iterations on the curved (P2) facet
+        N = _tri_shape(ref[:, 0], ref[:, 1], n)
+        xyz = np.einsum("kn,dkn->kd", N, P)
+        res = np.stack([np.asarray(s_of_point(xyz[:, :2]), float) - s[ii], xyz[:, 2] - z[jj]], -1)
+        ref = ref - np.einsum("kab,kb->ka", Ai, res)
+    N = _tri_shape(ref[:, 0], ref[:, 1], n)
+    out = np.empty(len(s) * len(z))
+    out[jj * len(s) + ii] = np.einsum("kn,kn->k", N, np.asarray(nodal, float)[nodes])
+    return out.reshape(len(z), len(s))
+
+
 def profile_plane_z(model: Model) -> float:
     """z of the section plane of a 3D model: the indenter's 2D section row
     (`BrailleIndenter.section_z`, the dot row nearest z = 0), else z = 0."""
@@ -185,7 +283,8 @@ def law_state(ev: Evaluation, sig: np.ndarray) -> dict:
 def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: str = "bone_interface",
                 vertical: int = 1, scene: dict | None = None, plane_z: float | None = None) -> Result:
     """Result of a converged state. 2D: the profile at the path's nodes. 3D: the profile on
-    the section plane z = plane_z (default `profile_plane_z(model)`), see `plane_profile`."""
+    the section plane z = plane_z (default `profile_plane_z(model)`), see `plane_profile`, and
+    the bone map P(s, z) on the grid (profile's s) x `map_planes` (see `surface_grid`)."""
     pj = Projector(model)
     sig = model.stress(ev)
     fields = nodal_fields(model, ev, pj, sig)
@@ -194,7 +293,14 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     if model.m == 3:
         plane_z = profile_plane_z(model) if plane_z is None else float(plane_z)
         s, p = plane_profile(model, fields["pressure"], path, s_of_point, plane_z)
+        zg = map_planes(model, path, plane_z)
+        grid = surface_grid(model, fields["pressure"], path, s_of_point, s, zg)
+        # the section row is the same interpolant as the profile (equal to rounding: checked
+        # in tests/test_bone_map.py); take the profile's values so that they agree exactly
+        grid[int(np.argmin(np.abs(zg - plane_z)))] = p
+        bmap = BoneMap(s, zg, grid, plane_z)
     else:
+        bmap = None
         # the profile from the local fit (second order at the boundary; the projected nodal
         # field, first order there, stays in the VTK output elsewhere): see recovery.PointFit
         sd, s = path_nodes(model, path, s_of_point)
@@ -230,4 +336,5 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           "reaction_vector": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, reaction=float(r[vertical]),
-                  stats=st, fields=vtk, history=list(stats.history), scene=scene)
+                  stats=st, fields=vtk, history=list(stats.history), scene=scene,
+                  bone_map=bmap)

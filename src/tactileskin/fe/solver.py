@@ -303,11 +303,26 @@ def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts
     raise _Failure("augmented Lagrangian did not settle", {"penetration_mm": pen, "multiplier_change": change})
 
 
+@dataclass(frozen=True)
+class IncrementInfo:
+    """What `run(..., progress=)` reports after each converged increment."""
+
+    increment: int         # number of converged increments so far
+    t: float               # time reached (s)
+    T: float               # end time (s)
+    travel: float          # indenter travel d at t (mm)
+    newton: int            # Newton iterations spent since the previous increment (incl. cutbacks)
+    newton_total: int      # Newton iterations of the whole run so far
+    cutbacks: int          # cut-back increments of the whole run so far
+
+
 def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: bool = False,
-        record: callable = None) -> tuple[Evaluation, Stats]:
-    """Integrate from the committed state at model.t to time T; returns the last evaluation."""
+        record: callable = None, progress: callable = None) -> tuple[Evaluation, Stats]:
+    """Integrate from the committed state at model.t to time T; returns the last evaluation.
+    progress: called with an IncrementInfo after each converged increment."""
     opts = opts or SolverOptions()
     stats = Stats()
+    newton_seen = 0
     t0 = time.perf_counter()
     t = model.t
     span = T - t
@@ -341,6 +356,10 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
         log.info("increment %d: t = %.5g s (dt %.3g), %d Newton iterations", stats.increments, t, dt, its)
         if history:
             stats.history.append({"t": t, **(record(model, ev) if record else {})})
+        if progress is not None:
+            progress(IncrementInfo(stats.increments, t, T, float(model.travel(t)),
+                                   stats.newton_iterations - newton_seen, stats.newton_iterations, stats.cutbacks))
+            newton_seen = stats.newton_iterations
         if its <= opts.easy_iterations:
             dt *= opts.growth
         if stats.increments >= opts.max_increments:

@@ -1,0 +1,197 @@
+"""3D bone-pressure map P(s, z) (fe.output.surface_grid, results.BoneMap), its files, the
+CLI figure, and the solver's per-increment progress hook."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tactileskin.errors import ParameterError
+from tactileskin.fe import Dirichlet, make_result, model_for_scene, run
+from tactileskin.fe.model import Model
+from tactileskin.fe.output import map_planes, plane_profile, surface_grid
+from tactileskin.results import OWN_NAMES, read_bone_map
+from tactileskin.scene import Scene
+
+# t = 3 silicone under the flat plate, elastic, 0.1 mm travel, on a 1.5 mm slab (quarter
+# model: z in [0, 0.75]) with u_z = 0 on both ends: plane strain, so the continuum solution
+# does not depend on z (the check benchmarks/braille_2d_vs_3d.py --flat-check makes against 2D)
+SCENE = Scene(thickness=3, indenter="flat", dim=3, mesh_size=1.0, refinement=2, viscoelastic=False, depth=0.1)
+LENGTH = 1.5
+
+
+def _slab(scene=SCENE, length=LENGTH):
+    from tactileskin.mesh.slab3d import build_slab_mesh
+
+    return build_slab_mesh(scene, length=length)
+
+
+@pytest.fixture(scope="module")
+def plane_strain():
+    """(model, result, progress reports) of the plane-strain slab (~3 s)."""
+    model, _ = model_for_scene(SCENE, _slab())
+    model = Model(model.mesh, model.boundaries, model.law, list(model.dirichlet) + [Dirichlet("end_front", (2,))],
+                  prony=model.prony, formulation=model.formulation, contact=model.contact, order=SCENE.order,
+                  stiffness=model.stiffness)
+    reports = []
+    ev, stats = run(model, SCENE.duration, progress=reports.append)
+    res = make_result(model, ev, stats, s_of_point=SCENE.section().s_of_point, scene=SCENE.to_dict())
+    return model, res, reports, stats
+
+
+def test_grid_is_the_facet_interpolant_on_every_plane(plane_strain):
+    # On an analytic field varying in s and z the grid must reproduce plane_profile (the same
+    # facet interpolant, located the other way round: from (s, z) to the facet) to rounding on
+    # every plane, and the field itself to the P2 interpolation error (< 0.01 at h = 1,
+    # tests/test_output3d.py). A wrong facet or a wrong z would be off by O(0.1).
+    model, _, _, _ = plane_strain
+    section = SCENE.section()
+    X = model.basis.doflocs
+    f = np.sin(X[0]) * np.cos(0.7 * X[2]) + X[1]
+    for z in (0.0, 0.37, 0.75):
+        s, v = plane_profile(model, f, "bone_interface", section.s_of_point, z)
+        g = surface_grid(model, f, "bone_interface", section.s_of_point, s, np.array([z]))[0]
+        np.testing.assert_allclose(g, v, rtol=0, atol=1e-12)
+    s = np.linspace(0.0, section.interface_length, 57)
+    z = np.linspace(0.0, 0.5 * LENGTH, 9)
+    g = surface_grid(model, f, "bone_interface", section.s_of_point, s, z)
+    xy = section.point_at_s(s).reshape(len(s), 2)
+    exact = np.sin(xy[:, 0])[None, :] * np.cos(0.7 * z)[:, None] + xy[:, 1][None, :]
+    assert np.abs(g - exact).max() < 0.01
+
+
+def test_grid_outside_the_surface_is_an_error(plane_strain):
+    model, _, _, _ = plane_strain
+    section = SCENE.section()
+    with pytest.raises(ParameterError, match="bone map point"):
+        surface_grid(model, model.basis.doflocs[0], "bone_interface", section.s_of_point,
+                     np.array([0.0, 1.0]), np.array([0.0, 5.0]))
+
+
+def test_map_planes_cover_the_slab_and_hold_the_section(plane_strain):
+    model, _, _, _ = plane_strain
+    z = map_planes(model, "bone_interface", 0.3, dz=0.2)
+    assert z[0] == 0.0 and z[-1] == pytest.approx(0.5 * LENGTH) and 0.3 in z
+    assert np.all(np.diff(z) > 0) and np.diff(z).max() <= 0.2 + 1e-12
+
+
+def test_plane_strain_map_is_independent_of_z(plane_strain):
+    # Plane strain: every row of the map is the section profile up to the discretisation of
+    # this unstructured h 1 / r 2 tet mesh: its P1-recovered pressure differs between rows by
+    # up to 7.3 % (relative L2) and 4.0 % in the peak, and the L2 spread shrinks with the mesh
+    # (measured at h 0.7 / 0.5: 5.5 % / 3.9 %, peaks 6.2 % / 2.0 %), so it is discretisation,
+    # not sampling (a wrong facet or z would be O(1)); benchmarks/results/braille_2d_vs_3d.md
+    # shows 1-3 % peak spreads between planes on the same nominal mesh.
+    _, res, _, _ = plane_strain
+    bm, p0 = res.bone_map, res.pressure
+    assert bm.z.size >= 3 and bm.z[0] == 0.0 and bm.z[-1] == pytest.approx(0.5 * LENGTH)
+    np.testing.assert_array_equal(bm.s, res.s)
+    np.testing.assert_array_equal(bm.row(bm.section_z), p0)  # the profile is the section row
+    norm = np.sqrt(np.trapezoid(p0 ** 2, bm.s))
+    for row in bm.pressure:
+        assert np.sqrt(np.trapezoid((row - p0) ** 2, bm.s)) / norm < 0.10
+        assert abs(row.max() / p0.max() - 1) < 0.06
+    # the load is carried near s = 0 (under the plate) on every row, as on the section
+    assert np.all(bm.s[np.argmax(bm.pressure, axis=1)] < 1.0)
+
+
+def test_max_over_z_and_peak_bound_the_section_profile(plane_strain):
+    _, res, _, _ = plane_strain
+    s, pmax, zmax = res.bone_map.max_over_z()
+    assert np.all(pmax >= res.pressure)
+    assert np.all((zmax >= 0) & (zmax <= 0.5 * LENGTH + 1e-12))
+    summ = res.summary()
+    assert summ["peak_map_mpa"] == pytest.approx(pmax.max(), rel=0, abs=0)
+    assert summ["peak_map_mpa"] >= summ["peak_mpa"]
+    j, i = np.unravel_index(np.argmax(res.bone_map.pressure), res.bone_map.pressure.shape)
+    assert (summ["peak_map_s_mm"], summ["peak_map_z_mm"]) == (res.bone_map.s[i], res.bone_map.z[j])
+
+
+def test_progress_once_per_increment(plane_strain):
+    _, _, reports, stats = plane_strain
+    assert len(reports) == stats.increments >= 2
+    t = np.array([r.t for r in reports])
+    assert np.all(np.diff(t) > 0) and t[-1] == pytest.approx(SCENE.duration, rel=1e-12)
+    assert [r.increment for r in reports] == list(range(1, stats.increments + 1))
+    assert sum(r.newton for r in reports) == reports[-1].newton_total == stats.newton_iterations
+    assert reports[-1].travel == pytest.approx(SCENE.depth)  # the full travel at t = T
+    assert all(r.T == SCENE.duration for r in reports)
+
+
+def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
+    import meshio
+
+    from tactileskin.cache import ResultCache
+
+    _, res, _, _ = plane_strain
+    out = res.write(tmp_path / "r")
+    assert {p.name for p in out.iterdir()} == set(OWN_NAMES)
+    bm = read_bone_map(out / "bone_map.csv", section_z=res.bone_map.section_z)
+    np.testing.assert_allclose(bm.s, res.bone_map.s, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(bm.z, res.bone_map.z, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(bm.pressure, res.bone_map.pressure, rtol=1e-9, atol=1e-15)
+    mx = np.loadtxt(out / "profile_max_z.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(mx.T, np.array(res.bone_map.max_over_z()), rtol=1e-9, atol=1e-15)
+    prof = np.loadtxt(out / "profile.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(prof[:, 1], res.pressure, rtol=1e-9, atol=1e-15)
+    summ = json.loads((out / "summary.json").read_text())
+    assert summ["peak_map_mpa"] == pytest.approx(res.bone_map.peak()[0], rel=1e-12)
+    # the map samples result.vtu's nodal pressure (linear on each facet): within its range
+    vtu = meshio.read(out / "result.vtu").point_data["pressure"]
+    assert vtu.min() - 1e-12 <= bm.pressure.min() and bm.pressure.max() <= vtu.max() + 1e-12
+    # a cache entry of a 3D result holds the map and validates
+    cache = ResultCache(tmp_path / "cache")
+    entry = cache.store(SCENE, res)
+    assert (entry / "bone_map.csv").is_file()
+    rec = cache.lookup(SCENE)
+    assert rec is not None and rec.summary["peak_map_mpa"] == summ["peak_map_mpa"]
+
+
+def test_damaged_bone_map_file_is_a_parameter_error(plane_strain, tmp_path):
+    _, res, _, _ = plane_strain
+    out = res.write(tmp_path / "r")
+    lines = (out / "bone_map.csv").read_text().splitlines()
+    (out / "bone_map.csv").write_text("\n".join(lines[:-1]) + "\n")  # one grid point missing
+    with pytest.raises(ParameterError, match="bone map file"):
+        read_bone_map(out / "bone_map.csv")
+
+
+def test_cli_writes_and_lists_the_map_figure(tmp_path, monkeypatch, capsys):
+    # The CLI on a short free-ended slab (the library's default mesh is 20 mm long: minutes):
+    # the solve, files, figure and listing are the real ones
+    import tactileskin.mesh as mesh_mod
+    from tactileskin.cli import main
+
+    build = mesh_mod.build_mesh
+    monkeypatch.setattr(mesh_mod, "build_mesh", lambda sc: _slab(sc) if sc.dim == 3 else build(sc))
+    out = tmp_path / "o"
+    args = ["solve", "--dim", "3", "-t", "3", "--mesh-size", "1", "--refinement", "2", "--depth", "0.1",
+            "--elastic", "--out", str(out)]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    png = out / "bone_map.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+    assert "bone_map.png" in text and "bone_map.csv" in text and "peak of the bone map" in text
+    # the same folder solved in 2D: the 3D map files of the earlier run are removed
+    assert main(["solve", "-t", "3", "--mesh-size", "1", "--refinement", "2", "--depth", "0.1", "--elastic",
+                 "--out", str(out)]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert not names & {"bone_map.png", "bone_map.csv", "profile_max_z.csv"} and "profile.csv" in names
+
+
+def test_figure_zoom_box_holds_the_loaded_region(tmp_path):
+    # a dot-like load in a corner of a 13 x 10 mm surface: the zoom panel's box holds every
+    # point with P >= 1 % of the peak and is much smaller than the surface
+    from tactileskin.report.bone_map import loaded_box, write_bone_map_figure
+    from tactileskin.results import BoneMap
+
+    s, z = np.linspace(0, 13, 131), np.linspace(0, 10, 41)
+    P = 0.004 * np.exp(-((s[None, :] - 0.3) ** 2 + z[:, None] ** 2) / 0.2)
+    bm = BoneMap(s, z, P, 0.0)
+    s0, s1, z0, z1 = loaded_box(bm)
+    j, i = np.nonzero(P >= 0.01 * P.max())
+    assert s0 <= s[i].min() and s[i].max() <= s1 and z0 <= z[j].min() and z[j].max() <= z1
+    assert (s1 - s0) < 0.3 * 13 and (z1 - z0) < 0.3 * 10
+    assert loaded_box(BoneMap(s, z, -P, 0.0)) is None  # no compression: nothing to zoom on
+    png = write_bone_map_figure(bm, tmp_path / "m.png", "synthetic")
+    assert png.read_bytes()[:4] == b"\x89PNG"
