@@ -1,14 +1,15 @@
-"""Plane-strain hyperfoam law: numpy vs compiled (run: python benchmarks/hyperfoam_law.py).
+"""Plane-strain hyperfoam law: general 3x3 path vs compiled (run: python benchmarks/hyperfoam_law.py).
 
 Prints median CPU times (ms; process time, calls of the two implementations alternating so
 that both see the same load on a shared machine) of
-  numpy     hyperfoam.pk2_tangent_plane_numpy (the closed-form 2x2 path in numpy),
+  3x3       hyperfoam.pk2_tangent on the embedded C (LAPACK eigh, numpy; the law of 3D and
+            non-plane states, and the compiled loop's test oracle); S only: hyperfoam.pk2,
   compiled  hyperfoam.pk2_tangent_plane (the numba point loop of materials._hyperfoam_nb),
 as fe.material_law calls them (out_of_plane=True: S (..., 3, 3), D (..., 3, 3, 3, 3)),
 with the tangent (S+D) and without (S only; the compiled tangent=False), on the point count
 of the 2D t = 5 mm fingertip model: 3823 P2 triangles x 3 points = 11,469 plane states,
 C = F^T F with F = I + 0.05 N(0, 1) per point (in-plane block, C33 = 1), both presets.
-Also the maximum difference compiled vs numpy (relative to max |S|, max |D|), and the JIT
+Also the maximum difference compiled vs 3x3 (relative to max |S|, max |D|), and the JIT
 cost: a fresh compile and a cached load, each in a new process with its own NUMBA_CACHE_DIR.
 
 Options: --repeat N (default 25); --points N (default 11469).
@@ -83,29 +84,28 @@ def main(argv=None):
     args = ap.parse_args(argv)
 
     from tactileskin.materials import get_material
-    from tactileskin.materials.hyperfoam import pk2_tangent_plane, pk2_tangent_plane_numpy
+    from tactileskin.materials.hyperfoam import pk2, pk2_tangent, pk2_tangent_plane
 
     C = states(args.points)
     C2 = C[..., :2, :2]               # strided view, as fe.material_law passes it
     print(f"{args.points} plane-strain points, median CPU ms of {args.repeat} alternating calls\n")
-    print(f"{'material':<13}{'output':<8}{'numpy':>9}{'compiled':>10}{'speed-up':>10}"
+    print(f"{'material':<13}{'output':<8}{'3x3':>9}{'compiled':>10}{'speed-up':>10}"
           f"{'max dS/max|S|':>15}{'max dD/max|D|':>15}")
     for name in ("polyurethane", "silicone"):
         hf = get_material(name).hyperfoam
         S, D, ok = pk2_tangent_plane(hf, C2, out_of_plane=True)
-        S0, D0, ok0 = pk2_tangent_plane_numpy(hf, C2, out_of_plane=True)
+        S0, D0, ok0 = pk2_tangent(hf, C)
         assert np.array_equal(ok, ok0) and ok.all()
         dS = np.abs(S - S0).max() / np.abs(S0).max()
         dD = np.abs(D - D0).max() / np.abs(D0).max()
-        t_np, t_nb, t_np_s, t_nb_s = paired_ms([
-            lambda: pk2_tangent_plane_numpy(hf, C2, out_of_plane=True),
+        t_3, t_c, t_3_s, t_c_s = paired_ms([
+            lambda: pk2_tangent(hf, C),
             lambda: pk2_tangent_plane(hf, C2, out_of_plane=True),
-            # the numpy path has no S-only variant: its S-only cost is that of S+D
-            lambda: pk2_tangent_plane_numpy(hf, C2, out_of_plane=True),
+            lambda: pk2(hf, C),
             lambda: pk2_tangent_plane(hf, C2, out_of_plane=True, tangent=False),
         ], args.repeat)
-        print(f"{name:<13}{'S+D':<8}{t_np:>8.2f} {t_nb:>9.2f} {t_np / t_nb:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
-        print(f"{name:<13}{'S only':<8}{t_np_s:>8.2f} {t_nb_s:>9.2f} {t_np_s / t_nb_s:>9.1f}x")
+        print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
+        print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")
     print("\nJIT (s; new process each): numba import, _hyperfoam_nb import (compile / cache load), first call")
     for label, (a, b, c) in jit_costs().items():
         print(f"  {label:<14} {a:6.3f} {b:6.3f} {c:6.3f}")

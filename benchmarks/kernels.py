@@ -10,10 +10,11 @@ kernels.residual and kernels.tangent, mixed formulation, on
 The trial state is a homogeneous 5 % deformation plus small random nodal noise (J > 0).
 
 Options: --repeat N (default 15); --no-scene (2D on a structured 31 x 31 x 2 triangle mesh,
-no gmsh); --thickness T (the 2D scene's skin thickness, default 1); --compiled: the numpy
-reference (kernels.COMPILED = False) against the compiled loops (fe._kernels_nb), calls
-alternating, plus the one-off JIT compile time (fresh NUMBA_CACHE_DIR) and the cached-load
-time of the compiled loops, each measured in a new process; --baseline REV: fe/kernels.py
+no gmsh); --thickness T (the 2D scene's skin thickness, default 1); --compiled: the compiled
+loops (fe._kernels_nb) with their largest difference from the oracle tests/reference_kernels.py
+on the first --oracle-elements (default 300) elements, plus the one-off JIT compile time
+(fresh NUMBA_CACHE_DIR) and the cached-load time of the compiled loops, each measured in a
+new process; --baseline REV: fe/kernels.py
 and materials/hyperfoam.py of git revision REV against this tree's, on the same models and states, calls alternating so that both see
 the same load on a shared machine (2D: the structured mesh, or the scene's with --scene);
 --solve: also the median of 3 fe.solve calls of the 2D scene.
@@ -100,16 +101,24 @@ def _model3(hf):
                  [Dirichlet("l", (0,))])
 
 
-def compiled_vs_numpy(a):
-    """kernels.COMPILED False (numpy reference) vs True, same models and states, alternating."""
+def compiled_vs_reference(a):
+    """The compiled kernels' CPU times and their difference from the oracle
+    (tests/reference_kernels.py) on the first --oracle-elements elements of each model. The
+    oracle is a literal einsum transcription, not a speed baseline: it is not timed (the
+    compiled loops' speed-up over the vectorised numpy kernels they replaced is in
+    benchmarks/results/kernels.md, measured when both existed)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    import reference_kernels as ref
+
     from tactileskin.fe import kernels, material_law
     from tactileskin.materials import get_material
 
     hf = get_material("silicone").hyperfoam
     law = material_law(hf)
-    print(f"CPU ms, medians of {a.repeat} alternating calls; numpy reference vs compiled (numba)")
-    print(f"{'mesh':<11}{'elements x points':>18}  {'call':<18}{'numpy':>10}{'compiled':>10}"
-          f"{'speed-up':>10}{'max rel diff':>14}")
+    n = a.oracle_elements
+    print(f"CPU ms, medians of {a.repeat} calls of the compiled kernels; max rel diff against "
+          f"the oracle on the first {n} elements")
+    print(f"{'mesh':<11}{'elements x points':>18}  {'call':<18}{'compiled':>10}{'max rel diff':>14}")
     for label, model in (("2D P2 tri", _model2(a.no_scene, a.thickness, hf)), ("3D P2 tet", _model3(hf))):
         m = model.m
         ue = trial_state(model).reshape(-1, m)[model.sdofs]
@@ -117,35 +126,25 @@ def compiled_vs_numpy(a):
         S3, D, _ = law(kin.C)
         # as Model.tangent passes them: S a strided view, D a contiguous product
         S, Dm = S3[..., :m, :m], 1.0 * D[..., :m, :m, :m, :m]
+        kin_r = ref.kinematics(ue[:n], model.G[:n], model.w[:n], model.mixed)
+        f_r, K_r = ref.residual_tangent(ue[:n], model.G[:n], model.w[:n], model.mixed, S[:n], Dm[:n])
 
-        def flag(on, fn):
-            def call():
-                kernels.COMPILED = on
-                return fn()
-            return call
+        def rel(x, r):
+            return float(np.abs(x[:n] - r).max() / np.abs(r).max())
 
-        kin_n = flag(False, lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed))()
-        kin_c = flag(True, lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed))()
         rows = [("Kinematics", lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed),
-                 lambda: kernels.Kinematics(ue, model.G, model.w, model.mixed), None),
-                ("kernels.residual", lambda: kernels.residual(kin_n, S), lambda: kernels.residual(kin_c, S),
-                 lambda r: r),
-                ("kernels.tangent", lambda: kernels.tangent(kin_n, S, Dm), lambda: kernels.tangent(kin_c, S, Dm),
-                 lambda r: r)]
+                 lambda k: max(rel(getattr(k, name), v) for name, v in kin_r.items())),
+                ("kernels.residual", lambda: kernels.residual(kin, S), lambda r: rel(r, f_r)),
+                ("kernels.tangent", lambda: kernels.tangent(kin, S, Dm), lambda r: rel(r, K_r))]
         E, Q = model.w.shape
         size = f"{E} x {Q}"
-        tot_n = tot_c = 0.0
-        for name, fn, fc, val in rows:
-            fn, fc = flag(False, fn), flag(True, fc)
-            diff = ""
-            if val is not None:
-                rn, rc = fn(), fc()
-                diff = f"{np.abs(rc - rn).max() / np.abs(rn).max():.1e}"
-            tn, tc = paired_ms(fn, fc, a.repeat)
-            tot_n, tot_c = tot_n + tn, tot_c + tc
-            print(f"{label:<11}{size:>18}  {name:<18}{tn:>8.2f}ms{tc:>8.2f}ms{tn / tc:>9.1f}x{diff:>14}")
-        print(f"{label:<11}{size:>18}  {'sum':<18}{tot_n:>8.2f}ms{tot_c:>8.2f}ms{tot_n / tot_c:>9.1f}x")
-        kernels.COMPILED = True
+        total = 0.0
+        for name, fn, diff in rows:
+            t = median_ms(fn, a.repeat)
+            total += t
+            d = diff(fn())
+            print(f"{label:<11}{size:>18}  {name:<18}{t:>8.2f}ms{d:>14.1e}")
+        print(f"{label:<11}{size:>18}  {'sum':<18}{total:>8.2f}ms")
     with tempfile.TemporaryDirectory() as cache:
         for what in ("first call, empty cache (JIT compile)", "first call, cache written above (load)"):
             out = subprocess.run([sys.executable, __file__, "--jit-probe"], check=True, capture_output=True,
@@ -278,7 +277,8 @@ def main():
     ap.add_argument("--baseline", default=None, help="git revision to compare with")
     ap.add_argument("--scene", action="store_true", help="with --baseline: the scene's 2D mesh")
     ap.add_argument("--thickness", type=float, default=1, help="the 2D scene's skin thickness (mm)")
-    ap.add_argument("--compiled", action="store_true", help="numpy reference vs compiled kernels")
+    ap.add_argument("--compiled", action="store_true", help="compiled kernels against the test oracle")
+    ap.add_argument("--oracle-elements", type=int, default=300, help="elements compared with the oracle")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--jit-probe", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
@@ -286,7 +286,7 @@ def main():
         jit_probe()
         return
     if a.compiled:
-        compiled_vs_numpy(a)
+        compiled_vs_reference(a)
     elif a.baseline:
         compare(a)
     else:

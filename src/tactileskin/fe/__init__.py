@@ -7,8 +7,8 @@ Low level (any mesh + named boundaries + BCs + indenter): `Model`, `Dirichlet`, 
 
 Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
 - total Lagrangian, P2 displacements (plane strain F33 = 1, or tets), scikit-fem for the
-  basis and quadrature, compiled (numba) element kernels (fe.kernels; the numpy versions
-  are the test references), assembly into a fixed CSR
+  basis and quadrature, compiled (numba) element kernels (fe.kernels; their oracle is
+  the literal transcription in tests/reference_kernels.py), assembly into a fixed CSR
   pattern, MKL PARDISO on the free block with the ordering analysed once per model
   (fe.linsolve; SuperLU where MKL is not installed);
 - 3-point (triangle) / 4-point (tet) rule, as Abaqus CPE6 / C3D10;

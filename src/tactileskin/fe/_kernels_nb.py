@@ -1,9 +1,23 @@
 """Compiled (numba) element loops behind fe.kernels: kinematics, residual and tangent.
 
-Same formulas and dof ordering as the numpy reference in fe.kernels (see its docstring);
-one element at a time, all points of it, with scratch arrays allocated once per call
-(the numpy version's whole-mesh temporaries dominated its cost). Every argument must be a
-C-contiguous float64 array; fe.kernels makes them so.
+The formulas and dof ordering of the fe.kernels docstring (tests/reference_kernels.py
+transcribes them literally and is the oracle of these loops); one element at a time, all
+points of it, with scratch arrays allocated once per call (whole-mesh temporaries of a
+vectorised version dominated its cost). Every argument must be a C-contiguous float64
+array; fe.kernels makes them so.
+
+Tangent algebra. With B the map from dofs to dF (dF_iJ = d_ik G_aJ at dof (a, k)) and
+AA_iJkL = d_ik S_JL + Fb_iI Fb_kK D_IJKL, the displacement part sum_q w B^T AA B is
+    material:  Y^T Dv Y, Y_(IJ),(a,i) = Fb_iI G_aJ + Fb_iJ G_aI (Voigt pairs IJ, D with
+               minor symmetry; Dv carries 1/2 on the diagonal pairs),
+    geometric: (G S G^T)_ab d_ik,
+and the mixed B_bar = alpha (B + F dphi) adds rank-one terms built from AA F =
+Fb (D : C_bar + S) / alpha (no AA formed; D with major symmetry):
+    alpha^2 (g dphi + dphi g + s dphi dphi) + tau dphi dphi + dphi p + p dphi
+        = dphi r + r dphi,  r = p + tau dphi / 2 + alpha^2 (g + s dphi / 2),
+    g = B^T AA F, s = F : AA F, p = alpha B^T P_bar,
+plus the d2phi terms: sum_q c_q h_bi h_ak at [(a,i),(b,k)] (the tr(F^-1 dF F^-1 dF) part,
+h = G F^-1, c_q = w tau / m - coef w J) and the dtheta products.
 
 The tangent of an element is one BLAS product Lft^T Rgt (np.dot, no allocation) over rows
 collected from its points (Lft row | Rgt row):
@@ -29,8 +43,8 @@ _jit = nb.njit(cache=True, error_model="numpy")
 
 @_impl
 def _voigt(r, m):
-    """Voigt pair (I, J) number r, the order of fe.kernels._VOIGT: (00, 11, 01) in 2D,
-    (00, 11, 22, 12, 02, 01) in 3D (arithmetic, not a table: folds to constants)."""
+    """Voigt pair (I, J) number r: (00, 11, 01) in 2D, (00, 11, 22, 12, 02, 01) in 3D
+    (arithmetic, not a table: folds to constants)."""
     if r < m:
         return r, r
     if m == 2:
@@ -41,8 +55,8 @@ def _voigt(r, m):
 @_impl
 def _kinematics(ue, G, w, mixed, F, J, Finv, alpha, Fbar, C, theta, m, A):
     """Fill F, J (always) and, if every J is finite and > 0, Finv, alpha, Fbar, C (E,Q,3,3)
-    and theta (mixed). Returns admissibility. Determinant and inverse by cofactors, in the
-    order of fe.kernels._det_inv."""
+    and theta (mixed). Returns admissibility. Determinant and inverse by cofactors (the
+    columns of the adjugate are cross products of the rows of F)."""
     E, Q = w.shape
     ok = True
     for e in range(E):
@@ -177,7 +191,7 @@ def _residual(G, w, Fbar, Finv, alpha, J, theta, S, mixed, out, m, A):
 @_impl
 def _tangent(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, out, m, A):
     """Consistent element stiffness into out (E, A*m, A*m); S (E,Q,m,m), D (E,Q,m,m,m,m)
-    with minor symmetry. The algebra of fe.kernels._tangent_block, regrouped per element."""
+    with minor (and, mixed, major) symmetry. The algebra of the module docstring."""
     E, Q = w.shape
     nd = A * m
     nv = m * (m + 1) // 2

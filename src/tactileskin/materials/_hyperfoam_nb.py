@@ -1,6 +1,6 @@
 """Compiled (numba) point loop of the plane-strain hyperfoam law, `hyperfoam.pk2_tangent_plane`.
 
-Same formulas and the same numerical care as the numpy path (see the docstring of
+Same formulas and the same numerical care as the 3x3 path `pk2_tangent` (see the docstring of
 tactileskin.materials.hyperfoam): ln c_a = log1p(e_a) from the eigenvalues of C - I, the
 exp * expm1 form of c^(alpha/2) - J^(-alpha beta) and of the divided differences (exact down
 to coincident stretches, g' at zero gap), the EXP_CAP / LOG_C_CAP guard with finite values
@@ -10,7 +10,7 @@ Cost: one pass over the points with scalar math. The transcendental calls are th
 so the exponentials are shared: per term i and in-plane direction a only
 c_a^(alpha_i/2) = exp(alpha_i/2 ln c_a), J^(-alpha_i beta) and 1/c_a = exp(-ln c_a) are
 evaluated, and every other power (c^(alpha/2 - 1), J^(-alpha beta)/c^2, ...) is a product
-of them (a few ulp from the numpy path's single exp of the summed exponent). The
+of them (a few ulp from the 3x3 path's single exp of the summed exponent). The
 differences keep their own expm1 calls. The third principal direction (e_z, c_3 = 1,
 ln c_3 = 0) needs no exp at all.
 
@@ -41,7 +41,7 @@ _SIG = ("void(float64[:, :, :], float64[:], boolean, float64[:], float64[:], flo
 
 @numba.njit(inline="always")
 def _pos(x):
-    """exp(x) with the numpy path's clip (finite for any exponent of an inadmissible point)."""
+    """exp(x) with the 3x3 path's clip (finite for any exponent of an inadmissible point)."""
     return math.exp(min(x, _CLIP))
 
 
@@ -55,7 +55,7 @@ def _diff(ex1, ex2, d):
 
 @numba.njit(inline="always")
 def _log_c(e):
-    """(ln c, e, admissible) of one eigenvalue e of C - I, with the numpy path's guard/clip."""
+    """(ln c, e, admissible) of one eigenvalue e of C - I, with the 3x3 path's guard/clip."""
     lc_raw = math.log1p(e) if e > -1.0 else -2.0 * LOG_C_CAP
     ok = e > -1.0 and abs(lc_raw) <= LOG_C_CAP
     lc = min(max(lc_raw, -LOG_C_CAP), LOG_C_CAP)
@@ -86,9 +86,10 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
         c00, c01, c10, c11 = C2[p, 0, 0], C2[p, 0, 1], C2[p, 1, 0], C2[p, 1, 1]
         finite = (math.isfinite(c00) and math.isfinite(c01) and math.isfinite(c10)
                   and math.isfinite(c11))
-        if not finite:                                       # as np.where(finite, C2, 1.0)
+        if not finite:                                       # flagged (ok False): any finite values
             c00 = c01 = c10 = c11 = 1.0
-        # closed-form eigenvalues of the in-plane block of C - I (see _spectral_plane)
+        # closed-form eigenvalues of the in-plane block of C - I: the one of larger magnitude
+        # from mid +- r (r half the gap), the other from the determinant (no cancellation)
         a = c00 - 1.0
         b = c11 - 1.0
         c = 0.5 * (c01 + c10)
@@ -108,7 +109,8 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
             cos2, sin2 = h / r, c / r
         p11 = 0.5 * (1.0 + cos2)
         p12 = 0.5 * sin2
-        # projectors n_a n_a as (11, 12, 22): direction 1 (larger e) and 0
+        # projectors n_a n_a as (11, 12, 22): direction 1 (larger e) is (I + R(2 theta)) / 2,
+        # tan 2 theta = c / h; direction 0 its complement
         P1_0, P1_1, P1_2 = p11, p12, 1.0 - p11
         P0_0, P0_1, P0_2 = 1.0 - p11, -p12, p11
         lc0, e0, ok0 = _log_c(e0)

@@ -31,13 +31,13 @@ Numerical care (see docs/architecture.md, "hard cases"):
   a stress of ~1e130 MPa (silicone term 2, alpha beta = 379.75: J < exp(-300/379.75) = 0.454;
   the confined-compression stress is already 4e5 MPa at J = 0.95).
 
-Speed (benchmarks/kernels.py): plane strain has a closed-form 2x2 path, `pk2_tangent_plane`
-(e_z is a principal direction with c_3 = 1), evaluating the same formulas ~2.5x faster
-than the 3x3 eigh path in numpy (`pk2_tangent_plane_numpy`), and several times faster
-again as the compiled point loop of `_hyperfoam_nb` (benchmarks/hyperfoam_law.py), which
-`pk2_tangent_plane` uses; tangent=False skips D. In numpy, per-term arrays put the term
-axis first; large inputs are evaluated in blocks of _BLOCK points written straight into
-the outputs.
+Two implementations, each needed: `pk2_tangent` (3x3 eigh, numpy; 3D and any non-plane
+state) and `pk2_tangent_plane` (plane strain: e_z is a principal direction with c_3 = 1, so
+the 2x2 eigenproblem has a closed form), the compiled point loop of `_hyperfoam_nb`, several
+times faster than the 3x3 path (benchmarks/hyperfoam_law.py); tangent=False skips D. The
+3x3 path is the plane loop's test oracle. In numpy, per-term arrays put the term axis
+first; large inputs are evaluated in blocks of _BLOCK points written straight into the
+outputs.
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2_tangent_plane_numpy", "pk2",
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2",
            "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
@@ -363,72 +363,7 @@ _I6, _J6 = np.array([0, 1, 2, 1, 0, 0]), np.array([0, 1, 2, 2, 2, 1])
 _T1_3, _T2_3, _C1_3, _C2_3, _V9 = _tables3()
 
 
-# --- plane strain fast path ----------------------------------------------------------------
-
-def _spectral_plane(C2, detF=None):
-    """Closed-form eigen-decomposition of a plane-strain C (in-plane block C2 (..., 2, 2),
-    C33 = 1, C13 = C23 = 0). Returns e (..., 3) (e_3 = 0: the third direction is e_z),
-    the in-plane projectors P (..., 2, 3) as [a, (11, 12, 22)] of n_a n_a, lc, lJ, ok,
-    with the guards of `_spectral`."""
-    finite = np.all(np.isfinite(C2), axis=(-2, -1))
-    E = np.where(finite[..., None, None], C2, 1.0)           # non-finite -> E = 0 below
-    a = E[..., 0, 0] - 1.0
-    b = E[..., 1, 1] - 1.0
-    c = 0.5 * (E[..., 0, 1] + E[..., 1, 0])
-    h = 0.5 * (a - b)
-    r = np.hypot(h, c)                                       # half the eigenvalue gap
-    mid = 0.5 * (a + b)
-    # the eigenvalue of larger magnitude from mid +- r, the other from the determinant
-    # (no cancellation: e_small = det / e_big)
-    big = np.where(mid >= 0.0, mid + r, mid - r)
-    det = a * b - c * c
-    small = np.where(big != 0.0, det / np.where(big != 0.0, big, 1.0), 0.0)
-    e1 = np.where(mid >= 0.0, small, big)                    # e1 <= e2
-    e2 = np.where(mid >= 0.0, big, small)
-    # projector of the larger eigenvalue: (I + R(2 theta)) / 2, tan 2 theta = c / h
-    iso = r == 0.0
-    rr = np.where(iso, 1.0, r)
-    cos2 = np.where(iso, 1.0, h / rr)
-    sin2 = np.where(iso, 0.0, c / rr)
-    p11, p12 = 0.5 * (1.0 + cos2), 0.5 * sin2
-    P = np.empty(a.shape + (2, 3))
-    P[..., 1, 0], P[..., 1, 1], P[..., 1, 2] = p11, p12, 1.0 - p11
-    P[..., 0, 0], P[..., 0, 1], P[..., 0, 2] = 1.0 - p11, -p12, p11
-    e = np.stack([e1, e2, np.zeros_like(e1)], axis=-1)
-    ok = finite & np.all(e > -1.0, axis=-1)
-    pd = e > -1.0
-    lc_raw = np.where(pd, np.log1p(np.where(pd, e, 0.0)), -2.0 * LOG_C_CAP)
-    ok &= np.all(np.abs(lc_raw) <= LOG_C_CAP, axis=-1)
-    lc = np.clip(lc_raw, -LOG_C_CAP, LOG_C_CAP)
-    e = np.where(lc_raw == lc, e, np.expm1(lc))
-    if detF is not None:
-        ok &= np.asarray(detF) > 0.0
-    lJ = 0.5 * lc.sum(axis=-1)
-    return e, P, lc, lJ, ok
-
-
-def _plane_tables():
-    """Gather indices of the plane-strain path (symmetric 2x2 stored as (11, 12, 22))."""
-    V = np.array([[0, 1], [1, 2]])                           # (a, b) -> compact index
-    a, b, c, d = np.indices((2, 2, 2, 2)).reshape(4, -1)
-    T1 = 3 * V[a, c] + V[b, d]                               # T[(ac),(bd)] in T.reshape(9)
-    T2 = 3 * V[a, d] + V[b, c]                               # T[(ad),(bc)]
-    C1, C2 = V[a, b], V[c, d]
-    S9 = np.array([0, 1, 4, 1, 2, 4, 4, 4, 3])               # from (S11, S12, S22, S33, 0)
-    # full D from vals = (D2 (16), qv Cinv (3), D3333, G3 (3), 0)
-    zero, d33 = 23, 19
-    D81 = np.full((3, 3, 3, 3), zero)
-    D81[:2, :2, :2, :2] = np.arange(16).reshape(2, 2, 2, 2)
-    D81[:2, :2, 2, 2] = D81[2, 2, :2, :2] = 16 + V
-    D81[2, 2, 2, 2] = d33
-    for idx in ((slice(2), 2, slice(2), 2), (slice(2), 2, 2, slice(2)),
-                (2, slice(2), slice(2), 2), (2, slice(2), 2, slice(2))):
-        D81[idx] = 20 + V
-    return T1, T2, C1, C2, S9, D81.ravel()
-
-
-_T1, _T2, _C1, _C2, _S9, _D81 = _plane_tables()
-
+# --- plane strain ---------------------------------------------------------------------------
 
 def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False,
                       tangent: bool = True):
@@ -440,15 +375,15 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     and ok (...). out_of_plane=True returns the full D (..., 3, 3, 3, 3) instead.
     tangent=False skips D and returns (S, None, ok) (residual-only evaluations).
 
-    Evaluated by the compiled point loop of `_hyperfoam_nb` (same values as the numpy
-    implementation `pk2_tangent_plane_numpy` to rounding, identical ok flags).
+    Evaluated by the compiled point loop of `_hyperfoam_nb`; `pk2_tangent` of the embedded
+    3x3 C is its oracle (same values to rounding, identical ok flags; tests/test_hyperfoam_nb.py).
     """
     C2 = np.asarray(C2, dtype=float)
     _check_shape("C2", C2, 2)
-    nb = _compiled()
-    if nb is None:
-        S, D, ok = pk2_tangent_plane_numpy(mat, C2, detF=detF, out_of_plane=out_of_plane)
-        return S, (D if tangent else None), ok
+    # imported on first use: numba's start-up and the cache load (~0.5-1 s) are not paid
+    # by programs that never evaluate the law
+    from tactileskin.materials import _hyperfoam_nb as nb
+
     lead = C2.shape[:-2]
     n = math.prod(lead)
     Ck = nb.as_kernel_input(C2, (n, 2, 2))
@@ -473,65 +408,6 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     else:
         D = None
     return S.reshape(lead + (3, 3)), D, ok
-
-
-_NB = []   # [module or None] once tried: numba is imported on first use, not at import
-
-
-def _compiled():
-    """The compiled kernel module, or None (numpy fallback) if numba cannot be loaded."""
-    if not _NB:
-        try:
-            from tactileskin.materials import _hyperfoam_nb
-        except ImportError as exc:  # numba is a dependency; a broken install still computes
-            log.warning("hyperfoam: compiled plane-strain law unavailable (%s); using numpy", exc)
-            _hyperfoam_nb = None
-        _NB.append(_hyperfoam_nb)
-    return _NB[0]
-
-
-def pk2_tangent_plane_numpy(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False):
-    """The numpy implementation of `pk2_tangent_plane` (reference for the compiled one)."""
-    C2 = np.asarray(C2, dtype=float)
-    _check_shape("C2", C2, 2)
-    S, D, ok = _blocked(lambda Cb, db, out: _pk2_tangent_plane(mat, Cb, db, out_of_plane, out), C2,
-                        detF, [(3, 3), (3, 3, 3, 3) if out_of_plane else (2, 2, 2, 2), ()])
-    _log_debug_inadmissible(ok)
-    return S, D, ok
-
-
-def _pk2_tangent_plane(mat, C2, detF, out_of_plane, out):
-    """pk2_tangent_plane of points C2 (n, 2, 2), written into out = [S, D, ok] (n, ...)."""
-    S_out, D_out, ok_out = out
-    e, P, lc, lJ, ok = _spectral_plane(C2, detF)
-    mu, alpha, k, beta = _params(mat)
-    ok = _guard(ok, alpha, beta, lc, lJ)
-    f = _principal_f(mu, alpha, k, beta, lc, lJ)            # (..., 3)
-    gamma, qv = _gamma(mu, alpha, k, beta, e, lc, lJ)
-    lead = lc.shape[:-1]
-
-    Sv = f[..., 0, None] * P[..., 0, :] + f[..., 1, None] * P[..., 1, :]       # (11, 12, 22)
-    # gathers with mode="clip" write straight into the output (indices are in range)
-    np.take(np.concatenate([Sv, f[..., 2:], np.zeros(lead + (1,))], axis=-1), _S9, axis=-1,
-            out=S_out.reshape(lead + (9,)), mode="clip")
-    ok_out[...] = ok
-    Civ = np.exp(-lc[..., 0, None]) * P[..., 0, :] + np.exp(-lc[..., 1, None]) * P[..., 1, :]
-    # in-plane D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd with
-    # T = sum_ab gamma_ab P_a x P_b over the in-plane directions (n_3 = e_z has no in-plane part)
-    T = (np.swapaxes(P, -1, -2) @ (gamma[..., :2, :2] @ P)).reshape(lead + (9,))
-    qC = qv[..., None] * Civ
-    D2 = D_out.reshape(lead + (16,)) if not out_of_plane else np.empty(lead + (16,))
-    np.add(T[..., _T1], T[..., _T2], out=D2)
-    D2 += qC[..., _C1] * Civ[..., _C2]
-    if not out_of_plane:
-        return
-    # out-of-plane components (P_3 = e_z e_z): D_ab33 = D_33ab = qv Cinv_ab,
-    # D_3333 = 2 gamma_33 + qv, D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab;
-    # the rest (an odd number of 3s) vanish. One gather from the distinct values.
-    G3 = gamma[..., 0, 2, None] * P[..., 0, :] + gamma[..., 1, 2, None] * P[..., 1, :]
-    d33 = (2.0 * gamma[..., 2, 2] + qv)[..., None]
-    vals = np.concatenate([D2, qC, d33, G3, np.zeros(lead + (1,))], axis=-1)
-    np.take(vals, _D81, axis=-1, out=D_out.reshape(lead + (81,)), mode="clip")
 
 
 def cauchy_principal(mat: Hyperfoam, stretches):
