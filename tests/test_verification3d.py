@@ -35,14 +35,16 @@ def test_fit_recovers_a_semi_ellipse_despite_point_scatter():
     a, p0 = 0.5, 0.02
     exact = p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None))
     af, pf, am = fit_hertz_pressure(r, exact, w)
-    assert af == pytest.approx(a, rel=1e-6) and pf == pytest.approx(p0, rel=1e-6)
+    assert af == pytest.approx(a, rel=1e-5) and pf == pytest.approx(p0, rel=1e-5)  # 2e-6: the solver's stop
     assert am == pytest.approx(a, rel=0.02)  # the moment estimate from 4000 random points
     noisy = exact * (1 + 0.3 * np.where(np.arange(n) % 2, 1.0, -1.0))
     af, pf, _ = fit_hertz_pressure(r, noisy, w)
-    assert af == pytest.approx(a, rel=0.01) and pf == pytest.approx(p0, rel=0.01)
+    # measured +0.10 % and -0.88 % (seeds 0-3: |a| <= 0.1 %, |p0| <= 0.9 %)
+    assert af == pytest.approx(a, rel=0.005) and pf == pytest.approx(p0, rel=0.015)
     sel = noisy > 0.2 * noisy.max()
     c0, c1 = np.linalg.lstsq(np.column_stack([np.ones(sel.sum()), r[sel] ** 2]), noisy[sel] ** 2, rcond=None)[0]
-    assert np.sqrt(-c0 / c1) > 1.02 * a
+    # a fit of p^2 sees sqrt(mean p^2) = sqrt(1.09) p0: +3.0 % here (seeds 0-3: +2.5 to +5.4 %)
+    assert np.sqrt(c0) > 1.02 * p0
 
 
 def test_hertz_sphere_force_indentation_and_contact_radius(hertz):

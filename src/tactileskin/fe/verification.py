@@ -100,9 +100,9 @@ def fit_hertz_pressure(r, p, w):
     times the moment estimate of a (so the fit sees where the pressure ends).
 
     Fitting p itself, not p^2 as `hertz_block` does: in 3D the point pressures of 3 points
-    per P2 triangle scatter by +-30 % about the mean at the same radius, and a fit of p^2
-    is biased by that scatter (mean of p^2 > square of the mean: a +3.6 %, p0 -2.2 % at
-    h = a/5, against +0.7 % / -1.9 % here)."""
+    per P2 triangle scatter by +-30 % about the mean at the same radius, which a fit of p^2
+    weighs quadratically (h = a/5, a/R = 0.05: p^2 fit a +3.6 %, p0 -2.2 %; this fit
+    +0.7 %, -1.9 %; tests/test_verification3d.py shows the bias on synthetic data)."""
     from scipy.optimize import least_squares
 
     load = np.sum(w * p)
