@@ -103,8 +103,7 @@ def test_flat_plate_on_extruded_slab_equals_2d_section(flat_plate):
     (3D 6429 dofs, 22 Newton iterations): load per mm -1.7 %; bone-pressure
     peak -1.9 / -2.6 / -3.3 % and relative L2 (s <= 6 mm) 1.2 / 2.2 / 1.1 % on the planes
     z = 0 / 0.25 / 0.5 (the spread between planes of one solve is of the same size as the
-    difference to 2D). A 3D path that lost plane strain (the end condition, the z symmetry)
-    would be off by tens of percent on this nearly incompressible silicone (nu = 0.49)."""
+    difference to 2D)."""
     from tactileskin.planner import profile_difference
 
     r2, r3, width = flat_plate
