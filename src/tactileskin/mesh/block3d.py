@@ -33,7 +33,8 @@ def build_quarter_block(size: float, h: float, r_fine: float, *, grade: float = 
     """(mesh, boundaries) of the graded quarter block (scikit-fem MeshTet1/MeshTet2)."""
     _check("size", size, 0.0, "the block edge in mm")
     _check("h", h, 0.0, "the element size at the load point in mm")
-    _check("r_fine", r_fine, -1e-300, "the radius of the uniformly fine zone in mm")
+    if not (np.isfinite(r_fine) and r_fine >= 0.0):
+        raise ParameterError("r_fine", r_fine, ">= 0", "the radius of the uniformly fine zone in mm")
     _check("grade", grade, 0.0, "the growth of the element size per unit distance, e.g. 0.3")
     if h >= size:
         raise ParameterError("h", h, f"< size ({size:g} mm)", "the fine size must be below the block size")
