@@ -28,7 +28,7 @@ from tactileskin.fe.model import Evaluation, Model
 log = logging.getLogger(__name__)
 
 # free dofs from which a 3D model reuses factorisations (benchmarks/results/linsolve3d.md)
-REUSE_MIN_DOFS = 30000
+REUSE_MIN_DOFS = 10000
 
 
 @dataclass
@@ -54,6 +54,11 @@ class SolverOptions:
     linear_method: str = "auto"
     # auto takes "reuse" for 3D models with at least this many free dofs and PARDISO
     reuse_min_dofs: int = REUSE_MIN_DOFS
+    # a reused-factorisation (GMRES) Newton step may stop at a relative linear residual of
+    # linear_forcing * |R| / scale (capped at 1e-3, at least linsolve.KRYLOV_RTOL): it
+    # shrinks with |R| as Newton converges, which keeps the convergence quadratic; 0: always
+    # KRYLOV_RTOL. Direct solves are exact whatever it is.
+    linear_forcing: float = 0.1
     sticky_contact: bool = True   # contact points stay active within a Newton solve (no cycling)
     max_residual_growth: float = 100.0  # a step raising |R| more than this fails the increment
     curvature_after: int = 2      # iterations before the indenter-curvature tangent term is added
@@ -278,7 +283,8 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         try:
             K = model.tangent(ev, curvature=it >= opts.curvature_after if model.surface else None)
             # the solve may refactorise too (a stale reused factorisation)
-            du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf)
+            eta = min(1e-3, opts.linear_forcing * rn / scale) if scale > 0 else None
+            du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf, rtol=eta)
         except (RuntimeError, FloatingPointError) as e:  # singular factor
             raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
         stats.factorizations += 1
