@@ -213,3 +213,23 @@ def test_3d_solve_with_reuse_matches_direct(slab3d):
     assert lr.method == "reuse" and lr.krylov_iterations > 0 and lr.factorizations < ld.factorizations
     assert nr <= nd
     assert np.linalg.norm(ur - ud) <= 1e-6 * np.linalg.norm(ud)
+
+
+def test_looser_krylov_tolerance_takes_fewer_iterations_and_is_met():
+    """The Newton-aware tolerance (solve(b, rtol)): looser stops earlier and still meets it;
+    direct solves ignore it."""
+    rng = np.random.default_rng(9)
+    A = _spd(900, rng)
+    B = _shifted(A, 1.0)
+    b = rng.standard_normal(900)
+    its = {}
+    for rtol in (None, 1e-4):
+        s = linsolve.SymmetricSolver(A, "superlu", "reuse", factor_cost=40)
+        s.factor(A).solve(b)
+        x = s.factor(B).solve(b, rtol=rtol)
+        its[rtol] = s.krylov_iterations
+        assert np.linalg.norm(B @ x - b) <= 10 * (rtol or linsolve.KRYLOV_RTOL) * np.linalg.norm(b)
+    assert 0 < its[1e-4] < its[None]
+    d = linsolve.SymmetricSolver(B, "superlu", "direct")
+    x = d.factor(B).solve(b, rtol=1e-2)
+    assert np.linalg.norm(B @ x - b) <= 1e-12 * np.linalg.norm(b)

@@ -50,7 +50,8 @@ class SolverOptions:
     max_increments: int = 2000
     linear_solver: str = "auto"   # fe.linsolve backend: auto | pardiso | superlu
     # fe.linsolve method: direct (refactorise every Newton iteration) | reuse (GMRES with the
-    # last factorisation, refactorised when that stops paying) | auto (reuse_if_dofs)
+    # last factorisation, refactorised when that stops paying) | auto (reuse on 3D models of
+    # at least reuse_min_dofs free dofs with PARDISO, else direct)
     linear_method: str = "auto"
     # auto takes "reuse" for 3D models with at least this many free dofs and PARDISO
     reuse_min_dofs: int = REUSE_MIN_DOFS
@@ -283,8 +284,8 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
         try:
             K = model.tangent(ev, curvature=it >= opts.curvature_after if model.surface else None)
             # the solve may refactorise too (a stale reused factorisation)
-            eta = min(1e-3, opts.linear_forcing * rn / scale) if scale > 0 else None
-            du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf, rtol=eta)
+            forcing = min(1e-3, opts.linear_forcing * rn / scale) if scale > 0 else None
+            du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf, rtol=forcing)
         except (RuntimeError, FloatingPointError) as e:  # singular factor
             raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
         stats.factorizations += 1
