@@ -20,7 +20,9 @@ Methods:
   last factorisation (factorisation included, in units of one preconditioned iteration),
   or when GMRES needs as many iterations as a factorisation costs. The cost ratio comes
   from PARDISO's flop counts (deterministic: the same run takes the same path).
-  benchmarks/linsolve3d.py measures when it wins (3D tangents, tens of thousands of dofs).
+  Measured (benchmarks/results/linsolve3d.md, 3D single dot): linear-solve CPU 1.6x less at
+  17.5k free dofs, 1.9x at 57.5k, same Newton iterations. Smoothed-aggregation AMG (pyamg)
+  was 6-10x slower than a PARDISO factorisation there and is not used.
 
 Threads: one, unless MKL_NUM_THREADS is set (Dask workers set it to 1 anyway).
 """
