@@ -139,6 +139,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     res.stats["wall_s"] = stats.wall_s
     res.stats["phases_s"] = phases(model, mesh=t_mesh, setup=t_setup,
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
+    if getattr(model, "_linsolve", None) is not None:
+        res.stats["linear_solver"] = model._linsolve.describe()
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)

@@ -1,7 +1,8 @@
 """Newton with a backtracking line search, augmented-Lagrangian contact loop, adaptive time steps.
 
-- Newton uses the consistent tangent and a sparse direct solve of the free block
-  (fe.linsolve: PARDISO with the ordering analysed once per model, else SuperLU).
+- Newton uses the consistent tangent and a sparse solve of the free block (fe.linsolve:
+  PARDISO with the ordering analysed once per model, else SuperLU; on large 3D models the
+  factorisation is reused across iterations and increments as a GMRES preconditioner).
   A line search halves the step while the trial state is inadmissible (J <= 0, material
   overflow guard) or the residual norm does not decrease; the residual norm of every
   iteration is logged (quadratic convergence is visible at DEBUG).
@@ -21,10 +22,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactileskin.errors import ConvergenceError
-from tactileskin.fe.linsolve import SymmetricSolver
+from tactileskin.fe.linsolve import METHODS, SymmetricSolver, pardiso_available
 from tactileskin.fe.model import Evaluation, Model
 
 log = logging.getLogger(__name__)
+
+# free dofs from which a 3D model reuses factorisations (benchmarks/results/linsolve3d.md)
+REUSE_MIN_DOFS = 10000
 
 
 @dataclass
@@ -45,6 +49,17 @@ class SolverOptions:
     easy_iterations: int = 7      # grow the increment when Newton needed at most this many (5: t3 flat 10 increments, 7: 6)
     max_increments: int = 2000
     linear_solver: str = "auto"   # fe.linsolve backend: auto | pardiso | superlu
+    # fe.linsolve method: direct (refactorise every Newton iteration) | reuse (GMRES with the
+    # last factorisation, refactorised when that stops paying) | auto (reuse on 3D models of
+    # at least reuse_min_dofs free dofs with PARDISO, else direct)
+    linear_method: str = "auto"
+    # auto takes "reuse" for 3D models with at least this many free dofs and PARDISO
+    reuse_min_dofs: int = REUSE_MIN_DOFS
+    # a reused-factorisation (GMRES) Newton step may stop at a relative linear residual of
+    # linear_forcing * |R| / scale (capped at 1e-3, at least linsolve.KRYLOV_RTOL): it
+    # shrinks with |R| as Newton converges, which keeps the convergence quadratic; 0: always
+    # KRYLOV_RTOL. Direct solves are exact whatever it is.
+    linear_forcing: float = 0.1
     sticky_contact: bool = True   # contact points stay active within a Newton solve (no cycling)
     max_residual_growth: float = 100.0  # a step raising |R| more than this fails the increment
     curvature_after: int = 2      # iterations before the indenter-curvature tangent term is added
@@ -85,11 +100,30 @@ def _worst(model: Model, R: np.ndarray) -> dict:
             "value": float(R[k]) if np.isfinite(R[k]) else None}
 
 
+def linear_method(model: Model, nfree: int, opts: SolverOptions) -> str:
+    """The fe.linsolve method for this model: opts.linear_method unless "auto"; auto reuses
+    factorisations on 3D models of at least opts.reuse_min_dofs free dofs solved by PARDISO
+    (there a factorisation costs tens of GMRES iterations), else refactorises every time."""
+    m = opts.linear_method
+    if m not in ("auto",) + METHODS:
+        from tactileskin.errors import ParameterError
+
+        raise ParameterError("linear_method", m, "auto, " + ", ".join(METHODS))
+    if m != "auto":
+        return m
+    pardiso = opts.linear_solver == "pardiso" or (opts.linear_solver == "auto" and pardiso_available())
+    return "reuse" if model.m == 3 and nfree >= opts.reuse_min_dofs and pardiso else "direct"
+
+
 def _factor(model: Model, K, opts: SolverOptions):
-    """Factorise the free block K; the solver (and its symbolic analysis) lives on the model."""
+    """Give the free block K to the model's linear solver (which keeps the symbolic analysis
+    and, with method "reuse", the factorisation it may precondition with)."""
     ls = getattr(model, "_linsolve", None)
-    if ls is None or opts.linear_solver not in ("auto", ls.backend):
-        ls = model._linsolve = SymmetricSolver(K, opts.linear_solver)
+    if ls is None or opts.linear_solver not in ("auto", ls.backend) or \
+            (opts.linear_method != "auto" and opts.linear_method != ls.method):
+        method = linear_method(model, K.shape[0], opts)
+        ls = model._linsolve = SymmetricSolver(K, opts.linear_solver, method)
+        log.debug("linear solver: %s, %s, %d free dofs", ls.backend, ls.method, K.shape[0])
     return ls.factor(K)
 
 
@@ -246,14 +280,15 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             return u, ev, it, hist
         if it >= opts.max_newton * (1 + releases):  # a release starts a fresh budget
             break
+        du = np.zeros_like(u)
         try:
             K = model.tangent(ev, curvature=it >= opts.curvature_after if model.surface else None)
-            lu = _factor(model, model.pattern.free_matrix(K), opts)
+            # the solve may refactorise too (a stale reused factorisation)
+            forcing = min(1e-3, opts.linear_forcing * rn / scale) if scale > 0 else None
+            du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf, rtol=forcing)
         except (RuntimeError, FloatingPointError) as e:  # singular factor
             raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
         stats.factorizations += 1
-        du = np.zeros_like(u)
-        du[free] = -lu.solve(Rf)
         if not np.all(np.isfinite(du)):
             raise _Failure("non-finite Newton step", {"history": hist, **_worst(model, ev.R)})
         eta, tn, trial = _line_search(model, u, du, ev, t, dt, lam, opts, sticky)
