@@ -73,6 +73,9 @@ def parse_values(text: str, name: str) -> list[float]:
 MAX_CASES = 10_000
 
 
+BRAILLE_DIMS = (2, 3)
+
+
 def expand_grid(
     thicknesses: Sequence[float] = PAPER_THICKNESSES,
     materials: Sequence[str] = PAPER_MATERIALS,
@@ -80,29 +83,62 @@ def expand_grid(
     depths: Sequence[float | None] = (None,),
     braille_texts: Sequence[str] = ("",),
     base: Scene | None = None,
+    braille_dims: Sequence[int] | None = None,
+    quality: str | None = None,
+    overrides: dict | None = None,
 ) -> list[Scene]:
-    """Cartesian product of the sweep axes; Braille texts apply to Braille indenters only."""
+    """Cartesian product of the sweep axes; Braille texts apply to Braille indenters only.
+
+    braille_dims: the dimensions of the Braille cases (2: the paper's ridge section, 3: the
+    slab with real dots; both: one case each). Flat and curved cases keep `base.dim`: they
+    are uniform along the finger, so the 2D section is exact for them. None: every case
+    has base.dim (as without the axis).
+    quality: a planner quality preset applied to each scene after its indenter and dim are
+    set (planner.with_quality), then `overrides` (Scene fields such as mesh_size, which
+    override the preset)."""
     base = base or Scene()
     for name, axis in (("thicknesses", thicknesses), ("materials", materials), ("indenters", indenters),
-                       ("depths", depths), ("braille_texts", braille_texts)):
+                       ("depths", depths), ("braille_texts", braille_texts), ("braille_dims", braille_dims)):
         if isinstance(axis, (str, bytes)):  # would iterate as one-letter values
             raise ParameterError(name, axis, "a sequence of values, not a string")
-    n = len(thicknesses) * len(materials) * len(indenters) * len(depths) * max(len(braille_texts), 1)
+    dims = check_braille_dims(braille_dims) if braille_dims is not None else (base.dim,)
+    n = (len(thicknesses) * len(materials) * len(indenters) * len(depths)
+         * max(len(braille_texts), 1) * len(dims))
     if n > MAX_CASES:
         raise ParameterError("sweep grid", f"{n} cases", f"at most {MAX_CASES} cases",
                              "split the sweep; every case is a separate solve")
+    if quality is not None:
+        from tactileskin.planner import quality_mesh, with_quality
+
+        quality_mesh(quality, base.indenter)  # an unknown preset fails before any scene
     scenes: list[Scene] = []
     seen: set[str] = set()
     for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
         kind = base.replace(thickness=t, indenter=ind).indenter  # validates the name
-        texts = braille_texts if kind is IndenterKind.BRAILLE else ("",)
-        for text in texts:
-            s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text)
-            if s.key() not in seen:
-                seen.add(s.key())
-                scenes.append(s)
+        braille = kind is IndenterKind.BRAILLE
+        for text in (braille_texts if braille else ("",)):
+            for dim in (dims if braille else (base.dim,)):
+                s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim)
+                if quality is not None:
+                    s = with_quality(s, quality)
+                if overrides:
+                    s = s.replace(**overrides)
+                if s.key() not in seen:
+                    seen.add(s.key())
+                    scenes.append(s)
     check_materials(s.material for s in scenes)
     return scenes
+
+
+def check_braille_dims(dims, name: str = "braille_dims") -> tuple[int, ...]:
+    """The dimensions of Braille cases: a non-empty list of 2 and/or 3 (duplicates dropped)."""
+    from tactileskin import validate
+
+    items = validate.integer_list(dims, name, MAX_AXIS_VALUES, "2 or 3", min_len=1)
+    for i, v in enumerate(items):
+        if v not in BRAILLE_DIMS:
+            raise ParameterError(f"{name}[{i}]", v, "2 or 3")
+    return tuple(dict.fromkeys(items))
 
 
 def check_materials(names: Iterable[str]) -> None:
@@ -116,13 +152,14 @@ def check_materials(names: Iterable[str]) -> None:
 
 MAX_AXIS_VALUES = 1000  # values per sweep axis, as parse_values allows
 _SPEC_LISTS = {"thicknesses": "numbers", "depths": "numbers", "materials": "strings",
-               "indenters": "strings", "braille_texts": "strings"}
+               "indenters": "strings", "braille_texts": "strings", "braille_dims": "dims"}
 
 
 def load_spec(path: str | Path) -> dict:
-    """A sweep TOML: [sweep] thicknesses/materials/indenters/depths/braille_texts lists,
-    optional [scene] base fields. Unknown tables or keys and values of the wrong type
-    (`materials = "silicone"`, a string, not a list) are ParameterErrors."""
+    """A sweep TOML: [sweep] thicknesses/materials/indenters/depths/braille_texts/braille_dims
+    lists (braille_dims: 2 and/or 3, see expand_grid), optional [scene] base fields. Unknown
+    tables or keys and values of the wrong type (`materials = "silicone"`, a string, not a
+    list; `braille_dims = [3.0]`, not an integer) are ParameterErrors."""
     from tactileskin import validate
     from tactileskin.params import read_toml
 
@@ -135,6 +172,8 @@ def load_spec(path: str | Path) -> dict:
         name = f"sweep.{k}"
         if _SPEC_LISTS[k] == "numbers":
             spec[k] = validate.number_list(v, name, MAX_AXIS_VALUES, min_len=1)
+        elif _SPEC_LISTS[k] == "dims":
+            spec[k] = check_braille_dims(v, name)
         else:
             spec[k] = validate.string_list(v, name, MAX_AXIS_VALUES, min_len=1)
     if "scene" in data:

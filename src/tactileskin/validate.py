@@ -90,3 +90,11 @@ def string_list(v, name: str, max_len: int, *, min_len: int = 0) -> tuple[str, .
     if len(items) < min_len:
         raise ParameterError(name, v, f"a list of at least {min_len} string(s)")
     return tuple(string(x, f"{name}[{i}]") for i, x in enumerate(items))
+
+
+def integer_list(v, name: str, max_len: int, valid: str, *, min_len: int = 0) -> tuple[int, ...]:
+    """A list of ints (not bools, not floats such as 2.0), e.g. the dims of a sweep."""
+    items = sequence(v, name, "integers", max_len)
+    if len(items) < min_len:
+        raise ParameterError(name, v, f"a list of at least {min_len} integer(s)")
+    return tuple(integer(x, f"{name}[{i}]", valid) for i, x in enumerate(items))

@@ -19,6 +19,7 @@ _RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by it
 
 
 EXIT_FAILED, EXIT_SUSPECT = 1, 3
+BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 
 
 @click.command("sweep", epilog=(
@@ -36,6 +37,10 @@ EXIT_FAILED, EXIT_SUSPECT = 1, 3
 @click.option("--indenter", "-i", default=None, help="Indenters, comma-separated. Default flat,curved,braille.")
 @click.option("--depth", default=None, help="Depths (mm), comma-separated; default 20 % of each thickness.")
 @click.option("--braille-text", multiple=True, help="Braille text(s) for Braille cases (repeatable).")
+@click.option("--braille-dim", "braille_dim", type=click.Choice(["2", "3", "both"]), default=None,
+              help="Braille cases as the paper's 2D ridge section (2), as the 3D slab with real "
+                   "dots (3), or both side by side in the report. Default 2 (the [scene] dim). "
+                   "Flat and curved cases stay 2D (exact for them). 3D solves take minutes each.")
 @click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
 @click.option("--quality", type=click.Choice(["preview", "default", "fine"]), default=None,
               help="Mesh preset from the speed-vs-error study (docs/speed_vs_error.md).")
@@ -48,7 +53,7 @@ EXIT_FAILED, EXIT_SUSPECT = 1, 3
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
 @click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
-def command(out, config, thickness, material, indenter, depth, braille_text, rate, quality, mesh_size,
+def command(out, config, thickness, material, indenter, depth, braille_text, braille_dim, rate, quality, mesh_size,
             formulation, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
@@ -68,12 +73,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         check_scheduler(scheduler)
     spec = load_spec(config) if config else {}
     base = spec.pop("base", Scene())
-    if quality:
-        from tactileskin.planner import with_quality
-
-        base = with_quality(base, quality)
-    changes = {k: v for k, v in dict(rate=rate, mesh_size=mesh_size, formulation=formulation).items()
-               if v is not None}
+    changes = {k: v for k, v in dict(rate=rate, formulation=formulation).items() if v is not None}
     if changes:
         base = base.replace(**changes)
     grid = dict(
@@ -82,8 +82,11 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         indenters=_names(indenter, "indenter") if indenter else spec.get("indenters", PAPER_INDENTERS),
         depths=parse_values(depth, "depth") if depth else spec.get("depths", (None,)),
         braille_texts=tuple(braille_text) if braille_text else spec.get("braille_texts", ("",)),
+        braille_dims=BRAILLE_DIM_CHOICES[braille_dim] if braille_dim else spec.get("braille_dims"),
     )
-    scenes = expand_grid(base=base, **grid)
+    # the preset per scene (it depends on the indenter and dim), --mesh-size over it
+    scenes = expand_grid(base=base, quality=quality,
+                         overrides=None if mesh_size is None else dict(mesh_size=mesh_size), **grid)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     with claimed_output(out, "sweep", _own_names(out)):  # before any solving
