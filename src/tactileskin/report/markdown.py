@@ -33,12 +33,28 @@ def at_paper_conditions(scene) -> bool:
             and scene.braille_standard == d.braille_standard)
 
 
-def _index(rows):
+BRAILLE_MODELS = {2: "2D ridge", 3: "3D dots"}
+
+
+def _other_dim(indenter: str, dim: int, braille_dim: int | None) -> bool:
+    """A Braille case of the other model when the checks use `braille_dim` (None: any)."""
+    return braille_dim is not None and indenter == "braille" and dim != braille_dim
+
+
+def has_3d_braille(rows) -> bool:
+    """Whether the sweep has a 3D Braille case (run or failed): the report then shows the
+    checks with the 2D ridge and with the 3D dots."""
+    return any(r.get("indenter") == "braille" and r.get("dim", 2) == 3 for r in rows)
+
+
+def _index(rows, braille_dim: int | None = None):
     """{(material, thickness, indenter): row} of the ok rows at the paper's conditions
-    without a Braille text; where several remain (two meshes, ...) the first one listed."""
+    without a Braille text; where several remain (two meshes, ...) the first one listed.
+    braille_dim: only Braille cases of that dimension (None: any)."""
     idx = {}
     for r in rows:
-        if r.get("status") == "ok" and r.get("paper", True) and not r.get("braille_text"):
+        if (r.get("status") == "ok" and r.get("paper", True) and not r.get("braille_text")
+                and not _other_dim(r["indenter"], r.get("dim", 2), braille_dim)):
             idx.setdefault((r["material"], r["thickness_mm"], r["indenter"]), r)
     return idx
 
@@ -48,18 +64,20 @@ def _suspect_records(records) -> list:
     return [rec for rec in records if quality.status(rec.summary) != "ok"]
 
 
-def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False):
+def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False,
+                       braille_dim: int | None = None):
     """Sorted ((material, thickness, variant), {indenter name: (s, P)}) groups of the sweep's
     profiles; Braille cases with a text are named 'braille[text]', or left out when not
     with_text. paper_only: only cases at the paper's conditions, the first per indenter,
-    all in one group per (material, thickness). Suspect results are left out (a verdict on
-    them would be a verdict on a wrong number)."""
+    all in one group per (material, thickness). braille_dim: only Braille cases of that
+    dimension (None: any). Suspect results are left out (a verdict on them would be a
+    verdict on a wrong number)."""
     groups = defaultdict(dict)
     suspect = {id(r) for r in _suspect_records(records)}
     for rec in records:
         sc = rec.scene
         if ((sc.braille_text and not with_text) or (paper_only and not at_paper_conditions(sc))
-                or id(rec) in suspect):
+                or id(rec) in suspect or _other_dim(sc.indenter.value, sc.dim, braille_dim)):
             continue
         name = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
         variant = "" if paper_only else getattr(rec, "variant", "")
@@ -67,9 +85,10 @@ def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False):
     return sorted(groups.items())
 
 
-def paper_checks(rows, records) -> list[dict]:
-    """Each paper claim with our value and a verdict."""
-    idx = _index(rows)
+def paper_checks(rows, records, braille_dim: int | None = None) -> list[dict]:
+    """Each paper claim with our value and a verdict. braille_dim: use only the Braille
+    cases of that dimension (2: the paper's ridge section, 3: the dots; None: any)."""
+    idx = _index(rows, braille_dim)
     checks = []
 
     for mat, ref in PAPER_PEAK_1MM_FLAT.items():
@@ -126,7 +145,8 @@ def paper_checks(rows, records) -> list[dict]:
                                ours=f"spread {(spread):.0%} of the mean",
                                verdict="agrees" if spread < THRESHOLD else "differs"))
 
-    for (mat, t, _), profs in _profiles_by_group(records, with_text=False, paper_only=True):
+    for (mat, t, _), profs in _profiles_by_group(records, with_text=False, paper_only=True,
+                                                 braille_dim=braille_dim):
         if len(profs) < 3:
             continue
         v = discriminate(profs)
@@ -137,13 +157,130 @@ def paper_checks(rows, records) -> list[dict]:
     return checks
 
 
+def paper_checks_by_model(rows, records) -> list[dict]:
+    """Each paper check computed twice, with the Braille cases as the 2D ridge and as the 3D
+    dots: dict(claim, ours={2: .., 3: ..}, verdict={2: .., 3: ..}, changed). A claim that
+    one model cannot test (its cases missing) has None there; `changed` is True when both
+    verdicts exist and differ."""
+    merged: dict[str, dict] = {}
+    for dim in BRAILLE_MODELS:
+        for c in paper_checks(rows, records, braille_dim=dim):
+            m = merged.setdefault(c["claim"], dict(claim=c["claim"], ours={}, verdict={}))
+            m["ours"][dim], m["verdict"][dim] = c["ours"], c["verdict"]
+    for m in merged.values():
+        v = m["verdict"]
+        m["changed"] = len(v) == len(BRAILLE_MODELS) and len(set(v.values())) > 1
+    return list(merged.values())
+
+
+def _discrimination_cells(profs) -> tuple[str, str]:
+    v = discriminate(profs)
+    d = ", ".join(f"{a}–{b} {x:.2f}" for (a, b), x in v.distances.items())
+    return d or "n/a", "distinguishable" if v.distinguishable else "not distinguishable"
+
+
 def discrimination_table(records) -> list[str]:
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     for (mat, t, variant), profs in _profiles_by_group(records, with_text=True):
-        v = discriminate(profs)
-        d = ", ".join(f"{a}–{b} {x:.2f}" for (a, b), x in v.distances.items())
-        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {d or 'n/a'} | "
-                     f"{'distinguishable' if v.distinguishable else 'not distinguishable'} |")
+        d, verdict = _discrimination_cells(profs)
+        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {d} | {verdict} |")
+    return lines
+
+
+def discrimination_by_model(records) -> list[dict]:
+    """The discrimination verdict of each (material, thickness, variant) group twice, with
+    the Braille cases as the 2D ridge and as the 3D dots: dict(group, distances={dim: ..},
+    verdict={dim: ..}, changed)."""
+    merged: dict[tuple, dict] = {}
+    for dim in BRAILLE_MODELS:
+        for key, profs in _profiles_by_group(records, with_text=True, braille_dim=dim):
+            m = merged.setdefault(key, dict(group=key, distances={}, verdict={}))
+            m["distances"][dim], m["verdict"][dim] = _discrimination_cells(profs)
+    for m in merged.values():
+        v = m["verdict"]
+        m["changed"] = len(v) == len(BRAILLE_MODELS) and len(set(v.values())) > 1
+    return [merged[k] for k in sorted(merged)]
+
+
+def _model_cell(d: dict, dim: int) -> str:
+    return d.get(dim, "n/a")
+
+
+def discrimination_table_by_model(groups: list[dict]) -> list[str]:
+    """The table of `discrimination_by_model` groups."""
+    r, t3 = BRAILLE_MODELS[2], BRAILLE_MODELS[3]
+    lines = [f"| material | t (mm) | variant | distances, {r} | verdict, {r} | distances, {t3} | "
+             f"verdict, {t3} | changes |", "|---|---|---|---|---|---|---|---|"]
+    for m in groups:
+        mat, t, variant = m["group"]
+        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {_model_cell(m['distances'], 2)} | "
+                     f"{_model_cell(m['verdict'], 2)} | {_model_cell(m['distances'], 3)} | "
+                     f"{_model_cell(m['verdict'], 3)} | {'**changes**' if m['changed'] else '–'} |")
+    return lines
+
+
+# --- Braille: the 2D ridge against the 3D dots ------------------------------------------------
+
+RIDGE_VS_DOTS_SOURCE = "benchmarks/results/braille_2d_vs_3d.md"
+_MESH_FIELDS = ("dim", "mesh_size", "refinement")
+
+
+def _pair_key(scene) -> tuple:
+    """A scene's fields except its dimension and mesh: a 2D and a 3D case with equal keys
+    are the same Braille case in the two models."""
+    return tuple(sorted((k, repr(v)) for k, v in scene.to_dict().items() if k not in _MESH_FIELDS))
+
+
+def braille_pairs(records) -> list[tuple]:
+    """(2D record, 3D record) of each Braille case solved in both dimensions, every other
+    scene field equal (the mesh aside), in sweep order."""
+    by_key = defaultdict(lambda: {2: [], 3: []})
+    for rec in records:
+        sc = rec.scene
+        if sc.indenter.value == "braille" and sc.dim in (2, 3):
+            by_key[_pair_key(sc)][sc.dim].append(rec)
+    return [(a, b) for g in by_key.values() for a in g[2] for b in g[3]]
+
+
+def _metrics(rec) -> dict:
+    from tactileskin import results
+
+    return {"peak": results.peak(rec.s, rec.pressure), "span": results.span(rec.s, rec.pressure),
+            "auc": results.auc(rec.s, rec.pressure)}
+
+
+def _ratio(a: float, b: float) -> str:
+    return f"{a / b:.2f}" if b > 0 else "n/a"
+
+
+def braille_comparison(records) -> list[str]:
+    """The report section comparing, per Braille case, the 2D ridge and the 3D dots."""
+    pairs = braille_pairs(records)
+    lines = ["## Braille: 2D ridge against 3D dots", "",
+             "The paper models a Braille dot row as a ridge in its 2D plane-strain section; the 3D "
+             "cases model the real dots on a slab. The 3D profile is the bone pressure on the "
+             "section plane through the dot row (the 3D result's profile.csv), so it compares "
+             "with the 2D section's profile point by point; '3D map max' is the largest pressure "
+             "over the whole bone surface. Ratios are 2D / 3D. The project measured the ridge "
+             f"at 2-3x the peak of a dot with spans within ~20 % ({RIDGE_VS_DOTS_SOURCE}).", ""]
+    if not pairs:
+        lines.append("No Braille case was solved in both dimensions (run the sweep with "
+                     "`--braille-dim both`).")
+        return lines
+    suspect = {id(r) for r in _suspect_records(records)}
+    lines += ["| cases (2D / 3D) | peak 2D (MPa) | peak 3D (MPa) | peak 2D/3D | span 2D (mm) | "
+              "span 3D (mm) | span 2D/3D | AUC 2D (MPa·mm) | AUC 3D (MPa·mm) | AUC 2D/3D | "
+              "3D map max (MPa) | note |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for a, b in pairs:
+        ma, mb = _metrics(a), _metrics(b)
+        name = lambda r: getattr(r, "case", "") or r.scene.label()  # noqa: E731
+        sus = [name(r) for r in (a, b) if id(r) in suspect]
+        cells = []
+        for k in ("peak", "span", "auc"):
+            cells += [_fmt(ma[k]), _fmt(mb[k]), _ratio(ma[k], mb[k])]
+        lines.append(f"| {name(a)} / {name(b)} | " + " | ".join(cells)
+                     + f" | {_fmt(b.summary.get('peak_map_mpa'))} | "
+                     + (f"suspect: {', '.join(sus)}" if sus else "–") + " |")
     return lines
 
 
@@ -181,13 +318,33 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
                    f"{r.get('increments', '')} | {r.get('newton_iterations', '')} | {_fmt(r.get('wall_s'), 2)} | "
                    f"{'**suspect**' if k == 'suspect' else 'ok'} |")
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
+    two_models = has_3d_braille(rows)
+    if two_models:
+        out += braille_comparison(records) + [""]
     out += ["## Against the paper", "",
             "Only the cases at the paper's conditions enter these checks (indentation 20 % of the "
             "thickness, the default rate, viscoelastic, the default fingertip and Braille standard); "
-            "where several remain for one material, thickness and indenter, the first listed is used.", "",
-            "| paper says | ours | verdict |", "|---|---|---|"]
-    for c in paper_checks(rows, records):
-        out.append(f"| {c['claim']} | {c['ours']} | {c['verdict']} |")
+            "where several remain for one material, thickness and indenter, the first listed is used.", ""]
+    if two_models:
+        r, d = BRAILLE_MODELS[2], BRAILLE_MODELS[3]
+        out += ["Each check is computed twice: with the Braille cases as the paper's 2D ridge (as the "
+                "paper did) and as the 3D dots (section-plane profile); flat and curved cases are the "
+                "same in both. 'changes' marks a verdict that the 3D dots turn; n/a: the model's "
+                "cases are missing, failed or suspect.", "",
+                f"| paper says | ours, {r} | verdict, {r} | ours, {d} | verdict, {d} | changes |",
+                "|---|---|---|---|---|---|"]
+        checks = paper_checks_by_model(rows, records)
+        for c in checks:
+            out.append(f"| {c['claim']} | {_model_cell(c['ours'], 2)} | {_model_cell(c['verdict'], 2)} | "
+                       f"{_model_cell(c['ours'], 3)} | {_model_cell(c['verdict'], 3)} | "
+                       f"{'**changes**' if c['changed'] else '–'} |")
+        changed = [c["claim"] for c in checks if c["changed"]]
+        out += ["", ("Verdicts the 3D dots change: " + "; ".join(changed) + ".") if changed
+                else "No verdict changes from the 2D ridge to the 3D dots."]
+    else:
+        out += ["| paper says | ours | verdict |", "|---|---|---|"]
+        for c in paper_checks(rows, records):
+            out.append(f"| {c['claim']} | {c['ours']} | {c['verdict']} |")
     out += ["",
             "Known causes of differences: (1) the paper reports film-style pressure per unit length "
             "(MPa/mm) while the simulation's mean pressure is in MPa; (2) our fingertip contour is a "
@@ -198,7 +355,15 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
             "## Discrimination", "",
             f"Relative L2 distance between profiles; distinguishable when every pair differs by ≥ {THRESHOLD} "
             "(see tactileskin/discrimination.py for why).", ""]
-    out += discrimination_table(records)
+    if two_models:
+        groups = discrimination_by_model(records)
+        out += discrimination_table_by_model(groups)
+        changed = [m["group"] for m in groups if m["changed"]]
+        out += ["", ("Discrimination verdicts the 3D dots change: "
+                     + "; ".join(f"{m} {t:g} mm" + (f" {v}" if v else "") for m, t, v in changed) + ".")
+                if changed else "No discrimination verdict changes from the 2D ridge to the 3D dots."]
+    else:
+        out += discrimination_table(records)
     sus = _suspect_records(records)
     if sus:
         out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]

@@ -1,0 +1,219 @@
+"""Braille in 2D and 3D in one sweep: the grid axis, the CLI option, and the report's side by
+side table and twice-computed verdicts, on synthetic records (no solving)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tactileskin.cli import main
+from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.report import markdown
+from tactileskin.scene import Scene, default_mesh
+from tactileskin.sweep import CaseRecord, case_ids, expand_grid, load_spec
+
+S = np.linspace(0, 8, 161)
+
+# --- grid -------------------------------------------------------------------------------------
+
+
+def test_both_dims_double_only_the_braille_cases():
+    scenes = expand_grid(thicknesses=[1.0, 3.0], materials=["silicone"], braille_dims=[2, 3])
+    ids = case_ids(scenes)
+    assert len(scenes) == 2 * 4 and len(set(ids)) == len(ids)
+    for sc, cid in zip(scenes, ids):
+        if sc.indenter.value == "braille":
+            assert cid.endswith(f"-{sc.dim}d")
+        else:  # uniform along the finger: the 2D section is exact
+            assert sc.dim == 2
+    three = [sc for sc in scenes if sc.dim == 3]
+    assert [sc.thickness for sc in three] == [1.0, 3.0]
+    assert all((sc.mesh_size, sc.refinement) == default_mesh(3, "braille") for sc in three)
+    two = [sc for sc in scenes if sc.dim == 2 and sc.indenter.value == "braille"]
+    assert all((sc.mesh_size, sc.refinement) == default_mesh(2, "braille") for sc in two)
+
+
+def test_default_and_3d_only():
+    plain = expand_grid(thicknesses=[1.0], materials=["silicone"])
+    assert expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2]) == plain
+    only3 = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=(3,))
+    assert [(sc.indenter.value, sc.dim) for sc in only3] == [("flat", 2), ("curved", 2), ("braille", 3)]
+
+
+def test_quality_applies_per_scene_and_mesh_size_over_it():
+    from tactileskin.planner import with_quality
+
+    scenes = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2, 3], quality="fine",
+                         overrides=dict(mesh_size=0.8))
+    for sc in scenes:
+        q = with_quality(sc.replace(mesh_size=None, refinement=None), "fine")
+        assert sc.refinement == q.refinement and sc.mesh_size == 0.8
+
+
+@pytest.mark.parametrize("dims", [[4], [], [2.0], [True], "23", [2, "3"]])
+def test_bad_braille_dims_are_parameter_errors(dims):
+    with pytest.raises(ParameterError, match="braille_dims"):
+        expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=dims)
+
+
+def test_sweep_file_braille_dims(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text('[sweep]\nthicknesses = [1]\nmaterials = ["silicone"]\nbraille_dims = [2, 3]\n')
+    spec = load_spec(f)
+    assert spec["braille_dims"] == (2, 3)
+    assert sum(sc.dim == 3 for sc in expand_grid(**spec)) == 1
+    for bad in ("[3.0]", "[1]", '"both"', "[]"):
+        f.write_text(f"[sweep]\nbraille_dims = {bad}\n")
+        with pytest.raises(ParameterError, match="sweep.braille_dims"):
+            load_spec(f)
+
+
+class _Stop(TactileSkinError):
+    pass
+
+
+@pytest.mark.parametrize("opt, dims", [(None, {2}), ("2", {2}), ("3", {3}), ("both", {2, 3})])
+def test_cli_braille_dim_option(tmp_path, monkeypatch, opt, dims):
+    import tactileskin.sweep as sweep
+
+    seen = []
+
+    def fake_run(scenes, *a, **k):  # the grid, without solving
+        seen.extend(scenes)
+        raise _Stop("stopped before solving")
+
+    monkeypatch.setattr(sweep, "run_sweep", fake_run)
+    argv = ["sweep", "-t", "1", "-m", "silicone", "--out", str(tmp_path / "o"), "--serial"]
+    assert main(argv + (["--braille-dim", opt] if opt else [])) == 2
+    assert {sc.dim for sc in seen if sc.indenter.value == "braille"} == dims
+    assert {sc.dim for sc in seen if sc.indenter.value != "braille"} == {2}
+
+
+def test_cli_rejects_a_bad_braille_dim(tmp_path):
+    assert main(["sweep", "--braille-dim", "4", "--out", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists()
+
+
+# --- report -----------------------------------------------------------------------------------
+
+def _case(t, ind, peak, w, *, dim=2, mat="silicone", summary=None, depth=None):
+    sc = Scene(thickness=t, material=mat, indenter=ind, dim=dim, depth=depth)
+    p = peak * np.exp(-(S / w) ** 2)
+    rec = CaseRecord(sc, S, p, dict(summary or {}), Path("."))
+    from tactileskin import quality
+
+    row = dict(status=quality.status(rec.summary), material=mat, thickness_mm=t, indenter=ind,
+               braille_text="", dim=dim, paper=markdown.at_paper_conditions(sc), depth_mm=sc.indentation,
+               rate_mm_s=sc.rate, reaction_n_per_mm=None,
+               peak_mpa=float(p.max()), span_mm=w * np.sqrt(np.log(10)), auc=float(np.trapezoid(p, S)))
+    return rec, row
+
+
+def _sweep(cases):
+    recs, rows = zip(*cases)
+    ids = case_ids([r.scene for r in recs])
+    for rec, row, cid in zip(recs, rows, ids):
+        rec.case = row["case"] = cid
+    return list(recs), list(rows)
+
+
+def _paper_like(braille3d=(0.1, 0.5), suspect3d=False):
+    """t = 1 and 5 mm silicone. 2D: distinguishable at 1 mm, the peak order broken at 5 mm
+    (as the paper says). 3D: the 1 mm dot reads like the curved plate (not distinguishable:
+    a verdict changes) and the 5 mm dot is a narrow low peak, which restores the order
+    flat > curved > Braille (another verdict changes)."""
+    cases = [_case(1.0, "flat", 0.5, 4.0), _case(1.0, "curved", 0.4, 2.0), _case(1.0, "braille", 0.3, 0.8),
+             _case(5.0, "flat", 0.2, 1.55), _case(5.0, "curved", 0.19, 1.55), _case(5.0, "braille", 0.2, 1.55),
+             _case(1.0, "braille", 0.39, 2.0, dim=3)]
+    summary = dict(contact_points=0) if suspect3d else None
+    cases.append(_case(5.0, "braille", *braille3d, dim=3, summary=summary))
+    return _sweep(cases)
+
+
+def test_side_by_side_pairs_equal_cases_only():
+    recs, _ = _paper_like()
+    # a 3D case at another depth has no 2D partner
+    extra, _ = _case(1.0, "braille", 0.2, 2.0, dim=3, depth=0.1)
+    extra.case = "t1-silicone-braille-3d-d0.1"
+    pairs = markdown.braille_pairs(recs + [extra])
+    assert [(a.scene.thickness, a.scene.dim, b.scene.dim) for a, b in pairs] == [(1.0, 2, 3), (5.0, 2, 3)]
+    lines = markdown.braille_comparison(recs + [extra])
+    assert lines[0] == "## Braille: 2D ridge against 3D dots"
+    text = "\n".join(lines)
+    assert "braille_2d_vs_3d.md" in text and "section plane" in text
+    rows = [ln for ln in lines if ln.startswith("| t")]
+    assert len(rows) == 2 and "d0.1" not in text
+    cells = [c.strip() for c in rows[0].strip("|").split("|")]
+    assert cells[0] == "t1-silicone-braille-2d / t1-silicone-braille-3d"
+    assert cells[1:4] == ["0.3", "0.39", "0.77"]          # peaks and their ratio
+    span2, span3 = (w * np.sqrt(np.log(10)) for w in (0.8, 2.0))
+    assert float(cells[4]) == pytest.approx(span2, rel=0.01) and float(cells[5]) == pytest.approx(span3, rel=0.01)
+    assert float(cells[6]) == pytest.approx(0.8 / 2.0, abs=0.006)
+    assert float(cells[9]) == pytest.approx(0.3 * 0.8 / (0.39 * 2.0), abs=0.006)  # AUC of a Gaussian: peak * w
+
+
+def test_verdicts_are_computed_with_each_model_and_changes_marked():
+    recs, rows = _paper_like()
+    checks = {c["claim"]: c for c in markdown.paper_checks_by_model(rows, recs)}
+    flat = checks["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm"]
+    assert flat["verdict"] == {2: "agrees", 3: "agrees"} and not flat["changed"]
+    order1 = checks["silicone 1 mm: peak order flat > curved > Braille holds"]
+    assert order1["ours"] == {2: "0.5 / 0.4 / 0.3 MPa", 3: "0.5 / 0.4 / 0.39 MPa"} and not order1["changed"]
+    order5 = checks["silicone 5 mm: peak order flat > curved > Braille breaks down"]
+    assert order5["verdict"] == {2: "agrees", 3: "differs"} and order5["changed"]
+    ind1 = checks["silicone 1 mm: indenters distinguishable"]
+    assert ind1["verdict"] == {2: "agrees", 3: "differs"} and ind1["changed"]
+    ind5 = checks["silicone 5 mm: indenters indistinguishable"]
+    assert ind5["verdict"] == {2: "agrees", 3: "agrees"} and not ind5["changed"]  # flat and curved alike
+    # the 2D-ridge column is the paper's single computation
+    assert {c["claim"]: c["verdict"] for c in markdown.paper_checks(rows, recs, braille_dim=2)} == \
+        {k: c["verdict"][2] for k, c in checks.items() if 2 in c["verdict"]}
+
+    groups = {m["group"]: m for m in markdown.discrimination_by_model(recs)}
+    g1 = groups[("silicone", 1.0, "")]
+    assert g1["verdict"] == {2: "distinguishable", 3: "not distinguishable"} and g1["changed"]
+    assert not groups[("silicone", 5.0, "")]["changed"]
+
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    assert "## Braille: 2D ridge against 3D dots" in report
+    assert "| paper says | ours, 2D ridge | verdict, 2D ridge | ours, 3D dots | verdict, 3D dots | changes |" in report
+    line = next(ln for ln in report.splitlines() if ln.startswith("| silicone 5 mm: peak order"))
+    assert line.endswith("| **changes** |")
+    said = next(ln for ln in report.splitlines() if ln.startswith("Verdicts the 3D dots change: "))
+    listed = said.removeprefix("Verdicts the 3D dots change: ").rstrip(".").split("; ")
+    assert listed == [c for c in checks if checks[c]["changed"]]
+    assert {"silicone 5 mm: peak order flat > curved > Braille breaks down",
+            "silicone 1 mm: indenters distinguishable"} <= set(listed)
+    assert "silicone 1 mm: peak order flat > curved > Braille holds" not in listed
+    assert "Discrimination verdicts the 3D dots change: silicone 1 mm." in report
+
+
+def test_no_change_is_said():
+    recs, rows = _paper_like(braille3d=(0.2, 1.55))  # the 3D dot as the 2D ridge at 5 mm
+    recs, rows = recs[:6] + recs[7:], rows[:6] + rows[7:]  # and no 3D case at 1 mm
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    assert "No verdict changes from the 2D ridge to the 3D dots." in report
+    assert "**changes**" not in report
+
+
+def test_suspect_3d_case_stays_out_of_the_verdicts():
+    recs, rows = _paper_like(suspect3d=True)
+    checks = {c["claim"]: c for c in markdown.paper_checks_by_model(rows, recs)}
+    ind5 = checks["silicone 5 mm: indenters indistinguishable"]
+    assert ind5["verdict"] == {2: "agrees"} and not ind5["changed"]  # untested with the dots
+    assert 3 not in checks["silicone 5 mm: peak order flat > curved > Braille breaks down"]["verdict"]
+    groups = {m["group"]: m for m in markdown.discrimination_by_model(recs)}
+    assert "braille" not in groups[("silicone", 5.0, "")]["distances"][3]
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    row5 = next(ln for ln in report.splitlines() if ln.startswith("| t5-silicone-braille-2d / "))
+    assert "suspect: t5-silicone-braille-3d" in row5
+
+
+def test_without_3d_braille_the_report_is_unchanged():
+    recs, rows = _sweep([_case(1.0, "flat", 0.5, 4.0), _case(1.0, "curved", 0.4, 2.0),
+                         _case(1.0, "braille", 0.3, 0.8)])
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    assert "2D ridge" not in report and "3D dots" not in report
+    assert "| paper says | ours | verdict |" in report
+    assert "| material | t (mm) | variant | pairwise distances | verdict |" in report
+    assert markdown.paper_checks(rows, recs) == markdown.paper_checks(rows, recs, braille_dim=2)
