@@ -71,11 +71,13 @@ def profiles_figure(records, out: Path) -> list[Path]:
         for j, t in enumerate(thick):
             ax = axes[i][j]
             variants = sorted({getattr(r, "variant", "") for r in records})
+            dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
             for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t),
                             key=lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,
-                                           getattr(r, "variant", ""))):
-                ls = _DASHES[variants.index(getattr(r, "variant", "")) % len(_DASHES)]
-                ax.plot(r.s, r.pressure, ls, color=COLOURS.get(r.scene.indenter.value), label=_ind_name(r))
+                                           getattr(r, "variant", ""), r.scene.dim)):
+                k = variants.index(getattr(r, "variant", "")) + len(variants) * dims.index(r.scene.dim)
+                ax.plot(r.s, r.pressure, _DASHES[k % len(_DASHES)], color=COLOURS.get(r.scene.indenter.value),
+                        label=_ind_name(r) + (f" {r.scene.dim}d" if len(dims) > 1 else ""))
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.set_xlim(0, 8)
