@@ -38,7 +38,7 @@ EXIT_FAILED, EXIT_SUSPECT = 1, 3
 @click.option("--braille-text", multiple=True, help="Braille text(s) for Braille cases (repeatable).")
 @click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
 @click.option("--quality", type=click.Choice(["preview", "default", "fine"]), default=None,
-              help="Mesh preset from the speed-vs-error study (docs/speed_vs_error.md).")
+              help="Mesh preset of each case's dimension (tactileskin/data/presets.json; docs/speed_vs_error.md).")
 @click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
 @click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
@@ -68,10 +68,6 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         check_scheduler(scheduler)
     spec = load_spec(config) if config else {}
     base = spec.pop("base", Scene())
-    if quality:
-        from tactileskin.planner import with_quality
-
-        base = with_quality(base, quality)
     changes = {k: v for k, v in dict(rate=rate, mesh_size=mesh_size, formulation=formulation).items()
                if v is not None}
     if changes:
@@ -84,6 +80,12 @@ def command(out, config, thickness, material, indenter, depth, braille_text, rat
         braille_texts=tuple(braille_text) if braille_text else spec.get("braille_texts", ("",)),
     )
     scenes = expand_grid(base=base, **grid)
+    if quality:  # per case: 2D and 3D cases get their dimension's preset; --mesh-size still wins
+        from tactileskin.planner import with_quality
+
+        scenes = [with_quality(s, quality) for s in scenes]
+        if mesh_size is not None:
+            scenes = [s.replace(mesh_size=mesh_size) for s in scenes]
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     with claimed_output(out, "sweep", _own_names(out)):  # before any solving
