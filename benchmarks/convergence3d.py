@@ -225,7 +225,22 @@ def table(study: dict) -> str:
             return f"{name} reference {r['value']:.5g} (Richardson, observed order {o})"
         return f"{name} reference {r['value']:.5g} = finest level ({r['why']}; observed order {o})"
 
-    return "\n".join(rows) + "\n\n" + says("peak", ref) + "; " + says("span", sref) + ".\n"
+    ok = cheapest_within(study["levels"])
+    pick = ("none of the levels (the finest is the reference: its own error is not measured)" if ok is None
+            else f"{ok['mesh_size']:g} / {ok['refinement']:g} ({ok['dofs']:,} dofs, {ok['cpu_s']:.0f} s CPU)")
+    return ("\n".join(rows) + "\n\n" + says("peak", ref) + "; " + says("span", sref) + ".\n"
+            f"Cheapest level within {PEAK_TOL:.0%} peak and {MAP_TOL:.0%} map L2 (excluding the finest, "
+            f"whose map error is zero by construction): {pick}.\n")
+
+
+PEAK_TOL, MAP_TOL = 0.02, 0.05   # issue 13's accuracy target of the `default` preset
+
+
+def cheapest_within(levels: list[dict], peak_tol: float = PEAK_TOL, map_tol: float = MAP_TOL) -> dict | None:
+    """The level with the fewest dofs whose |peak error| <= peak_tol and map L2 <= map_tol,
+    the finest level excluded (it is the map reference); None if none is."""
+    ok = [d for d in levels[:-1] if abs(d["peak_error"]) <= peak_tol and d["map_l2"] <= map_tol]
+    return min(ok, key=lambda d: d["dofs"]) if ok else None
 
 
 def write_presets(path: Path, key: str, study: dict) -> None:

@@ -88,3 +88,11 @@ def test_map_l2_on_the_coarsest_grid():
     # on the coarse grid points the fine map (bilinear in z, exact there; linear in s on nodes
     # that include the coarse ones) is 1.1 P: relative difference 0.1 / 1.1
     assert e[0] == pytest.approx(0.1 / 1.1, rel=1e-9)
+
+
+def test_cheapest_level_within_the_targets():
+    lv = [{"dofs": 10, "peak_error": -0.05, "map_l2": 0.03}, {"dofs": 20, "peak_error": -0.015, "map_l2": 0.04},
+          {"dofs": 40, "peak_error": -0.005, "map_l2": 0.01}, {"dofs": 80, "peak_error": 0.0, "map_l2": 0.0}]
+    assert cv.cheapest_within(lv)["dofs"] == 20
+    assert cv.cheapest_within(lv, peak_tol=0.01)["dofs"] == 40
+    assert cv.cheapest_within(lv, peak_tol=0.001) is None  # the finest level does not count
