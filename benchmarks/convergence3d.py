@@ -90,7 +90,7 @@ def richardson(h, f, p_range=(P_MIN, P_MAX)) -> dict:
     f2, f3 = float(f[1]), float(f[2])
     if p is None:
         return {"value": f3, "order": None, "method": "finest",
-                "why": "differences change sign (or vanish): no observed order"}
+                "why": "no observed order (differences change sign or vanish, or no p in (0.05, 20) fits)"}
     if not (p_range[0] <= p <= p_range[1]):
         return {"value": f3, "order": p, "method": "finest",
                 "why": f"observed order {p:.2f} outside [{p_range[0]:g}, {p_range[1]:g}]"}
