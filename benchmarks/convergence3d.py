@@ -225,10 +225,13 @@ def table(study: dict) -> str:
             return f"{name} reference {r['value']:.5g} (Richardson, observed order {o})"
         return f"{name} reference {r['value']:.5g} = finest level ({r['why']}; observed order {o})"
 
+    a, b = study["levels"][-2:]
+    two = (f"Finest two levels differ by {(a['peak'] - b['peak']) / b['peak']:+.2%} (peak), "
+           f"{(a['span'] - b['span']) / b['span']:+.2%} (span), {a['map_l2']:.2%} (map L2).\n")
     ok = cheapest_within(study["levels"])
     pick = ("none of the levels (the finest is the reference: its own error is not measured)" if ok is None
             else f"{ok['mesh_size']:g} / {ok['refinement']:g} ({ok['dofs']:,} dofs, {ok['cpu_s']:.0f} s CPU)")
-    return ("\n".join(rows) + "\n\n" + says("peak", ref) + "; " + says("span", sref) + ".\n"
+    return ("\n".join(rows) + "\n\n" + says("peak", ref) + "; " + says("span", sref) + ".\n" + two +
             f"Cheapest level within {PEAK_TOL:.0%} peak and {MAP_TOL:.0%} map L2 (excluding the finest, "
             f"whose map error is zero by construction): {pick}.\n")
 
