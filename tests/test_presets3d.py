@@ -96,3 +96,13 @@ def test_cheapest_level_within_the_targets():
     assert cv.cheapest_within(lv)["dofs"] == 20
     assert cv.cheapest_within(lv, peak_tol=0.01)["dofs"] == 40
     assert cv.cheapest_within(lv, peak_tol=0.001) is None  # the finest level does not count
+
+
+def test_preset_errors_name_where_a_level_is_the_reference():
+    for q in presets.QUALITIES:
+        e = presets.preset_errors(q)
+        assert set(e["reference_in"]) <= set(e["cases"])
+        assert set(e["cases"]).isdisjoint(e["not_measured"])
+        assert set(e["cases"]) | set(e["not_measured"]) == set(presets.load()["cases3d"])
+        if e["cases"] and set(e["cases"]) - set(e["reference_in"]):
+            assert e["map_l2"] > 0.0  # measured against a finer level somewhere

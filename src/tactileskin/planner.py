@@ -157,7 +157,9 @@ class Plan:
 # 3D ("mesh3d"): the levels of the 3D convergence study (benchmarks/convergence3d.py,
 # benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
-# "cases3d_not_measured" names the studied cases without that level).
+# "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
+# those where it is the finest level, i.e. the reference, so its error there is 0 by
+# construction).
 def _quality_table() -> dict[str, dict]:
     from tactileskin import presets
 
@@ -167,7 +169,8 @@ def _quality_table() -> dict[str, dict]:
         out[q] = {"mesh": presets.mesh(2, q), "braille_mesh": presets.mesh(2, q, braille=True),
                   "peak_error": float(presets.load()["2"][q]["peak_error"]),
                   "mesh3d": presets.mesh(3, q), "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
-                  "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"])}
+                  "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"]),
+                  "cases3d_reference": tuple(e3["reference_in"])}
     return out
 
 

@@ -56,17 +56,20 @@ def _same(a: float, b: float) -> bool:
 def preset_errors(quality: str) -> dict:
     """Measured errors of a 3D preset over the convergence study's cases: {"peak_error": worst
     |relative peak error|, "map_l2": worst map L2, "cases": measured case keys, "not_measured":
-    case keys whose levels do not include this preset's mesh}. Errors are None when no case
-    measured the level."""
+    case keys whose levels do not include this preset's mesh, "reference_in": cases where this
+    level is the finest, i.e. the reference (error 0 by construction, not a measurement)}.
+    Errors are None when no case measured the level."""
     h, r = mesh(3, quality)
-    peak, l2, seen, missing = [], [], [], []
+    peak, l2, seen, missing, ref = [], [], [], [], []
     for key, case in load().get("cases3d", {}).items():
         lv = [v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)]
         if not lv:
             missing.append(key)
             continue
         seen.append(key)
+        if _same(case["levels"][-1]["mesh_size"], h) and _same(case["levels"][-1]["refinement"], r):
+            ref.append(key)  # the case's finest level: its errors are 0 by construction
         peak.append(abs(float(lv[0]["peak_error"])))
         l2.append(float(lv[0]["map_l2"]))
     return {"peak_error": max(peak) if peak else None, "map_l2": max(l2) if l2 else None,
-            "cases": seen, "not_measured": missing}
+            "cases": seen, "not_measured": missing, "reference_in": ref}
