@@ -121,6 +121,7 @@ def test_quality_presets_order_cost_and_error():
     assert sizes == sorted(sizes, reverse=True)  # finer preset, smaller refined size
     errs = [QUALITY[q]["peak_error"] for q in ("preview", "default", "fine")]
     assert errs == sorted(errs, reverse=True)
-    assert with_quality(sc.replace(dim=3, indenter="braille"), "fine").mesh_size == sc.replace(dim=3).mesh_size
+    s3 = with_quality(sc.replace(dim=3, indenter="braille"), "fine")  # 3D: the 3D preset
+    assert (s3.mesh_size, s3.refinement) == QUALITY["fine"]["mesh3d"]
     with pytest.raises(ParameterError, match="quality"):
         with_quality(sc, "ultra")

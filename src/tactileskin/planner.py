@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
-from tactileskin.scene import DEFAULT_MESH, DEFAULT_MESH_BRAILLE_2D, IndenterKind, Scene
+from tactileskin.scene import IndenterKind, Scene
 
 log = logging.getLogger(__name__)
 
@@ -147,35 +147,49 @@ class Plan:
         return "\n".join([head] + ["  - " + str(c) for c in self.choices])
 
 
-# Quality presets for 2D solves: (mesh_size mm, refinement) for flat / curved indenters and
-# for Braille (the dot needs the finer size), with the relative peak error expected from
-# them, measured against Richardson-extrapolated references of the 18 paper cases
-# (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md). `default` is the
-# Scene default (scene.default_mesh).
-# Measured (commit e355ae2 code, 18 cases): preview -0.12..-3.18 % (t1 silicone Braille),
-# default -0.10..-0.47 %, fine (= the series' 0.177 / 3 level) +0.03..-0.17 %; every preset
-# reads low (the meshes converge from below). Against 5-level series the t = 1 cases read
-# lower still: preview down to -3.54 %, default -0.67 % (preset_accuracy_fit_t1.md).
-QUALITY: dict[str, dict] = {
-    "preview": {"mesh": (1.0, 5.0), "braille_mesh": (1.0, 5.0), "peak_error": 0.04},
-    "default": {"mesh": DEFAULT_MESH[2], "braille_mesh": DEFAULT_MESH_BRAILLE_2D, "peak_error": 0.007},
-    "fine": {"mesh": (0.177, 3.0), "braille_mesh": (0.177, 3.0), "peak_error": 0.002},
-}
+# Quality presets (tactileskin/data/presets.json, read by tactileskin.presets; `default` is
+# the Scene default, scene.default_mesh). 2D: (mesh_size mm, refinement) for flat / curved
+# indenters and for Braille (the dot needs the finer size), with the relative peak error
+# measured against Richardson-extrapolated references of the 18 paper cases
+# (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md): preview
+# -0.12..-3.18 %, default -0.10..-0.47 %, fine +0.03..-0.17 %, every preset reading low;
+# against 5-level series the t = 1 cases read lower still (preset_accuracy_fit_t1.md).
+# 3D ("mesh3d"): the levels of the 3D convergence study (benchmarks/convergence3d.py,
+# benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
+# over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
+# "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
+# those where it is the finest level, i.e. the reference, so its error there is 0 by
+# construction).
+def _quality_table() -> dict[str, dict]:
+    from tactileskin import presets
+
+    out = {}
+    for q in presets.QUALITIES:
+        e3 = presets.preset_errors(q)
+        out[q] = {"mesh": presets.mesh(2, q), "braille_mesh": presets.mesh(2, q, braille=True),
+                  "peak_error": float(presets.load()["2"][q]["peak_error"]),
+                  "mesh3d": presets.mesh(3, q), "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
+                  "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"]),
+                  "cases3d_reference": tuple(e3["reference_in"])}
+    return out
 
 
-def quality_mesh(quality: str, indenter) -> tuple[float, float]:
-    """(mesh_size, refinement) of a 2D quality preset for an indenter kind."""
+QUALITY: dict[str, dict] = _quality_table()
+
+
+def quality_mesh(quality: str, indenter, dim: int = 2) -> tuple[float, float]:
+    """(mesh_size, refinement) of a quality preset for an indenter kind and dimension."""
     if quality not in QUALITY:
         raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
     q = QUALITY[quality]
+    if dim == 3:
+        return q["mesh3d"]
     return q["braille_mesh"] if IndenterKind(indenter) is IndenterKind.BRAILLE else q["mesh"]
 
 
 def with_quality(scene: Scene, quality: str) -> Scene:
-    """The scene meshed at a quality preset (2D; a 3D scene keeps its own sizes)."""
-    size, ref = quality_mesh(quality, scene.indenter)
-    if scene.dim == 3:
-        return scene
+    """The scene meshed at a quality preset of its dimension."""
+    size, ref = quality_mesh(quality, scene.indenter, scene.dim)
     return scene.replace(mesh_size=size, refinement=ref)
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
+from tactileskin import presets as _presets
 from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
 
@@ -30,8 +31,10 @@ SCHEMA_VERSION = 2
 # which 0.5 / 6 gives with 25 % fewer dofs than 0.25 / 3 at t = 5 for the same peak (within
 # 0.1 %); see benchmarks/results/preset_accuracy_fit.md. In 3D the same sizes would be ~1e6
 # P2 tetrahedra.
-DEFAULT_MESH = {2: (0.5, 3.0), 3: (0.6, 2.0)}
-DEFAULT_MESH_BRAILLE_2D = (0.5, 6.0)
+# The sizes are the `default` quality preset (tactileskin/data/presets.json, the one source;
+# 3D: chosen by the convergence study benchmarks/convergence3d.py).
+DEFAULT_MESH = {2: _presets.mesh(2, "default"), 3: _presets.mesh(3, "default")}
+DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
 
 
 def default_mesh(dim: int, indenter) -> tuple[float, float]:

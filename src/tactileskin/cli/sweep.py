@@ -43,7 +43,7 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
                    "Flat and curved cases stay 2D (exact for them). 3D solves take minutes each.")
 @click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
 @click.option("--quality", type=click.Choice(["preview", "default", "fine"]), default=None,
-              help="Mesh preset from the speed-vs-error study (docs/speed_vs_error.md).")
+              help="Mesh preset of each case's dimension (tactileskin/data/presets.json; docs/speed_vs_error.md).")
 @click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
 @click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")

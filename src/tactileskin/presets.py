@@ -1,0 +1,75 @@
+"""Mesh quality presets (`preview` / `default` / `fine`) per dimension, read from
+tactileskin/data/presets.json (importlib.resources): the one place the preset sizes and
+their measured errors live (scene.default_mesh and planner.QUALITY read it).
+
+File layout: "2" and "3" map each preset to its mesh ([mesh_size, refinement]); 2D also has
+"braille_mesh" and the "peak_error" measured by benchmarks/preset_accuracy.py. "cases3d"
+holds the 3D convergence study (benchmarks/convergence3d.py writes it): per case (thickness,
+material, dot pattern) each level's dofs, relative peak error against the reference, map L2
+against the finest level and CPU time. A 3D preset's errors are the worst over the cases
+that measured its level (`preset_errors`); cases that did not are listed as not measured.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import lru_cache
+from importlib import resources
+
+from tactileskin.errors import ParameterError
+
+QUALITIES = ("preview", "default", "fine")
+DATA = ("data", "presets.json")
+
+
+@lru_cache(maxsize=1)
+def load() -> dict:
+    """The parsed preset file (cached; do not mutate)."""
+    text = resources.files("tactileskin").joinpath(*DATA).read_text(encoding="utf-8")
+    data = json.loads(text)
+    for dim in ("2", "3"):
+        for q in QUALITIES:
+            mesh = data.get(dim, {}).get(q, {}).get("mesh")
+            if not (isinstance(mesh, list) and len(mesh) == 2 and all(float(v) > 0 for v in mesh)):
+                raise ParameterError(f"presets.json {dim}D {q} mesh", mesh, "[mesh_size, refinement] > 0")
+    return data
+
+
+def check_quality(quality: str) -> str:
+    if quality not in QUALITIES:
+        raise ParameterError("quality", quality, "one of " + ", ".join(QUALITIES))
+    return quality
+
+
+def mesh(dim: int, quality: str, braille: bool = False) -> tuple[float, float]:
+    """(mesh_size, refinement) of a preset; 2D Braille has its own (finer) mesh."""
+    q = load()[str(int(dim))][check_quality(quality)]
+    m = q["braille_mesh"] if braille and "braille_mesh" in q else q["mesh"]
+    return float(m[0]), float(m[1])
+
+
+def _same(a: float, b: float) -> bool:
+    return math.isclose(float(a), float(b), rel_tol=1e-9)
+
+
+def preset_errors(quality: str) -> dict:
+    """Measured errors of a 3D preset over the convergence study's cases: {"peak_error": worst
+    |relative peak error|, "map_l2": worst map L2, "cases": measured case keys, "not_measured":
+    case keys whose levels do not include this preset's mesh, "reference_in": cases where this
+    level is the finest, i.e. the reference (error 0 by construction, not a measurement)}.
+    Errors are None when no case measured the level."""
+    h, r = mesh(3, quality)
+    peak, l2, seen, missing, ref = [], [], [], [], []
+    for key, case in load().get("cases3d", {}).items():
+        lv = [v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)]
+        if not lv:
+            missing.append(key)
+            continue
+        seen.append(key)
+        if _same(case["levels"][-1]["mesh_size"], h) and _same(case["levels"][-1]["refinement"], r):
+            ref.append(key)  # the case's finest level: its errors are 0 by construction
+        peak.append(abs(float(lv[0]["peak_error"])))
+        l2.append(float(lv[0]["map_l2"]))
+    return {"peak_error": max(peak) if peak else None, "map_l2": max(l2) if l2 else None,
+            "cases": seen, "not_measured": missing, "reference_in": ref}

@@ -1,0 +1,108 @@
+"""Quality presets from tactileskin/data/presets.json (2D and 3D) and the helpers of the 3D
+convergence study (benchmarks/convergence3d.py)."""
+
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tactileskin import presets
+from tactileskin.errors import ParameterError
+from tactileskin.planner import QUALITY, with_quality
+from tactileskin.scene import DEFAULT_MESH, Scene
+
+_spec = importlib.util.spec_from_file_location(
+    "convergence3d", Path(__file__).resolve().parents[1] / "benchmarks" / "convergence3d.py")
+cv = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(cv)
+
+
+def test_preset_file_has_three_levels_per_dim_with_finite_errors():
+    data = presets.load()
+    for dim in ("2", "3"):
+        assert set(presets.QUALITIES) <= set(data[dim])
+        fine_sizes = [presets.mesh(int(dim), q)[0] / presets.mesh(int(dim), q)[1] for q in presets.QUALITIES]
+        assert fine_sizes == sorted(fine_sizes, reverse=True)  # preview coarsest, fine finest
+    for q in presets.QUALITIES:
+        assert math.isfinite(QUALITY[q]["peak_error"])
+        e = presets.preset_errors(q)
+        assert e["cases"], f"3D {q}: no convergence case measured its level"
+        assert math.isfinite(e["peak_error"]) and math.isfinite(e["map_l2"])
+    assert presets.preset_errors("preview")["peak_error"] >= presets.preset_errors("fine")["peak_error"]
+
+
+def test_3d_cases_in_the_file_are_consistent():
+    for key, case in presets.load()["cases3d"].items():
+        lv = case["levels"]
+        assert len(lv) >= 3, key
+        dofs = [v["dofs"] for v in lv]
+        assert dofs == sorted(dofs) and len(set(dofs)) == len(dofs), key
+        assert lv[-1]["map_l2"] == 0.0  # the map error is measured against the finest level
+
+
+def test_with_quality_applies_the_dimensions_preset():
+    s3 = Scene(dim=3, thickness=1.0, indenter="braille")
+    for q in presets.QUALITIES:
+        assert (with_quality(s3, q).mesh_size, with_quality(s3, q).refinement) == presets.mesh(3, q)
+        s2 = with_quality(s3.replace(dim=2), q)
+        assert (s2.mesh_size, s2.refinement) == presets.mesh(2, q, braille=True)
+    assert (s3.mesh_size, s3.refinement) == DEFAULT_MESH[3] == presets.mesh(3, "default")
+    assert presets.mesh(3, "preview") != presets.mesh(3, "fine")
+    with pytest.raises(ParameterError, match="quality"):
+        with_quality(s3, "ultra")
+
+
+def test_observed_order_and_richardson_on_a_known_series():
+    h = np.array([0.8, 0.5, 0.3])  # unequal ratios
+    f = 1.0 + 0.3 * h ** 2
+    assert cv.observed_order(h, f) == pytest.approx(2.0, abs=1e-6)
+    r = cv.richardson(h, f)
+    assert r["method"] == "richardson" and r["value"] == pytest.approx(1.0, abs=1e-9)
+    g = 2.0 - 0.1 * h ** 1.5  # converging from below
+    assert cv.richardson(h, g)["order"] == pytest.approx(1.5, abs=1e-6)
+    assert cv.richardson(h, g)["value"] == pytest.approx(2.0, abs=1e-9)
+
+
+def test_richardson_falls_back_to_the_finest_level():
+    h = [0.8, 0.5, 0.3]
+    wiggle = cv.richardson(h, [1.0, 1.02, 1.01])  # differences change sign
+    assert wiggle["method"] == "finest" and wiggle["value"] == 1.01 and wiggle["order"] is None
+    h_arr = np.array(h)
+    steep = cv.richardson(h, 1.0 + h_arr ** 9)  # order 9: outside the trusted range
+    assert steep["method"] == "finest" and steep["order"] == pytest.approx(9.0, abs=1e-4)
+    with pytest.raises(ValueError):
+        cv.observed_order([0.3, 0.5, 0.8], [1, 2, 3])
+
+
+def test_map_l2_on_the_coarsest_grid():
+    s = np.linspace(0.0, 6.0, 13)
+    z = np.linspace(0.0, 2.0, 5)
+    P = np.outer(1.0 + z, np.exp(-s))
+    fine_s, fine_z = np.linspace(0.0, 7.0, 57), np.linspace(0.0, 2.0, 9)
+    fine = {"s": fine_s, "z": fine_z, "pressure": 1.1 * np.outer(1.0 + fine_z, np.exp(-fine_s))}
+    coarse = {"s": s, "z": z, "pressure": P}
+    e = cv.map_l2([coarse, fine])
+    assert e[1] == 0.0
+    # on the coarse grid points the fine map (bilinear in z, exact there; linear in s on nodes
+    # that include the coarse ones) is 1.1 P: relative difference 0.1 / 1.1
+    assert e[0] == pytest.approx(0.1 / 1.1, rel=1e-9)
+
+
+def test_cheapest_level_within_the_targets():
+    lv = [{"dofs": 10, "peak_error": -0.05, "map_l2": 0.03}, {"dofs": 20, "peak_error": -0.015, "map_l2": 0.04},
+          {"dofs": 40, "peak_error": -0.005, "map_l2": 0.01}, {"dofs": 80, "peak_error": 0.0, "map_l2": 0.0}]
+    assert cv.cheapest_within(lv)["dofs"] == 20
+    assert cv.cheapest_within(lv, peak_tol=0.01)["dofs"] == 40
+    assert cv.cheapest_within(lv, peak_tol=0.001) is None  # the finest level does not count
+
+
+def test_preset_errors_name_where_a_level_is_the_reference():
+    for q in presets.QUALITIES:
+        e = presets.preset_errors(q)
+        assert set(e["reference_in"]) <= set(e["cases"])
+        assert set(e["cases"]).isdisjoint(e["not_measured"])
+        assert set(e["cases"]) | set(e["not_measured"]) == set(presets.load()["cases3d"])
+        if e["cases"] and set(e["cases"]) - set(e["reference_in"]):
+            assert e["map_l2"] > 0.0  # measured against a finer level somewhere
