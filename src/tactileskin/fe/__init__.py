@@ -28,7 +28,9 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import os
 import time
 
 import numpy as np
@@ -106,6 +108,22 @@ def phases(model: Model, **extra: float) -> dict:
     return out
 
 
+THREAD_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def blas_threads():
+    """One BLAS/OpenMP thread during a solve unless the user set a count in the environment.
+    The solver's vectors and element blocks are small: threaded BLAS only spins, and on a
+    busy 2-core machine a coarse 3D solve took 55 s CPU with the default threads against
+    21 s with one (measured while benchmarking fe.linsolve's reuse method). The CLI, the
+    tests and the Dask workers already set the variables; this covers library callers."""
+    if any(os.environ.get(v) for v in THREAD_VARS):
+        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1)
+
+
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None,
           progress=None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
@@ -132,7 +150,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     def record(model, ev):
         return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1])}
 
-    ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
+    with blas_threads():
+        ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
     t2 = time.perf_counter()
     res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
     stats.wall_s = time.perf_counter() - t0
