@@ -52,9 +52,6 @@ except ImportError:  # pragma: no cover - not POSIX
 
 log = logging.getLogger(__name__)
 
-ENTRY_FILES = ("profile.csv", "summary.json", "contact.csv", "result.vtu", "bone_map.csv", "profile_max_z.csv",
-               "scene.toml", "cache.json")
-
 
 class CacheError(TactileSkinError):
     """A cache entry that should be valid is missing or damaged."""

@@ -45,9 +45,8 @@ def geometry_dir() -> Path:
 MAX_TOML_BYTES = 1 << 20
 
 
-def read_toml(path: str | Path, what: str) -> dict:
-    """Parse a user's TOML file; a missing, unreadable, oversized (> MAX_TOML_BYTES), non-UTF-8
-    or malformed file is a ParameterError naming `what`."""
+def _read_capped(path, what: str) -> bytes:
+    """The bytes of a TOML file, at most MAX_TOML_BYTES; a ParameterError naming `what` else."""
     try:
         with open(path, "rb") as fh:
             raw = fh.read(MAX_TOML_BYTES + 1)
@@ -57,6 +56,10 @@ def read_toml(path: str | Path, what: str) -> dict:
         raise ParameterError(what, str(path), "a readable TOML file", e.strerror or str(e)) from None
     if len(raw) > MAX_TOML_BYTES:
         raise ParameterError(what, str(path), f"a TOML file of at most {MAX_TOML_BYTES // 1024} KiB")
+    return raw
+
+
+def _parse(raw: bytes, path, what: str) -> dict:
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -70,29 +73,23 @@ def read_toml(path: str | Path, what: str) -> dict:
         raise ParameterError(what, str(path), "valid TOML", "nested too deeply") from None
 
 
+def read_toml(path: str | Path, what: str) -> dict:
+    """Parse a user's TOML file; a missing, unreadable, oversized (> MAX_TOML_BYTES), non-UTF-8
+    or malformed file is a ParameterError naming `what`."""
+    return _parse(_read_capped(path, what), path, what)
+
+
 # parsed files by content: a file edited during a process is read again, never served stale
 _PARSED: dict[tuple[str, bytes], dict] = {}
-
-
-def _read_bytes(path: Path, what: str) -> bytes:
-    try:
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise ParameterError(what, str(path), "an existing TOML file") from None
-    except OSError as e:
-        raise ParameterError(what, str(path), "a readable TOML file", e.strerror or type(e).__name__) from None
 
 
 def load(name: str) -> dict:
     """Parsed <geometry_dir>/<name>.toml (memoised by content; treat as read-only)."""
     path = geometry_dir() / f"{name}.toml"
-    data = _read_bytes(path, "parameter file")
+    data = _read_capped(path, "parameter file")
     hit = _PARSED.get((name, data))
     if hit is None:
-        try:
-            hit = tomllib.loads(data.decode("utf-8"))
-        except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
-            raise ParameterError("parameter file", str(path), f"valid UTF-8 TOML ({e})") from None
+        hit = _parse(data, path, "parameter file")
         if len(_PARSED) > 64:  # only edits add entries; keep the memo small
             _PARSED.clear()
         _PARSED[(name, data)] = hit
@@ -111,6 +108,6 @@ def geometry_digest() -> str:
                              e.strerror or type(e).__name__) from None
     h = hashlib.sha256()
     for p in paths:
-        data = _read_bytes(p, "parameter file")
+        data = _read_capped(p, "parameter file")
         h.update(p.name.encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
     return h.hexdigest()

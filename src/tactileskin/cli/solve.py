@@ -6,11 +6,11 @@ import contextlib
 
 import click
 
+from tactileskin import results
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
 # every name `solve` writes into its folder (also how a folder of an earlier version is recognised)
-RESULT_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
-                "bone_map.png")
+RESULT_FILES = (*results.OWN_NAMES, "bone_map.png")
 OWN_NAMES = RESULT_FILES + ("section_2d", "compare_2d.json")
 
 

@@ -102,7 +102,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, bra
                 extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
                 word, why = oc.status, ""
                 if oc.status != "failed":
-                    st = _case_status(cache, oc.scene)
+                    st = _case_status(cache, oc)
                     if st != "ok":
                         word, style, why = "suspect", "bold yellow", f" - {st.split(': ', 1)[-1]}"
                 line = Text.assemble((f"{word:>7}", style), f" {oc.case or oc.scene.label()}{extra}{why}")
@@ -120,12 +120,14 @@ def command(out, config, thickness, material, indenter, depth, braille_text, bra
     return EXIT_FAILED if nfail else (EXIT_SUSPECT if nsus else 0)
 
 
-def _case_status(cache, scene) -> str:
-    """Status of a finished case from its cached numbers (tactileskin.quality)."""
+def _case_status(cache, oc) -> str:
+    """Status of a finished case from its numbers (tactileskin.quality): the record run_sweep
+    already validated, read from the cache only if the outcome carries none."""
     from tactileskin import quality
 
     try:
-        return quality.status(cache.load(scene).summary)
+        rec = oc.record if oc.record is not None else cache.load(oc.scene)
+        return quality.status(rec.summary)
     except Exception as e:  # noqa: BLE001 - the report step reports an unreadable entry
         return f"suspect: cached entry unreadable ({e})"
 
