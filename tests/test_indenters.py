@@ -231,3 +231,21 @@ def test_gap_shapes_vectorised():
     p = np.zeros((4, 5, 3))
     g, n = ind.gap(p, 0.0)
     assert g.shape == (4, 5) and n.shape == (4, 5, 3)
+
+
+@pytest.mark.parametrize("text", ["b", "\u2812", "\u283f", "", "e"])
+def test_the_3d_section_plane_lies_in_the_modelled_slab(text):
+    """The profile plane of a 3D Braille scene must be inside the meshed z range: the quarter
+    model (z >= 0) when the dot pattern is mirror-symmetric in z ('b': rows at -+1.17 mm once
+    picked z = -1.17 and the solve failed after it had run), the full length otherwise."""
+    from tactileskin.mesh.slab3d import z_symmetric
+    from tactileskin.scene import Scene
+
+    scene = Scene(dim=3, indenter="braille", braille_text=text)
+    ind = make_indenter(scene)
+    half = 0.5 * scene.section().fingertip.sample_length
+    lo = 0.0 if z_symmetric(scene) else -half
+    assert lo <= ind.section_z <= half
+    # rows -+z of a z-symmetric pattern cut the same section: the 2D answer cannot change
+    two = make_indenter(scene.replace(dim=2))
+    assert abs(two.section_z) == min(abs(ind.rows))

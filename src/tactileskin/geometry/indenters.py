@@ -284,7 +284,12 @@ def make_indenter(kind, *, y0: float | None = None, braille_text: str = "",
                           plate_thickness=float(q["plate_thickness"]), margin=margin, **stem)
     rows = ind.rows
     if row is None:
-        row = int(np.argmin(np.abs(rows)))  # nearest z = 0; ties -> the first (smallest z)
+        # nearest z = 0; ties -> the smallest z, except for a dot pattern mirror-symmetric in z:
+        # its rows +-z cut the same section, and the 3D quarter model holds only z >= 0
+        ties = np.flatnonzero(np.abs(rows) <= np.min(np.abs(rows)) + _ROW_TOL)
+        zkey = {tuple(np.round(r, 9)) for r in dots}
+        zsym = {tuple(np.round(r * (1.0, -1.0), 9)) for r in dots} == zkey
+        row = int(ties[-1] if zsym else ties[0])
     elif not (isinstance(row, (int, np.integer)) and 0 <= row < len(rows)):
         raise ParameterError("row", row, f"an integer in [0, {len(rows) - 1}] (dot rows of the text)")
     object.__setattr__(ind, "row", int(row))
