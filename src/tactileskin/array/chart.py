@@ -1,0 +1,268 @@
+"""The design chart: classification accuracy over skin thickness x array pitch x noise.
+
+Per material and thickness the stimulus maps come from map sources (today: the bone
+surface, the paper's sensor film):
+
+- "paper": the paper's three indenters: flat and curved (their 2D plane-strain bone profile
+  extruded along z; exact for an indenter uniform along the finger, away from the slab
+  ends) and one Braille dot (the 3D bone map of the single-dot solve).
+- "letters": the 26 letters a-z as cells (digits share the masks of a-j), each the
+  superposition of the single-dot response at its dots in the frame of the full cell
+  (surrogate.py; its error against full solves is stated by `validate_surrogate`).
+
+Solves go through the sweep's result cache (run_sweep), so a rerun only reads files.
+Each (material, thickness, set, pitch) gets one draw of offsets; every noise level reads
+the same noise-free readings (so the noise axis compares like with like).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from tactileskin.array import classify, surrogate
+from tactileskin.array.maps import mirrored
+from tactileskin.array.sampler import ArraySpec, Readout
+from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.results import BoneMap, read_bone_map
+
+log = logging.getLogger(__name__)
+
+PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm -> 0.75 mm pitch
+GOOD = 0.95                 # accuracy at which a set counts as discriminated
+LETTERS = "abcdefghijklmnopqrstuvwxyz"
+SETS = ("paper", "letters")
+
+
+@dataclass(frozen=True)
+class ChartConfig:
+    thicknesses: tuple = (1.0, 3.0)
+    materials: tuple = ("silicone",)
+    pitches: tuple = (0.5, 0.75, 1.0, 1.5, 2.0, 4.0)
+    noise_fs: tuple = (0.01, 0.05, 0.1)   # noise std as a fraction of each set's full scale
+    taxel_fraction: float = 0.8            # taxel side / pitch (area averaging)
+    bits: int | None = 12
+    window: float = 8.0                    # array side (mm): n = floor(window / pitch) + 1 taxels a side
+    sets: tuple = SETS
+    letters: str = LETTERS
+    n_train: int = 16
+    n_test: int = 16
+    template_grid: int = 4
+    seed: int = 0
+    mesh_size: float = 1.2                 # 3D single-dot solves
+    refinement: float = 2.0
+    standard: str = "standard_american"
+
+    def __post_init__(self):
+        for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
+            if len(getattr(self, name)) == 0:
+                raise ParameterError(name, getattr(self, name), "at least one value")
+        for p in self.pitches:
+            if not (np.isfinite(p) and 0.05 <= p <= 20):
+                raise ParameterError("pitch", p, "[0.05, 20] mm")
+        for v in self.noise_fs:
+            if not (np.isfinite(v) and 0 <= v <= 10):
+                raise ParameterError("noise", v, "[0, 10] x full scale")
+        if not 0 <= self.taxel_fraction <= 1:
+            raise ParameterError("taxel_fraction", self.taxel_fraction, "[0, 1] of the pitch")
+        bad = [s for s in self.sets if s not in SETS]
+        if bad:
+            raise ParameterError("set", bad[0], " or ".join(SETS))
+        bad = [c for c in self.letters if c not in LETTERS]
+        if bad or len(set(self.letters)) < 2:
+            raise ParameterError("letters", self.letters, "at least two distinct letters a-z")
+
+    def spec(self, pitch: float) -> ArraySpec:
+        n = int(np.floor(self.window / pitch + 1e-9)) + 1
+        return ArraySpec(pitch=pitch, taxel=self.taxel_fraction * pitch, n=min(n, 200))
+
+
+# --- map sources ----------------------------------------------------------------------------
+
+def dot_scene(thickness, material, cfg: ChartConfig, text: str = ""):
+    from tactileskin.scene import Scene
+
+    return Scene(dim=3, indenter="braille", thickness=thickness, material=material, braille_text=text,
+                 braille_standard=cfg.standard, mesh_size=cfg.mesh_size, refinement=cfg.refinement)
+
+
+def section_scene(thickness, material, indenter):
+    from tactileskin.scene import Scene
+
+    return Scene(dim=2, indenter=indenter, thickness=thickness, material=material)
+
+
+def solve_cached(scenes, cache, on_event=None) -> dict:
+    """{scene: cache record} through the sweep's cache (serial: one heavy solve at a time).
+    A failed case raises TactileSkinError naming it."""
+    from tactileskin.sweep import run_sweep
+
+    out = {}
+    for oc in run_sweep(list(scenes), cache, serial=True, on_event=on_event):
+        if oc.status == "failed":
+            raise TactileSkinError(f"solve of {oc.case or oc.scene.label()} failed: {oc.error}")
+        out[oc.scene] = oc.record
+    return out
+
+
+def bone_map_of(record) -> BoneMap:
+    return mirrored(read_bone_map(record.path / "bone_map.csv"))
+
+
+def extruded(s, p, z) -> BoneMap:
+    """A plane-strain profile P(s) (s >= 0) as a map uniform along z, mirrored to s < 0."""
+    s, p = np.asarray(s, float), np.asarray(p, float)
+    s, idx = np.unique(np.round(s, 9), return_index=True)
+    return mirrored(BoneMap(s, np.asarray(z, float), np.tile(p[idx], (len(z), 1))))
+
+
+def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig) -> dict:
+    """{set: {name: BoneMap}} for one material and thickness."""
+    out = {}
+    if "paper" in cfg.sets:
+        out["paper"] = {name: extruded(*profiles[name], kernel.z) for name in ("flat", "curved")}
+        out["paper"]["braille"] = kernel
+    if "letters" in cfg.sets:
+        from tactileskin.geometry.braille import LETTERS as MASKS
+
+        out["letters"] = {c: surrogate.superpose(kernel, surrogate.cell_centres(MASKS[c], cfg.standard), section)
+                          for c in cfg.letters}
+    return out
+
+
+# --- the chart ------------------------------------------------------------------------------
+
+@dataclass
+class Chart:
+    config: ChartConfig
+    rows: list = field(default_factory=list)        # one dict per (material, t, set, pitch, noise, method)
+    confusions: dict = field(default_factory=dict)  # (material, t, set, pitch, noise) -> {method: matrix}
+    labels: dict = field(default_factory=dict)      # set -> class names
+    cutoffs: list = field(default_factory=list)     # per (material, t): the single dot's measured cut-off
+    seconds: float = 0.0
+
+    def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
+        for r in self.rows:
+            if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r["noise_fs"], r["method"]) == \
+                    (material, t, set_, pitch, noise, method):
+                return r["accuracy"]
+        return float("nan")
+
+    def to_csv(self) -> str:
+        cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "noise_fs", "noise_mpa",
+                "full_scale_mpa", "bits", "method", "accuracy", "chance", "n_test"]
+        lines = [",".join(cols)]
+        for r in self.rows:
+            lines.append(",".join(f"{r[c]:.6g}" if isinstance(r[c], float) else str(r[c]) for c in cols))
+        return "\n".join(lines) + "\n"
+
+
+def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = None) -> Chart:
+    """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`."""
+    from tactileskin.array import halfspace
+
+    say = progress or (lambda msg: None)
+    t0 = time.perf_counter()
+    chart = Chart(cfg)
+    for material in cfg.materials:
+        for t in cfg.thicknesses:
+            dot = dot_scene(t, material, cfg)
+            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if "paper" in cfg.sets else {}
+            say(f"{material} t = {t:g} mm: solving (cached cases are read)")
+            recs = solve_cached([dot, *sec2.values()], cache,
+                                on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
+            kernel = bone_map_of(recs[dot])
+            profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
+            row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
+            kc = _cutoff(kernel.s, row, halfspace)
+            chart.cutoffs.append({"material": material, "thickness_mm": t, "peak_mpa": float(kernel.pressure.max()),
+                                  "kc_rad_per_mm": kc, "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
+                                  "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
+            sets = stimulus_maps(kernel, dot.section(), profiles, cfg)
+            for set_, maps_ in sets.items():
+                chart.labels[set_] = list(maps_)
+                fs = max(float(m.pressure.max()) for m in maps_.values())
+                for pitch in cfg.pitches:
+                    spec = cfg.spec(pitch)
+                    rng = np.random.default_rng([cfg.seed, int(t * 1000), int(pitch * 1000), SETS.index(set_)])
+                    clean = classify.clean_readings(maps_, spec, rng, n_train=cfg.n_train, n_test=cfg.n_test,
+                                                    template_grid=cfg.template_grid)
+                    for noise in cfg.noise_fs:
+                        ro = Readout(full_scale=fs, noise_fs=noise, bits=cfg.bits)
+                        ev = classify.evaluate(maps_, spec, ro, rng, clean=clean)
+                        chart.confusions[(material, t, set_, pitch, noise)] = ev.confusion
+                        for m, acc in ev.accuracy.items():
+                            chart.rows.append(dict(material=material, thickness_mm=float(t), set=set_,
+                                                   pitch_mm=float(pitch), taxel_mm=float(spec.taxel),
+                                                   noise_fs=float(noise), noise_mpa=float(ro.sigma),
+                                                   full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
+                                                   chance=ev.chance, n_test=ev.n_test))
+                    say(f"  {set_} pitch {pitch:g} mm: " + ", ".join(
+                        f"{chart.accuracy(material, t, set_, pitch, n):.2f}" for n in cfg.noise_fs))
+    chart.seconds = time.perf_counter() - t0
+    return chart
+
+
+def _cutoff(s, row, halfspace) -> float:
+    """Measured cut-off of the single dot's section row, resampled on an even grid."""
+    grid = np.arange(s[0], s[-1], 0.02)
+    try:
+        kc, _, _ = halfspace.measured_cutoff(grid, np.interp(grid, s, row))
+    except ParameterError:
+        return float("nan")
+    return kc
+
+
+# --- the paper's claims ---------------------------------------------------------------------
+
+def verdicts(chart: Chart, method: str = "template") -> list[dict]:
+    """The paper's two design claims checked on the chart, per material, at the lowest noise."""
+    cfg = chart.config
+    noise = min(cfg.noise_fs)
+    out = []
+    for material in cfg.materials:
+        if "letters" in cfg.sets and 1.0 in cfg.thicknesses and PAPER_PITCH in cfg.pitches:
+            a = chart.accuracy(material, 1.0, "letters", PAPER_PITCH, noise, method)
+            coarser = [p for p in cfg.pitches if p > PAPER_PITCH]
+            worst = {p: chart.accuracy(material, 1.0, "letters", p, noise, method) for p in coarser}
+            ok = a >= GOOD
+            out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
+                        "verdict": "supported" if ok else "not supported",
+                        "evidence": f"letters at 0.75 mm: {a:.2f}; " + ", ".join(f"{p:g} mm: {v:.2f}" for p, v in worst.items())})
+        else:
+            out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
+                        "verdict": "not evaluated", "evidence": "needs t = 1, pitch 0.75 and the letters set"})
+        if "paper" in cfg.sets and 5.0 in cfg.thicknesses:
+            acc5 = [chart.accuracy(material, 5.0, "paper", p, noise, method) for p in cfg.pitches]
+            best = max(acc5)
+            out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
+                        "verdict": "supported" if best < GOOD else "not supported",
+                        "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}"})
+        else:
+            thick = [t for t in cfg.thicknesses if "paper" in cfg.sets]
+            ev = ", ".join(f"t = {t:g}: {max(chart.accuracy(material, t, 'paper', p, noise, method) for p in cfg.pitches):.2f}"
+                           for t in thick)
+            out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
+                        "verdict": "not evaluated (no t = 5 mm)", "evidence": f"best accuracy {ev}" if ev else ""})
+    return out
+
+
+def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None) -> list[dict]:
+    """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row each."""
+    say = progress or (lambda msg: None)
+    rows = []
+    for t in thicknesses:
+        dot = dot_scene(t, material, cfg)
+        fulls = [dot_scene(t, material, cfg, x) for x in texts]
+        say(f"validation {material} t = {t:g} mm: {len(fulls)} full solves (cached cases are read)")
+        recs = solve_cached([dot, *fulls], cache,
+                            on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
+        kernel = bone_map_of(recs[dot])
+        for x, sc in zip(texts, fulls):
+            err = surrogate.validate(kernel, read_bone_map(recs[sc].path / "bone_map.csv"), x, dot.section(), cfg.standard)
+            rows.append({"material": material, "thickness_mm": t, "text": x, **err})
+    return rows

@@ -1,0 +1,70 @@
+"""Pressure maps on tensor grids: the common currency of the array package.
+
+A map is a `results.BoneMap` (s, z grids in mm, pressure[j, i] at (s_i, z_j)). A *map source*
+is any function returning one: today the bone-pressure map of a 3D solve (the sensor film on
+the bone, Result.bone_map); a sensor plane at another depth is another source, and nothing
+downstream (sampler, classify, chart) needs to change.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+
+from tactileskin.errors import ParameterError
+from tactileskin.results import BoneMap
+
+MapSource = Callable[..., BoneMap]
+
+
+def mirrored(m: BoneMap, tol: float = 1e-9) -> BoneMap:
+    """The full map of a symmetric half or quarter model: a grid starting at s = 0 (z = 0) is
+    mirrored to negative s (z), the symmetry planes of the solver's reduced models."""
+    s, z, P = m.s, m.z, m.pressure
+    if abs(s[0]) <= tol:
+        s = np.concatenate([-s[:0:-1], s])
+        P = np.concatenate([P[:, :0:-1], P], axis=1)
+    if abs(z[0]) <= tol:
+        z = np.concatenate([-z[:0:-1], z])
+        P = np.concatenate([P[:0:-1], P], axis=0)
+    return BoneMap(s, z, P, m.section_z)
+
+
+def interpolator(m: BoneMap) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """f(s, z) -> P, bilinear on the map's grid and zero outside it (no load beyond the
+    modelled surface). A one-point axis is constant along it."""
+    axes, vals = [], m.pressure
+    for ax, v in ((0, m.z), (1, m.s)):
+        if v.size == 1:  # RegularGridInterpolator needs two points per axis
+            v = np.array([v[0] - 1e9, v[0] + 1e9])
+            vals = np.repeat(vals, 2, axis=ax)
+        axes.append(v)
+    f = RegularGridInterpolator(tuple(axes), vals, method="linear", bounds_error=False, fill_value=0.0)
+
+    def at(s, z):
+        s, z = np.broadcast_arrays(np.asarray(s, float), np.asarray(z, float))
+        return f(np.column_stack([z.ravel(), s.ravel()])).reshape(s.shape)
+
+    return at
+
+
+def on_grid(f: Callable, s, z, section_z: float = 0.0) -> BoneMap:
+    """A BoneMap of the function f(s, z) on the grid s x z."""
+    s, z = np.asarray(s, float), np.asarray(z, float)
+    S, Z = np.meshgrid(s, z)
+    return BoneMap(s, z, f(S, Z), section_z)
+
+
+def relative_error(approx: BoneMap, ref: BoneMap) -> dict:
+    """Errors of `approx` against `ref` on ref's grid: rel_l2 = ||a - r|| / ||r|| and
+    max_abs_over_peak = max |a - r| / max r, peak_rel = (max a - max r) / max r."""
+    a = interpolator(approx)(*np.meshgrid(ref.s, ref.z))
+    r = ref.pressure
+    top = float(r.max())
+    if top <= 0:
+        raise ParameterError("reference map", f"peak {top:g}", "a map with a positive peak")
+    return {"rel_l2": float(np.linalg.norm(a - r) / np.linalg.norm(r)),
+            "max_abs_over_peak": float(np.abs(a - r).max() / top),
+            "peak_rel": float((a.max() - top) / top)}

@@ -1,0 +1,73 @@
+"""Braille characters' sensor maps by superposing single-dot responses.
+
+In the linear limit the map of a character is the sum of the single-dot response
+P1(s - s_k, z - z_k) over its raised dots k. The skin slab is uniform along z (exact
+translation in z away from the sample's ends); across the finger the dot at face
+coordinate x_k is placed at the bone arc length s_k of the bone point on the skin's inward
+normal under x_k (the surface is curved, so the translation in s is approximate: an
+off-centre dot meets a skin that has dropped away; `validate` measures what this and the
+contact nonlinearity cost against full solves).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tactileskin.array.maps import interpolator, mirrored, relative_error
+from tactileskin.errors import ParameterError
+from tactileskin.geometry import braille
+from tactileskin.results import BoneMap
+
+FULL_CELL = 0x3F        # all six dots (U+283F)
+TOLERANCE = 0.05        # the issue's bound: max |surrogate - full| <= 5 % of the full map's peak
+
+
+def bone_s_under(x, section) -> np.ndarray:
+    """Bone arc length s of the interface point on the inward normal through the skin's outer
+    point at lateral position x (signed like x)."""
+    x = np.asarray(x, float)
+    ft = section.fingertip
+    u = np.arcsin(np.clip(np.abs(x) / ft.half_width, 0.0, 1.0))
+    s = section.s_of_point(section.interface(u))
+    return np.sign(x) * s.reshape(x.shape)
+
+
+def cell_centres(mask: int, standard="standard_american") -> np.ndarray:
+    """(k, 2) face coordinates (x, z) of the raised dots of cell `mask`, in the frame of the
+    full cell centred on the origin (as a reader's finger sits on a cell, whatever its dots;
+    braille.dot_centres instead centres each pattern on its own dots)."""
+    if not (isinstance(mask, (int, np.integer)) and 0 < mask <= FULL_CELL):
+        raise ParameterError("cell mask", mask, "an integer in [1, 63] (at least one raised dot)")
+    full = braille.dot_centres(chr(0x2800 + FULL_CELL), standard)  # dots 1..6 in order
+    return full[[k for k in range(6) if mask >> k & 1]]
+
+
+def superpose(kernel: BoneMap, centres, section, s=None, z=None) -> BoneMap:
+    """Map of the dots at face coordinates `centres` (k, 2) = (x, z): sum of the single-dot
+    response `kernel` (a full map centred on the dot, see maps.mirrored) translated to each
+    (s_k, z_k). Evaluated on the grid s x z (default: the kernel's grid)."""
+    centres = np.atleast_2d(np.asarray(centres, float))
+    if centres.shape[1] != 2 or centres.shape[0] < 1:
+        raise ParameterError("dot centres", centres.shape, "(k, 2) face coordinates (x, z)")
+    s = kernel.s if s is None else np.asarray(s, float)
+    z = kernel.z if z is None else np.asarray(z, float)
+    f = interpolator(kernel)
+    S, Z = np.meshgrid(s, z)
+    sk = bone_s_under(centres[:, 0], section)
+    P = sum(f(S - a, Z - b) for a, b in zip(sk, centres[:, 1]))
+    return BoneMap(s, z, P, kernel.section_z)
+
+
+def kernel_from(bone_map: BoneMap) -> BoneMap:
+    """The full single-dot response from a (possibly quarter) solved map."""
+    return mirrored(bone_map)
+
+
+def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american") -> dict:
+    """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
+    quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres)."""
+    ref = mirrored(full)
+    approx = superpose(kernel, braille.dot_centres(text, standard), section, ref.s, ref.z)
+    err = relative_error(approx, ref)
+    err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
+    return err

@@ -1,0 +1,97 @@
+"""`tactileskin array`: the sensor-array design chart (accuracy over thickness x pitch x noise)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import click
+
+from tactileskin.cli._common import claimed_output
+from tactileskin.errors import ParameterError
+
+OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
+             *(f"array_{m}_{s}.{e}" for m in ("silicone", "polyurethane") for s in ("paper", "letters")
+               for e in ("png", "svg")))
+KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
+        "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
+        "validate"}
+
+
+def load_config(path) -> dict:
+    """The [array] table of a TOML file; unknown keys raise ParameterError naming them."""
+    try:
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        raise ParameterError("config", str(path), "a readable TOML file with an [array] table", hint=str(e)) from None
+    table = data.get("array", {})
+    bad = sorted(set(table) - KEYS)
+    if bad or not isinstance(table, dict):
+        raise ParameterError("config [array] key", bad[0] if bad else table, ", ".join(sorted(KEYS)))
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}
+
+
+@click.command("array")
+@click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out_array", show_default=True,
+              help="Output folder: accuracies.csv, array_chart.md, figures (new, empty or written by `array`).")
+@click.option("--config", type=click.Path(dir_okay=False), default=None, help="TOML with an [array] table; flags override it.")
+@click.option("--thickness", "-t", default=None, help="Thicknesses (mm), e.g. '1,3'. Default 1,3.")
+@click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone.")
+@click.option("--pitch", default=None, help="Array pitches (mm). Default 0.5,0.75,1,1.5,2,4.")
+@click.option("--noise", default=None, help="Noise std as fractions of full scale. Default 0.01,0.05,0.1.")
+@click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
+@click.option("--bits", type=int, default=None, help="ADC bits over full scale. Default 12.")
+@click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters. Default both.")
+@click.option("--letters", default=None, help="Letters of the letters set. Default a-z.")
+@click.option("--offsets", type=int, default=None, help="Random offsets per stimulus (train and test each). Default 16.")
+@click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm). Default 1.2.")
+@click.option("--refinement", type=float, default=None, help="3D single-dot refinement ratio. Default 2.")
+@click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
+@click.option("--validate", default=None,
+              help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
+@click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
+              help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
+def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
+            refinement, seed, validate, cache_dir):
+    """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast."""
+    from rich.console import Console
+    from rich.markup import escape
+
+    from tactileskin.array.chart import ChartConfig, compute, validate_surrogate
+    from tactileskin.cache import ResultCache
+    from tactileskin.report.array_chart import write_outputs
+    from tactileskin.sweep import parse_values
+
+    console = Console(stderr=True)
+    kw = load_config(config) if config else {}
+    texts = kw.pop("validate", None)
+    names = lambda v, n: tuple(x.strip() for x in v.split(",") if x.strip())  # noqa: E731
+    flags = dict(thicknesses=thickness and tuple(parse_values(thickness, "thickness")),
+                 materials=material and names(material, "material"),
+                 pitches=pitch and tuple(parse_values(pitch, "pitch")),
+                 noise_fs=noise and tuple(parse_values(noise, "noise")),
+                 taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
+                 n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed)
+    kw.update({k: v for k, v in flags.items() if v is not None})
+    if validate is not None:
+        texts = names(validate, "validate")
+    try:
+        cfg = ChartConfig(**kw)
+    except TypeError as e:
+        raise ParameterError("config", str(e), "keys " + ", ".join(sorted(KEYS))) from None
+    from tactileskin.sweep import check_materials
+
+    check_materials(cfg.materials)
+    out = Path(out)
+    cache = ResultCache(cache_dir or out / "cache")
+    say = lambda msg: console.print(escape(msg), highlight=False)  # noqa: E731
+    with claimed_output(out, "array", OWN_NAMES):
+        chart = compute(cfg, cache, progress=say)
+        rows = None
+        if texts:
+            rows = [r for m in cfg.materials
+                    for r in validate_surrogate(cfg.thicknesses, m, list(texts), cfg, cache, progress=say)]
+        paths = write_outputs(chart, out, rows)
+    console.print(f"report: {escape(str(paths['report']))} ({chart.seconds:.0f} s)", highlight=False)
+    return 0

@@ -1,0 +1,106 @@
+"""Figures and report section of the sensor-array design chart (array.chart)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin.array.chart import GOOD, PAPER_PITCH, verdicts
+from tactileskin.fileio import atomic_write_text
+from tactileskin.report.figures import _plt, _save
+
+SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille letters a-z"}
+
+
+def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
+    """One figure per material and stimulus set: accuracy over thickness (rows) x pitch
+    (columns), a panel per noise level; the paper's 0.75 mm pitch dashed, the paper's
+    "5 mm cannot" row hatched; PNG and SVG."""
+    plt = _plt()
+    cfg = chart.config
+    paths = []
+    ts, ps = list(cfg.thicknesses), list(cfg.pitches)
+    for material in cfg.materials:
+        for set_ in cfg.sets:
+            fig, axes = plt.subplots(1, len(cfg.noise_fs), figsize=(3.6 * len(cfg.noise_fs) + 1.0, 0.55 * len(ts) + 2.0),
+                                     squeeze=False, constrained_layout=True)
+            for ax, noise in zip(axes[0], cfg.noise_fs):
+                A = np.array([[chart.accuracy(material, t, set_, p, noise, method) for p in ps] for t in ts])
+                im = ax.imshow(A, vmin=0, vmax=1, cmap="viridis", aspect="auto", origin="lower")
+                for i in range(len(ts)):
+                    for j in range(len(ps)):
+                        ax.text(j, i, f"{A[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                                color="white" if A[i, j] < 0.6 else "black")
+                ax.set_xticks(range(len(ps)), [f"{p:g}" for p in ps])
+                ax.set_yticks(range(len(ts)), [f"{t:g}" for t in ts])
+                ax.set_xlabel("pitch (mm)")
+                ax.set_ylabel("skin thickness t (mm)")
+                ax.set_title(f"noise {noise:g} x full scale", fontsize=9)
+                if PAPER_PITCH in ps:
+                    ax.axvline(ps.index(PAPER_PITCH), color="tab:red", ls="--", lw=1.2, label="paper: 0.75 mm")
+                if 5.0 in ts and set_ == "paper":
+                    i = ts.index(5.0)
+                    ax.add_patch(plt.Rectangle((-0.5, i - 0.5), len(ps), 1, fill=False, hatch="//",
+                                               edgecolor="tab:red", lw=0.0, label="paper: 5 mm cannot"))
+            axes[0][0].legend(loc="upper right", fontsize=7, framealpha=0.8)
+            fig.colorbar(im, ax=axes[0].tolist(), label=f"accuracy ({method})", shrink=0.9)
+            fig.suptitle(f"{material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", fontsize=10)
+            paths += _save(fig, out, f"array_{material}_{set_}")
+    return paths
+
+
+def markdown(chart, validation=None, method: str = "template") -> str:
+    """The report section: conditions, the skin as a filter, accuracy tables, verdicts, and the
+    surrogate's validation."""
+    cfg = chart.config
+    lines = ["## Sensor-array design chart", "",
+             f"Sensor plane: the bone surface (the paper's film), map P(s, z) of 3D single-dot solves "
+             f"(mesh {cfg.mesh_size:g} / {cfg.refinement:g}); flat and curved: 2D bone profiles extruded "
+             f"along z. Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
+             f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
+             f"a fraction of full scale; stimuli at random sub-pitch offsets ({cfg.n_test} test and "
+             f"{cfg.n_train} training reads per stimulus); rule: {method} (nearest template over "
+             f"{cfg.template_grid}x{cfg.template_grid} offsets; `lda` in the CSV). "
+             f"Computed in {chart.seconds:.0f} s.", "",
+             "### The skin as a spatial filter", "",
+             "| material | t (mm) | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
+             "|---|---|---|---|---|---|"]
+    for c in chart.cutoffs:
+        lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
+                     f"{c['nyquist_pitch_mm']:.2f} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
+    lines += ["", "Cut-off where the spectrum of the single dot's section row (or of the half-space "
+              "kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1.", ""]
+    for set_ in cfg.sets:
+        for material in cfg.materials:
+            lines += [f"### {material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", "",
+                      "| t (mm) | noise | " + " | ".join(f"{p:g} mm" for p in cfg.pitches) + " |",
+                      "|---|---|" + "---|" * len(cfg.pitches)]
+            for t in cfg.thicknesses:
+                for n in cfg.noise_fs:
+                    lines.append(f"| {t:g} | {n:g} | " + " | ".join(
+                        _cell(chart.accuracy(material, t, set_, p, n, method)) for p in cfg.pitches) + " |")
+            lines.append("")
+    lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
+    lines += [f"| {v['material']} | {v['claim']} | {v['verdict']} | {v['evidence']} |" for v in verdicts(chart, method)]
+    lines += ["", f"(a set counts as discriminated at accuracy >= {GOOD:g}, at the lowest noise level)", ""]
+    if validation:
+        lines += ["### Surrogate validation (superposition of single-dot responses against full 3D solves)", "",
+                  "| material | t (mm) | text | rel. L2 | max error / peak | peak error | within 5 % |",
+                  "|---|---|---|---|---|---|---|"]
+        for r in validation:
+            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r['rel_l2']:.1%} | "
+                         f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%} | {'yes' if r['within_tolerance'] else 'no'} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _cell(a: float) -> str:
+    return f"**{a:.2f}**" if a >= GOOD else f"{a:.2f}"
+
+
+def write_outputs(chart, out: Path, validation=None, method: str = "template") -> dict:
+    """accuracies.csv, array_chart.md and the figures into `out` (claimed by the caller)."""
+    atomic_write_text(out / "accuracies.csv", chart.to_csv())
+    atomic_write_text(out / "array_chart.md", markdown(chart, validation, method) + "\n")
+    return {"csv": out / "accuracies.csv", "report": out / "array_chart.md", "figures": write_figures(chart, out, method)}

@@ -1,0 +1,58 @@
+"""Superposition of single-dot responses on analytic kernels, and the chart's map helpers."""
+
+import numpy as np
+import pytest
+
+from tactileskin.array import chart, maps, surrogate
+from tactileskin.errors import ParameterError
+from tactileskin.geometry import braille
+from tactileskin.scene import Scene
+
+SEC = Scene(thickness=1.0).section()
+
+
+def _gauss(cs=0.0, cz=0.0, w=0.4):
+    return lambda s, z: np.exp(-((s - cs) ** 2 + (z - cz) ** 2) / (2 * w * w))
+
+
+def test_bone_s_under_is_odd_and_shorter_than_the_outer_arc():
+    s = surrogate.bone_s_under(np.array([-1.5, 0.0, 1.5]), SEC)
+    assert s[1] == 0.0 and s[0] == pytest.approx(-s[2])
+    # the bone lies inside the skin: its arc under x is shorter than x (the outer chord ~ x)
+    assert 0.8 * 1.5 < s[2] < 1.5
+
+
+def test_superposition_of_gaussian_kernel_is_sum_of_gaussians():
+    grid = np.linspace(-6, 6, 481)  # h = 0.025: bilinear error <= h^2/8 max|f''| = 1e-3 per dot
+    kernel = maps.on_grid(_gauss(), grid, grid)
+    centres = surrogate.cell_centres(surrogate.FULL_CELL)
+    got = surrogate.superpose(kernel, centres, SEC)
+    sk = surrogate.bone_s_under(centres[:, 0], SEC)
+    expect = maps.on_grid(lambda s, z: sum(_gauss(a, b)(s, z) for a, b in zip(sk, centres[:, 1])), grid, grid)
+    assert np.max(np.abs(got.pressure - expect.pressure)) < 6e-3  # six dots x 1e-3
+    err = maps.relative_error(got, expect)
+    assert err["rel_l2"] < 5e-3 and abs(err["peak_rel"]) < 5e-3
+
+
+def test_cell_centres_in_the_full_cell_frame():
+    full = braille.dot_centres(chr(0x283F))
+    a = surrogate.cell_centres(braille.LETTERS["a"])           # dot 1: top left
+    assert np.allclose(a, full[:1]) and a[0, 0] < 0 and a[0, 1] < 0
+    assert len(surrogate.cell_centres(braille.LETTERS["y"])) == 5
+    with pytest.raises(ParameterError):
+        surrogate.cell_centres(0)
+
+
+def test_extruded_profile_is_uniform_along_z_and_mirrored():
+    s = np.linspace(0, 5, 51)
+    m = chart.extruded(s, np.exp(-s), np.linspace(-2, 2, 9))
+    assert m.s[0] == pytest.approx(-5) and np.allclose(m.pressure, m.pressure[0])
+    assert np.allclose(m.pressure[0], np.exp(-np.abs(m.s)))
+
+
+def test_chart_config_refuses_bad_values():
+    with pytest.raises(ParameterError):
+        chart.ChartConfig(pitches=(0.0,))
+    with pytest.raises(ParameterError):
+        chart.ChartConfig(sets=("nope",))
+    assert chart.ChartConfig().spec(0.5).n == 17
