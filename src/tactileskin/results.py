@@ -146,6 +146,8 @@ class Result:
       sampled along the cut of each bone-interface facet (fe.output.plane_profile).
     bone_map: 3D only, P(s, z) over the whole bone surface (BoneMap); its row z =
       profile_plane_z is the profile.
+    sensors: the readings of the scene's sensor layouts (sensors.SensorReadings), or None;
+      written as sensors.csv.
     contact_x, contact_pressure: contact pressure (per current area) at the contact points
       of the outer surface, sorted by the current x.
     reaction: vertical force the fixed boundaries exert on the modelled (half) domain.
@@ -164,6 +166,7 @@ class Result:
     history: list = field(default_factory=list)
     scene: dict | None = None
     bone_map: BoneMap | None = None
+    sensors: object | None = None  # sensors.SensorReadings of the scene's sensor layouts
 
     def __post_init__(self):
         for name in ("s", "pressure", "contact_x", "contact_pressure"):
@@ -213,6 +216,7 @@ class Result:
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
             **self._map_summary(),
+            **(self.sensors.summary() if self.sensors is not None else {}),
             **({"scene": self.scene} if self.scene else {}),
         }
         found = quality.flags(out)
@@ -232,7 +236,8 @@ class Result:
         return self.summary()["status"]
 
     def write(self, directory) -> Path:
-        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu; 3D: also
+        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu; with sensors
+        sensors.csv; 3D: also
         bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
         where it occurs) into `directory`, creating it; each file is written atomically and
         only these names are touched (a result.vtu or map of an earlier write is removed when
@@ -255,13 +260,18 @@ class Result:
         else:
             _remove(directory / "bone_map.csv")
             _remove(directory / "profile_max_z.csv")
+        if self.sensors is not None:
+            fileio.atomic_write_text(directory / "sensors.csv", self.sensors.to_csv())
+        else:
+            _remove(directory / "sensors.csv")
         # last: a folder with a summary.json holds a complete result
         fileio.atomic_write_json(directory / "summary.json", self.summary())
         return directory
 
 
 # the file names Result.write owns in a folder
-OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv")
+OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
+             "sensors.csv")
 
 
 def _remove(path: Path) -> None:

@@ -94,6 +94,7 @@ class Scene:
     formulation: Formulation = Formulation.MIXED
     viscoelastic: bool = True
     fingertip: tuple[tuple[str, float], ...] = field(default_factory=tuple)  # overrides of fingertip.toml
+    sensors: tuple = field(default_factory=tuple)  # sensors.SensorLayout, TOML [[sensors]]; () none
 
     def __post_init__(self):
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
@@ -129,6 +130,13 @@ class Scene:
                                        1.0, 20.0))
         if not self.material:
             raise ParameterError("material", self.material, "a material preset name")
+        if self.sensors:
+            from tactileskin import sensors
+
+            set_("sensors", sensors.layouts(self.sensors))
+            sensors.sites_for(self)  # raises ParameterError for a sensor outside the skin
+        else:
+            set_("sensors", ())
         if self.indenter is IndenterKind.BRAILLE:
             from tactileskin.geometry import braille
 
@@ -176,6 +184,8 @@ class Scene:
                 v = v.value
             if f.name == "fingertip":
                 v = dict(v)
+            if f.name == "sensors":  # none: absent, so that scenes without sensors keep their keys
+                v = [lay.to_dict() for lay in v] or None
             if v is None:
                 continue
             d[f.name] = v

@@ -10,7 +10,7 @@ from tactileskin import results
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
 # every name `solve` writes into its folder (also how a folder of an earlier version is recognised)
-RESULT_FILES = (*results.OWN_NAMES, "bone_map.png")
+RESULT_FILES = (*results.OWN_NAMES, "bone_map.png", "sensors.png")
 OWN_NAMES = RESULT_FILES + ("section_2d", "compare_2d.json")
 
 
@@ -30,7 +30,10 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
                    "the default 2D mesh, write it to OUT/section_2d and report the differences.")
-def command(out, elastic, compare_2d, **kw):
+@click.option("--sensors", "sensors_file", type=click.Path(dir_okay=False), default=None,
+              help="TOML file of [[sensors]] layouts (replaces the scene file's): writes "
+                   "sensors.csv and sensors.png.")
+def command(out, elastic, compare_2d, sensors_file=None, **kw):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.markup import escape
@@ -42,6 +45,16 @@ def command(out, elastic, compare_2d, **kw):
     scene = scene_from_options(**kw)
     if elastic:
         scene = scene.replace(viscoelastic=False)
+    if sensors_file:
+        from tactileskin import validate
+        from tactileskin.errors import ParameterError
+        from tactileskin.params import read_toml
+
+        doc = read_toml(sensors_file, "sensors file")
+        validate.known_keys(doc, ["sensors"], "sensors file")
+        if not doc.get("sensors"):
+            raise ParameterError("sensors file", sensors_file, "[[sensors]] tables (one per layout)")
+        scene = scene.replace(sensors=doc["sensors"])
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
@@ -49,6 +62,7 @@ def command(out, elastic, compare_2d, **kw):
             res = solve(scene, progress=show)
         path = res.write(out)
         _write_map_figure(res, path, scene.label())
+        _write_sensors_figure(res, path, scene.label())
     s = res.summary()
     t = Table(title=escape(f"{scene.label()} -> {path}"), show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
@@ -62,6 +76,9 @@ def command(out, elastic, compare_2d, **kw):
         t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
     else:
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
+    if "peak_sensor_pressure_mpa" in s:
+        t.add_row("sensors / peak sensor P", f"{s['sensors']} / {s['peak_sensor_pressure_mpa']:.4g} MPa "
+                  f"({s['peak_sensor_id']})")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
     t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).is_file()))
@@ -116,6 +133,21 @@ def _write_map_figure(res, path, label: str) -> None:
     from tactileskin.report.bone_map import write_bone_map_figure
 
     write_bone_map_figure(res.bone_map, png, title=f"bone pressure, {label}")
+
+
+def _write_sensors_figure(res, path, label: str) -> None:
+    """sensors.png of a result with sensors; one without removes one left by an earlier solve."""
+    from tactileskin import fileio
+
+    png = path / "sensors.png"
+    if res.sensors is None:
+        if png.is_file():
+            with fileio.os_errors(png):
+                png.unlink()
+        return
+    from tactileskin.report.sensors import write_sensors_figure
+
+    write_sensors_figure(res.sensors, png, title=f"sensor readings, {label}")
 
 
 def _compare_2d(scene, s3, out) -> None:

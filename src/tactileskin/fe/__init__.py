@@ -41,7 +41,7 @@ from tactileskin.fe.solver import IncrementInfo, SolverOptions, run
 
 log = logging.getLogger(__name__)
 
-__all__ = ["solve", "model_for_scene", "material_law", "Model", "Dirichlet", "Contact", "run",
+__all__ = ["solve", "read_sensors", "model_for_scene", "material_law", "Model", "Dirichlet", "Contact", "run",
            "SolverOptions", "IncrementInfo", "make_result", "reaction"]
 
 
@@ -124,6 +124,19 @@ def blas_threads():
     return threadpool_limits(limits=1)
 
 
+def read_sensors(scene, model, result, *, z_symmetric: bool = False):
+    """The readings (sensors.SensorReadings) of the scene's sensor layouts from a result's
+    nodal stress fields, interpolated inside the elements (fe.probe); the modelled half (x >= 0,
+    and z >= 0 for a z-symmetric slab) answers for its mirror image."""
+    from tactileskin import sensors
+    from tactileskin.fe.probe import stress_sampler
+
+    sites = sensors.sites_for(scene)
+    sampler = sensors.symmetric_sampler(stress_sampler(model, result.fields["point_data"]),
+                                        mirror_x=True, mirror_z=z_symmetric)
+    return sensors.read(sites, sampler)
+
+
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None,
           progress=None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
@@ -154,6 +167,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
     t2 = time.perf_counter()
     res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
+    if scene.sensors:
+        res.sensors = read_sensors(scene, model, res, z_symmetric=bool(getattr(sm, "z_symmetric", False)))
     stats.wall_s = time.perf_counter() - t0
     res.stats["wall_s"] = stats.wall_s
     res.stats["phases_s"] = phases(model, mesh=t_mesh, setup=t_setup,

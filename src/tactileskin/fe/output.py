@@ -12,6 +12,8 @@ from tactileskin.results import BoneMap, Result
 
 _VTK_CELL = {(2, 6): "triangle6", (2, 3): "triangle", (3, 10): "tetra10", (3, 4): "tetra",
              (2, 9): "quad9", (2, 4): "quad"}
+# nodal Cauchy stress components of the result fields (plane strain: no syz, sxz)
+STRESS_COMPONENTS = {"sxx": (0, 0), "syy": (1, 1), "szz": (2, 2), "sxy": (0, 1), "syz": (1, 2), "sxz": (0, 2)}
 
 
 def reaction(model: Model, ev: Evaluation, names=None) -> np.ndarray:
@@ -31,9 +33,7 @@ def nodal_fields(model: Model, ev: Evaluation, projector: Projector | None = Non
     sig = model.stress(ev) if sig is None else sig
     P = kernels.mean_pressure(sig)
     out = {"pressure": pj.project(P)}
-    names = ["sxx", "syy", "szz", "sxy", "syz", "sxz"]
-    idx = [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)]
-    for n, (i, j) in zip(names, idx):
+    for n, (i, j) in STRESS_COMPONENTS.items():
         if model.m == 2 and n in ("syz", "sxz"):
             continue
         out[n] = pj.project(sig[..., i, j])
@@ -304,8 +304,14 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
         # the profile from the local fit (second order at the boundary; the projected nodal
         # field, first order there, stays in the VTK output elsewhere): see recovery.PointFit
         sd, s = path_nodes(model, path, s_of_point)
-        p = PointFit(model, model.basis.doflocs[:, sd].T).values(kernels.mean_pressure(sig))
+        fit = PointFit(model, model.basis.doflocs[:, sd].T)
+        p = fit.values(kernels.mean_pressure(sig))
         fields["pressure"][sd] = p  # the VTK field agrees with the profile on the path
+        # and so do the stress components (the fit is linear: their -trace/3 is p), which
+        # sensors on the bone interpolate (fe.probe)
+        for name, (i, j) in STRESS_COMPONENTS.items():
+            if name in fields:
+                fields[name][sd] = fit.values(sig[..., i, j])
     if model.surface is not None and ev.contact is not None:
         g, lamN, x, n = ev.contact
         pc = model.surface.current_pressure(model.u, lamN)

@@ -1,0 +1,490 @@
+"""Sensor layouts inside the skin and their readings: the stress at each sensor.
+
+A layout is part of a Scene (`Scene.sensors`, a tuple of `SensorLayout`; TOML `[[sensors]]`
+tables). Positions are in the skin's own coordinates (`SectionCoordinates` for the fingertip):
+- s (mm): arc length along the bone interface from the symmetry line x = 0 (the paper's path);
+  negative s is the mirror half (x < 0), which the symmetric model answers by reflection;
+- depth (mm) below the outer surface, measured along the common normal of the outer contour
+  and the bone interface (the interface is the contour's inward offset by t, so the normal
+  at s is one line from the surface to the bone); or height above the bone, = t - depth.
+  depth 0 is the outer surface, depth t (height 0) the bonded (bone) surface;
+- z (mm, 3D only): along the finger; the slab spans [-L/2, L/2] (L = fingertip sample_length).
+
+Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
+one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
+`taxel` (mm; 0 = a point sensor) is area-averaged: Gauss-Legendre `taxel_points` per direction
+(taxel_points in 2D, taxel_points**2 in 3D) over the square in (s, z) on the sensor's depth
+surface, weighted by the surface's area element (exact mean of a field linear over a flat taxel).
+
+Readings, per sensor, from the Cauchy stress sigma of the final state (sampled by interpolation
+inside the elements, fe.probe): P = -tr(sigma)/3 (the paper's mean pressure, compression
+positive), sigma_nn = n.sigma.n (tension positive) and the shears tau_1 = t1.sigma.n,
+tau_2 = t2.sigma.n, with n the sensor plane's normal in the undeformed skin (the local normal of
+the depth surface, pointing out of the skin; exact on the bonded surface, which does not move),
+t1 along increasing s in the section plane and t2 = t1 x n along +z. A taxel averages the tensor
+over its area, then projects it on its centre's frame (a flat, rigid chip). In 2D plane strain
+sigma_xz = sigma_yz = 0, so tau_2 = 0 exactly.
+
+Pure numpy (no solver import): `read(sites, sampler)` takes any sampler points -> Cauchy
+stresses; the solver's is `fe.probe.stress_sampler`.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tactileskin import validate
+from tactileskin.errors import ParameterError
+
+KINDS = ("points", "line", "grid")
+MAX_SENSORS = 20000          # all layouts of a scene together
+MAX_TAXEL_POINTS = 8         # Gauss points per direction
+DEFAULT_TAXEL_POINTS = 3     # exact for fields up to degree 5 across a flat taxel
+_KEYS = ("name", "kind", "s", "z", "depth", "height", "pitch", "taxel", "taxel_points")
+_TOL = 1e-9                  # mm: positions on a range's end are inside
+
+
+@dataclass(frozen=True)
+class SensorLayout:
+    """One layout of sensors (see the module docstring for the coordinates)."""
+
+    name: str
+    kind: str = "points"
+    s: tuple[float, ...] = (0.0,)
+    z: tuple[float, ...] = ()
+    depth: float | None = None
+    height: float | None = None
+    pitch: tuple[float, ...] = ()
+    taxel: float = 0.0
+    taxel_points: int = DEFAULT_TAXEL_POINTS
+
+    @classmethod
+    def from_dict(cls, d, index: int = 0) -> "SensorLayout":
+        if isinstance(d, SensorLayout):
+            return d
+        where = f"sensors[{index}]"
+        validate.table(d, where)
+        validate.known_keys(d, _KEYS, where)
+        name = validate.string(d.get("name", f"L{index}"), f"{where}.name", "a layout name")
+        if not name or any(c in name for c in ",\n\r\"") or len(name) > 64:
+            raise ParameterError(f"{where}.name", name, "1-64 characters without commas or quotes")
+        where = f"sensor layout {name!r}"
+        kind = validate.string(d.get("kind", "points"), f"{where} kind")
+        if kind not in KINDS:
+            raise ParameterError(f"{where} kind", kind, "one of " + ", ".join(KINDS),
+                                 validate.did_you_mean(kind, KINDS))
+        s = _numbers(d.get("s", [0.0]), f"{where} s")
+        z = _numbers(d.get("z", []), f"{where} z")
+        pitch = _numbers(d.get("pitch", []), f"{where} pitch")
+        depth = d.get("depth")
+        height = d.get("height")
+        if (depth is None) == (height is None):
+            raise ParameterError(f"{where} depth/height", f"depth={depth}, height={height}",
+                                 "exactly one: depth below the outer surface or height above the bone (mm)")
+        depth = None if depth is None else validate.number(depth, f"{where} depth")
+        height = None if height is None else validate.number(height, f"{where} height")
+        taxel = validate.number(d.get("taxel", 0.0), f"{where} taxel")
+        if taxel < 0:
+            raise ParameterError(f"{where} taxel", taxel, ">= 0 mm (0: a point sensor)")
+        tp = validate.integer(d.get("taxel_points", DEFAULT_TAXEL_POINTS), f"{where} taxel_points",
+                              f"1..{MAX_TAXEL_POINTS}")
+        if not 1 <= tp <= MAX_TAXEL_POINTS:
+            raise ParameterError(f"{where} taxel_points", tp, f"1..{MAX_TAXEL_POINTS}")
+        if kind == "points":
+            if not s:
+                raise ParameterError(f"{where} s", list(s), "one s (mm) per sensor")
+            if z and len(z) not in (1, len(s)):
+                raise ParameterError(f"{where} z", list(z), f"one z for all or one per sensor ({len(s)})")
+            if pitch:
+                raise ParameterError(f"{where} pitch", list(pitch), "none for kind 'points'")
+        else:
+            if len(s) != 2 or s[1] < s[0]:
+                raise ParameterError(f"{where} s", list(s), "[s0, s1] with s0 <= s1 (mm)")
+            npitch = 1 if kind == "line" else (1, 2)
+            if len(pitch) not in np.atleast_1d(npitch) or min(pitch) <= 0:
+                raise ParameterError(f"{where} pitch", list(pitch),
+                                     "one pitch > 0 (mm)" if kind == "line" else "[p] or [ps, pz], > 0 (mm)")
+            if kind == "line" and len(z) > 1:
+                raise ParameterError(f"{where} z", list(z), "one z (mm) for a line")
+            if kind == "grid" and (len(z) != 2 or z[1] < z[0]):
+                raise ParameterError(f"{where} z", list(z), "[z0, z1] with z0 <= z1 (mm)")
+        lay = cls(name, kind, s, z, depth, height, pitch, taxel, tp)
+        if lay.count() > MAX_SENSORS:
+            raise ParameterError(f"{where} sensors", lay.count(), f"<= {MAX_SENSORS} (a larger pitch)")
+        return lay
+
+    def to_dict(self) -> dict:
+        d = {"name": self.name, "kind": self.kind, "s": list(self.s)}
+        if self.z:
+            d["z"] = list(self.z)
+        if self.depth is not None:
+            d["depth"] = self.depth
+        if self.height is not None:
+            d["height"] = self.height
+        if self.pitch:
+            d["pitch"] = list(self.pitch)
+        if self.taxel:
+            d["taxel"] = self.taxel
+            d["taxel_points"] = self.taxel_points
+        return d
+
+    def _axis(self, lo, hi, p):
+        n = int(np.floor((hi - lo) / p * (1 + 1e-12) + 1e-9)) + 1
+        return lo + p * np.arange(n)
+
+    def positions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(s, z) of the layout's sensor centres (z = 0 where not given)."""
+        if self.kind == "points":
+            s = np.asarray(self.s, float)
+            z = np.broadcast_to(np.asarray(self.z or (0.0,), float), s.shape).copy()
+            return s, z
+        if self.kind == "line":
+            s = self._axis(self.s[0], self.s[1], self.pitch[0])
+            return s, np.full(s.shape, self.z[0] if self.z else 0.0)
+        ps, pz = (self.pitch[0], self.pitch[-1])
+        S, Z = np.meshgrid(self._axis(self.s[0], self.s[1], ps), self._axis(self.z[0], self.z[1], pz))
+        return S.ravel(), Z.ravel()  # z-major: row j is one z
+
+    def count(self) -> int:
+        if self.kind == "points":
+            return len(self.s)
+        n = len(self._axis(self.s[0], self.s[1], self.pitch[0]))
+        if self.kind == "grid":
+            n *= len(self._axis(self.z[0], self.z[1], self.pitch[-1]))
+        return n
+
+    def depth_in(self, thickness: float) -> float:
+        return float(self.depth) if self.depth is not None else float(thickness - self.height)
+
+
+def _numbers(v, name) -> tuple[float, ...]:
+    if validate.is_number(v):
+        v = [v]
+    return validate.number_list(v, name, MAX_SENSORS)
+
+
+def layouts(value) -> tuple[SensorLayout, ...]:
+    """Scene.sensors from a list of tables (TOML [[sensors]]) or SensorLayout objects."""
+    if value is None:
+        return ()
+    if isinstance(value, (SensorLayout, dict)):
+        value = [value]
+    if not isinstance(value, (list, tuple)):
+        raise ParameterError("sensors", value, "a list of sensor layout tables ([[sensors]] in TOML)")
+    out = tuple(SensorLayout.from_dict(d, i) for i, d in enumerate(value))
+    names = [lay.name for lay in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ParameterError("sensors name", dup[0], "unique layout names")
+    total = sum(lay.count() for lay in out)
+    if total > MAX_SENSORS:
+        raise ParameterError("sensors", f"{total} sensors", f"<= {MAX_SENSORS} in all layouts")
+    return out
+
+
+# --- skin coordinates ---------------------------------------------------------------------------
+
+class SectionCoordinates:
+    """(s, depth) -> point, normal, tangent of the fingertip section (Section of
+    geometry.fingertip): the point at depth d on the outer contour's normal through the bone
+    point at arc length |s|, mirrored to x < 0 for s < 0."""
+
+    def __init__(self, section):
+        self.section = section
+        self.thickness = float(section.thickness)
+        self.s_max = float(section.interface_length)
+
+    def frame(self, s, depth):
+        """(xy (n, 2), outward unit normal (n, 2), unit tangent along +s (n, 2), |d point / ds|
+        (n,), the area element of the depth surface per unit bone arc length)."""
+        s = np.asarray(s, float)
+        depth = np.broadcast_to(np.asarray(depth, float), s.shape)
+        sec = self.section
+        ft = sec.fingertip
+        u = sec.u_of_s(np.minimum(np.abs(s), self.s_max))
+        n = ft.outer_normal(u)
+        p = ft.outer(u) - depth[:, None] * n
+        sign = np.where(s < 0, -1.0, 1.0)
+        p[:, 0] *= sign
+        n[:, 0] *= sign
+        tang = np.stack([n[:, 1], -n[:, 0]], axis=-1)  # d point / ds: +x-ward in both halves
+        kap = ft.curvature(u)
+        jac = (1.0 - depth * kap) / (1.0 - self.thickness * kap)
+        return p, n, tang, jac
+
+
+class FlatCoordinates:
+    """A flat layer: s = x in [-half_width, half_width], depth below y = top. For blocks
+    and pads (the tests' homogeneous block)."""
+
+    def __init__(self, top: float, thickness: float, half_width: float):
+        self.top, self.thickness, self.s_max = float(top), float(thickness), float(half_width)
+
+    def frame(self, s, depth):
+        s = np.asarray(s, float)
+        depth = np.broadcast_to(np.asarray(depth, float), s.shape)
+        p = np.stack([s, self.top - depth], axis=-1)
+        n = np.tile([0.0, 1.0], (len(s), 1))
+        t = np.tile([1.0, 0.0], (len(s), 1))
+        return p, n, t, np.ones(len(s))
+
+
+def coordinates_for(scene):
+    """The skin coordinates of a scene (the fingertip section today)."""
+    return SectionCoordinates(scene.section())
+
+
+# --- sites: the resolved points ---------------------------------------------------------------
+
+@dataclass
+class Sites:
+    """Resolved sensors: centres, frames and taxel sample points with their weights.
+
+    xyz (n, 3) centres; normal, t1, t2 (n, 3); samples (n, k, 3) taxel points and weights
+    (n, k) summing to 1 per sensor; ids, layout names, s, z, depth per sensor."""
+
+    ids: list
+    layout: list
+    s: np.ndarray
+    z: np.ndarray
+    depth: np.ndarray
+    xyz: np.ndarray
+    normal: np.ndarray
+    t1: np.ndarray
+    t2: np.ndarray
+    samples: np.ndarray
+    weights: np.ndarray
+    dim: int = 2
+
+    @classmethod
+    def at(cls, points, normals, ids=None, dim: int | None = None) -> "Sites":
+        """Point sensors at given points with given plane normals (any orientation; t1 =
+        n x e_z normalised, t2 = t1 x n: in 2D t1 lies in the plane and t2 = e_z)."""
+        pts = np.atleast_2d(np.asarray(points, float))
+        dim = dim or pts.shape[1]
+        xyz = _to3(pts)
+        n = _to3(np.atleast_2d(np.asarray(normals, float)))
+        n = n / np.linalg.norm(n, axis=1, keepdims=True)
+        t1 = np.cross(n, [0.0, 0.0, 1.0])
+        norm = np.linalg.norm(t1, axis=1, keepdims=True)
+        if np.any(norm < 1e-12):
+            raise ParameterError("sensor normal", "along z", "a normal with an x or y component")
+        t1 /= norm
+        t2 = np.cross(t1, n)
+        k = len(xyz)
+        ids = list(ids) if ids is not None else [f"p{i}" for i in range(k)]
+        return cls(ids, ["points"] * k, np.full(k, np.nan), xyz[:, 2].copy(), np.full(k, np.nan), xyz, n,
+                   t1, t2, xyz[:, None, :].copy(), np.ones((k, 1)), dim)
+
+
+def _to3(p):
+    return p if p.shape[1] == 3 else np.column_stack([p, np.zeros(len(p))])
+
+
+def _check_range(where, what, v, lo, hi, unit="mm"):
+    v = np.atleast_1d(v)
+    bad = (v < lo - _TOL) | (v > hi + _TOL)
+    if np.any(bad):
+        raise ParameterError(f"{where} {what}", float(v[bad][0]), f"[{lo:.6g}, {hi:.6g}] {unit}")
+
+
+def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) -> Sites:
+    """Sites of the layouts in the skin coordinates `coords`; a sensor (or a taxel's edge)
+    outside the skin is a ParameterError naming the layout and the valid range."""
+    t, smax = coords.thickness, coords.s_max
+    ids, names, S, Z, D, layout_of = [], [], [], [], [], []
+    for lay in lays:
+        where = f"sensor layout {lay.name!r}"
+        if dim == 2 and (lay.kind == "grid"):
+            raise ParameterError(f"{where} kind", "grid", "points or line in 2D (plane strain is uniform "
+                                 "along z: a grid is a line)")
+        if dim == 2 and lay.z and any(v != 0 for v in lay.z):
+            raise ParameterError(f"{where} z", list(lay.z), "omitted in 2D (plane strain)")
+        d = lay.depth_in(t)
+        if lay.depth is not None:
+            _check_range(where, "depth", d, 0.0, t)
+        else:
+            _check_range(where, "height", lay.height, 0.0, t)
+        s, z = lay.positions()
+        h = 0.5 * lay.taxel
+        _check_range(where, "s" + (" +- taxel/2" if h else ""), np.concatenate([s - h, s + h]), -smax, smax)
+        if dim == 3 and z_range is not None:
+            _check_range(where, "z" + (" +- taxel/2" if h else ""), np.concatenate([z - h, z + h]), *z_range)
+        n0 = len(ids)
+        ids += [f"{lay.name}-{i}" for i in range(len(s))]
+        names += [lay.name] * len(s)
+        S.append(s), Z.append(z), D.append(np.full(len(s), d)), layout_of.append((lay, n0, len(s)))
+    s, z, depth = np.concatenate(S), np.concatenate(Z), np.concatenate(D)
+    if dim == 2:
+        z = np.zeros_like(z)
+    xy, n2, t2d, _ = coords.frame(s, depth)
+    xyz = np.column_stack([xy, z])
+    normal = np.column_stack([n2, np.zeros(len(s))])
+    t1 = np.column_stack([t2d, np.zeros(len(s))])
+    t2 = np.cross(t1, normal)
+    # taxel samples: Gauss-Legendre in (s, z) on the depth surface, area-weighted
+    kmax = max((lay.taxel_points ** (dim - 1) if lay.taxel else 1) for lay, _, _ in layout_of)
+    samples = np.repeat(xyz[:, None, :], kmax, axis=1)
+    weights = np.zeros((len(s), kmax))
+    weights[:, 0] = 1.0
+    for lay, i0, cnt in layout_of:
+        if not lay.taxel:
+            continue
+        g, w = np.polynomial.legendre.leggauss(lay.taxel_points)
+        a = 0.5 * lay.taxel * g
+        if dim == 2:
+            ds, dz, wq = a, np.zeros_like(a), w
+        else:
+            ds, dz = (m.ravel() for m in np.meshgrid(a, a))
+            wq = np.outer(w, w).ravel()
+        k = len(ds)
+        rows = slice(i0, i0 + cnt)
+        ss = (s[rows, None] + ds[None, :]).ravel()
+        pq, _, _, jac = coords.frame(ss, np.repeat(depth[rows], k))
+        zz = (z[rows, None] + dz[None, :]).ravel() if dim == 3 else np.zeros(len(ss))
+        samples[rows, :k] = np.column_stack([pq, zz]).reshape(cnt, k, 3)
+        ww = wq[None, :] * jac.reshape(cnt, k)
+        weights[rows, :k] = ww / ww.sum(axis=1, keepdims=True)
+        weights[rows, k:] = 0.0
+    return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim)
+
+
+def sites_for(scene, z_range=None) -> Sites:
+    """Sites of a scene's layouts (validated against its skin; z_range: the 3D slab's z)."""
+    if z_range is None and scene.dim == 3:
+        L = scene.fingertip_model().sample_length
+        z_range = (-0.5 * L, 0.5 * L)
+    return resolve(scene.sensors, coordinates_for(scene), scene.dim, z_range)
+
+
+# --- sampling and readings ----------------------------------------------------------------------
+
+def symmetric_sampler(sampler, *, mirror_x: bool = True, mirror_z: bool = False):
+    """A sampler of the whole skin from one of the modelled part: a point with x < 0 (z < 0 when
+    mirror_z) is sampled at its mirror image and the tensor reflected (sigma' = R sigma R)."""
+
+    def sample(points):
+        pts = np.array(points, float)
+        flips = []
+        if mirror_x:
+            flips.append((0, pts[:, 0] < 0))
+        if mirror_z and pts.shape[1] == 3:
+            flips.append((2, pts[:, 2] < 0))
+        for ax, neg in flips:
+            pts[neg, ax] *= -1
+        sig = np.array(sampler(pts), float)
+        for ax, neg in flips:
+            r = np.ones(3)
+            r[ax] = -1
+            sig[neg] *= r[:, None] * r[None, :]
+        return sig
+
+    return sample
+
+
+def read(sites: Sites, sampler) -> "SensorReadings":
+    """Readings at the sites: sampler(points (N, dim)) -> Cauchy stress (N, 3, 3)."""
+    n, k, _ = sites.samples.shape
+    pts = sites.samples.reshape(-1, 3)[:, :sites.dim]
+    sig = np.asarray(sampler(pts), float).reshape(n, k, 3, 3)
+    sig = np.einsum("nk,nkij->nij", sites.weights, sig)
+    return readings_from_stress(sites, sig)
+
+
+def readings_from_stress(sites: Sites, sig: np.ndarray) -> "SensorReadings":
+    """Readings of the (taxel-averaged) Cauchy stresses (n, 3, 3) at the sites."""
+    n = sites.normal
+    tn = np.einsum("kij,kj->ki", sig, n)            # traction on the sensor plane
+    return SensorReadings(
+        ids=list(sites.ids), layout=list(sites.layout), xyz=sites.xyz.copy(), s=sites.s.copy(),
+        depth=sites.depth.copy(), normal=n.copy(),
+        pressure=-np.trace(sig, axis1=1, axis2=2) / 3.0,
+        sigma_nn=np.einsum("ki,ki->k", n, tn), tau_1=np.einsum("ki,ki->k", sites.t1, tn),
+        tau_2=np.einsum("ki,ki->k", sites.t2, tn),
+        taxel_points=(sites.weights > 0).sum(axis=1))
+
+
+COLUMNS = ("sensor_id", "layout", "x_mm", "y_mm", "z_mm", "s_mm", "depth_mm", "pressure_mpa",
+           "sigma_nn_mpa", "tau_1_mpa", "tau_2_mpa", "taxel_points")
+
+
+@dataclass
+class SensorReadings:
+    """One row per sensor: ids, layout, centre xyz (mm), s and depth (mm, skin coordinates),
+    plane normal, and P, sigma_nn, tau_1, tau_2 (MPa), the taxel's sample count."""
+
+    ids: list
+    layout: list
+    xyz: np.ndarray
+    s: np.ndarray
+    depth: np.ndarray
+    normal: np.ndarray
+    pressure: np.ndarray
+    sigma_nn: np.ndarray
+    tau_1: np.ndarray
+    tau_2: np.ndarray
+    taxel_points: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+
+    def __post_init__(self):
+        from tactileskin.errors import ConvergenceError
+
+        for name in ("pressure", "sigma_nn", "tau_1", "tau_2"):
+            v = np.asarray(getattr(self, name), float)
+            if not np.all(np.isfinite(v)):
+                raise ConvergenceError(f"non-finite sensor reading {name!r}", {"field": name})
+            setattr(self, name, v)
+
+    def __len__(self):
+        return len(self.ids)
+
+    def select(self, layout: str) -> "SensorReadings":
+        """The rows of one layout."""
+        keep = np.array([name == layout for name in self.layout])
+        return SensorReadings(
+            [i for i, k in zip(self.ids, keep) if k], [layout] * int(keep.sum()), self.xyz[keep],
+            self.s[keep], self.depth[keep], self.normal[keep], self.pressure[keep], self.sigma_nn[keep],
+            self.tau_1[keep], self.tau_2[keep], np.asarray(self.taxel_points)[keep])
+
+    def summary(self) -> dict:
+        """Summary fields: sensor count, the largest sensor pressure, its sensor and position."""
+        i = int(np.argmax(self.pressure))
+        return {"sensors": len(self), "peak_sensor_pressure_mpa": float(self.pressure[i]),
+                "peak_sensor_id": self.ids[i], "peak_sensor_xyz_mm": [float(v) for v in self.xyz[i]],
+                "max_abs_sensor_shear_mpa": float(np.max(np.hypot(self.tau_1, self.tau_2)))}
+
+    def to_csv(self) -> str:
+        """Tidy table, one row per sensor (COLUMNS)."""
+        buf = io.StringIO()
+        buf.write(",".join(COLUMNS) + "\n")
+        for i in range(len(self)):
+            x, y, z = self.xyz[i]
+            vals = (x, y, z, self.s[i], self.depth[i], self.pressure[i], self.sigma_nn[i], self.tau_1[i],
+                    self.tau_2[i])
+            buf.write(",".join([self.ids[i], self.layout[i], *(f"{v:.10g}" for v in vals),
+                                str(int(self.taxel_points[i]))]) + "\n")
+        return buf.getvalue()
+
+
+def read_sensors_csv(path) -> SensorReadings:
+    """The SensorReadings of a sensors.csv (as Result.write writes it); a file that is not one
+    raises ParameterError naming it."""
+    import csv
+    from pathlib import Path
+
+    path = Path(path)
+    valid = "a sensors.csv written by tactileskin solve (" + ", ".join(COLUMNS) + ")"
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+        if not rows or tuple(rows[0].keys()) != COLUMNS:
+            raise ValueError("unexpected header")
+        f = {c: np.array([float(r[c]) for r in rows]) for c in COLUMNS[2:]}
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise ParameterError("sensors file", str(path), valid, hint=str(e)) from None
+    xyz = np.column_stack([f["x_mm"], f["y_mm"], f["z_mm"]])
+    return SensorReadings([r["sensor_id"] for r in rows], [r["layout"] for r in rows], xyz, f["s_mm"],
+                          f["depth_mm"], np.full((len(rows), 3), np.nan), f["pressure_mpa"],
+                          f["sigma_nn_mpa"], f["tau_1_mpa"], f["tau_2_mpa"], f["taxel_points"].astype(int))
