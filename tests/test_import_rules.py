@@ -23,3 +23,19 @@ def _imports(module):
 @pytest.mark.parametrize("module", CORE + LATER)
 def test_core_stays_light(module):
     assert _imports(module) == ""
+
+
+def test_only_the_file_indenter_uses_trimesh():
+    """geometry/indenters/ is pure numpy/scipy, except file.py: a user's STL must be read and
+    its triangles' closest points computed by a maintained library (trimesh), imported inside
+    its functions. Importing the package must not load trimesh, and no other kind names it."""
+    from pathlib import Path
+
+    import tactileskin.geometry.indenters as pkg
+
+    code = "import sys, tactileskin.geometry.indenters; print('trimesh' in sys.modules)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "False"
+    users = sorted(p.name for p in Path(pkg.__path__[0]).glob("*.py") if "trimesh" in p.read_text())
+    assert users == ["file.py"]

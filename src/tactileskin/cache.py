@@ -8,6 +8,8 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   user's material file: editing the file changes the key, renaming or moving it does not;
 - the bytes of every geometry parameter file (`params.geometry_digest()`: fingertip,
   indenters, Braille standards, molds);
+- the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL), not
+  their paths;
 - `scene.SCHEMA_VERSION` and the package version.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
@@ -75,10 +77,12 @@ def material_content(material: str) -> dict:
 
 def cache_key(scene: Scene) -> str:
     """Hash of everything that can change `scene`'s result (see the module docstring)."""
-    fields = scene.to_dict()
-    fields.pop("material")
+    fields = _scene_fields(scene)
     payload = {"scene": fields, "material": material_content(scene.material),
                "geometry": params.geometry_digest(), "schema": SCHEMA_VERSION, "version": __version__}
+    files = scene.indenter_kind.cache_content(scene)
+    if files:  # only kinds that read files add the key (the others' keys stay as they were)
+        payload["indenter_files"] = files
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
@@ -107,6 +111,8 @@ def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
 def _scene_fields(scene: Scene) -> dict:
     d = scene.to_dict()
     d.pop("material")  # its content is in the key; the file may have been renamed
+    for name in scene.indenter_kind.cache_content(scene):
+        d.pop(name, None)  # likewise an indenter file: its bytes are in the key, not its path
     return d
 
 

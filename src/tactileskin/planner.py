@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
-from tactileskin.scene import IndenterKind, Scene
+from tactileskin.scene import Scene
 
 log = logging.getLogger(__name__)
 
@@ -184,7 +184,9 @@ def quality_mesh(quality: str, indenter, dim: int = 2) -> tuple[float, float]:
     q = QUALITY[quality]
     if dim == 3:
         return q["mesh3d"]
-    return q["braille_mesh"] if IndenterKind(indenter) is IndenterKind.BRAILLE else q["mesh"]
+    from tactileskin.geometry.indenters import get_kind
+
+    return q["braille_mesh"] if get_kind(indenter).fine_2d_mesh else q["mesh"]
 
 
 def with_quality(scene: Scene, quality: str) -> Scene:
@@ -286,16 +288,21 @@ def plan(scene: Scene, tolerance: float = 0.01, *, braille: str = "dots", verify
                               + (" and z = 0" if sz else ""), 0.0))
     else:
         choices.append(Choice("symmetry", "half model (x >= 0), the only model the solver has",
-                              f"the Braille text {scene.braille_text!r} is not symmetric about x = 0: "
+                              f"the {scene.indenter_label()} indenter is not symmetric about x = 0: "
                               "the half model mirrors it; no full model is available", None, "unknown"))
 
     # dimension --------------------------------------------------------------------------
-    if scene.indenter is not IndenterKind.BRAILLE:
+    model_2d = scene.indenter_kind.model_2d(scene)
+    if model_2d == "exact":
         if scene.dim == 3:
             out = out.replace(dim=2)
         choices.append(Choice("dimension", "2D plane strain",
                               f"the {scene.indenter.value} indenter is uniform along the finger", 0.0))
-    else:
+    elif model_2d is None:
+        choices.append(Choice("dimension", "3D slab",
+                              f"the {scene.indenter_label()} indenter is not uniform along the finger and "
+                              "has no 2D model", 0.0))
+    else:  # "ridge": the Braille dot row as a ridge
         meas = measured_ridge_vs_dots(scene)
         if braille == "ridge":
             out = out.replace(dim=2)

@@ -18,6 +18,7 @@ from pathlib import Path
 from tactileskin import presets as _presets
 from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
+from tactileskin.geometry.indenters import registry as _indenters
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
 # not reused (2: bone pressure from the boundary fit, second-order QLV update)
@@ -38,16 +39,17 @@ DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
 
 
 def default_mesh(dim: int, indenter) -> tuple[float, float]:
-    """(mesh_size, refinement) a scene of this dimension and indenter gets by default."""
-    if dim == 2 and IndenterKind(indenter) is IndenterKind.BRAILLE:
+    """(mesh_size, refinement) a scene of this dimension and indenter gets by default (the
+    kind says whether its 2D section needs the finer preset)."""
+    if dim == 2 and _indenters.get(indenter).fine_2d_mesh:
         return DEFAULT_MESH_BRAILLE_2D
     return DEFAULT_MESH[dim]
 
 
-class IndenterKind(str, Enum):
-    FLAT = "flat"
-    CURVED = "curved"
-    BRAILLE = "braille"
+# The registered indenter kinds (geometry/indenters/, one file per kind) as an enum, so
+# `scene.indenter.value` and `IndenterKind.FLAT` keep working; the kind objects answer
+# everything else (`Scene.indenter_kind`).
+IndenterKind = Enum("IndenterKind", [(n.upper(), n) for n in _indenters.names()], type=str)
 
 
 class Formulation(str, Enum):
@@ -95,6 +97,10 @@ class Scene:
     viscoelastic: bool = True
     fingertip: tuple[tuple[str, float], ...] = field(default_factory=tuple)  # overrides of fingertip.toml
     sensors: tuple = field(default_factory=tuple)  # sensors.SensorLayout, TOML [[sensors]]; () none
+    # parameters of some indenter kinds (None: not given; a kind that does not read one refuses it)
+    indenter_radius: float | None = None   # sphere, cylinder (mm)
+    indenter_axis: str | None = None       # cylinder: "z" (along the finger, default) or "x"
+    indenter_file: str | None = None       # file: closed STL/OBJ/PLY/OFF or STEP surface (mm)
 
     def __post_init__(self):
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
@@ -130,6 +136,19 @@ class Scene:
                                        1.0, 20.0))
         if not self.material:
             raise ParameterError("material", self.material, "a material preset name")
+        kind = self.indenter_kind
+        for name in ("indenter_radius", "indenter_axis", "indenter_file"):
+            if getattr(self, name) is not None and name not in kind.scene_params:
+                takers = [k for k in _indenters.names() if name in _indenters.get(k).scene_params]
+                raise ParameterError(name, getattr(self, name), f"only with indenter = {' or '.join(takers)}",
+                                     f"the {kind.name} indenter does not take it")
+        if self.indenter_axis is not None:
+            set_("indenter_axis", validate.string(self.indenter_axis, "indenter_axis", "'z' or 'x'"))
+        if self.indenter_file is not None:
+            set_("indenter_file", validate.string(str(self.indenter_file) if isinstance(self.indenter_file, Path)
+                                                  else self.indenter_file, "indenter_file", "a file path"))
+        for name, value in kind.check_scene(self).items():
+            set_(name, value)
         if self.sensors:
             from tactileskin import sensors
 
@@ -137,12 +156,6 @@ class Scene:
             sensors.sites_for(self)  # raises ParameterError for a sensor outside the skin
         else:
             set_("sensors", ())
-        if self.indenter is IndenterKind.BRAILLE:
-            from tactileskin.geometry import braille
-
-            braille.get_standard(self.braille_standard)  # raises ParameterError if unknown
-            if self.braille_text:
-                braille.check_text(self.braille_text)   # raises on unknown characters, > MAX_CELLS
 
     # --- derived -----------------------------------------------------------------------
     @property
@@ -163,10 +176,21 @@ class Scene:
     def section(self):
         return self.fingertip_model().section(self.thickness)
 
+    @property
+    def indenter_kind(self):
+        """The indenter kind object (geometry.indenters: gap, symmetry, 2D model, extent, label)."""
+        return _indenters.get(self.indenter)
+
     def replace(self, **changes) -> "Scene":
-        """A changed copy. Changing `dim` or `indenter` re-derives mesh defaults left at default."""
+        """A changed copy. Changing `dim` or `indenter` re-derives mesh defaults left at
+        default; changing `indenter` drops kind parameters the new kind does not read."""
         new_dim = changes.get("dim", self.dim)
         new_ind = changes.get("indenter", self.indenter)
+        if new_ind != self.indenter:
+            reads = _indenters.get(new_ind).scene_params
+            for name in ("indenter_radius", "indenter_axis", "indenter_file"):
+                if name not in changes and name not in reads:
+                    changes[name] = None
         if (new_dim != self.dim or new_ind != self.indenter) and new_dim in DEFAULT_MESH:
             size0, ref0 = default_mesh(self.dim, self.indenter)
             if "mesh_size" not in changes and self.mesh_size == size0:
@@ -208,9 +232,12 @@ class Scene:
                              separators=(",", ":"))
         return hashlib.sha256(payload.encode()).hexdigest()[:20]
 
+    def indenter_label(self) -> str:
+        """The indenter as case ids, tables and figures name it (braille[text], sphere-R2.5, ...)."""
+        return self.indenter_kind.label(self)
+
     def label(self) -> str:
-        ind = self.indenter.value + (f"[{self.braille_text}]" if self.braille_text else "")
-        return f"t{self.thickness:g}-{self.material}-{ind}-{self.dim}d"
+        return f"t{self.thickness:g}-{self.material}-{self.indenter_label()}-{self.dim}d"
 
     def to_toml(self, path: str | Path) -> None:
         import tomli_w

@@ -32,7 +32,8 @@ import numpy as np
 
 from tactileskin.cache import CaseRecord, ResultCache, cache_key, read_profile  # noqa: F401 (API)
 from tactileskin.errors import ParameterError, TactileSkinError
-from tactileskin.scene import IndenterKind, Scene
+from tactileskin.geometry.indenters.registry import get as get_kind
+from tactileskin.scene import Scene
 
 log = logging.getLogger(__name__)
 
@@ -114,10 +115,13 @@ def expand_grid(
     scenes: list[Scene] = []
     seen: set[str] = set()
     for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
-        kind = base.replace(thickness=t, indenter=ind).indenter  # validates the name
-        braille = kind is IndenterKind.BRAILLE
+        kind = get_kind(ind)  # validates the name
+        braille = "braille_text" in kind.scene_params  # the kind reads the texts axis
+        own = dims if kind.section_2d == "ridge" else (base.dim,)
+        if kind.section_2d is None:
+            own = (3,)  # no 2D model of this kind: its cases are 3D
         for text in (braille_texts if braille else ("",)):
-            for dim in (dims if braille else (base.dim,)):
+            for dim in own:
                 s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim)
                 if quality is not None:
                     s = with_quality(s, quality)
@@ -188,8 +192,7 @@ def _material_tag(material: str) -> str:
 
 
 def _base_id(sc: Scene) -> str:
-    ind = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
-    return f"t{sc.thickness:g}-{_material_tag(sc.material)}-{ind}-{sc.dim}d"
+    return f"t{sc.thickness:g}-{_material_tag(sc.material)}-{sc.indenter_label()}-{sc.dim}d"
 
 
 # Fields outside the base id that change a result, with the suffix naming each value.
@@ -287,7 +290,7 @@ def _cost_rank(scene: Scene) -> float:
     """A rough relative cost of solving a scene, for scheduling only: 3D far above 2D, then
     the skin thickness (dofs and Newton iterations grow with it: benchmarks/paper_sweep.py,
     t = 5 mm cases 3-10x the t = 1 mm ones), Braille (more increments) above the rest."""
-    return (100.0 if scene.dim == 3 else 0.0) + scene.thickness + (0.5 if scene.indenter == IndenterKind.BRAILLE else 0.0)
+    return (100.0 if scene.dim == 3 else 0.0) + scene.thickness + (0.5 if scene.indenter_kind.fine_2d_mesh else 0.0)
 
 
 def _run_one_safely(scene: Scene, key: str | None = None):

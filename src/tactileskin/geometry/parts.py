@@ -16,7 +16,7 @@ from tactileskin import params
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille as _braille
 from tactileskin.geometry.fingertip import Fingertip
-from tactileskin.geometry.indenters import KINDS, make_indenter
+from tactileskin.geometry.indenters import KINDS, PAPER_KINDS, get_kind, make_indenter
 
 log = logging.getLogger(__name__)
 
@@ -38,7 +38,7 @@ def resolve_indenters(indenters) -> tuple[str, ...]:
     if indenters is None or indenters == "none":
         return ()
     if indenters == "all":
-        return KINDS
+        return PAPER_KINDS
     kinds = (indenters,) if isinstance(indenters, str) else tuple(indenters)
     for k in kinds:
         if k not in KINDS:
@@ -48,8 +48,11 @@ def resolve_indenters(indenters) -> tuple[str, ...]:
 
 def build_parts(thickness: float | None = None, *, indenters="all", braille_text: str = "",
                 braille_standard: str = "standard_american", fingertip: bool = True, molds: bool = True,
-                fingertip_overrides: dict | None = None) -> list[Part]:
+                fingertip_overrides: dict | None = None, indenter_params: dict | None = None) -> list[Part]:
     """Build the requested parts (full width) for skin thickness `thickness` (mm).
+
+    "all" indenters are the paper's (flat, curved, braille); other kinds are named and take
+    their parameters from `indenter_params` (e.g. {"indenter_radius": 2.5}).
 
     Parameters are validated before any CAD work, so a bad value costs no kernel time.
     Raises ParameterError for invalid inputs and CadError if the kernel fails.
@@ -62,9 +65,13 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
     sec = ft.section(t)  # validates t
     kinds = resolve_indenters(indenters)
     if "braille" in kinds:
-        std = _braille.get_standard(braille_standard)
+        _braille.get_standard(braille_standard)
         if braille_text:
             _braille.check_text(braille_text)
+    opts = {"braille_text": braille_text, "braille_standard": braille_standard, **(indenter_params or {})}
+    inds = [(kind, make_indenter(kind, y0=sec.top, dim=3, sample_length=ft.sample_length,
+                                 **{k: v for k, v in opts.items() if k in get_kind(kind).scene_params}))
+            for kind in kinds]  # validates every kind's parameters before any CAD work
     mold_params = _molds.MoldParams.from_params() if molds else None
     if mold_params is not None:
         mold_params.check(sec)
@@ -84,22 +91,11 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
         parts.append(Part("mold_lower", "casting mold, lower half (holds the base, pins)", lower, mp))
         parts.append(Part("mold_upper", "casting mold, upper half (sprue, vents)", upper, mp))
     log.info("fingertip parts in %.2f s", time.perf_counter() - t0)
-    for kind in kinds:
+    for kind, ind in inds:
         t1 = time.perf_counter()
-        ind = make_indenter(kind, y0=sec.top, dim=3, braille_text=braille_text,
-                            braille_standard=braille_standard, sample_length=ft.sample_length)
         ip = dict(kind=kind, y0=ind.y0, width=ind.width, length=ind.length,
-                  stem_diameter=ind.stem_diameter, stem_length=ind.stem_length)
-        if kind == "flat":
-            desc = "flat plate indenter"
-        elif kind == "curved":
-            desc = f"convex indenter, R = {ind.radius:g} mm"
-            ip.update(radius=ind.radius)
-        else:
-            ip.update(text=braille_text, standard=std.name, dots=int(len(ind.dots)), base_diameter=std.base_diameter,
-                      height=std.height, dot_pitch=std.dot_pitch, cell_pitch=std.cell_pitch, line_pitch=std.line_pitch)
-            desc = f"Braille indenter {braille_text!r} ({std.name}, {len(ind.dots)} dots)" if braille_text \
-                else f"Braille indenter, single dot ({std.name})"
+                  stem_diameter=ind.stem_diameter, stem_length=ind.stem_length, **ind.part_parameters())
+        desc = ind.describe()
         parts.append(Part(f"indenter_{kind}", desc, solids.indenter_solid(ind), ip))
         log.info("%s indenter in %.2f s", kind, time.perf_counter() - t1)
     return parts

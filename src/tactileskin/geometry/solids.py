@@ -27,7 +27,8 @@ import numpy as np
 from tactileskin import params
 from tactileskin.errors import CadError, TactileSkinError
 from tactileskin.geometry.fingertip import Section
-from tactileskin.geometry.indenters import BrailleIndenter, CurvedIndenter, FlatIndenter, Indenter
+from tactileskin.geometry.indenters import (BrailleIndenter, CylinderIndenter, FlatIndenter, Indenter,
+                                            SphereIndenter)
 
 log = logging.getLogger(__name__)
 
@@ -189,17 +190,12 @@ def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) 
 
 
 def indenter_solid(ind: Indenter) -> bd.Solid:
-    """The printable indenter in its scene position (lowest point y0), with its mounting stem."""
-    if isinstance(ind, FlatIndenter):
-        return _flat(ind)
-    if isinstance(ind, CurvedIndenter):
-        return _curved(ind)
-    if isinstance(ind, BrailleIndenter):
-        return _braille(ind)
-    raise CadError(f"no CAD builder for indenter kind {ind.kind!r}")
+    """The printable indenter in its scene position (lowest point y0), with its mounting stem:
+    the kind's answer (`Indenter.solid()`, which calls its builder here)."""
+    return ind.solid()
 
 
-def _flat(ind: FlatIndenter) -> bd.Solid:
+def flat_indenter(ind: FlatIndenter) -> bd.Solid:
     w, L, y0 = ind.width, ind.length, ind.y0
     p = dict(kind="flat", width=w, length=L, thickness=ind.thickness)
     with occ_guard("building the flat indenter plate", **p):
@@ -207,24 +203,46 @@ def _flat(ind: FlatIndenter) -> bd.Solid:
     return _add_stem(plate, ind, y0 + ind.thickness, "flat indenter", p)
 
 
-def _curved(ind: CurvedIndenter) -> bd.Solid:
-    w, L, y0, R = ind.width, ind.length, ind.y0, ind.radius
+def cylinder_indenter(ind: CylinderIndenter) -> bd.Solid:
+    """The cylinder's lowest strip (chord `ind.chord` across the axis) under a flat back;
+    built along z and turned about y for an axis along x."""
+    along = ind.length if ind.axis == "z" else ind.width
+    w, L, y0, R = ind.chord, along, ind.y0, ind.radius
     y_back = y0 + ind.sagitta + ind.back_thickness
-    p = dict(kind="curved", radius=R, chord_width=w, length=L, back_thickness=ind.back_thickness)
-    with occ_guard("building the curved indenter", **p):
+    p = dict(kind=ind.kind, radius=R, chord_width=w, length=L, back_thickness=ind.back_thickness, axis=ind.axis)
+    with occ_guard(f"building the {ind.kind} indenter", **p):
         block = box(-w / 2, w / 2, y0, y_back, -L / 2, L / 2)
         # the block top (y0 + sagitta + back) stays below the axis only if back < R - sagitta;
         # then block ∩ cylinder is exactly the arc face under a flat back
         if y_back >= y0 + R:
-            raise CadError(f"curved indenter: back_thickness={ind.back_thickness:g} reaches the cylinder "
+            raise CadError(f"{ind.kind} indenter: back_thickness={ind.back_thickness:g} reaches the cylinder "
                            f"axis; valid: < radius - sagitta = {R - ind.sagitta:g} mm")
         cyl = bd.Solid.make_cylinder(R, L, plane=bd.Plane((0.0, y0 + R, -L / 2), x_dir=(1, 0, 0), z_dir=(0, 0, 1)))
         body = _single(block.intersect(cyl)).clean()
-    body = check_solid(body, "curved indenter body", **p)
-    return _add_stem(body, ind, y_back, "curved indenter", p)
+        if ind.axis == "x":
+            body = body.rotate(bd.Axis.Y, 90)
+    body = check_solid(body, f"{ind.kind} indenter body", **p)
+    return _add_stem(body, ind, y_back, f"{ind.kind} indenter", p)
 
 
-def _braille(ind: BrailleIndenter) -> bd.Solid:
+def sphere_indenter(ind: SphereIndenter) -> bd.Solid:
+    """The ball fused into a plate whose underside is 0.05 R below the ball's equator: the
+    working face is the spherical cap of height 0.95 R (the model's ball, for any depth
+    below that), and the sphere's poles (axis along z, on the equator) lie inside the plate,
+    where OCC's degenerate pole facets cannot break the STL (as for the Braille dots)."""
+    R, y0 = ind.radius, ind.y0
+    yc, yb = y0 + R, y0 + 0.95 * R
+    half, y_back = 1.2 * R, y0 + 2.2 * R
+    p = dict(kind="sphere", radius=R)
+    with occ_guard("building the sphere indenter", **p):
+        plate = box(-half, half, yb, y_back, -half, half)
+        ball = bd.Solid.make_sphere(R, plane=bd.Plane((0.0, yc, 0.0), x_dir=(1, 0, 0), z_dir=(0, 0, 1)))
+        body = plate.fuse(ball).clean()
+    body = check_solid(body, "sphere indenter body", **p)
+    return _add_stem(body, ind, y_back, "sphere indenter", p)
+
+
+def braille_indenter(ind: BrailleIndenter) -> bd.Solid:
     std = ind.standard
     w, L = ind.width, ind.length
     R, yb = std.sphere_radius, ind.base_plane(0.0)

@@ -74,46 +74,27 @@ class SizePlan:
 
 
 def contact_halfwidth(scene, section) -> float:
-    """Half-width (x, mm) of the skin that may touch the indenter at full depth, with margin.
+    """Half-width (x, mm) of the skin that may touch the indenter at full depth, with margin:
+    the indenter kind's answer (`Indenter.contact_halfwidth`; plates and cylinders: the
+    Hertz-like estimate 1.5 sqrt(2 R d), R the contour's radius at the top, a^2/b), clipped
+    to the skin."""
+    from tactileskin.geometry.indenters import indenter_for_scene
 
-    Hertz-like estimate sqrt(2 R d) with R the contour's radius at the top (a^2/b) and a
-    factor 1.5 for the skin's own deformation; it bounds the convex (curved) indenter from
-    above too. Braille: the dot row's extent plus a dot radius, and the flat estimate for
-    the base plate if the depth exceeds the dot height.
-    """
     ft = section.fingertip
-    d = scene.indentation
     r_top = ft.half_width ** 2 / ft.height
-
-    def flat(depth):
-        return 1.5 * math.sqrt(2.0 * r_top * max(depth, 0.0))
-
-    kind = scene.indenter.value
-    if kind in ("flat", "curved"):
-        w = flat(d)
-    else:
-        from tactileskin.geometry import braille
-
-        std = braille.get_standard(scene.braille_standard)
-        xz = braille.dot_centres(scene.braille_text, std)
-        row = xz[np.argmin(np.abs(xz[:, 1])), 1]
-        xs = xz[np.abs(xz[:, 1] - row) < 1e-9, 0]
-        w = float(np.max(np.abs(xs))) + 2.0 * std.base_radius
-        w = max(w, flat(d - std.height))
+    w = indenter_for_scene(scene, warn=False).contact_halfwidth(scene.indentation, r_top)
     return min(w, ft.half_width)
 
 
 def contact_zrange(scene, length: float, z_symmetric: bool) -> tuple[float, float]:
-    """z range of the contact zone in the 3D slab."""
-    z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
-    if scene.indenter.value != "braille":
-        return z0, z1  # plate and cylinder touch along the whole slab
-    from tactileskin.geometry import braille
+    """z range of the contact zone in the 3D slab (the indenter kind's `contact_zrange`)."""
+    from tactileskin.geometry.indenters import indenter_for_scene
 
-    std = braille.get_standard(scene.braille_standard)
-    _, _, zmin, zmax = braille.footprint(scene.braille_text, std)
-    m = std.base_radius
-    return max(z0, zmin - m), min(z1, zmax + m)
+    z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
+    zr = indenter_for_scene(scene, warn=False).contact_zrange(scene.indentation)
+    if zr is None:
+        return z0, z1  # e.g. plate and cylinder along z touch along the whole slab
+    return max(z0, zr[0]), min(z1, zr[1])
 
 
 def _arc_length_to_x(ft, x_end: float) -> float:

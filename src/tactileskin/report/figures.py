@@ -50,7 +50,10 @@ def _series(indenter: str, text: str, variant: str) -> str:
 
 
 def _ind_name(r) -> str:
-    return _series(r.scene.indenter.value, r.scene.braille_text, getattr(r, "variant", ""))
+    label, text = r.scene.indenter_label(), r.scene.braille_text
+    if text and label.endswith(f"[{text}]"):
+        label = label[: -len(text) - 2]  # the text is named separately
+    return _series(label, text, getattr(r, "variant", ""))
 
 
 def _order(indenter: str) -> int:

@@ -79,7 +79,7 @@ def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False,
         if ((sc.braille_text and not with_text) or (paper_only and not at_paper_conditions(sc))
                 or id(rec) in suspect or _other_dim(sc.indenter.value, sc.dim, braille_dim)):
             continue
-        name = sc.indenter.value + (f"[{sc.braille_text}]" if sc.braille_text else "")
+        name = sc.indenter_label()
         variant = "" if paper_only else getattr(rec, "variant", "")
         groups[(sc.material, sc.thickness, variant)].setdefault(name, (rec.s, rec.pressure))
     return sorted(groups.items())

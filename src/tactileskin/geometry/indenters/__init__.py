@@ -1,0 +1,122 @@
+"""Rigid indenters: each kind an object that answers for itself (pure numpy).
+
+The contract is `base.Indenter` (gap function, symmetry, 2D model, contact extent, label,
+printable solid); the kinds live one per module here and register themselves in
+`registry` (flat, curved, braille: the paper's; cylinder, sphere, file). The dimensions of
+the paper's kinds come from data/geometry/indenters.toml and braille.toml, the same numbers
+the CAD solids are built from. See docs/architecture.md, "geometry.indenters".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tactileskin import params
+from tactileskin.errors import ParameterError, check_range
+from tactileskin.geometry.indenters import registry
+from tactileskin.geometry.indenters.base import KIND_FIELDS, Indenter, hertz_halfwidth  # noqa: F401
+from tactileskin.geometry.indenters.registry import get as get_kind  # noqa: F401
+
+registry._load()
+from tactileskin.geometry.indenters.braille import BrailleIndenter  # noqa: E402,F401
+from tactileskin.geometry.indenters.cylinder import CurvedIndenter, CylinderIndenter  # noqa: E402,F401
+from tactileskin.geometry.indenters.file import FileIndenter  # noqa: E402,F401
+from tactileskin.geometry.indenters.flat import FlatIndenter  # noqa: E402,F401
+from tactileskin.geometry.indenters.sphere import SphereIndenter  # noqa: E402,F401
+
+KINDS = registry.names()
+PAPER_KINDS = tuple(k for k in KINDS if get_kind(k).paper)
+
+
+def _sample_length() -> float:
+    return float(params.load("fingertip")["sample"]["length"])
+
+
+def scene_kind_params(scene) -> dict:
+    """The Scene fields the scene's indenter kind reads, by name."""
+    return {f: getattr(scene, f) for f in get_kind(scene.indenter).scene_params}
+
+
+def make_indenter(kind, *, y0: float | None = None, dim: int = 2, row: int | None = None,
+                  sample_length: float | None = None, warn: bool = True, **kind_params) -> Indenter:
+    """Build the indenter of `kind` (a registered name) with lowest point y0.
+
+    `kind` may also be a Scene, in which case everything comes from the scene (see
+    `indenter_for_scene`). `kind_params` are the kind's Scene fields (braille_text,
+    braille_standard, indenter_radius, indenter_axis, indenter_file). `row` picks the dot row
+    of the 2D Braille section (default the row nearest z = 0). `sample_length` (default
+    fingertip.toml [sample] length) is the z extent of the face plates. warn=False keeps a
+    kind's warnings (an asymmetric Braille section) for the solve that uses it.
+    """
+    if hasattr(kind, "indenter") and hasattr(kind, "section"):
+        return indenter_for_scene(kind, row=row, warn=warn)
+    cls = get_kind(kind)
+    if y0 is None:
+        raise ParameterError("y0", None, "a finite number (mm): the skin top on x = 0")
+    y0 = check_range("y0", y0, -1e6, 1e6, unit="mm")
+    if dim not in (2, 3):
+        raise ParameterError("dim", dim, "2 or 3")
+    length = _sample_length() if sample_length is None else check_range(
+        "sample_length", sample_length, 0.0, None, lo_open=True, unit="mm")
+    return cls.from_params(y0=y0, dim=dim, length=length, row=row, warn=warn, **kind_params)
+
+
+def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> Indenter:
+    """The scene's indenter; its lowest point initially touches the skin top on x = 0."""
+    return make_indenter(scene.indenter, y0=scene.section().top, dim=scene.dim, row=row,
+                         sample_length=scene.fingertip_model().sample_length, warn=warn,
+                         **scene_kind_params(scene))
+
+
+def indenter_symmetry(scene) -> tuple[bool, bool]:
+    """(about x = 0, about z = 0): mirror symmetry of the scene's indenter (the kind's
+    answer). The one symmetry test of the 3D mesher and the planner."""
+    return indenter_for_scene(scene, warn=False).symmetry()
+
+
+def first_contact_travel(scene, samples: int = 4000) -> float:
+    """Travel (mm) after which the scene's indenter first touches the skin, as the model
+    sees it: the smallest gap at the start over the outer contour x >= 0 (the half model),
+    sampled every ~0.01 mm, in 3D on the kind's contact planes (`contact_planes`: the
+    Braille dot rows; the slab is uniform along z, so a dot's gap is smallest in its own
+    row's plane). 0 for plates, cylinders and spheres (they touch at x = 0 at the start); a
+    Braille text without a dot near the centre touches later, or only with its base plate."""
+    ind = indenter_for_scene(scene, warn=False)
+    sec = scene.section()
+    pts = sec.fingertip.outer(np.linspace(0.0, sec.u_outer_end, samples))
+    if scene.dim == 3:
+        pts = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in ind.contact_planes()])
+    g, _ = ind.gap(pts, 0.0)
+    return max(0.0, float(np.min(g)))
+
+
+def require_contact(scene) -> None:
+    """Raise ParameterError if the scene's indenter cannot touch the skin within its depth
+    (a solve would return zero pressure everywhere: no contact)."""
+    travel = first_contact_travel(scene)
+    depth = scene.indentation
+    if depth > travel + 1e-9:
+        return
+    label = get_kind(scene.indenter).label(scene)
+    why = f"the {label} indenter first touches the skin after {travel:.3g} mm of travel"
+    ind = indenter_for_scene(scene, warn=False)
+    if isinstance(ind, BrailleIndenter):
+        x = ind.section_x if scene.dim == 2 else ind.dots[:, 0]
+        seen = x[x >= -1e-9]  # the half model (x >= 0)
+        why += f": the pattern of {scene.braille_text!r} is centred on x = 0"
+        if seen.size:
+            why += (f"; its nearest modelled dot is at x = {seen.min():.3g} mm, where the fingertip has "
+                    f"curved away{'' if scene.dim == 3 else ' (a 3D model has the same contour)'}")
+        symmetric = ind.section_symmetric if scene.dim == 2 else ind.symmetry()[0]
+        if not symmetric:
+            why += "; the half model (x >= 0) does not see the dots at x < 0"
+    dmax = 0.6 * scene.thickness
+    if travel < dmax:
+        raise ParameterError("depth", depth, f"> {travel:.3g} mm for this indenter, at most {dmax:g} mm",
+                             f"no contact: {why}; use a larger --depth or a text with a dot on the centre line")
+    # the kind's own parameters place it: name the first (the text, the file), else the kind
+    field_ = next(iter(get_kind(scene.indenter).scene_params), "indenter")
+    value = getattr(scene, field_) if field_ != "indenter" else scene.indenter.value
+    raise ParameterError(field_, value, "an indenter that reaches the skin within the depth",
+                         f"no contact: {why}; use a text with a dot on the centre line"
+                         if isinstance(ind, BrailleIndenter) else f"no contact: {why}")

@@ -1,0 +1,224 @@
+"""file: a user's rigid indenter from a closed triangle surface (STL, OBJ, PLY, OFF) or a
+STEP solid (tessellated through build123d at 0.005 mm), in millimetres, working face
+towards -y.
+
+Placement: the surface is translated along y so that its lowest point starts at y0 (touching
+the skin top); x and z are used as given (x = 0 is the skin's symmetry plane, z = 0 its
+mid-plane), so an off-centre press is modelled where the file puts it. 3D only.
+
+Gap: the distance to the nearest triangle, exact: a k-d tree of the vertices bounds it from
+above (nearest vertex), a k-d tree of the triangle centroids gives every triangle that can
+be that near (centroid within the bound plus the largest centroid-to-vertex radius), and
+`trimesh.triangles.closest_point` gives the closest point on each candidate. The sign is that
+of (p - c) . n_t on the nearest triangle (of tied ones at a shared edge or vertex, the one
+with the largest |(p - c) . n_t|, which is right for any edge and for the convex and concave
+vertices a smooth-ish indenter has); the normal is sign (p - c) / |p - c|, the gradient of g.
+
+This is the one indenter file that uses trimesh (imported lazily: loading and closest points
+on triangles); tests/test_import_rules.py checks that no other indenter module names it and
+that importing the package does not load it. rtree is not needed.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import itertools
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from tactileskin.errors import CadError, ParameterError
+from tactileskin.geometry.indenters.base import Indenter, hertz_halfwidth, stem_params
+from tactileskin.geometry.indenters.registry import register
+
+log = logging.getLogger(__name__)
+
+MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off")
+STEP_SUFFIXES = (".step", ".stp")
+SIZE_RANGE = (0.1, 1000.0)  # mm: largest bounding-box extent of a plausible indenter
+STEP_TOLERANCE = 0.005      # mm, as geometry/export.py meshes the project's own solids
+_PAIR_CHUNK = 200_000       # (point, triangle) pairs per closest-point batch (memory)
+_VALID = "a closed triangle surface in mm (" + ", ".join(MESH_SUFFIXES + STEP_SUFFIXES) + ")"
+
+
+def file_digest(path) -> str:
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as e:
+        raise ParameterError("indenter_file", str(path), _VALID, f"cannot read it: {e.strerror or e}") from None
+
+
+def _read(path: Path):
+    """(vertices, faces) of the file, merged, oriented outwards."""
+    import trimesh
+
+    suffix = path.suffix.lower()
+    try:
+        if suffix in STEP_SUFFIXES:
+            import build123d as bd
+
+            shape = bd.import_step(str(path))
+            verts, tris = shape.tessellate(STEP_TOLERANCE, 0.1)
+            mesh = trimesh.Trimesh(np.array([tuple(v) for v in verts], float), np.asarray(tris, int))
+        else:
+            mesh = trimesh.load_mesh(str(path), file_type=suffix[1:], process=True)
+    except Exception as e:  # the readers raise many types on a damaged file
+        raise ParameterError("indenter_file", str(path), _VALID,
+                             f"cannot read it: {type(e).__name__}: {e}") from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ParameterError("indenter_file", str(path), _VALID, "it holds no triangles")
+    mesh.merge_vertices()
+    if not mesh.is_watertight:
+        edges = trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)
+        raise ParameterError("indenter_file", str(path), "a closed (watertight) triangle surface",
+                             f"{len(edges)} edges belong to one triangle only (holes or gaps); close it "
+                             "in the CAD tool or with trimesh.repair.fill_holes")
+    extent = float(np.max(mesh.extents))
+    lo, hi = SIZE_RANGE
+    if not lo <= extent <= hi:
+        guess = "metres (scale by 1000)" if extent < lo else "micrometres (scale by 0.001)"
+        raise ParameterError("indenter_file", str(path), f"a solid in mm, largest extent {lo:g} mm to {hi:g} mm",
+                             f"its largest extent is {extent:g}: the file looks like it is in {guess}")
+    if mesh.volume < 0:
+        mesh.invert()  # faces wound inwards: the normals must point out of the solid
+    return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, int)
+
+
+@functools.lru_cache(maxsize=8)
+def _load(path: str, digest: str):
+    """Cached by content: the same bytes load once per process."""
+    return _read(Path(path))
+
+
+def load_surface(path) -> tuple[np.ndarray, np.ndarray]:
+    p = Path(path)
+    if p.suffix.lower() not in MESH_SUFFIXES + STEP_SUFFIXES:
+        raise ParameterError("indenter_file", str(path), _VALID, f"unsupported suffix {p.suffix!r}")
+    if not p.is_file():
+        raise ParameterError("indenter_file", str(path), _VALID, "no such file")
+    return _load(str(p.resolve()), file_digest(p))
+
+
+@register
+@dataclass(frozen=True, eq=False)
+class FileIndenter(Indenter):
+    file: str = ""
+    vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # placed (lowest y = y0)
+    faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), int))
+
+    name = "file"
+    order = 20
+    scene_params = ("indenter_file",)
+    section_2d = None
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        if not scene.indenter_file:
+            raise ParameterError("indenter_file", scene.indenter_file, _VALID, "the file is required")
+        super().check_scene(scene)
+        load_surface(scene.indenter_file)
+        return {}
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return f"file-{Path(scene.indenter_file).stem}"
+
+    @classmethod
+    def cache_content(cls, scene) -> dict:
+        return {"indenter_file": file_digest(scene.indenter_file)}
+
+    @classmethod
+    def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_file=None, **_):
+        if not indenter_file:
+            raise ParameterError("indenter_file", indenter_file, _VALID, "the file is required")
+        v, f = load_surface(indenter_file)
+        v = v + np.array([0.0, y0 - v[:, 1].min(), 0.0])
+        ext = v.max(axis=0) - v.min(axis=0)
+        return cls(kind=cls.name, y0=y0, dim=dim, width=float(ext[0]), length=float(ext[2]),
+                   file=str(indenter_file), vertices=v, faces=f, **stem_params())
+
+    # -- geometry ----------------------------------------------------------------------------
+    @functools.cached_property
+    def _trees(self):
+        tri = self.vertices[self.faces]                       # (T, 3, 3)
+        cen = tri.mean(axis=1)
+        rmax = float(np.max(np.linalg.norm(tri - cen[:, None, :], axis=2)))
+        nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
+        return cKDTree(self.vertices), cKDTree(cen), rmax, tri, nrm
+
+    def _gap(self, p, d):
+        from trimesh.triangles import closest_point
+
+        if p.shape[1] == 2:  # the section z = 0
+            p = np.column_stack([p, np.zeros(len(p))])
+            g, n = self._gap(p, d)
+            return g, n[:, :2]
+        q = p + np.array([0.0, d, 0.0])                        # the indenter moved by -d
+        vtree, ctree, rmax, tri, nrm = self._trees
+        bound, _ = vtree.query(q)
+        cand = ctree.query_ball_point(q, bound * (1 + 1e-12) + rmax + 1e-12)
+        counts = np.fromiter(map(len, cand), int, len(q))
+        pi = np.repeat(np.arange(len(q)), counts)
+        ti = np.fromiter(itertools.chain.from_iterable(cand), int, int(counts.sum()))
+        c = np.empty((len(pi), 3))
+        for s in range(0, len(pi), _PAIR_CHUNK):
+            c[s:s + _PAIR_CHUNK] = closest_point(tri[ti[s:s + _PAIR_CHUNK]], q[pi[s:s + _PAIR_CHUNK]])
+        v = q[pi] - c
+        dist = np.linalg.norm(v, axis=1)
+        dot = np.einsum("ij,ij->i", v, nrm[ti])
+        dmin = np.full(len(q), np.inf)
+        np.minimum.at(dmin, pi, dist)
+        tol = 1e-9 * max(1.0, float(np.max(np.abs(self.vertices))))
+        score = np.where(dist <= dmin[pi] + tol, np.abs(dot), -1.0)
+        order = np.lexsort((-score, pi))
+        best = order[np.concatenate([[0], np.flatnonzero(np.diff(pi[order])) + 1])]
+        sign = np.where(dot[best] < 0.0, -1.0, 1.0)
+        db = dist[best]
+        tiny = db <= tol
+        n = sign[:, None] * v[best] / np.where(tiny, 1.0, db)[:, None]
+        n[tiny] = nrm[ti[best]][tiny]  # on the surface: the face normal
+        return sign * db, n
+
+    def _surface_y(self, x, z, d):
+        raise ParameterError("surface_y", self.file, "an analytic indenter", "a file indenter has no height map")
+
+    def symmetry(self) -> tuple[bool, bool]:
+        """A plane is a mirror plane if every mirrored vertex lies on the surface (within
+        1e-5 of the size: STL stores 32-bit floats, ~1e-7 relative)."""
+        tol = 1e-5 * float(np.max(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+        out = []
+        for ax in (0, 2):
+            m = self.vertices.copy()
+            m[:, ax] *= -1.0
+            g, _ = self._gap(m, 0.0)
+            out.append(bool(np.max(np.abs(g)) <= tol))
+        return out[0], out[1]
+
+    def _band(self, depth: float) -> np.ndarray:
+        """Vertices of the triangles that reach below y0 + depth (the part that can touch)."""
+        low = self.vertices[self.faces][:, :, 1].min(axis=1) <= self.y0 + max(depth, 0.0)
+        return self.vertices[np.unique(self.faces[low])]
+
+    def contact_halfwidth(self, depth, r_top):
+        b = self._band(depth)
+        return max(1.5 * float(np.max(np.abs(b[:, 0]))), hertz_halfwidth(r_top, 0.25 * depth))
+
+    def contact_zrange(self, depth):
+        b = self._band(depth)
+        lo, hi = float(b[:, 2].min()), float(b[:, 2].max())
+        mid, half = 0.5 * (lo + hi), 0.75 * (hi - lo) + hertz_halfwidth(1.0, depth)
+        return mid - half, mid + half
+
+    def contact_planes(self) -> np.ndarray:
+        return np.array([float(self.vertices[np.argmin(self.vertices[:, 1]), 2])])
+
+    def describe(self) -> str:
+        return f"indenter from {Path(self.file).name}"
+
+    def solid(self):
+        raise CadError(f"the file indenter's printable solid is the user's file itself ({self.file})")

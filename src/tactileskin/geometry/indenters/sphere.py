@@ -1,0 +1,78 @@
+"""sphere: a rigid ball of radius R whose lowest point starts at (0, y0, 0).
+
+Not uniform along the finger, so 3D only: its plane-strain section would be a cylinder
+(use the cylinder kind with axis z for that model, and say so)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.indenters.base import Indenter, check_radius, hertz_halfwidth, stem_params
+from tactileskin.geometry.indenters.registry import register
+
+
+@register
+@dataclass(frozen=True, eq=False)
+class SphereIndenter(Indenter):
+    radius: float = 2.5
+
+    name = "sphere"
+    order = 11
+    scene_params = ("indenter_radius",)
+    section_2d = None
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        radius = check_radius(scene.indenter_radius, cls.name)
+        if scene.dim == 2:
+            raise ParameterError("dim", 2, "3 for the sphere indenter",
+                                 "a sphere is not uniform along the finger; its plane-strain section "
+                                 "is a cylinder: use indenter = 'cylinder' (indenter_axis = 'z') for "
+                                 "that 2D model")
+        return {"indenter_radius": radius}
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return f"sphere-R{scene.indenter_radius:g}"
+
+    @classmethod
+    def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None, **_):
+        R = check_radius(indenter_radius, cls.name)
+        stem = stem_params()
+        stem["stem_diameter"] = min(stem["stem_diameter"], 1.6 * R)  # the stem fits the ball
+        return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem)
+
+    def centre(self, d: float = 0.0) -> np.ndarray:
+        return np.array([0.0, self.y0 + self.radius - d, 0.0])
+
+    def _gap(self, p, d):
+        c = self.centre(d)[: p.shape[1]]  # 2D points: the section z = 0 through the centre
+        v = p - c
+        dist = np.sqrt(np.einsum("ij,ij->i", v, v))
+        at_centre = dist == 0.0
+        n = v / np.where(at_centre, 1.0, dist)[:, None]
+        n[at_centre] = 0.0
+        n[at_centre, 1] = -1.0  # at the centre any direction is a normal; take -y
+        return dist - self.radius, n
+
+    def _surface_y(self, x, z, d):
+        rho2 = x * x + (0.0 if z is None else z * z)
+        return self.centre(d)[1] - np.sqrt(np.maximum(self.radius ** 2 - rho2, 0.0))
+
+    def contact_zrange(self, depth):
+        a = hertz_halfwidth(self.radius, depth)  # the skin is straight along z
+        return -a, a
+
+    def solid(self):
+        from tactileskin.geometry import solids
+
+        return solids.sphere_indenter(self)
+
+    def describe(self) -> str:
+        return f"sphere indenter, R = {self.radius:g} mm"
+
+    def part_parameters(self) -> dict:
+        return {"radius": self.radius}

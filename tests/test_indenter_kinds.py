@@ -1,0 +1,222 @@
+"""Indenter kinds as objects: gap functions against closed forms, the STL kind against the
+analytic sphere, symmetry flags, the registry, Scene validation and cache keys."""
+
+import numpy as np
+import pytest
+
+from tactileskin.cache import cache_key
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.indenters import KINDS, get_kind, indenter_for_scene, indenter_symmetry, make_indenter
+from tactileskin.scene import Scene
+
+Y0 = 7.0
+RNG = np.random.default_rng(3)
+
+
+def _points(n=400, spread=4.0):
+    return RNG.normal(size=(n, 3)) * spread + np.array([0.0, Y0 + 1.0, 0.0])
+
+
+def _fd_gradient(ind, p, d, h=1e-6):
+    """Central differences of g: the normal must be its gradient (exact up to O(h^2) and
+    round-off ~1e-16/h = 1e-10; 1e-6 tolerance leaves room for points near a kink)."""
+    grad = np.zeros_like(p)
+    for k in range(p.shape[1]):
+        e = np.zeros(p.shape[1])
+        e[k] = h
+        grad[:, k] = (ind.gap(p + e, d)[0] - ind.gap(p - e, d)[0]) / (2 * h)
+    return grad
+
+
+def test_sphere_gap_closed_form_sign_and_normal():
+    R, d = 2.5, 0.3
+    ind = make_indenter("sphere", y0=Y0, dim=3, indenter_radius=R)
+    p = _points()
+    c = np.array([0.0, Y0 + R - d, 0.0])
+    g, n = ind.gap(p, d)
+    np.testing.assert_allclose(g, np.linalg.norm(p - c, axis=1) - R, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(n, _fd_gradient(ind, p, d), atol=1e-6)
+    # the lowest point is at y0 - d; just below it separated, just above penetrating
+    g2, n2 = ind.gap(np.array([[0.0, Y0 - d - 0.1, 0.0], [0.0, Y0 - d + 0.1, 0.0]]), d)
+    np.testing.assert_allclose(g2, [0.1, -0.1], atol=1e-12)
+    np.testing.assert_allclose(n2, [[0, -1, 0], [0, -1, 0]], atol=1e-12)
+
+
+@pytest.mark.parametrize("axis", ["z", "x"])
+def test_cylinder_gap_closed_form(axis):
+    R, d = 4.0, 0.2
+    ind = make_indenter("cylinder", y0=Y0, dim=3, indenter_radius=R, indenter_axis=axis)
+    p = _points()
+    across = 0 if axis == "z" else 2
+    g, n = ind.gap(p, d)
+    dist = np.hypot(p[:, across], p[:, 1] - (Y0 + R - d))
+    np.testing.assert_allclose(g, dist - R, atol=1e-12)
+    np.testing.assert_allclose(n[:, 2 - across], 0.0, atol=1e-15)  # no component along the axis
+    np.testing.assert_allclose(n, _fd_gradient(ind, p, d), atol=1e-6)
+
+
+def test_cylinder_along_z_is_the_papers_curved_indenter():
+    curved = make_indenter("curved", y0=Y0, dim=2)
+    cyl = make_indenter("cylinder", y0=Y0, dim=2, indenter_radius=12.0, indenter_axis="z")
+    p = _points()[:, :2]
+    for a, b in zip(curved.gap(p, 0.4), cyl.gap(p, 0.4)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_sphere_section_in_2d_is_the_plane_z0():
+    ind = make_indenter("sphere", y0=Y0, dim=3, indenter_radius=2.0)
+    p3 = _points()
+    p3[:, 2] = 0.0
+    g3, n3 = ind.gap(p3, 0.1)
+    g2, n2 = ind.gap(p3[:, :2], 0.1)
+    np.testing.assert_allclose(g2, g3, atol=1e-14)
+    np.testing.assert_allclose(n2, n3[:, :2], atol=1e-14)
+
+
+def test_stl_sphere_matches_the_analytic_sphere_within_tessellation(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    R = 2.5
+    mesh = trimesh.creation.icosphere(subdivisions=4, radius=R)
+    f = tmp_path / "ball.stl"
+    mesh.export(f)
+    stl = make_indenter("file", y0=Y0, dim=3, indenter_file=str(f))
+    ana = make_indenter("sphere", y0=Y0, dim=3, indenter_radius=R)
+    # the icosphere's vertices are on the sphere; its flat faces lie inside it by at most the
+    # sagitta of a face, R (1 - cos(theta)) with theta the largest vertex-to-centroid angle
+    tri = mesh.vertices[mesh.faces]
+    cen = tri.mean(axis=1)
+    cos = np.einsum("ijk,ik->ij", tri, cen) / (R * np.linalg.norm(cen, axis=1))[:, None]
+    sag = R * (1 - cos.min())
+    # stl's lowest vertex sits at y0; the analytic sphere's lowest point too, so their centres
+    # differ by R - (lowest vertex depth), at most sag: allow 2 sag
+    p = _points(600, 3.0)
+    g_s, n_s = stl.gap(p, 0.2)
+    g_a, n_a = ana.gap(p, 0.2)
+    assert sag < 0.01
+    np.testing.assert_allclose(g_s, g_a, atol=2 * sag)
+    assert np.all(np.sign(g_s) == np.sign(g_a)) or np.all(np.abs(g_a[np.sign(g_s) != np.sign(g_a)]) < 2 * sag)
+    far = np.abs(g_a) > 0.2  # away from the surface the normals agree to ~ the facet angle
+    assert np.max(np.linalg.norm(n_s[far] - n_a[far], axis=1)) < 0.1
+    np.testing.assert_allclose(np.linalg.norm(n_s, axis=1), 1.0, atol=1e-12)
+    np.testing.assert_allclose(n_s[far], _fd_gradient(stl, p[far], 0.2), atol=1e-5)
+    assert stl.symmetry() == (True, True)
+
+
+def test_stl_errors_name_the_file_and_what_is_wrong(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    box = trimesh.creation.box(extents=(2.0, 2.0, 2.0))
+    open_box = trimesh.Trimesh(box.vertices, box.faces[:-1])
+    f = tmp_path / "open.stl"
+    open_box.export(f)
+    with pytest.raises(ParameterError, match="indenter_file.*watertight"):
+        make_indenter("file", y0=Y0, dim=3, indenter_file=str(f))
+    m = tmp_path / "metres.stl"
+    trimesh.creation.box(extents=(0.002, 0.002, 0.002)).export(m)
+    with pytest.raises(ParameterError, match="metres"):
+        Scene(dim=3, indenter="file", indenter_file=str(m))
+    with pytest.raises(ParameterError, match="indenter_file"):
+        Scene(dim=3, indenter="file", indenter_file=str(tmp_path / "missing.stl"))
+
+
+def test_symmetry_flags():
+    assert indenter_symmetry(Scene(indenter="flat")) == (True, True)
+    assert indenter_symmetry(Scene(dim=3, indenter="sphere", indenter_radius=2.0)) == (True, True)
+    assert indenter_symmetry(Scene(dim=3, indenter="cylinder", indenter_radius=3.0, indenter_axis="x")) == (True, True)
+    # the layout is centred on its dots: one dot is symmetric; 'd' (dots 1, 4, 5) is not
+    assert indenter_symmetry(Scene(dim=3, indenter="braille", braille_text="a")) == (True, True)
+    assert indenter_symmetry(Scene(dim=3, indenter="braille", braille_text="d")) == (False, False)
+
+
+def test_stl_symmetry_detects_an_off_centre_file(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    ball = trimesh.creation.icosphere(subdivisions=2, radius=2.0)
+    ball.apply_translation((0.7, 0.0, 0.0))
+    f = tmp_path / "off.stl"
+    ball.export(f)
+    assert make_indenter("file", y0=Y0, dim=3, indenter_file=str(f)).symmetry() == (False, True)
+
+
+def test_registry_lists_valid_kinds_on_unknown_name():
+    assert KINDS[:3] == ("flat", "curved", "braille")
+    assert {"sphere", "cylinder", "file"} <= set(KINDS)
+    with pytest.raises(ParameterError, match="one of flat, curved, braille, cylinder, sphere, file"):
+        get_kind("cone")
+    with pytest.raises(ParameterError, match="one of flat, curved, braille"):
+        Scene(indenter="cone")
+
+
+def test_scene_validates_kind_parameters():
+    with pytest.raises(ParameterError, match=r"indenter_radius.*\(0.1, 1000\] mm"):
+        Scene(dim=3, indenter="sphere")
+    with pytest.raises(ParameterError, match=r"indenter_radius=-1.*\(0.1, 1000\] mm"):
+        Scene(dim=3, indenter="sphere", indenter_radius=-1)
+    with pytest.raises(ParameterError, match="indenter_axis"):
+        Scene(indenter="cylinder", indenter_radius=3.0, indenter_axis="y")
+    with pytest.raises(ParameterError, match="indenter_radius.*only with indenter = cylinder or sphere"):
+        Scene(indenter="flat", indenter_radius=3.0)
+    # a sphere has no plane-strain model: 2D is refused, pointing at the cylinder section
+    with pytest.raises(ParameterError, match="dim=2.*cylinder"):
+        Scene(dim=2, indenter="sphere", indenter_radius=2.0)
+    with pytest.raises(ParameterError, match="dim=2"):
+        Scene(dim=2, indenter="cylinder", indenter_radius=2.0, indenter_axis="x")
+    # changing the kind drops the parameters the new kind does not read
+    s = Scene(dim=3, indenter="sphere", indenter_radius=2.0).replace(indenter="flat")
+    assert s.indenter_radius is None
+
+
+def test_cache_key_changes_with_kind_parameters_and_file_bytes(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    a = Scene(indenter="cylinder", indenter_radius=12.0)
+    assert cache_key(a) != cache_key(a.replace(indenter_radius=10.0))
+    s = Scene(dim=3, indenter="sphere", indenter_radius=2.0)
+    assert cache_key(s) != cache_key(s.replace(indenter_radius=2.5))
+    assert cache_key(a) != cache_key(Scene(indenter="curved"))  # different scenes, same answer
+    f = tmp_path / "ind.stl"
+    trimesh.creation.icosphere(subdivisions=2, radius=2.0).export(f)
+    sf = Scene(dim=3, indenter="file", indenter_file=str(f))
+    k1 = cache_key(sf)
+    g = tmp_path / "moved.stl"
+    g.write_bytes(f.read_bytes())
+    assert cache_key(sf.replace(indenter_file=str(g))) == k1  # the bytes count, not the path
+    trimesh.creation.icosphere(subdivisions=2, radius=2.1).export(f)
+    assert cache_key(sf) != k1
+
+
+def test_contact_extent_for_mesh_sizing():
+    from tactileskin.mesh import sizing
+
+    s = Scene(dim=3, thickness=2.0, indenter="sphere", indenter_radius=2.5)
+    z0, z1 = sizing.contact_zrange(s, 20.0, True)
+    a = 1.5 * np.sqrt(2 * 2.5 * s.indentation)  # Hertz-like half-length along the straight slab
+    assert (z0, z1) == (0.0, pytest.approx(a))
+    c = Scene(dim=3, thickness=2.0, indenter="curved")
+    assert sizing.contact_zrange(c, 20.0, True) == (0.0, 10.0)  # the whole slab
+    assert sizing.contact_halfwidth(c, c.section()) == sizing.contact_halfwidth(s, s.section())
+
+
+def test_cylinder_in_2d_answers_as_curved():
+    """A 2D solve with the cylinder kind (R 12, axis z) is the paper's curved solve: same
+    gap, same mesh sizing, so the same numbers (coarse mesh: a cross-check, not accuracy)."""
+    from tactileskin.fe import solve
+
+    kw = dict(thickness=1.0, mesh_size=1.0, refinement=2.0, viscoelastic=False)
+    a = solve(Scene(indenter="curved", **kw))
+    b = solve(Scene(indenter="cylinder", indenter_radius=12.0, **kw))
+    np.testing.assert_allclose(b.pressure, a.pressure, rtol=1e-10, atol=1e-12)
+    assert b.reaction == pytest.approx(a.reaction, rel=1e-10)
+
+
+def test_sphere_3d_coarse_solve():
+    """A coarse 3D sphere press: the pressure map peaks under the ball (z near 0) and the
+    reaction is positive; the section profile is the plane z = 0."""
+    from tactileskin.fe import solve
+
+    s = Scene(dim=3, thickness=1.0, indenter="sphere", indenter_radius=2.5, mesh_size=1.2, refinement=2,
+              viscoelastic=False)
+    r = solve(s)
+    assert r.reaction > 0
+    p_max, _, z_at = r.bone_map.peak()
+    assert p_max > 0
+    assert abs(z_at) < 1.5  # under the ball, within ~ the contact half-length 1.5 sqrt(2 R d) = 1.5 mm
+    assert indenter_for_scene(s).section_z == 0.0
