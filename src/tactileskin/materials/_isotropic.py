@@ -176,7 +176,7 @@ def assemble(kin: Kinematics, names, grad, hess, *, tangent=True):
     return S, 4.0 * D
 
 
-def isochoric_chain(I1, I2, J, w, w1, w2, w11, w12, w22):
+def isochoric_chain(I1, I2, J, w1, w2, w11, w12, w22):
     """Gradient (n, 3) and Hessian (n, 3, 3) over (I1, I2, J) of W(I1b, I2b) given its
     derivatives in I1b = J^(-2/3) I1, I2b = J^(-4/3) I2 (w2, w12, w22 may be 0)."""
     a1, a2 = J ** (-2.0 / 3.0), J ** (-4.0 / 3.0)
@@ -204,7 +204,7 @@ def volumetric(kappa, J):
     return 0.5 * kappa * (J - 1.0) ** 2, kappa * (J - 1.0), np.full_like(J, kappa)
 
 
-def finish(kin: Kinematics, S, D, out_of_lead=True):
+def finish(kin: Kinematics, S, D):
     """Reshape the flat (n, ...) outputs to the caller's leading shape."""
     lead = kin.lead
     S = S.reshape(lead + (3, 3))
@@ -283,7 +283,3 @@ def read_table(d, keys, what, *, optional=()):
     if missing:
         raise ParameterError(what, sorted(d), "keys " + ", ".join(keys), "missing " + ", ".join(missing))
     return d
-
-
-def params_from(x, n):
-    return np.asarray(x, dtype=float)[:n]

@@ -59,7 +59,7 @@ class MooneyRivlin(InvariantLaw):
     def _derivs(self, kin):
         I1, I2, J = kin.I1, kin.I2, kin.J
         z = np.zeros_like(J)
-        grad, hess, I1b, I2b = isochoric_chain(I1, I2, J, None, self.c10 + z, self.c01 + z, z, z, z)
+        grad, hess, I1b, I2b = isochoric_chain(I1, I2, J, self.c10 + z, self.c01 + z, z, z, z)
         U, dU, d2U = volumetric(self.kappa, J)
         W = self.c10 * (I1b - 3.0) + self.c01 * (I2b - 3.0) + U
         grad[:, 2] += dU

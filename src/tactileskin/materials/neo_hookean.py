@@ -56,7 +56,7 @@ class NeoHookean(InvariantLaw):
     def _derivs(self, kin):
         I1, J = kin.I1, kin.J
         z = np.zeros_like(J)
-        grad, hess, I1b, _ = isochoric_chain(I1, 0.0 * J, J, None, 0.5 * self.mu, z, z, z, z)
+        grad, hess, I1b, _ = isochoric_chain(I1, 0.0 * J, J, 0.5 * self.mu, z, z, z, z)
         U, dU, d2U = volumetric(self.kappa, J)
         W = 0.5 * self.mu * (I1b - 3.0) + U
         grad[:, 2] += dU

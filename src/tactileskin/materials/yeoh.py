@@ -67,7 +67,7 @@ class Yeoh(InvariantLaw):
             if i >= 2:
                 w11 = w11 + i * (i - 1) * ci * x ** (i - 2)
         z = np.zeros_like(J)
-        grad, hess, _, _ = isochoric_chain(I1, z, J, None, w1 + z, z, w11 + z, z, z)
+        grad, hess, _, _ = isochoric_chain(I1, z, J, w1 + z, z, w11 + z, z, z)
         U, dU, d2U = volumetric(self.kappa, J)
         grad[:, 2] += dU
         hess[:, 2, 2] += d2U
