@@ -4,7 +4,7 @@ Key. `Scene.key()` hashes the scene's own fields only (it names a scene, e.g. to
 duplicates from a grid). A cached result also depends on files and code the scene merely
 names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
 - the scene's fields except the material's name or path;
-- the material's numbers (hyperfoam and Prony terms), read from the preset table or the
+- the material's law name and numbers (its parameters and Prony terms), read from the preset table or the
   user's material file: editing the file changes the key, renaming or moving it does not;
 - the bytes of every geometry parameter file (`params.geometry_digest()`: fingertip,
   indenters, Braille standards, molds);
@@ -72,7 +72,9 @@ def material_content(material: str) -> dict:
     from tactileskin.materials import get_material
 
     m = get_material(material)
-    return {"hyperfoam": _floats(m.hyperfoam.to_dict()), "prony": _floats(m.prony.to_dict())}
+    # the law's name is the key of its numbers: a change of law or of any parameter changes
+    # the cache key (hyperfoam materials keep the key they always had)
+    return {m.law_name: _floats(m.law.to_dict()), "prony": _floats(m.prony.to_dict())}
 
 
 def cache_key(scene: Scene) -> str:

@@ -34,6 +34,7 @@ COMMANDS = {
     "sweep": "sweep",
     "film": "film",
     "array": "array",
+    "material": "material",
 }
 
 

@@ -45,25 +45,25 @@ __all__ = ["solve", "read_sensors", "model_for_scene", "material_law", "Model", 
            "SolverOptions", "IncrementInfo", "make_result", "reaction"]
 
 
-def material_law(hyperfoam):
-    """C -> (S, D, ok) for a Hyperfoam (tactileskin.materials).
+def material_law(law):
+    """C -> (S, D, ok) for a material law (any of tactileskin.materials.laws).
 
     A plane-strain C (C33 = 1, C13 = C23 = 0 exactly, as the 2D kinematics build it) takes
-    the closed-form 2x2 path (same values to rounding, ~3x cheaper than the 3x3 eigh);
+    the law's plane-strain path (hyperfoam: the compiled closed-form 2x2 loop, same values
+    to rounding, ~3x cheaper than the 3x3 eigh; other laws: their 3D law on the embedded C);
     D is still the full (..., 3, 3, 3, 3), so a 3D state that happens to be plane is
     served correctly too. law(C, tangent=False) skips D on the plane path and returns
-    (S, None, ok) (residual-only evaluations); the 3D path returns its D regardless.
+    (S, None, ok) (residual-only evaluations); the hyperfoam 3D path returns its D regardless.
     """
-    from tactileskin.materials.hyperfoam import pk2_tangent, pk2_tangent_plane
 
-    def law(C, tangent=True):
+    def evaluate(C, tangent=True):
         C = np.asarray(C, dtype=float)
         if (C.ndim >= 2 and C.shape[-2:] == (3, 3) and np.all(C[..., 2, 2] == 1.0)
                 and not np.any(C[..., 2, :2]) and not np.any(C[..., :2, 2])):
-            return pk2_tangent_plane(hyperfoam, C[..., :2, :2], out_of_plane=True, tangent=tangent)
-        return pk2_tangent(hyperfoam, C)
+            return law.pk2_tangent_plane(C[..., :2, :2], out_of_plane=True, tangent=tangent)
+        return law.pk2_tangent(C, tangent=tangent)
 
-    return law
+    return evaluate
 
 
 def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
@@ -76,7 +76,7 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
 
         mesh = build_mesh(scene)
     mat = get_material(scene.material)
-    hf = mat.hyperfoam
+    law = mat.law
     prony = mat.prony if scene.viscoelastic and mat.prony.n_terms else None
     m = scene.dim
     allc = tuple(range(m))
@@ -84,9 +84,9 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
     contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate)
-    model = Model(mesh.mesh, mesh.boundaries, material_law(hf), bcs, prony=prony,
+    model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
                   formulation=scene.formulation.value, contact=contact, order=scene.order,
-                  stiffness=max(hf.K0, hf.mu0))
+                  stiffness=max(law.K0, law.mu0))
     return model, mesh
 
 

@@ -163,11 +163,10 @@ class Model:
         # committed state
         E, Q = self.w.shape
         self.u = np.zeros(self.ndof)
-        self.S0_old = np.zeros((E, Q, 3, 3))
-        self.S0_prev = self.S0_old       # S0 one increment before S0_old (second-order QLV)
-        self.dt_prev = None
-        nterms = 0 if prony is None else len(prony.g)
-        self.H = np.zeros((nterms, E, Q, 3, 3))
+        # the viscoelastic state belongs to the material's Prony series (any law inside it)
+        from tactileskin.materials.prony import Prony
+
+        self.history = (Prony.elastic() if prony is None else prony).history((E, Q, 3, 3), qlv_order)
         self.t = 0.0
 
     # -- helpers ------------------------------------------------------------------------------
@@ -200,18 +199,8 @@ class Model:
 
     def qlv(self, dt: float):
         """(gamma, decay, gain, back) of the Prony update for a step dt from the committed
-        state; elastic: (1, [], [], []). Second order (materials.prony.Prony.
-        step_factors_quadratic) once a previous increment exists, else the linear update
-        (back = 0)."""
-        if self.prony is None:
-            return 1.0, np.zeros(0), np.zeros(0), np.zeros(0)
-        if self.qlv_order == 2 and self.dt_prev is not None and dt > 0.0:
-            decay, gain, back = self.prony.step_factors_quadratic(dt, self.dt_prev)
-        else:
-            decay, gain = self.prony.step_factors(dt)
-            back = np.zeros_like(np.atleast_1d(gain))
-        decay, gain, back = np.atleast_1d(decay), np.atleast_1d(gain), np.atleast_1d(back)
-        return float(self.prony.g_inf + gain.sum()), decay, gain, back
+        state (materials.prony.QLVHistory.factors); elastic: (1, [], [], [])."""
+        return self.history.factors(dt)
 
     # -- evaluation ---------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, t: float, dt: float, lam_k: np.ndarray | None = None,
@@ -234,12 +223,7 @@ class Model:
         S0, D0, ok = self._law(kin.C, tangent)
         if not np.all(ok) or not np.all(np.isfinite(S0)):
             return Evaluation(R=np.full(self.ndof, np.nan), ok=False, why="material state inadmissible")
-        gamma, decay, gain, back = self.qlv(dt)
-        S = gamma * S0
-        for i in range(len(decay)):
-            S = S + decay[i] * self.H[i] - gain[i] * self.S0_old
-            if back[i]:
-                S = S - back[i] * (self.S0_old - self.S0_prev)
+        S, gamma = self.history.stress(S0, dt)
         Sm = S[..., :m, :m]
         fint = assemble_vector(self.ndof, self.edofs, kernels.residual(kin, Sm))
         R = fint.copy()
@@ -290,14 +274,7 @@ class Model:
         return Kd
 
     def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
-        _, decay, gain, back = self.qlv(dt)
-        for i in range(len(decay)):
-            self.H[i] = decay[i] * self.H[i] + gain[i] * (ev.S0 - self.S0_old)
-            if back[i]:
-                self.H[i] -= back[i] * (self.S0_old - self.S0_prev)
-        self.S0_prev, self.S0_old = self.S0_old, ev.S0
-        if dt > 0.0:
-            self.dt_prev = dt
+        self.history.commit(ev.S0, dt)
         self.u = u.copy()
         self.t = t
         if self.surface is not None and ev.contact is not None:

@@ -45,6 +45,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -81,6 +82,8 @@ class Hyperfoam:
     mu: tuple[float, ...]
     alpha: tuple[float, ...]
     nu: float
+
+    law: ClassVar[str] = "hyperfoam"
 
     def __post_init__(self):
         mu = _as_float_tuple("mu", self.mu)
@@ -131,6 +134,46 @@ class Hyperfoam:
 
     def to_dict(self) -> dict:
         return {"mu": list(self.mu), "alpha": list(self.alpha), "nu": self.nu}
+
+    @classmethod
+    def from_dict(cls, d, what="hyperfoam") -> "Hyperfoam":
+        """From a TOML table {mu, alpha, nu} (keys and types checked, ranges by the class)."""
+        from tactileskin import validate
+
+        hf = validate.table(d, what)
+        validate.known_keys(hf, ("mu", "alpha", "nu"), what)
+        missing = [k for k in ("mu", "alpha", "nu") if k not in hf]
+        if missing:
+            raise ParameterError(what, sorted(hf), "keys mu, alpha, nu", "missing " + ", ".join(missing))
+        return cls(validate.number_list(hf["mu"], "mu", MAX_TERMS, min_len=1),
+                   validate.number_list(hf["alpha"], "alpha", MAX_TERMS, min_len=1),
+                   validate.number(hf["nu"], "nu"))
+
+    # the law interface of materials.laws (the module functions below do the work)
+    def energy(self, C, *, detF=None):
+        return energy(self, C, detF=detF)
+
+    def pk2(self, C, *, detF=None):
+        return pk2(self, C, detF=detF)
+
+    def pk2_tangent(self, C, *, detF=None, tangent=True):
+        """The 3x3 path; tangent=False still returns D (the eigh path computes it anyway)."""
+        return pk2_tangent(self, C, detF=detF)
+
+    def pk2_tangent_plane(self, C2, *, detF=None, out_of_plane=False, tangent=True):
+        return pk2_tangent_plane(self, C2, detF=detF, out_of_plane=out_of_plane, tangent=tangent)
+
+    # fitting (materials.fit): x = (mu_1..mu_n, alpha_1..alpha_n), nu given
+    @staticmethod
+    def fit_start(mu0, terms=2):
+        alphas = [2.0, -2.0, 5.0, -4.0, 8.0, 1.0][:terms]
+        x0 = np.array([mu0 / terms] * terms + alphas)
+        return x0, (np.full(2 * terms, -np.inf), np.full(2 * terms, np.inf))
+
+    @classmethod
+    def from_fit(cls, x, nu):
+        n = len(x) // 2
+        return cls(tuple(x[:n]), tuple(x[n:]), nu)
 
 
 # --- scalar helpers (elementwise) ---------------------------------------------------------

@@ -1,12 +1,14 @@
-"""Named materials: a hyperfoam law plus its Prony series, with where the numbers came from.
+"""Named materials: a law (materials.laws) plus its Prony series, with where the numbers came from.
 
-Presets live in the package data file presets.toml (paper Table I). Users define their own
-in a TOML file of the same shape (see `Material.from_toml`).
+Presets live in the package data file presets.toml (paper Table I and published fits of
+skin elastomers, each with its source). Users define their own in a TOML file of the same
+shape (see `Material.from_toml`).
 """
 
 from __future__ import annotations
 
 import functools
+import json
 import tomllib
 from dataclasses import dataclass
 from importlib import resources
@@ -14,7 +16,8 @@ from pathlib import Path
 
 from tactileskin import validate
 from tactileskin.errors import ParameterError
-from tactileskin.materials.hyperfoam import MAX_TERMS as HF_TERMS, Hyperfoam
+from tactileskin.materials.hyperfoam import Hyperfoam
+from tactileskin.materials.laws import get_law, law_from_dict, list_laws
 from tactileskin.materials.prony import MAX_TERMS as PRONY_TERMS, Prony
 from tactileskin.params import read_toml
 
@@ -23,31 +26,54 @@ __all__ = ["Material", "get_material", "list_materials"]
 
 @dataclass(frozen=True)
 class Material:
+    """A named material: its law (any registered in `materials.laws`), its Prony series
+    (the viscoelastic part, wrapping whatever law; `Prony.elastic()` for none) and where
+    the numbers came from."""
+
     name: str
-    hyperfoam: Hyperfoam
+    law: object
     prony: Prony
     source: str = ""
 
+    @property
+    def law_name(self) -> str:
+        return self.law.law
+
+    @property
+    def hyperfoam(self) -> Hyperfoam:
+        """The law, for the paper's hyperfoam materials (ParameterError for another law)."""
+        if not isinstance(self.law, Hyperfoam):
+            raise ParameterError(f"material {self.name!r} law", self.law_name, "hyperfoam",
+                                 "use Material.law")
+        return self.law
+
     @classmethod
     def from_dict(cls, name: str, d: dict) -> "Material":
-        """Build from {"name"?: str, "source"?: str, "hyperfoam": {mu, alpha, nu}, "prony"?: {g, tau}}.
+        """Build from {"name"?, "source"?, "law"?, <law>: {its parameters}, "prony"?: {g, tau}}.
 
-        Every table is checked for unknown keys and value types here (a `[prnoy]` typo must
-        not silently make the material elastic); Hyperfoam and Prony check the ranges."""
+        `law` names the law (`materials.laws.list_laws()`) and the table of the same name
+        holds its parameters; without `law` the one law table present names it
+        (`[hyperfoam]` alone: the paper's format). Every table is checked for unknown keys
+        and value types (a `[prnoy]` typo must not silently make the material elastic); the
+        law and Prony classes check the ranges."""
         what = f"material {name!r}"
-        if not isinstance(d, dict) or "hyperfoam" not in d:
-            raise ParameterError(what, d if not isinstance(d, dict) else sorted(d),
-                                 "a table with a [hyperfoam] sub-table (mu, alpha, nu)")
-        validate.known_keys(d, ("name", "source", "hyperfoam", "prony"), what)
-        hf = validate.table(d["hyperfoam"], f"{what} hyperfoam")
-        validate.known_keys(hf, ("mu", "alpha", "nu"), f"{what} hyperfoam")
-        missing = [k for k in ("mu", "alpha", "nu") if k not in hf]
-        if missing:
-            raise ParameterError(f"{what} hyperfoam", sorted(hf), "keys mu, alpha, nu",
-                                 "missing " + ", ".join(missing))
-        mu = validate.number_list(hf["mu"], "mu", HF_TERMS, min_len=1)
-        alpha = validate.number_list(hf["alpha"], "alpha", HF_TERMS, min_len=1)
-        nu = validate.number(hf["nu"], "nu")
+        laws = list_laws()
+        if not isinstance(d, dict):
+            raise ParameterError(what, d, "a table with a law table (" + ", ".join(laws) + ")")
+        present = [k for k in d if k in laws]
+        if "law" in d:
+            law = validate.string(d["law"], f"{what} law", "one of " + ", ".join(laws))
+            get_law(law)  # unknown name: ParameterError listing the laws
+            if law not in d:
+                raise ParameterError(f"{what} [{law}]", "missing", f"a [{law}] table with the law's parameters")
+            if len(present) > 1:
+                raise ParameterError(what, present, f"only the [{law}] law table")
+        elif len(present) == 1:
+            law = present[0]
+        else:
+            raise ParameterError(what, sorted(d), "one law table: " + ", ".join(laws),
+                                 "or law = \"<name>\" and its table")
+        validate.known_keys(d, ("name", "source", "law", law, "prony"), what)
         pr = validate.table(d.get("prony", {"g": [], "tau": []}), f"{what} prony")
         validate.known_keys(pr, ("g", "tau"), f"{what} prony")
         if ("g" in pr) != ("tau" in pr):
@@ -56,7 +82,7 @@ class Material:
         tau = validate.number_list(pr.get("tau", []), "tau", PRONY_TERMS)
         return cls(
             name=validate.string(d.get("name", name), f"{what} name"),
-            hyperfoam=Hyperfoam(mu, alpha, nu),
+            law=law_from_dict(law, d[law], what),
             prony=Prony(g, tau),
             source=validate.string(d.get("source", ""), f"{what} source"),
         )
@@ -65,24 +91,48 @@ class Material:
     def from_toml(cls, path) -> "Material":
         """Read a user-defined material.
 
-        The file holds either one material at top level (keys name?, source?, tables
-        [hyperfoam] and optional [prony]) or exactly one named table of that shape, like
-        presets.toml. Without [prony] the material is purely elastic.
+        The file holds either one material at top level (keys name?, source?, law?, its law
+        table, optional [prony]) or exactly one named table of that shape, like presets.toml.
+        Without [prony] the material is purely elastic.
         """
         path = Path(path)
         data = read_toml(path, "material file")
-        if "hyperfoam" in data:
+        if "law" in data or any(k in data for k in list_laws()):
             return cls.from_dict(str(data.get("name", path.stem)), data)
         tables = {k: v for k, v in data.items() if isinstance(v, dict)}
         if len(tables) != 1 or len(data) != 1:
             raise ParameterError("material file", str(path),
-                                 "one material: top-level [hyperfoam] table, or exactly one named table")
+                                 "one material: a top-level law table (e.g. [hyperfoam]), or exactly one named table")
         (name, d), = tables.items()
         return cls.from_dict(name, d)
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "source": self.source,
-                "hyperfoam": self.hyperfoam.to_dict(), "prony": self.prony.to_dict()}
+        """The TOML shape read by `from_dict` (hyperfoam materials keep the paper's format)."""
+        d = {"name": self.name, "source": self.source}
+        if self.law_name != "hyperfoam":
+            d["law"] = self.law_name
+        d[self.law_name] = self.law.to_dict()
+        d["prony"] = self.prony.to_dict()
+        return d
+
+    def to_toml(self) -> str:
+        """TOML text of `to_dict()` (read back by `from_toml`)."""
+        return _toml(self.to_dict())
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string is a valid TOML basic string
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(float(v))
+
+
+def _toml(d: dict) -> str:
+    top = [f"{k} = {_toml_value(v)}" for k, v in d.items() if not isinstance(v, dict)]
+    tables = [f"\n[{k}]\n" + "\n".join(f"{kk} = {_toml_value(vv)}" for kk, vv in v.items())
+              for k, v in d.items() if isinstance(v, dict)]
+    return "\n".join(top) + "\n" + "\n".join(tables) + "\n"
 
 
 @functools.cache

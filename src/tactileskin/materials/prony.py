@@ -26,7 +26,7 @@ import numpy as np
 
 from tactileskin.errors import ParameterError
 
-__all__ = ["Prony"]
+__all__ = ["Prony", "QLVHistory"]
 
 
 # One term per decade of time is the usual fit; 12 cover 1 ms to 1e9 s, far beyond any
@@ -162,3 +162,59 @@ class Prony:
 
     def to_dict(self) -> dict:
         return {"g": list(self.g), "tau": list(self.tau)}
+
+    def history(self, shape, order: int = 2) -> "QLVHistory":
+        """The viscoelastic state of this series at points whose stresses have `shape`
+        (e.g. (elements, quadrature points, 3, 3)): wraps the elastic PK2 S0 of any law."""
+        return QLVHistory(self, tuple(shape), order)
+
+
+class QLVHistory:
+    """Internal variables of the QLV update at a set of points, with the update rule.
+
+    State: H (n_terms, *shape), the elastic stresses S0 of the last two committed states and
+    the previous step. `stress(S0, dt)` is the trial stress for a step dt (pure: the state
+    is not changed; Newton calls it at every iterate), `commit(S0, dt)` accepts the step.
+    order 2: S0 interpolated by the parabola through the last three states
+    (`Prony.step_factors_quadratic`) once a previous step exists; order 1 (or the first
+    step): the chord (`Prony.step_factors`)."""
+
+    def __init__(self, prony: Prony, shape: tuple, order: int = 2):
+        if order not in (1, 2):
+            raise ParameterError("qlv_order", order, "1 (linear S0 per increment) or 2 (parabola)")
+        self.prony, self.order = prony, order
+        self.S0_old = np.zeros(shape)
+        self.S0_prev = self.S0_old       # S0 one increment before S0_old
+        self.dt_prev = None
+        self.H = np.zeros((prony.n_terms,) + tuple(shape))
+
+    def factors(self, dt: float):
+        """(gamma, decay, gain, back) for a step dt from the committed state; gamma =
+        g_inf + sum(gain) scales the elastic tangent."""
+        if self.order == 2 and self.dt_prev is not None and dt > 0.0:
+            decay, gain, back = self.prony.step_factors_quadratic(dt, self.dt_prev)
+        else:
+            decay, gain = self.prony.step_factors(dt)
+            back = np.zeros_like(np.atleast_1d(gain))
+        decay, gain, back = np.atleast_1d(decay), np.atleast_1d(gain), np.atleast_1d(back)
+        return float(self.prony.g_inf + gain.sum()), decay, gain, back
+
+    def stress(self, S0, dt: float):
+        """(S, gamma): the viscoelastic PK2 at the end of a trial step dt with elastic S0."""
+        gamma, decay, gain, back = self.factors(dt)
+        S = gamma * S0
+        for i in range(len(decay)):
+            S = S + decay[i] * self.H[i] - gain[i] * self.S0_old
+            if back[i]:
+                S = S - back[i] * (self.S0_old - self.S0_prev)
+        return S, gamma
+
+    def commit(self, S0, dt: float) -> None:
+        _, decay, gain, back = self.factors(dt)
+        for i in range(len(decay)):
+            self.H[i] = decay[i] * self.H[i] + gain[i] * (S0 - self.S0_old)
+            if back[i]:
+                self.H[i] -= back[i] * (self.S0_old - self.S0_prev)
+        self.S0_prev, self.S0_old = self.S0_old, S0
+        if dt > 0.0:
+            self.dt_prev = dt

@@ -1,0 +1,66 @@
+"""`tactileskin material ...`: material laws, presets, fitting to test data."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+MARK = "# written by tactileskin material fit"
+
+
+@click.group("material")
+def command() -> None:
+    """Material laws and presets; fit a law to your own uniaxial test."""
+
+
+@command.command("list")
+def list_() -> None:
+    """The registered laws and the preset materials with their sources."""
+    from tactileskin.materials import get_material, list_laws, list_materials
+
+    click.echo("laws: " + ", ".join(list_laws()))
+    for name in list_materials():
+        m = get_material(name)
+        click.echo(f"{name}: {m.law_name}, mu0 = {m.law.mu0:.4g} MPa, K0 = {m.law.K0:.4g} MPa; {m.source}")
+
+
+@command.command()
+@click.argument("data", type=click.Path(dir_okay=False))
+@click.option("--law", "-l", required=True, help="Law to fit (tactileskin material list).")
+@click.option("--out", "-o", type=click.Path(dir_okay=False), required=True, help="Material TOML to write.")
+@click.option("--nu", type=float, default=None,
+              help="Poisson ratio of the test (default: incompressible; hyperfoam needs it).")
+@click.option("--terms", type=int, default=None, help="Terms of yeoh (1-3), ogden or hyperfoam (1-3).")
+@click.option("--name", default=None, help="Material name (default: the CSV's name).")
+def fit(data, law, out, nu, terms, name):
+    """Fit LAW to the uniaxial test in DATA (CSV: stretch or strain, nominal_stress_mpa).
+
+    Prints the parameters and the fit quality (R^2, RMSE, max relative error) and writes a
+    material file usable as --material OUT or Scene(material="OUT")."""
+    from tactileskin import fileio
+    from tactileskin.errors import ParameterError
+    from tactileskin.materials.fit import fit as fit_law, read_uniaxial_csv
+
+    outp = Path(out)
+    if outp.suffix != ".toml":
+        raise ParameterError("--out", out, "a path ending in .toml")
+    if outp.exists():
+        try:
+            ours = outp.read_text(encoding="utf-8", errors="replace").startswith(MARK)
+        except OSError:
+            ours = False
+        if not ours:
+            raise ParameterError("--out", out, "a new file or one this command wrote",
+                                 "it exists and was not written by tactileskin material fit")
+    lam, P = read_uniaxial_csv(data)
+    f = fit_law(law, lam, P, nu=nu, terms=terms)
+    q = f.quality
+    kin = "incompressible" if nu is None else f"nu = {nu:g}"
+    source = (f"fit of {law} to {Path(data).name} (uniaxial nominal stress, {kin}, {q['n_points']} points): "
+              f"R^2 = {q['r2']:.5f}, RMSE = {q['rmse_mpa']:.3g} MPa, max relative error "
+              f"{100 * q['max_rel_err']:.2f} %")
+    mat = f.material(name or Path(data).stem, source)
+    fileio.atomic_write_text(outp, MARK + "\n" + mat.to_toml())
+    click.echo(f.describe())
+    click.echo(f"wrote {out}")

@@ -1,0 +1,287 @@
+"""Fit any registered law to a uniaxial test: nominal stress (MPa) against stretch.
+
+`fit(law, stretch, stress, nu=None, terms=None) -> Fit` (scipy.optimize.least_squares on
+the absolute stress residuals, i.e. it minimises the RMSE the report states):
+- nu=None: incompressible kinematics (J = 1, lateral stretch l^(-1/2)); the nominal stress
+  is (sigma_1 - sigma_3)/l, independent of the volumetric term. The fitted law gets the
+  bulk modulus of `NU_INCOMPRESSIBLE` (kappa = 2 mu0 (1 + nu)/(3 (1 - 2 nu))), the usual
+  near-incompressible silicone value; hyperfoam has no incompressible form and needs nu.
+- nu given: the lateral stretch is solved so that the lateral stress vanishes (vectorised
+  Newton), with kappa from nu (hyperfoam: nu is its own parameter).
+Quality: R^2, RMSE (MPa) and the largest relative error over the points whose |stress| is
+at least 5 % of the largest (relative error near zero stress means nothing).
+Bad data (fewer points than parameters + 3, NaN/inf, stretch <= 0, stretch not strictly
+monotone, no point away from stretch 1) raise `FitDataError` naming the column and what
+is wrong.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.materials.laws import get_law
+
+log = logging.getLogger(__name__)
+
+__all__ = ["Fit", "FitDataError", "FitError", "fit", "read_uniaxial_csv", "uniaxial_nominal",
+           "NU_INCOMPRESSIBLE"]
+
+NU_INCOMPRESSIBLE = 0.49   # bulk modulus given to a law fitted as incompressible (K/mu0 = 49.7)
+REL_FLOOR = 0.05           # relative errors only where |stress| >= 5 % of the largest
+MAX_CSV_BYTES = 10 << 20   # a test file is at most a few 10k rows
+
+
+class FitDataError(ParameterError):
+    """The test data cannot be fitted (too few points, NaN, non-monotone stretch, ...)."""
+
+
+class FitError(TactileSkinError):
+    """The least-squares fit did not give an admissible law."""
+
+
+def uniaxial_nominal(law, stretch, nu=None):
+    """Nominal (first Piola-Kirchhoff) stress of uniaxial tension/compression at `stretch`.
+    nu=None: incompressible kinematics; else the lateral stress is made zero."""
+    lam = np.asarray(stretch, dtype=float)
+    if nu is None:
+        lt2 = 1.0 / lam
+        C = np.zeros(lam.shape + (3, 3))
+        C[..., 0, 0], C[..., 1, 1], C[..., 2, 2] = lam**2, lt2, lt2
+        S, ok = law.pk2(C)
+        return (lam**2 * S[..., 0, 0] - lt2 * S[..., 2, 2]) / lam, ok
+    lt = lam ** (-float(nu))   # the small-strain lateral stretch as the start
+    scale = max(law.mu0, law.K0)
+    for _ in range(50):
+        C = np.zeros(lam.shape + (3, 3))
+        C[..., 0, 0], C[..., 1, 1], C[..., 2, 2] = lam**2, lt**2, lt**2
+        S, D, ok = law.pk2_tangent(C)
+        r = S[..., 1, 1]
+        # dS22/dl = (D2222 + D2233)/2 * 2 l (C22 and C33 both move with l)
+        slope = (D[..., 1, 1, 1, 1] + D[..., 1, 1, 2, 2]) * lt
+        step = r / np.where(slope != 0.0, slope, 1.0)
+        lt = np.clip(lt - step, 0.5 * lt, 2.0 * lt)
+        if np.all(np.abs(r) <= 1e-12 * scale):
+            break
+    C = np.zeros(lam.shape + (3, 3))
+    C[..., 0, 0], C[..., 1, 1], C[..., 2, 2] = lam**2, lt**2, lt**2
+    S, ok = law.pk2(C)
+    return lam * S[..., 0, 0], ok & (np.abs(S[..., 1, 1]) <= 1e-9 * scale)
+
+
+@dataclass
+class Fit:
+    law: object
+    stretch: np.ndarray
+    stress: np.ndarray
+    predicted: np.ndarray
+    nu: float | None
+    quality: dict = field(default_factory=dict)
+
+    def material(self, name: str, source: str = ""):
+        from tactileskin.materials.presets import Material
+        from tactileskin.materials.prony import Prony
+
+        return Material(name=name, law=self.law, prony=Prony.elastic(), source=source)
+
+    def describe(self) -> str:
+        q = self.quality
+        return (f"{self.law.law}: {self.law.to_dict()}; R^2 = {q['r2']:.5f}, RMSE = {q['rmse_mpa']:.3g} MPa, "
+                f"max relative error {100 * q['max_rel_err']:.2f} % ({q['n_points']} points, "
+                f"{'incompressible' if self.nu is None else f'nu = {self.nu:g}'})")
+
+
+def _quality(stress, pred, n_params) -> dict:
+    res = pred - stress
+    ss_res = float(np.sum(res**2))
+    ss_tot = float(np.sum((stress - stress.mean()) ** 2))
+    big = np.abs(stress) >= REL_FLOOR * np.abs(stress).max()
+    return {"r2": 1.0 - ss_res / ss_tot if ss_tot > 0 else float("nan"),
+            "rmse_mpa": float(np.sqrt(ss_res / len(stress))),
+            "max_rel_err": float(np.max(np.abs(res[big]) / np.abs(stress[big]))),
+            "n_points": int(len(stress)), "n_params": int(n_params)}
+
+
+def check_data(stretch, stress, n_params: int):
+    """(stretch, stress) as float arrays ordered by increasing stretch, or FitDataError."""
+    try:
+        lam = np.asarray(stretch, dtype=float).ravel()
+        P = np.asarray(stress, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise FitDataError("data", "non-numeric values", "numbers (stretch, nominal stress MPa)") from None
+    if lam.shape != P.shape:
+        raise FitDataError("stress", f"{P.size} values", f"{lam.size} values (one per stretch)")
+    need = max(5, n_params + 3)
+    if lam.size < need:
+        raise FitDataError("data", f"{lam.size} points", f">= {need} points",
+                           f"{n_params} parameters need more points than that")
+    for name, x in (("stretch", lam), ("stress", P)):
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise FitDataError(name, f"non-finite value at row {bad[0] + 1}", "finite numbers")
+    if np.any(lam <= 0.0):
+        raise FitDataError("stretch", float(lam[lam <= 0.0][0]), "> 0 (stretch = 1 + engineering strain)")
+    d = np.diff(lam)
+    if not (np.all(d > 0) or np.all(d < 0)):
+        i = int(np.flatnonzero(np.sign(d) != np.sign(d[0]))[0]) if np.any(d) else 0
+        raise FitDataError("stretch", f"not strictly monotone at row {i + 2}",
+                           "strictly increasing or decreasing (one loading branch, no repeats)")
+    if np.max(np.abs(lam - 1.0)) < 1e-4:
+        raise FitDataError("stretch", "all within 1e-4 of 1", "a test beyond 0.01 % strain")
+    order = np.argsort(lam)
+    return lam[order], P[order]
+
+
+def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None = None) -> Fit:
+    """Least-squares fit of law `law` (a name of materials.laws) to uniaxial nominal stress.
+
+    terms: number of terms for yeoh (1-3, default 3), ogden and hyperfoam (1-3, default 2)."""
+    from scipy.optimize import least_squares
+
+    cls = get_law(law)
+    if nu is not None:
+        from tactileskin.errors import check_range
+
+        nu = check_range("nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
+    elif law == "hyperfoam":
+        raise ParameterError("nu", None, "(-1, 0.5)", "hyperfoam has no incompressible form: give nu")
+    if law in ("ogden", "hyperfoam"):
+        terms = 2 if terms is None else terms
+        if not (isinstance(terms, int) and 1 <= terms <= 3):
+            raise ParameterError("terms", terms, "1, 2 or 3")
+        start = lambda mu0: cls.fit_start(mu0, terms)  # noqa: E731
+        n_params = 2 * terms
+    elif law == "yeoh":
+        terms = 3 if terms is None else terms
+        if not (isinstance(terms, int) and 1 <= terms <= 3):
+            raise ParameterError("terms", terms, "1, 2 or 3")
+        start = lambda mu0: _cut(cls.fit_start(mu0), terms)  # noqa: E731
+        n_params = terms
+    else:
+        if terms is not None:
+            raise ParameterError("terms", terms, f"not given ({law} has a fixed number of parameters)")
+        start = cls.fit_start
+        n_params = len(cls.fit_names)
+    lam, P = check_data(stretch, stress, n_params)
+
+    # start: the neo-Hookean shear modulus of the data, P = mu (l - l^-2)
+    f = lam - lam**-2.0
+    mu0 = max(float(np.sum(P * f) / np.sum(f * f)), 1e-6 * float(np.abs(P).max()) + 1e-300)
+    x0, bounds = start(mu0)
+    scale = float(np.abs(P).max())
+    vol = NU_INCOMPRESSIBLE if nu is None else nu
+
+    def predict(x):
+        mat = cls.from_fit(x, vol)
+        pred, ok = uniaxial_nominal(mat, lam, nu)
+        return mat, pred, ok
+
+    def residual(x):
+        try:
+            _, pred, ok = predict(x)
+        except (ParameterError, FloatingPointError, OverflowError):
+            return np.full(lam.size, 1e3)
+        if not np.all(ok) or not np.all(np.isfinite(pred)):
+            return np.full(lam.size, 1e3)
+        return (pred - P) / scale
+
+    starts = [x0]
+    if law in ("ogden", "hyperfoam"):
+        # stretch exponents make the cost multi-modal: a few seeds, the best fit kept
+        starts += [np.concatenate([x0[:terms], a]) for a in _alpha_seeds(terms)]
+    with np.errstate(all="ignore"):
+        sol = None
+        for xs in starts:
+            s = least_squares(residual, xs, bounds=bounds, x_scale="jac", xtol=1e-14, ftol=1e-14,
+                              gtol=1e-14, max_nfev=2000)
+            if sol is None or s.cost < sol.cost:
+                sol = s
+        try:
+            mat, pred, ok = predict(sol.x)
+        except ParameterError as e:
+            raise FitError(f"fit of {law} gave inadmissible parameters ({e})") from None
+    if not np.all(ok) or not np.all(np.isfinite(pred)):
+        raise FitError(f"fit of {law} did not converge to an admissible law ({sol.message})")
+    q = _quality(P, pred, n_params)
+    q["nfev"] = int(sol.nfev)
+    return Fit(law=mat, stretch=lam, stress=P, predicted=pred, nu=nu, quality=q)
+
+
+def _alpha_seeds(terms):
+    seeds = {1: [(5.0,), (-2.0,), (10.0,)], 2: [(2.0, 6.0), (-2.0, 6.0), (5.0, 10.0)],
+             3: [(2.0, -2.0, 8.0), (1.0, 4.0, 10.0)]}
+    return [np.array(a) for a in seeds[terms]]
+
+
+def _cut(start, terms):
+    x0, (lo, hi) = start
+    return x0[:terms], (lo[:terms], hi[:terms])
+
+
+_STRETCH = ("stretch", "lambda")
+_STRAIN = ("strain",)
+_STRESS = ("nominal_stress_mpa", "stress_mpa", "nominal_stress", "stress")
+
+
+def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
+    """(stretch, nominal stress MPa) from a CSV with a header naming a stretch column
+    (stretch | lambda, or strain: engineering strain, stretch = 1 + strain) and a stress
+    column (nominal_stress_mpa | stress_mpa | nominal_stress | stress; MPa), or from two
+    unnamed numeric columns (stretch, stress)."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_CSV_BYTES + 1)
+    except FileNotFoundError:
+        raise FitDataError("data", str(path), "an existing CSV file") from None
+    except OSError as e:
+        raise FitDataError("data", str(path), "a readable CSV file", e.strerror or str(e)) from None
+    if len(raw) > MAX_CSV_BYTES:
+        raise FitDataError("data", str(path), f"a CSV of at most {MAX_CSV_BYTES >> 20} MiB")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise FitDataError("data", str(path), "a UTF-8 text CSV") from None
+    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
+    rows = [r for r in rows if not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise FitDataError("data", str(path), "a CSV with rows of stretch and stress")
+    head = [c.strip().lower() for c in rows[0]]
+
+    def col(names):
+        return next((head.index(n) for n in names if n in head), None)
+
+    if _is_number(rows[0][0]):
+        i_s, i_p, strain, body = 0, 1, False, rows
+    else:
+        i_s, strain = col(_STRETCH), False
+        if i_s is None:
+            i_s, strain = col(_STRAIN), True
+        i_p = col(_STRESS)
+        if i_s is None or i_p is None:
+            raise FitDataError("data header", ",".join(head),
+                               "a stretch (or strain) column and a stress column (nominal_stress_mpa)")
+        body = rows[1:]
+    lam, P = [], []
+    for n, r in enumerate(body, start=2 if body is not rows else 1):
+        try:
+            lam.append(float(r[i_s]))
+            P.append(float(r[i_p]))
+        except (ValueError, IndexError):
+            raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", "two numbers (stretch, stress)") from None
+    lam = np.array(lam)
+    return (1.0 + lam if strain else lam), np.array(P)
+
+
+def _is_number(s) -> bool:
+    try:
+        float(s)
+        return True
+    except ValueError:
+        return False
