@@ -6,8 +6,10 @@
   A line search halves the step while the trial state is inadmissible (J <= 0, material
   overflow guard) or the residual norm does not decrease; the residual norm of every
   iteration is logged (quadratic convergence is visible at DEBUG).
-- Each increment: Newton at fixed multipliers, then Uzawa updates until the largest
-  penetration is below tolerance; the penalty grows when the penetration stalls.
+- Each increment: Newton with Uzawa multiplier updates once |R| <= uzawa_rtol * scale
+  (one per iteration, the sticky set kept), until the largest gap of a pressed point is
+  below the tolerance; a fresh Newton solve per update (uzawa_inline=False) cost 2-5
+  iterations each. The penalty grows when the gap stalls.
 - Increments grow after easy convergence and are cut back after a failure; below the
   minimum increment a ConvergenceError carries a diagnosis (time, increment, residual
   history, where the worst residual sits).
