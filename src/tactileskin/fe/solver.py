@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -357,7 +357,16 @@ def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts
     lam = None if model.surface is None else model.surface.lam.copy()
     if opts.predict_multipliers and getattr(model.surface, "lam_prev", None) is not None and model.dt_prev:
         lam = np.maximum(0.0, lam + (lam - model.surface.lam_prev) * (dt / model.dt_prev))
-    u, ev, its, hist, lam = newton(model, u_pred, t, dt, lam, opts, stats)
+    try:
+        u, ev, its, hist, lam = newton(model, u_pred, t, dt, lam, opts, stats)
+    except _Failure:
+        if not opts.uzawa_inline or model.surface is None:
+            raise
+        # in the lock-up the inline updates can keep Newton from settling (1 mm silicone at
+        # 40 %): retry the increment with a fresh Newton solve per update
+        opts = replace(opts, uzawa_inline=False)
+        lam = model.surface.lam.copy()
+        u, ev, its, hist, lam = newton(model, u_pred, t, dt, lam, opts, stats)
     if model.surface is None:
         return u, ev, its
     last_pen = np.inf
