@@ -8,7 +8,10 @@ tolerance and the multipliers settle.
 
 Points in `sticky` keep the linear law lambda_k - eps g within a Newton solve (see
 fe.solver.newton: a kink rounded over 1e-4 mm of gap did not stop the active-set cycling
-at the contact edge; holding points active did). The tangent may include the curvature
+at the contact edge; holding points active did. A softplus over a wider band does not
+either, and it presses at positive gaps: over 1e-2 mm of gap the t = 1 curved peak rose
+33 %, over 1e-3 mm 0.2 %, with more Newton iterations than the sticky set;
+benchmarks/results/contact_newton.md). The tangent may include the curvature
 of the indenter surface (dn/dx, by central differences of the normal, since `gap` gives
 only g and n); fe.model.Contact says why it is off by default.
 """

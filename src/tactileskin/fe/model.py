@@ -76,7 +76,13 @@ class Contact:
     boundary: str = "outer_surface"
     rate: float = 1.0
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
-    tol_penetration: float = 1e-4  # mm
+    # penetration tolerance (mm) of the augmented Lagrangian; None: tol_relative x the
+    # contact facet size (Model.surface_size), so that it shrinks with the mesh and a
+    # convergence study sees no fixed floor. 1e-4 x h (2e-5 mm at the 2D preview facet of
+    # 0.2 mm): 5e-4 x h left t1 silicone flat 0.16 % below its 1e-6 mm answer (lock-up:
+    # the stress moves ~ alpha beta x gap / thickness); benchmarks/results/contact_newton.md
+    tol_penetration: float | None = None
+    tol_relative: float = 1e-4
     # The indenter-curvature term -lambda dn/dx of the consistent tangent. The solver adds it
     # only after its first iterates (SolverOptions.curvature_after): it is negative
     # semi-definite, and early iterates with overshooting multipliers made the tangent
@@ -159,6 +165,8 @@ class Model:
                 h = self.surface_size()
                 contact.penalty = PENALTY_FACTOR * stiffness / h
                 log.debug("contact penalty %.3g MPa/mm (h = %.3g mm)", contact.penalty, h)
+            if contact.tol_penetration is None:
+                contact.tol_penetration = contact.tol_relative * self.surface_size()
 
         # committed state
         E, Q = self.w.shape
@@ -278,6 +286,7 @@ class Model:
         self.u = u.copy()
         self.t = t
         if self.surface is not None and ev.contact is not None:
+            self.surface.lam_prev = self.surface.lam
             self.surface.lam = np.maximum(ev.contact[1], 0.0)  # no adhesion carried over
 
     # -- output -------------------------------------------------------------------------------
