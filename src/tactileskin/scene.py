@@ -21,8 +21,9 @@ from tactileskin.errors import ParameterError, check_range
 from tactileskin.geometry.indenters import registry as _indenters
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
-# not reused (2: bone pressure from the boundary fit, second-order QLV update)
-SCHEMA_VERSION = 2
+# not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: contact
+# penetration tolerance relative to the facet size, multipliers updated within Newton)
+SCHEMA_VERSION = 3
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
