@@ -22,15 +22,14 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
     "the material law outside its range: see 'status' and 'flags' in summary.json); 2 an "
     "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
-@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+@click.option("--out", "-o", "out", type=click.Path(file_okay=False), required=True,
               help="Output folder (profile.csv, contact.csv, summary.json, result.vtu; 3D also "
                    "bone_map.csv, bone_map.png, profile_max_z.csv): a new or empty folder, or one "
                    "written by `solve`; only these files are replaced.")
-@click.option("--elastic", is_flag=True, default=False, help="Ignore viscoelasticity (Prony series).")
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
                    "the default 2D mesh, write it to OUT/section_2d and report the differences.")
-def command(out, elastic, compare_2d, **kw):
+def command(out, compare_2d, scene_opts):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.markup import escape
@@ -39,9 +38,7 @@ def command(out, elastic, compare_2d, **kw):
 
     from tactileskin.fe import solve
 
-    scene = scene_from_options(**kw)
-    if elastic:
-        scene = scene.replace(viscoelastic=False)
+    scene = scene_from_options(scene_opts, "solve")
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
