@@ -174,6 +174,20 @@ class Result:
         if not np.isfinite(self.reaction):
             raise ConvergenceError("non-finite reaction force", {"field": "reaction"})
 
+    def __repr__(self) -> str:
+        """One line: the scene, the metrics, the status and the sizes (not the arrays)."""
+        sc = self.scene or {}
+        name = (f"t{sc['thickness']:g}-{sc.get('material', '?')}-{sc.get('indenter', '?')}-{sc.get('dim', 2)}d"
+                if "thickness" in sc else "scene ?")
+        try:
+            metrics = f"peak={self.peak:.4g} MPa, span={self.span:.3g} mm, auc={self.auc:.4g} MPa*mm"
+        except ParameterError:  # a profile too short for the metrics
+            metrics = "no profile"
+        extra = ", bone_map" if self.bone_map is not None else ""
+        return (f"<Result {name}: {metrics}, reaction={self.reaction:.4g}, status={self.status!r}; "
+                f"{self.s.size} profile points, {self.contact_x.size} contact points, "
+                f"{int(self.stats.get('dofs', 0))} dofs{extra}>")
+
     @property
     def peak(self) -> float:
         return peak(*self._profile())
