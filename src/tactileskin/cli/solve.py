@@ -26,10 +26,13 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
               help="Output folder (profile.csv, contact.csv, summary.json, result.vtu; 3D also "
                    "bone_map.csv, bone_map.png, profile_max_z.csv): a new or empty folder, or one "
                    "written by `solve`; only these files are replaced.")
+@click.option("--history", is_flag=True, default=False,
+              help="Also write result.pvd: the displacement of every increment as a ParaView time "
+                   "series (result_steps/).")
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
                    "the default 2D mesh, write it to OUT/section_2d and report the differences.")
-def command(out, compare_2d, scene_opts):
+def command(out, history, compare_2d, scene_opts):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.markup import escape
@@ -43,7 +46,7 @@ def command(out, compare_2d, scene_opts):
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
-            res = solve(scene, progress=show)
+            res = solve(scene, progress=show, history=history)
         path = res.write(out)
         _write_map_figure(res, path, scene.label())
     s = res.summary()
@@ -61,7 +64,7 @@ def command(out, compare_2d, scene_opts):
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
-    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).is_file()))
+    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).exists()))
     if "min_J" in s:
         t.add_row("min volume ratio J / max |stress|",
                   f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")
