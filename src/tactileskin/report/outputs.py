@@ -112,7 +112,8 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
                     renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
                     log.warning("render of %s failed: %s", rec.case, e)
-    report = build_report(rows, records, failures, figures, renders, wall_s)
+    report = build_report(rows, records, failures, figures, renders, wall_s,
+                          scenes=[oc.scene for oc in outcomes])
     atomic_write_text(out / "report.md", report)
     return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",
                 figures=figures, renders=renders, failures=failures, rows=rows, records=records)
