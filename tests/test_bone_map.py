@@ -125,7 +125,9 @@ def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
 
     _, res, _, _ = plane_strain
     out = res.write(tmp_path / "r")
-    assert {p.name for p in out.iterdir()} == set(OWN_NAMES) - {"sensors.csv"}  # a scene without sensors
+    # every owned name but the time series (result.pvd, result_steps/), written only with a
+    # history, and sensors.csv (a scene without sensors)
+    assert {p.name for p in out.iterdir()} == set(OWN_NAMES) - {"result.pvd", "result_steps", "sensors.csv"}
     bm = read_bone_map(out / "bone_map.csv", section_z=res.bone_map.section_z)
     np.testing.assert_allclose(bm.s, res.bone_map.s, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(bm.z, res.bone_map.z, rtol=1e-9, atol=1e-12)
@@ -137,7 +139,7 @@ def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
     summ = json.loads((out / "summary.json").read_text())
     assert summ["peak_map_mpa"] == pytest.approx(res.bone_map.peak()[0], rel=1e-12)
     # the map samples result.vtu's nodal pressure (linear on each facet): within its range
-    vtu = meshio.read(out / "result.vtu").point_data["pressure"]
+    vtu = meshio.read(out / "result.vtu").point_data["pressure_MPa"]
     assert vtu.min() - 1e-12 <= bm.pressure.min() and bm.pressure.max() <= vtu.max() + 1e-12
     # a cache entry of a 3D result holds the map and validates
     cache = ResultCache(tmp_path / "cache")

@@ -47,7 +47,8 @@ def test_history_follows_the_indenter(flat_1mm):
 def test_result_write_is_complete(flat_1mm, tmp_path):
     out = flat_1mm.write(tmp_path / "res")
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["contact.csv", "profile.csv", "result.vtu", "summary.json"]
+    # solved with history=True: also the time series result.pvd over result_steps/
+    assert names == ["contact.csv", "profile.csv", "result.pvd", "result.vtu", "result_steps", "summary.json"]
     rows = list(csv.reader(open(out / "profile.csv")))
     assert rows[0] == ["s_mm", "pressure_mpa"]
     s = np.array([float(a) for a, _ in rows[1:]])
@@ -61,10 +62,10 @@ def test_result_write_is_complete(flat_1mm, tmp_path):
 
     vtu = meshio.read(out / "result.vtu")
     assert vtu.cells[0].type == "triangle6"
-    for k in ("pressure", "displacement", "sxx", "syy", "szz", "sxy"):
+    for k in ("pressure_MPa", "displacement_mm", "sxx_MPa", "syy_MPa", "szz_MPa", "sxy_MPa"):
         assert np.all(np.isfinite(vtu.point_data[k]))
     # the bone nodes of the profile are among the mesh nodes, with the same pressure
-    assert vtu.point_data["pressure"].max() >= flat_1mm.peak - 1e-12
+    assert vtu.point_data["pressure_MPa"].max() >= flat_1mm.peak - 1e-12
     # rewriting replaces the folder without leaving temporary siblings
     flat_1mm.write(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]

@@ -2,6 +2,13 @@
 
 Units throughout: millimetres, seconds, newtons, megapascals (N/mm^2).
 Pressures per unit depth in plane strain are N/mm per mm of depth = MPa.
+
+    import tactileskin as ts
+    scene = ts.Scene(thickness=1, material="polyurethane", indenter="braille")  # help(ts.Scene)
+    r = ts.solve(scene, quality="preview")          # r.peak, r.span, r.auc, r.write("out")
+    df = ts.sweep({"thickness": [1, 2, 3]}, quality="preview")   # a pandas DataFrame
+
+The names below are imported on first use, so `import tactileskin` stays light.
 """
 
 __version__ = "0.1.0"
@@ -13,3 +20,35 @@ from tactileskin.errors import (  # noqa: F401  (re-exported API)
     ParameterError,
     TactileSkinError,
 )
+
+# top-level name -> (module, attribute), imported on first access (PEP 562)
+_LAZY = {
+    "Scene": ("tactileskin.scene", "Scene"),
+    "Result": ("tactileskin.results", "Result"),
+    "solve": ("tactileskin.api", "solve"),
+    "scenes": ("tactileskin.api", "scenes"),
+    "default_cache_dir": ("tactileskin.api", "default_cache_dir"),
+    "list_materials": ("tactileskin.materials", "list_materials"),
+}
+
+__all__ = ["__version__", "CadError", "ConvergenceError", "MeshError", "ParameterError",
+           "TactileSkinError", "sweep", *_LAZY]
+
+
+def __getattr__(name):
+    if name == "sweep":  # the module tactileskin.sweep, which is callable: api.sweep (see there)
+        import importlib
+
+        return importlib.import_module("tactileskin.sweep")
+    if name in _LAZY:
+        import importlib
+
+        mod, attr = _LAZY[name]
+        value = getattr(importlib.import_module(mod), attr)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'tactileskin' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY) | {"sweep"})

@@ -177,6 +177,20 @@ class Result:
         if not np.isfinite(self.reaction):
             raise ConvergenceError("non-finite reaction force", {"field": "reaction"})
 
+    def __repr__(self) -> str:
+        """One line: the scene, the metrics, the status and the sizes (not the arrays)."""
+        sc = self.scene or {}
+        name = (f"t{sc['thickness']:g}-{sc.get('material', '?')}-{sc.get('indenter', '?')}-{sc.get('dim', 2)}d"
+                if "thickness" in sc else "scene ?")
+        try:
+            metrics = f"peak={self.peak:.4g} MPa, span={self.span:.3g} mm, auc={self.auc:.4g} MPa*mm"
+        except ParameterError:  # a profile too short for the metrics
+            metrics = "no profile"
+        extra = ", bone_map" if self.bone_map is not None else ""
+        return (f"<Result {name}: {metrics}, reaction={self.reaction:.4g}, status={self.status!r}; "
+                f"{self.s.size} profile points, {self.contact_x.size} contact points, "
+                f"{int(self.stats.get('dofs', 0))} dofs{extra}>")
+
     @property
     def peak(self) -> float:
         return peak(*self._profile())
@@ -236,8 +250,9 @@ class Result:
         return self.summary()["status"]
 
     def write(self, directory) -> Path:
-        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu; with sensors
-        sensors.csv; 3D: also
+        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
+        displacement_mm and the other fields named with their unit, boundaries by name);
+        with a history, result.pvd over result_steps/; with sensors, sensors.csv; 3D: also
         bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
         where it occurs) into `directory`, creating it; each file is written atomically and
         only these names are touched (a result.vtu or map of an earlier write is removed when
@@ -253,6 +268,7 @@ class Result:
             _write_vtu(vtu, self.fields)
         else:  # a stale field file would not match the new profile
             _remove(vtu)
+        _write_steps(directory, self.fields)
         if self.bone_map is not None:
             fileio.atomic_write_text(directory / "bone_map.csv", self.bone_map.to_csv())
             fileio.atomic_write_text(directory / "profile_max_z.csv",
@@ -271,7 +287,7 @@ class Result:
 
 # the file names Result.write owns in a folder
 OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
-             "sensors.csv")
+             "sensors.csv", "result.pvd", "result_steps")
 
 
 def _remove(path: Path) -> None:
@@ -286,18 +302,74 @@ def _csv(header: list[str], *cols) -> str:
     return buf.getvalue()
 
 
-def _write_vtu(path: Path, fields: dict) -> None:
+def _pad3(v) -> np.ndarray:
+    v = np.asarray(v, float)
+    if v.ndim == 2 and v.shape[1] == 2:
+        v = np.column_stack([v, np.zeros(len(v))])
+    return v
+
+
+def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None:
+    """One .vtu of `fields` (fe.output.vtk_fields): the cells with cell data `boundary_id` 0,
+    then each named boundary's facets with its id, and field data {name: [id, dim]}, the
+    names of the ids (as gmsh and meshio keep them)."""
     import meshio  # only when writing files (keeps the solver import light)
 
-    pts = np.asarray(fields["points"], float)
-    if pts.shape[1] == 2:
-        pts = np.column_stack([pts, np.zeros(len(pts))])
-    pdata = {}
-    for k, v in fields["point_data"].items():
-        v = np.asarray(v, float)
-        if v.ndim == 2 and v.shape[1] == 2:
-            v = np.column_stack([v, np.zeros(len(v))])
-        pdata[k] = v
+    pts = _pad3(fields["points"])
+    pdata = {k: _pad3(v) for k, v in (fields["point_data"] if point_data is None else point_data).items()}
+    blocks = [(fields["cell_type"], np.asarray(fields["cells"]))]
+    ids = [np.zeros(len(blocks[0][1]), np.int32)]
+    field_data = {}
+    for k, (name, (ctype, conn)) in enumerate(sorted(fields.get("boundaries", {}).items()), start=1):
+        blocks.append((ctype, np.asarray(conn)))
+        ids.append(np.full(len(conn), k, np.int32))
+        field_data[name] = np.array([k, pts.shape[1] - 1 if ctype == "triangle" else 1], np.int32)
+    mesh = meshio.Mesh(pts, blocks, point_data=pdata, cell_data={"boundary_id": ids} if len(blocks) > 1 else {},
+                       field_data=field_data)
     with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
-        meshio.Mesh(pts, [(fields["cell_type"], np.asarray(fields["cells"]))], point_data=pdata).write(
-            tmp, file_format="vtu")
+        mesh.write(tmp, file_format="vtu")
+        if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it
+            _add_field_data(Path(tmp), field_data)
+
+
+def _add_field_data(path: Path, field_data: dict) -> None:
+    arrays = "".join(f'<DataArray type="Int32" Name="{name}" NumberOfTuples="1" NumberOfComponents="2" '
+                     f'format="ascii">{v[0]} {v[1]}</DataArray>\n' for name, v in field_data.items())
+    data = path.read_bytes()
+    tag = b"<UnstructuredGrid>"
+    i = data.index(tag) + len(tag)
+    path.write_bytes(data[:i] + b"\n<FieldData>\n" + arrays.encode() + b"</FieldData>" + data[i:])
+
+
+STEPS_DIR = "result_steps"  # the .vtu of each increment, listed by result.pvd
+
+
+def _write_steps(directory: Path, fields: dict) -> None:
+    """result.pvd, a ParaView time series over result_steps/step_NNNN.vtu (the displacement
+    of each converged increment on the reference mesh; the final state's stresses and
+    pressure are in result.vtu), or remove those of an earlier write when there are none."""
+    steps = fields.get("steps") if fields else None
+    sd = directory / STEPS_DIR
+    if not steps:
+        _remove(directory / "result.pvd")
+        if sd.is_dir():
+            for p in sd.glob("step_*.vtu"):
+                _remove(p)
+            with fileio.os_errors(sd):
+                if not any(sd.iterdir()):
+                    sd.rmdir()
+        return
+    sd = fileio.make_dirs(sd)
+    keep = set()
+    entries = []
+    for i, (t, u) in enumerate(steps):
+        name = f"step_{i:04d}.vtu"
+        _write_vtu(sd / name, fields, {"displacement_mm": u})
+        keep.add(name)
+        entries.append(f'    <DataSet timestep="{t:.9g}" group="" part="0" file="{STEPS_DIR}/{name}"/>')
+    for p in sd.glob("step_*.vtu"):  # fewer increments than an earlier write
+        if p.name not in keep:
+            _remove(p)
+    fileio.atomic_write_text(directory / "result.pvd",
+                             '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+                             "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")

@@ -252,3 +252,8 @@ class Scene:
         from tactileskin.params import read_toml
 
         return cls.from_dict(read_toml(path, "scene file"))
+
+
+from tactileskin import scene_doc as _scene_doc  # noqa: E402 (needs the class)
+
+Scene.__doc__ = _scene_doc.docstring(Scene)

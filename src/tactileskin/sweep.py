@@ -475,3 +475,18 @@ def run_sweep(
         for lock in locks.values():
             lock.release()
     return outcomes
+
+
+class _CallableModule(type(os)):
+    """`tactileskin.sweep(grid, ...)` runs a sweep from Python (tactileskin.api.sweep) while
+    `tactileskin.sweep` stays this module (run_sweep, expand_grid, ...)."""
+
+    def __call__(self, grid=None, **kw):
+        from tactileskin.api import sweep
+
+        return sweep(grid, **kw)
+
+
+import sys as _sys  # noqa: E402
+
+_sys.modules[__name__].__class__ = _CallableModule

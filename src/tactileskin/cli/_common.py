@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 from pathlib import Path
 
 import click
@@ -10,41 +11,107 @@ import click
 from tactileskin.scene import Formulation, IndenterKind
 
 
-def scene_options(f):
-    """Click options that map one-to-one onto Scene fields."""
+QUALITIES = ("preview", "default", "fine")
+# Scene options every scene command takes (geometry and mesh), then the loading and material
+# ones of the commands that solve. `grid=True` (sweep): the axis options take lists.
+SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text", "braille_standard",
+              "indenter_radius", "indenter_axis", "indenter_file", "depth", "dim", "quality", "mesh_size", "refinement", "order")
+PHYSICS_KEYS = ("rate", "formulation", "elastic")
+
+
+def scene_options(f=None, *, grid: bool = False, physics: bool = True):
+    """Click options that map onto Scene fields, the same on `solve`, `mesh` and `sweep` (one
+    definition, so they cannot drift). The command receives them as one dict `scene_opts`.
+    grid: thickness, material, indenter, depth and Braille text take lists (sweep axes).
+    physics: also --rate, --formulation, --elastic (not on `mesh`: they do not change it)."""
+    if f is None:
+        return lambda g: scene_options(g, grid=grid, physics=physics)
+    many = " (comma-separated list, or start:stop:step)" if grid else ""
+    names = " (comma-separated list)" if grid else ""
     opts = [
-        click.option("--scene", "scene_file", type=click.Path(dir_okay=False), default=None,
-                     help="Scene TOML file; flags below override its fields."),
-        click.option("--thickness", "-t", type=float, default=None, help="Skin thickness (mm)."),
-        click.option("--material", "-m", type=str, default=None, help="Material preset name."),
-        click.option("--indenter", "-i", type=click.Choice([k.value for k in IndenterKind]), default=None),
-        click.option("--braille-text", type=str, default=None, help="Text for a Braille indenter."),
+        click.option("--scene", "--config", "scene_file", type=click.Path(dir_okay=False), default=None,
+                     help="Scene or sweep TOML (Scene fields, optional quality, optional [sweep] lists); "
+                          "the options below override it."),
+        click.option("--thickness", "-t", type=str if grid else float, default=None,
+                     help="Skin thickness (mm)" + many + (". Default 1,3,5." if grid else ".")),
+        click.option("--material", "-m", type=str, default=None,
+                     help="Material preset name or .toml file" + names
+                          + (". Default silicone,polyurethane." if grid else ".")),
+        click.option("--indenter", "-i", default=None,
+                     type=str if grid else click.Choice([k.value for k in IndenterKind]),
+                     help=("Indenters: flat, curved, braille" + names + ". Default all three.") if grid
+                     else "Indenter kind."),
+        click.option("--braille-text", type=str, default=None, multiple=grid,
+                     help="Text for a Braille indenter" + (" (repeatable)." if grid else ".")),
         click.option("--braille-standard", type=str, default=None, help="Braille standard name."),
         click.option("--indenter-radius", type=float, default=None, help="Sphere or cylinder radius (mm)."),
         click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
                      help="Cylinder axis: z along the finger (2D-exact), x across it (3D)."),
         click.option("--indenter-file", type=str, default=None,
                      help="Closed STL/OBJ/PLY/OFF or STEP surface (mm) of a 'file' indenter."),
-        click.option("--depth", type=float, default=None, help="Indentation depth (mm); default 20% of t."),
-        click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
-        click.option("--dim", type=click.Choice(["2", "3"]), default=None, help="2D section or 3D slab."),
-        click.option("--mesh-size", type=float, default=None, help="Global element size (mm)."),
-        click.option("--refinement", type=float, default=None, help="Global/refined size ratio."),
-        click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
+        click.option("--depth", type=str if grid else float, default=None,
+                     help="Indentation depth (mm)" + many + "; default 20 % of t."),
+        click.option("--dim", type=click.Choice(["2", "3"]), default=None,
+                     help="2D plane-strain section or 3D slab."),
+        click.option("--quality", type=click.Choice(QUALITIES), default=None,
+                     help="Mesh preset of the scene's dimension (data/presets.json; "
+                          "docs/speed_vs_error.md). Default: the `default` sizes."),
+        click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality."),
+        click.option("--refinement", type=float, default=None,
+                     help="Global / refined element size ratio; overrides --quality."),
+        click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default 2)."),
     ]
+    if physics:
+        opts += [
+            click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
+            click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
+            click.option("--elastic", is_flag=True, default=None,
+                         help="Ignore viscoelasticity (the Prony series)."),
+        ]
+    keys = SCENE_KEYS + (PHYSICS_KEYS if physics else ())
+
+    @functools.wraps(f)
+    def wrapper(*args, **kw):
+        kw["scene_opts"] = {k: kw.pop(k, None) for k in keys}
+        return f(*args, **kw)
+
     for o in reversed(opts):
-        f = o(f)
-    return f
+        wrapper = o(wrapper)
+    return wrapper
 
 
-def scene_from_options(scene_file=None, **kw):
+def _field_changes(opts: dict) -> dict:
+    """Scene-field changes of the single-valued options (None: not given)."""
+    ch = {k: opts.get(k) for k in ("thickness", "material", "indenter", "braille_text", "braille_standard",
+                                    "indenter_radius", "indenter_axis", "indenter_file",
+                                    "depth", "rate", "formulation")}
+    if opts.get("dim") is not None:
+        ch["dim"] = int(opts["dim"])
+    if opts.get("order") is not None:
+        ch["order"] = int(opts["order"])
+    if opts.get("elastic"):
+        ch["viscoelastic"] = False
+    return {k: v for k, v in ch.items() if v is not None and v != ()}
+
+
+def scene_from_options(scene_opts: dict, command: str = "solve"):
+    """The Scene of `solve`/`mesh`: the file (scene or one-case sweep), the options over it,
+    then the quality preset (option, else file) and explicit mesh sizes over that."""
+    from tactileskin import scenefile
     from tactileskin.scene import Scene
 
-    base = Scene.from_toml(scene_file) if scene_file else Scene()
-    changes = {k: v for k, v in kw.items() if v is not None}
-    if "dim" in changes:
-        changes["dim"] = int(changes["dim"])
-    return base.replace(**changes) if changes else base
+    sf = scenefile.read(scene_opts.get("scene_file"))
+    fields = scenefile.single_scene_fields(sf, command)
+    mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
+    changes = _field_changes(scene_opts)
+    if command == "mesh" and changes.get("order") == 1:
+        changes["formulation"] = "displacement"  # the mesh does not depend on it; P1 needs it
+    base = Scene.from_dict(fields).replace(**changes)
+    mesh.update({k: scene_opts[k] for k in scenefile.MESH_FIELDS if scene_opts.get(k) is not None})
+    quality = scene_opts.get("quality") or sf.quality
+    if quality is None and mesh:  # sizes without a preset: over the defaults, as Scene does
+        return base.replace(**mesh)
+    return scenefile.apply_quality(base, quality, mesh)
 
 
 @contextlib.contextmanager

@@ -8,13 +8,13 @@ from tactileskin.cli._common import scene_from_options, scene_options
 
 
 @click.command("mesh")
-@scene_options
+@scene_options(physics=False)
 @click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
               help="Mesh file to write: .msh (gmsh 2.2), .vtu (ParaView) or .inp (Abaqus/CalculiX).")
-@click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default: scene).")
 @click.option("--cell", type=click.Choice(["tri", "quad"]), default="tri", show_default=True,
-              help="2D cell shape (quad: all-quadrilateral, 9-node when order 2).")
-def command(out, order, cell, **scene_kw):
+              help="2D cell shape (quad: all-quadrilateral, 9-node when order 2; for export: "
+                   "the solver meshes with triangles).")
+def command(out, cell, scene_opts):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
     from rich.console import Console
     from rich.markup import escape
@@ -25,9 +25,7 @@ def command(out, order, cell, **scene_kw):
 
     if out is not None and not any(out.lower().endswith(s) for s in FORMATS):
         raise ParameterError("--out", out, "a file name ending in " + ", ".join(FORMATS))
-    scene = scene_from_options(**scene_kw)
-    if order is not None:
-        scene = scene.replace(order=int(order))
+    scene = scene_from_options(scene_opts, "mesh")
     sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
 

@@ -22,18 +22,20 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
     "the material law outside its range: see 'status' and 'flags' in summary.json); 2 an "
     "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
-@click.option("--out", "out", type=click.Path(file_okay=False), required=True,
+@click.option("--out", "-o", "out", type=click.Path(file_okay=False), required=True,
               help="Output folder (profile.csv, contact.csv, summary.json, result.vtu; 3D also "
                    "bone_map.csv, bone_map.png, profile_max_z.csv): a new or empty folder, or one "
                    "written by `solve`; only these files are replaced.")
-@click.option("--elastic", is_flag=True, default=False, help="Ignore viscoelasticity (Prony series).")
+@click.option("--history", is_flag=True, default=False,
+              help="Also write result.pvd: the displacement of every increment as a ParaView time "
+                   "series (result_steps/).")
 @click.option("--compare-2d", is_flag=True, default=False,
               help="3D scenes: also solve the paper's 2D section (a Braille row as a ridge) at "
                    "the default 2D mesh, write it to OUT/section_2d and report the differences.")
 @click.option("--sensors", "sensors_file", type=click.Path(dir_okay=False), default=None,
               help="TOML file of [[sensors]] layouts (replaces the scene file's): writes "
                    "sensors.csv and sensors.png.")
-def command(out, elastic, compare_2d, sensors_file=None, **kw):
+def command(out, history, compare_2d, scene_opts, sensors_file=None):
     """Solve the finite-strain contact problem of one scene and write the results."""
     from rich.console import Console
     from rich.markup import escape
@@ -42,9 +44,7 @@ def command(out, elastic, compare_2d, sensors_file=None, **kw):
 
     from tactileskin.fe import solve
 
-    scene = scene_from_options(**kw)
-    if elastic:
-        scene = scene.replace(viscoelastic=False)
+    scene = scene_from_options(scene_opts, "solve")
     if sensors_file:
         from tactileskin import validate
         from tactileskin.errors import ParameterError
@@ -59,7 +59,7 @@ def command(out, elastic, compare_2d, sensors_file=None, **kw):
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
     with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
-            res = solve(scene, progress=show)
+            res = solve(scene, progress=show, history=history)
         path = res.write(out)
         _write_map_figure(res, path, scene.label())
         _write_sensors_figure(res, path, scene.label())
@@ -81,7 +81,7 @@ def command(out, elastic, compare_2d, sensors_file=None, **kw):
                   f"({s['peak_sensor_id']})")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
-    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).is_file()))
+    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).exists()))
     if "min_J" in s:
         t.add_row("min volume ratio J / max |stress|",
                   f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import click
 
-from tactileskin.cli._common import claimed_output
+from tactileskin.cli._common import _field_changes, claimed_output, scene_options
 from tactileskin.errors import ParameterError
 
 # the names a sweep writes into OUT (a folder of an earlier version holding only these is ours)
-OWN_NAMES = ("results.csv", "profiles.csv", "report.md", "cache",
-             *(f"{stem}.{ext}" for stem in ("fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
+OWN_NAMES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md", "cache",
+             *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
                for ext in ("png", "svg")))
 _RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
@@ -27,25 +27,14 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
     "failed but some result is suspect (no contact, or the material law outside its range: "
     "the 'status' column of results.csv and the top of report.md say why); 2 an error "
     "before any case ran (bad parameter, output folder)."))
-@click.option("--out", "out", type=click.Path(file_okay=False), default="out", show_default=True,
-              help="Output folder: results.csv, profiles.csv, figures, report.md (a new or empty "
-                   "folder, or one written by `sweep`; other files are never touched).")
-@click.option("--config", type=click.Path(dir_okay=False), default=None,
-              help="Sweep TOML ([sweep] lists, optional [scene] base); flags override it.")
-@click.option("--thickness", "-t", default=None, help="Thicknesses (mm): '1,3,5' or '1:5:0.5'. Default 1,3,5.")
-@click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone,polyurethane.")
-@click.option("--indenter", "-i", default=None, help="Indenters, comma-separated. Default flat,curved,braille.")
-@click.option("--depth", default=None, help="Depths (mm), comma-separated; default 20 % of each thickness.")
-@click.option("--braille-text", multiple=True, help="Braille text(s) for Braille cases (repeatable).")
+@scene_options(grid=True)
+@click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out", show_default=True,
+              help="Output folder: results.csv/.parquet, profiles.csv/.parquet, figures, report.md (a "
+                   "new or empty folder, or one written by `sweep`; other files are never touched).")
 @click.option("--braille-dim", "braille_dim", type=click.Choice(["2", "3", "both"]), default=None,
               help="Braille cases as the paper's 2D ridge section (2), as the 3D slab with real "
                    "dots (3), or both side by side in the report. Default 2 (the [scene] dim). "
                    "Flat and curved cases stay 2D (exact for them). 3D solves take minutes each.")
-@click.option("--rate", type=float, default=None, help="Indentation rate (mm/s).")
-@click.option("--quality", type=click.Choice(["preview", "default", "fine"]), default=None,
-              help="Mesh preset of each case's dimension (tactileskin/data/presets.json; docs/speed_vs_error.md).")
-@click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality.")
-@click.option("--formulation", type=click.Choice(["mixed", "displacement"]), default=None)
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Local worker processes (default: all cores).")
@@ -53,8 +42,7 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
 @click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
-def command(out, config, thickness, material, indenter, depth, braille_text, braille_dim, rate, quality, mesh_size,
-            formulation, scheduler, workers, serial, cache_dir, no_render):
+def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.console import Console
     from rich.markup import escape
@@ -64,29 +52,12 @@ def command(out, config, thickness, material, indenter, depth, braille_text, bra
     from tactileskin import quality as result_quality  # `quality` is the mesh preset option
 
     from tactileskin.report.outputs import write_outputs
-    from tactileskin.scene import Scene
-    from tactileskin.sweep import (PAPER_INDENTERS, PAPER_MATERIALS, PAPER_THICKNESSES, ResultCache,
-                                   check_scheduler, expand_grid, load_spec, parse_values, run_sweep)
+    from tactileskin.sweep import ResultCache, check_scheduler, run_sweep
 
     console = Console()
     if scheduler is not None:
         check_scheduler(scheduler)
-    spec = load_spec(config) if config else {}
-    base = spec.pop("base", Scene())
-    changes = {k: v for k, v in dict(rate=rate, formulation=formulation).items() if v is not None}
-    if changes:
-        base = base.replace(**changes)
-    grid = dict(
-        thicknesses=parse_values(thickness, "thickness") if thickness else spec.get("thicknesses", PAPER_THICKNESSES),
-        materials=_names(material, "material") if material else spec.get("materials", PAPER_MATERIALS),
-        indenters=_names(indenter, "indenter") if indenter else spec.get("indenters", PAPER_INDENTERS),
-        depths=parse_values(depth, "depth") if depth else spec.get("depths", (None,)),
-        braille_texts=tuple(braille_text) if braille_text else spec.get("braille_texts", ("",)),
-        braille_dims=BRAILLE_DIM_CHOICES[braille_dim] if braille_dim else spec.get("braille_dims"),
-    )
-    # the preset per scene (it depends on the indenter and dim), --mesh-size over it
-    scenes = expand_grid(base=base, quality=quality,
-                         overrides=None if mesh_size is None else dict(mesh_size=mesh_size), **grid)
+    scenes = scenes_from_options(scene_opts, braille_dim)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     with claimed_output(out, "sweep", _own_names(out)):  # before any solving
@@ -118,6 +89,42 @@ def command(out, config, thickness, material, indenter, depth, braille_text, bra
     console.print(f"report: {escape(str(paths['report']))}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
                   f"{nsus} suspect, {nfail} failed, {wall:.1f} s)", highlight=False)
     return EXIT_FAILED if nfail else (EXIT_SUSPECT if nsus else 0)
+
+
+def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
+    """The sweep's scenes: the file's [sweep] lists and Scene fields (a field is a one-value
+    list), the options over them (lists), the quality preset of each case's dimension and
+    the explicit mesh sizes over it. Axes given nowhere are the paper's (1,3,5 mm x silicone,
+    polyurethane x flat, curved, Braille)."""
+    from tactileskin import scenefile
+    from tactileskin.scene import Scene
+    from tactileskin.sweep import expand_grid, parse_values
+
+    o = scene_opts
+    sf = scenefile.read(o.get("scene_file"))
+    fields = dict(sf.fields)
+    axes = dict(sf.axes)
+    for f, ax in scenefile.AXES.items():
+        if f in fields:
+            axes[ax] = (fields.pop(f),)
+    mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
+    mesh.update({k: o[k] for k in scenefile.MESH_FIELDS if o.get(k) is not None})
+    single = {k: v for k, v in o.items() if k not in ("thickness", "material", "indenter", "depth", "braille_text")}
+    base = Scene.from_dict(fields).replace(**_field_changes(single))
+    if o.get("thickness"):
+        axes["thicknesses"] = parse_values(o["thickness"], "thickness")
+    if o.get("material"):
+        axes["materials"] = _names(o["material"], "material")
+    if o.get("indenter"):
+        axes["indenters"] = _names(o["indenter"], "indenter")
+    if o.get("depth"):
+        axes["depths"] = parse_values(o["depth"], "depth")
+    if o.get("braille_text"):
+        axes["braille_texts"] = tuple(o["braille_text"])
+    if braille_dim:
+        axes["braille_dims"] = BRAILLE_DIM_CHOICES[braille_dim]
+    # the preset per scene (it depends on the indenter and dim), explicit mesh sizes over it
+    return expand_grid(base=base, quality=o.get("quality") or sf.quality, overrides=mesh or None, **axes)
 
 
 def _case_status(cache, oc) -> str:

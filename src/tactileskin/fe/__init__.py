@@ -162,7 +162,9 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     t_setup = time.perf_counter() - t1
 
     def record(model, ev):
-        return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1])}
+        # the displacement of each increment: result.pvd, a time series (fe.output.vtk_fields)
+        return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1]),
+                "displacement": model.u.reshape(-1, model.m).copy()}
 
     with blas_threads():
         ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)

@@ -280,6 +280,37 @@ def law_state(ev: Evaluation, sig: np.ndarray) -> dict:
             "max_pressure_mpa": float(np.max(kernels.mean_pressure(sig)))}
 
 
+# units of the nodal fields, put into their names in result.vtu (ParaView shows the names)
+FIELD_UNITS = {"pressure": "MPa", "displacement": "mm", "sxx": "MPa", "syy": "MPa", "szz": "MPa",
+               "sxy": "MPa", "syz": "MPa", "sxz": "MPa"}
+_VTK_FACET = {2: "line", 3: "triangle"}
+
+
+def vtk_fields(model: Model, fields: dict, history=()) -> dict:
+    """The result.vtu content: the reference (undeformed) node positions, the nodal fields
+    named with their unit (displacement_mm, pressure_MPa, sxx_MPa, ...; ParaView's Warp By
+    Vector on displacement_mm shows the deformed skin), the named boundaries as facet cells
+    (linear, on the vertices) with their name in field data, and the displacement of every
+    increment of `history` (entries with "t" and "displacement") for result.pvd."""
+    cells = model.sdofs
+    X = model.basis.doflocs.T
+    mesh, b = model.mesh, model.basis
+    boundaries = {}
+    for name, facets in getattr(model, "boundaries", {}).items():
+        v = mesh.facets[:, np.asarray(facets)].T
+        boundaries[name] = (_VTK_FACET[model.m], b.dofs.nodal_dofs[0, v])
+    steps = [(float(h["t"]), np.asarray(h["displacement"], float)) for h in history if "displacement" in h]
+    return {
+        "points": X,
+        "cells": cells,
+        "cell_type": _VTK_CELL[(model.m, cells.shape[1])],
+        "point_data": {f"{k}_{FIELD_UNITS[k]}" if k in FIELD_UNITS else k: v for k, v in fields.items()},
+        "boundaries": boundaries,
+        "steps": steps,
+        "reference": True,
+    }
+
+
 def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: str = "bone_interface",
                 vertical: int = 1, scene: dict | None = None, plane_z: float | None = None) -> Result:
     """Result of a converged state. 2D: the profile at the path's nodes. 3D: the profile on
@@ -326,21 +357,14 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     for name, v in fields.items():
         if not np.all(np.isfinite(v)):
             raise ConvergenceError(f"non-finite nodal field {name!r}", {"field": name})
-    cells = model.sdofs
-    X = model.basis.doflocs.T
-    u = model.u.reshape(-1, model.m)
-    vtk = {
-        "points": X + u,
-        "cells": cells,
-        "cell_type": _VTK_CELL[(model.m, cells.shape[1])],
-        "point_data": {k: v for k, v in fields.items()},
-    }
-    st = {"dofs": int(model.ndof), "free_dofs": int(len(model.free)), "elements": int(len(cells)),
+    vtk = vtk_fields(model, fields, stats.history)
+    st = {"dofs": int(model.ndof), "free_dofs": int(len(model.free)), "elements": int(len(model.sdofs)),
           "increments": stats.increments, "newton_iterations": stats.newton_iterations,
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
           "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           "reaction_vector": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, reaction=float(r[vertical]),
-                  stats=st, fields=vtk, history=list(stats.history), scene=scene,
+                  stats=st, fields=vtk, history=[{k: v for k, v in h.items() if k != "displacement"}
+                                                 for h in stats.history], scene=scene,
                   bone_map=bmap)

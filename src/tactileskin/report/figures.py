@@ -1,6 +1,11 @@
-"""The paper's figures from sweep records: Fig. 10 (profiles), 11 (peak), 12 (span), 13 (AUC).
+"""The paper's figures from sweep records: Fig. 10 (profiles), 11 (peak), 12 (span), 13 (AUC),
+and the designer's figure: peak, span and AUC against thickness, one line per indenter and
+material (metrics_vs_thickness), the one a thickness is chosen from.
 
-Each figure is written as PNG and SVG. matplotlib runs on the Agg backend (no display).
+Each figure is written as PNG and SVG (text kept as text). Sizes follow the grid: panels wrap
+into rows of at most MAX_COLUMNS, so 11 thicknesses give a block, not a strip. Colours are
+the Okabe-Ito palette (safe for the common colour-vision deficiencies), told apart by line
+style and marker too. matplotlib runs on the Agg backend (no display).
 """
 
 from __future__ import annotations
@@ -13,7 +18,10 @@ import numpy as np
 from tactileskin.fileio import atomic_write_bytes, make_dirs
 
 INDENTER_ORDER = ("flat", "curved", "braille")
-COLOURS = {"flat": "#1f77b4", "curved": "#d62728", "braille": "#2ca02c"}
+# Okabe & Ito (2008), "Color Universal Design": blue, vermillion, bluish green
+COLOURS = {"flat": "#0072B2", "curved": "#D55E00", "braille": "#009E73"}
+MATERIAL_MARKERS = ("o", "s", "^", "D", "v", "P")
+MAX_COLUMNS = 4
 
 
 def _plt():
@@ -22,7 +30,14 @@ def _plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    plt.rcParams["svg.fonttype"] = "none"  # SVG text stays text (searchable, editable)
     return plt
+
+
+def _grid(n: int, max_cols: int = MAX_COLUMNS) -> tuple[int, int]:
+    """(rows, columns) of n panels wrapped at max_cols columns."""
+    cols = max(1, min(n, max_cols))
+    return -(-n // cols), cols
 
 
 def _save(fig, out: Path, stem: str) -> list[Path]:
@@ -65,16 +80,21 @@ _HATCHES = ("", "//", "..", "xx", "\\\\", "++")
 
 
 def profiles_figure(records, out: Path) -> list[Path]:
-    """Fig. 10 style: P(s) along the bone; rows materials, columns thicknesses."""
+    """Fig. 10 style: P(s) along the bone; one panel per (material, thickness), thicknesses
+    in rows of at most MAX_COLUMNS per material; one y axis for all (they are compared)."""
     plt = _plt()
     mats, thick = _axes_keys(records)
-    fig, axes = plt.subplots(len(mats), len(thick), figsize=(3.6 * len(thick), 2.8 * len(mats)),
-                             squeeze=False, sharex=True)
+    rows_per_mat, cols = _grid(len(thick))
+    nrows = rows_per_mat * len(mats)
+    fig, axes = plt.subplots(nrows, cols, figsize=(3.2 * cols, 2.5 * nrows + 0.6),
+                             squeeze=False, sharex=True, sharey=True, constrained_layout=True)
+    variants = sorted({getattr(r, "variant", "") for r in records})
+    dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
+    used = set()
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
-            ax = axes[i][j]
-            variants = sorted({getattr(r, "variant", "") for r in records})
-            dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
+            ax = axes[i * rows_per_mat + j // cols][j % cols]
+            used.add(id(ax))
             for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t),
                             key=lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,
                                            getattr(r, "variant", ""), r.scene.dim)):
@@ -84,11 +104,17 @@ def profiles_figure(records, out: Path) -> list[Path]:
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.set_xlim(0, 8)
-            if j == 0:
+            if j % cols == 0:
                 ax.set_ylabel("mean pressure P (MPa)")
-            if i == len(mats) - 1:
-                ax.set_xlabel("distance along bone s (mm)")
-    axes[0][0].legend(fontsize=8)
+            ax.set_xlabel("distance along bone s (mm)")
+            ax.label_outer()
+    for row in axes:
+        for ax in row:
+            if id(ax) not in used:
+                ax.set_visible(False)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 4), fontsize=8)
     fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)", fontsize=10)
     return _save(fig, out, "fig10_profiles")
 
@@ -104,10 +130,16 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     series = sorted({key(r) + (r["indenter"],) for r in rows})
     variants = sorted({r.get("variant") or "" for r in rows})
     dims = {r.get("dim", 2) for r in rows}
-    fig, axes = plt.subplots(1, len(mats), figsize=(4.2 * len(mats), 3.2), squeeze=False)
+    nrows, cols = _grid(len(mats), 2)
+    width = float(np.clip(1.2 + 0.22 * len(thick) * max(len(series), 1), 3.6, 7.5))  # per panel
+    fig, axes = plt.subplots(nrows, cols, figsize=(width * cols, 3.2 * nrows + 0.5), squeeze=False,
+                             sharey=True, constrained_layout=True)
+    for row in axes:
+        for ax in row[len(mats):]:
+            ax.set_visible(False)
     w = 0.8 / max(len(series), 1)
     for k, m in enumerate(mats):
-        ax = axes[0][k]
+        ax = axes[k // cols][k % cols]
         for q, (*sk, ind) in enumerate(series):
             vals = []
             for t in thick:
@@ -118,17 +150,61 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
                    label=_series(ind, sk[1], sk[2]) + (f" {sk[3]}d" if len(dims) > 1 else ""),
                    color=COLOURS.get(ind),
                    hatch=_HATCHES[variants.index(sk[2]) % len(_HATCHES)])
-        ax.set_xticks(np.arange(len(thick)), [f"{t:g} mm" for t in thick])
+        ax.set_xticks(np.arange(len(thick)), [f"{t:g}" for t in thick],
+                      rotation=45 if len(thick) > 8 else 0)
+        ax.set_xlabel("skin thickness t (mm)")
         ax.set_title(m, fontsize=9)
-        ax.set_ylabel(ylabel)
-    axes[0][0].legend(fontsize=8)
+        if k % cols == 0:
+            ax.set_ylabel(ylabel)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 4), fontsize=8)
     fig.suptitle(title, fontsize=10)
     return _save(fig, out, stem)
 
 
+METRICS = (("peak_mpa", "peak P (MPa)"), ("span_mm", "span (mm)"), ("auc", "area under P(s) (MPa mm)"))
+
+
+def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
+    """Peak, span and AUC against skin thickness: one panel per metric, one line per
+    indenter (colour) and material (marker, line style) and case variant; ok cases only.
+    The figure a thickness is chosen from (docs/metrics.md)."""
+    plt = _plt()
+    ok = [r for r in rows if r.get("status", "ok") == "ok" and r.get("peak_mpa") is not None]
+    mats = sorted({r["material"] for r in ok})
+    dims = {r.get("dim", 2) for r in ok}
+    key = lambda r: (_order(r["indenter"]), r["indenter"], r.get("braille_text") or "",  # noqa: E731
+                     r.get("variant") or "", r.get("dim", 2), r["material"])
+    series = sorted({key(r) for r in ok})
+    fig, axes = plt.subplots(1, len(METRICS), figsize=(4.0 * len(METRICS), 3.4), squeeze=False,
+                             constrained_layout=True)
+    for ax, (metric, label) in zip(axes[0], METRICS):
+        for sk in series:
+            pts = sorted((r["thickness_mm"], r[metric]) for r in ok if key(r) == sk)
+            if not pts:
+                continue
+            _, ind, text, variant, dim, mat = sk
+            mi = mats.index(mat)
+            t, v = zip(*pts)
+            ax.plot(t, v, _DASHES[mi % len(_DASHES)], marker=MATERIAL_MARKERS[mi % len(MATERIAL_MARKERS)],
+                    color=COLOURS.get(ind), ms=4,
+                    label=f"{_series(ind, text, variant)}{f' {dim}d' if len(dims) > 1 else ''}, {mat}")
+        ax.set_xlabel("skin thickness t (mm)")
+        ax.set_ylabel(label)
+        ax.set_ylim(bottom=0)
+        ax.grid(True, lw=0.3, color="0.85")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 3), fontsize=8)
+    fig.suptitle("Bone-pressure metrics against skin thickness", fontsize=10)
+    return _save(fig, out, "metrics_vs_thickness")
+
+
 def all_figures(records, rows, out: Path) -> list[Path]:
     make_dirs(out)
-    paths = profiles_figure(records, out)
+    paths = thickness_figure(rows, out)
+    paths += profiles_figure(records, out)
     paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
     paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)
     paths += metric_figure(rows, "auc", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)

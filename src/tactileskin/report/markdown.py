@@ -290,7 +290,70 @@ def _status_order(rows):
     return sorted(rows, key=lambda r: rank[quality.kind(r.get("status", ""))])
 
 
-def build_report(rows, records, failures, figures, renders, wall_s: float) -> str:
+def package_version() -> str:
+    """The package version, and the git commit (with '+dirty' for uncommitted changes) when
+    the package runs from a checkout."""
+    import subprocess
+    from pathlib import Path
+
+    from tactileskin import __version__
+
+    here = Path(__file__).resolve().parents[1]
+    try:
+        top = subprocess.run(["git", "-C", str(here), "rev-parse", "--show-toplevel", "--short", "HEAD"],
+                             capture_output=True, text=True, timeout=5)
+        if top.returncode != 0:
+            return __version__
+        root, commit = top.stdout.split()[:2]
+        if not (Path(root) / "pyproject.toml").is_file():  # some other repository around an install
+            return __version__
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=5).stdout.strip()
+        return f"{__version__} (git {commit}{'+dirty' if dirty else ''})"
+    except (OSError, subprocess.SubprocessError, ValueError):
+        return __version__
+
+
+def quality_name(scene) -> str:
+    """The quality preset whose mesh sizes the scene has, or 'custom'."""
+    from tactileskin import presets
+
+    braille = scene.indenter.value == "braille"
+    for q in presets.QUALITIES:
+        size, ref = presets.mesh(scene.dim, q, braille=braille and scene.dim == 2)
+        if math.isclose(size, scene.mesh_size, rel_tol=1e-9) and math.isclose(ref, scene.refinement, rel_tol=1e-9):
+            return q
+    return "custom"
+
+
+def run_settings(scenes) -> list[str]:
+    """The section stating what produced the numbers: version, mesh presets and sizes, model
+    and solver settings (the solver's defaults: a sweep does not change them)."""
+    import dataclasses
+    import platform
+
+    from tactileskin.fe.solver import SolverOptions
+
+    scenes = list(scenes)
+    out = ["## Run settings", "",
+           f"tactileskin {package_version()}, Python {platform.python_version()}.", ""]
+    if scenes:
+        out += ["| dim | indenter | quality preset | mesh size (mm) | refinement | refined size (mm) | "
+                "order | formulation | viscoelastic | rate (mm/s) | cases |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+        groups = defaultdict(int)
+        for sc in scenes:
+            groups[(sc.dim, sc.indenter.value, quality_name(sc), sc.mesh_size, sc.refinement, sc.order,
+                    sc.formulation.value, sc.viscoelastic, sc.rate)] += 1
+        for (dim, ind, q, h, ref, order, form, visco, rate), n in sorted(groups.items(), key=str):
+            out.append(f"| {dim}D | {ind} | {q} | {h:g} | {ref:g} | {h / ref:.3g} | P{order} | {form} | "
+                       f"{'yes' if visco else 'no'} | {rate:g} | {n} |")
+        out.append("")
+    opts = ", ".join(f"{f.name} = {getattr(SolverOptions(), f.name)!r}" for f in dataclasses.fields(SolverOptions))
+    out += [f"Solver settings (fe.solver.SolverOptions): {opts}.", ""]
+    return out
+
+
+def build_report(rows, records, failures, figures, renders, wall_s: float, scenes=None) -> str:
     kinds = [quality.kind(r.get("status", "")) for r in rows]
     nok, nsus = kinds.count("ok"), kinds.count("suspect")
     out = ["# tactileskin sweep report", "",
@@ -305,7 +368,13 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
                 "tactileskin/quality.py, docs/hard_cases.md) are listed in the tables but left out of "
                 "the paper checks and the discrimination verdicts; failed cases have no result.", ""]
         out += [f"- {r['case']}: {r['status']}" for r in bad]
-    out += ["", "## Cases", "",
+    out += ["", "## Which thickness?", "",
+            "Peak, span and AUC of the bone pressure against the skin thickness, one line per "
+            "indenter and material (ok cases only): `metrics_vs_thickness.png` / `.svg`.", "",
+            "![metrics against thickness](metrics_vs_thickness.png)"] if any(
+                p.name == "metrics_vs_thickness.png" for p in figures) else []
+    out += [""] + run_settings(scenes if scenes is not None else [r.scene for r in records])
+    out += ["## Cases", "",
             "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm) | increments | Newton its | wall (s) | status |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in _status_order(rows):
@@ -369,7 +438,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float) -> st
         out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]
     out += ["", "## Figures", ""]
     for p in figures:
-        if p.suffix == ".png":
+        if p.suffix == ".png" and p.stem != "metrics_vs_thickness":
             out.append(f"![{p.stem}]({p.name})")
     for p in renders:
         out.append(f"![{p.stem}]({p.name})")

@@ -51,7 +51,28 @@ def collect(outcomes, cache):
     return records, rows, failures
 
 
-def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = True) -> dict:
+def profile_rows(records):
+    """(case, s_mm, pressure_mpa) of every profile point, in long form."""
+    for rec in records:
+        for s, p in zip(rec.s, rec.pressure):
+            yield rec.case, float(s), float(p)
+
+
+def _write_parquet(path: Path, columns: list[str], rows) -> None:
+    """A Parquet table (pyarrow) of `rows`, written atomically; the columns keep their types."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from tactileskin.fileio import atomic_path, os_errors
+
+    data = {c: [r[i] if isinstance(r, tuple) else r.get(c) for r in rows] for i, c in enumerate(columns)}
+    table = pa.table(data)
+    with atomic_path(path) as tmp, os_errors(path):
+        pq.write_table(table, tmp)
+
+
+def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = True,
+                  figures: bool = True) -> dict:
     from tactileskin.report.figures import all_figures
     from tactileskin.report.markdown import build_report
 
@@ -63,15 +84,17 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     w.writeheader()
     w.writerows(rows)
     atomic_write_text(out / "results.csv", buf.getvalue())
+    _write_parquet(out / "results.parquet", RESULT_COLUMNS + ["dim", "variant"], rows)
 
     buf = io.StringIO()
     buf.write("case,s_mm,pressure_mpa\n")
-    for rec in records:
-        for s, p in zip(rec.s, rec.pressure):
-            buf.write(f"{rec.case},{s:.6g},{p:.6g}\n")
+    prof = list(profile_rows(records))
+    for case, s, p in prof:
+        buf.write(f"{case},{s:.6g},{p:.6g}\n")
     atomic_write_text(out / "profiles.csv", buf.getvalue())
+    _write_parquet(out / "profiles.parquet", ["case", "s_mm", "pressure_mpa"], prof)
 
-    figures = all_figures(records, rows, out) if records else []
+    figures = all_figures(records, rows, out) if records and figures else []
     renders = []
     if render and records:
         from tactileskin.report.render import render_case
@@ -89,7 +112,8 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
                     renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
                     log.warning("render of %s failed: %s", rec.case, e)
-    report = build_report(rows, records, failures, figures, renders, wall_s)
+    report = build_report(rows, records, failures, figures, renders, wall_s,
+                          scenes=[oc.scene for oc in outcomes])
     atomic_write_text(out / "report.md", report)
     return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",
-                figures=figures, renders=renders, failures=failures, rows=rows)
+                figures=figures, renders=renders, failures=failures, rows=rows, records=records)

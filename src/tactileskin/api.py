@@ -1,0 +1,180 @@
+"""The Python API a notebook user finds at the top level: `tactileskin.solve`, `tactileskin.sweep`.
+
+    import tactileskin as ts
+    r = ts.solve(ts.Scene(thickness=1, material="polyurethane"), quality="preview")
+    df = ts.sweep({"thickness": [1, 2, 3], "indenter": ["flat", "braille"]}, quality="preview")
+
+`sweep` caches every case (cache.py: keyed by everything that produced it), so rerunning a
+cell reuses the finished cases. The cache is `out/cache` when `out` is given, else
+`default_cache_dir()`: $TACTILESKIN_CACHE, else $XDG_CACHE_HOME/tactileskin (~/.cache/tactileskin).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+from pathlib import Path
+
+from tactileskin.errors import ParameterError
+
+# sweep(grid) keys: a Scene field (one value or a list) or a sweep list name
+_GRID_ALIASES = {"thickness": "thicknesses", "material": "materials", "indenter": "indenters",
+                 "depth": "depths", "braille_text": "braille_texts", "braille_dim": "braille_dims"}
+
+
+def default_cache_dir() -> Path:
+    """Where `sweep` caches results when no `out` or `cache` is given."""
+    env = os.environ.get("TACTILESKIN_CACHE")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "tactileskin"
+
+
+def solve(scene=None, *, quality: str | None = None, history: bool = False, progress=None, **fields):
+    """Solve one scene and return its Result (profile, metrics, fields; .write(folder) saves it).
+
+    scene: a Scene, a scene/one-case sweep TOML path, or None (Scene fields from **fields).
+    quality: 'preview', 'default' or 'fine' mesh preset (explicit mesh_size/refinement win).
+    history: keep per-increment records (and write result.pvd, a time series, with .write).
+    """
+    from tactileskin import scenefile
+    from tactileskin.fe import solve as fe_solve
+
+    sc, file_quality, mesh = _scene(scene, fields)
+    if quality or file_quality:
+        sc = scenefile.apply_quality(sc, quality or file_quality, mesh)
+    return fe_solve(sc, history=history, progress=progress)
+
+
+def _scene(scene, fields: dict):
+    """(Scene, file's quality, explicit mesh fields) of solve()'s arguments."""
+    from tactileskin import scenefile
+    from tactileskin.scene import Scene
+
+    quality = None
+    if isinstance(scene, Scene):
+        base = scene
+    elif scene is None:
+        base = Scene()
+    elif isinstance(scene, (str, os.PathLike)):
+        sf = scenefile.read(scene)
+        quality = sf.quality
+        base = Scene.from_dict(scenefile.single_scene_fields(sf, "tactileskin.solve"))
+    else:
+        raise ParameterError("scene", type(scene).__name__, "a Scene, a TOML file path or None")
+    mesh = {k: fields[k] for k in scenefile.MESH_FIELDS if fields.get(k) is not None}
+    return (base.replace(**fields) if fields else base), quality, mesh
+
+
+def scenes(grid=None, *, quality: str | None = None, base=None) -> list:
+    """The Scenes of a sweep grid (see `sweep`)."""
+    from tactileskin import scenefile
+    from tactileskin.scene import Scene
+    from tactileskin.sweep import expand_grid
+
+    if isinstance(grid, (list, tuple)) and all(isinstance(s, Scene) for s in grid):
+        if quality is None:
+            return list(grid)
+        return [scenefile.apply_quality(s, quality, {}) for s in grid]
+    axes, fields, file_quality = {}, {}, None
+    if isinstance(grid, (str, os.PathLike)):
+        sf = scenefile.read(grid)
+        fields, axes, file_quality = dict(sf.fields), dict(sf.axes), sf.quality
+        for f, ax in scenefile.AXES.items():
+            if f in fields:
+                axes[ax] = (fields.pop(f),)
+    elif isinstance(grid, dict):
+        for k, v in grid.items():
+            ax = _GRID_ALIASES.get(k, k)
+            if ax in _GRID_ALIASES.values():
+                axes[ax] = [v] if isinstance(v, (str, int, float)) or v is None else list(v)
+            else:
+                fields[k] = v  # a Scene field, the same in every case
+    elif grid is not None:
+        raise ParameterError("grid", type(grid).__name__,
+                             "a dict of axes (thickness=[...], material=[...], ...), a list of Scenes, "
+                             "a sweep/scene TOML path, or None (the paper's grid)")
+    mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
+    b = base if base is not None else Scene()
+    b = b.replace(**fields) if fields else b
+    return expand_grid(base=b, quality=quality or file_quality, overrides=mesh or None, **axes)
+
+
+def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, workers: int | None = None,
+          serial: bool = False, scheduler: str | None = None, profiles: bool = False,
+          report: bool = True, base=None):
+    """Run a cached sweep and return its metrics as a pandas DataFrame (one row per case:
+    case, status, thickness_mm, material, indenter, ..., peak_mpa, span_mm, auc, ...).
+
+    grid: {"thickness": [1, 3, 5], "material": [...], "indenter": [...], "depth": [...],
+      "braille_text": [...], "braille_dim": [2, 3]} (any subset; other Scene fields such as
+      rate=2 or dim=3 apply to every case), a list of Scenes, a scene/sweep TOML path, or
+      None (the paper's 18 cases).
+    quality: mesh preset of each case's dimension ('preview', 'default', 'fine').
+    out: also write the folder the `tactileskin sweep` command writes (results.csv and
+      .parquet, profiles.csv and .parquet, figures, report.md); `report=False` skips figures
+      and report. cache: the result cache folder (default out/cache, else default_cache_dir()).
+    workers / serial / scheduler: as the command (default: a local Dask cluster, one worker
+      process per core). A script needs no `if __name__ == "__main__":` guard.
+    profiles: return (metrics, profiles), profiles in long form (case, s_mm, pressure_mpa).
+    A case that failed is a row with status 'failed: ...' and its error; nothing is raised.
+    """
+    import pandas as pd
+
+    from tactileskin.cache import ResultCache
+    from tactileskin.report.outputs import collect, profile_rows
+    from tactileskin.sweep import run_sweep
+
+    scs = scenes(grid, quality=quality, base=base)
+    if cache is None:
+        cache = Path(out) / "cache" if out is not None else default_cache_dir()
+    rc = ResultCache(cache)
+    if out is not None:
+        from tactileskin.fileio import claim_dir
+
+        claim_dir(Path(out), "sweep", own_names=_own_names(out), what="out")
+    with _script_not_rerun():
+        outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
+    if out is not None:
+        from tactileskin.report.outputs import write_outputs
+
+        res = write_outputs(Path(out), outcomes, rc, 0.0, render=False, figures=report)
+        rows, records = res["rows"], res["records"]
+    else:
+        records, rows, _ = collect(outcomes, rc)
+    from tactileskin.report.outputs import RESULT_COLUMNS
+
+    metrics = pd.DataFrame(rows)
+    cols = [c for c in RESULT_COLUMNS + ["dim", "variant"] if c in metrics.columns]
+    metrics = metrics[cols]
+    if not profiles:
+        return metrics
+    prof = pd.DataFrame(profile_rows(records), columns=["case", "s_mm", "pressure_mpa"])
+    return metrics, prof
+
+
+def _own_names(out) -> set[str]:
+    from tactileskin.cli.sweep import _own_names as names
+
+    return names(Path(out))
+
+
+@contextlib.contextmanager
+def _script_not_rerun():
+    """Worker processes start by `spawn`, which re-runs the main script (the reason for the
+    usual `if __name__ == "__main__":` guard; without it each worker would start a sweep of
+    its own). The workers need nothing from the script (cases are Scenes, solved by
+    tactileskin functions), so while the sweep runs, __main__ does not name its file."""
+    main = sys.modules.get("__main__")
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if main is not None and k in main.__dict__}
+    if main is None or "__file__" not in saved:
+        yield
+        return
+    try:
+        del main.__file__
+        main.__spec__ = None
+        yield
+    finally:
+        main.__dict__.update(saved)

@@ -1,0 +1,64 @@
+"""The reference of every Scene field (unit, range, default), which becomes `Scene.__doc__`,
+so that `help(tactileskin.Scene)` answers "what can I set, in what unit, within what range".
+
+A new Scene field needs an entry here (tests/test_api.py checks that every field has one).
+"""
+
+from __future__ import annotations
+
+# field -> (unit, valid values, what it is)
+FIELDS: dict[str, tuple[str, str, str]] = {
+    "thickness": ("mm", "[fingertip thickness_min, largest the fingertip allows] (0.5-5.51 mm "
+                  "for the default fingertip)", "skin thickness t over the rigid bone"),
+    "material": ("-", "a preset name (tactileskin.materials.list_materials(): silicone, "
+                 "polyurethane, ...) or a material .toml file", "skin material (its law + Prony)"),
+    "indenter": ("-", "a registered kind: 'flat', 'curved', 'braille', 'cylinder', 'sphere' (3D), "
+                 "'file' (3D)", "the rigid indenter (tactileskin.geometry.indenters)"),
+    "braille_text": ("-", "up to 40 Braille cells of text; '' = one dot on the symmetry line",
+                     "Braille indenter only"),
+    "braille_standard": ("-", "a standard of data/geometry/braille.toml", "dot size and spacing"),
+    "depth": ("mm", "(0, 0.6 t]; None = depth_fraction * t", "final indentation depth"),
+    "depth_fraction": ("-", "(0, 0.6] (0.2: the paper's 20 % nominal strain)",
+                       "depth as a fraction of t when depth is None"),
+    "rate": ("mm/s", "[1e-6, 1e6]", "indentation rate (loading time = depth / rate)"),
+    "dim": ("-", "2 (plane-strain half section) or 3 (extruded slab)", "model dimension"),
+    "order": ("-", "1 or 2 (1 needs formulation='displacement')", "element order"),
+    "mesh_size": ("mm", "[0.01, 5]; None = the `default` quality preset of dim and indenter",
+                  "global element size"),
+    "refinement": ("-", "[1, 20]; None = the `default` preset", "global / refined element size "
+                   "ratio at the contact and the bone"),
+    "formulation": ("-", "'mixed' (locking-free) or 'displacement'", "finite-element formulation"),
+    "viscoelastic": ("-", "True or False", "include the Prony series (False: elastic hyperfoam)"),
+    "fingertip": ("mm, deg", "a table of overrides of data/geometry/fingertip.toml: half_width, "
+                  "height, max_fraction_of_min_radius, nail_angle_deg, sample_length, thickness_min",
+                  "fingertip geometry"),
+    "sensors": ("mm", "[[sensors]] layouts: kind points / line / grid (3D), s along the bone, depth "
+                "below the surface or height above the bone, pitch, taxel (inside the skin)",
+                "where stresses are read (sensors.csv); () = none"),
+    "indenter_radius": ("mm", "> 0; sphere and cylinder only", "indenter radius"),
+    "indenter_axis": ("-", "'z' (along the finger, 2D-exact) or 'x' (3D); cylinder only", "cylinder axis"),
+    "indenter_file": ("mm", "a closed STL/OBJ/PLY/OFF or STEP surface in mm; 'file' indenter only",
+                      "the user's indenter surface"),
+}
+
+
+def docstring(cls) -> str:
+    """The class docstring: a table of every dataclass field with its unit, range and default."""
+    import dataclasses
+
+    lines = ["The single, validated, immutable description of one indentation (units mm, s, N, MPa).",
+             "",
+             "    Scene(thickness=1.0, material='polyurethane', indenter='braille', braille_text='a')",
+             "",
+             "Change a copy with .replace(**fields); save and load with .to_toml(path) / Scene.from_toml(path).",
+             "An invalid value raises tactileskin.ParameterError naming the field and its valid range.",
+             "",
+             "Fields (unit; valid values; default):", ""]
+    for f in dataclasses.fields(cls):
+        unit, valid, what = FIELDS.get(f.name, ("?", "undocumented", ""))
+        default = f.default if f.default is not dataclasses.MISSING else (
+            f.default_factory() if f.default_factory is not dataclasses.MISSING else None)
+        default = getattr(default, "value", default)
+        lines.append(f"{f.name} ({unit}): {what}.")
+        lines.append(f"    valid: {valid}; default: {default!r}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,114 @@
+"""One TOML layout for a scene and a sweep (read by `solve`, `mesh`, `sweep` and the Python API).
+
+A file holds Scene fields, either at the top level (as `Scene.to_toml` writes them) or in a
+`[scene]` table, an optional `quality` preset (preview / default / fine) beside them, and an
+optional `[sweep]` table of lists (thicknesses, materials, indenters, depths, braille_texts,
+braille_dims) that turns it into a grid:
+
+    thickness = 2.0            # or, as a sweep: [sweep] thicknesses = [1, 2, 3]
+    material = "silicone"
+    quality = "preview"        # mesh sizes; mesh_size / refinement, if given, override it
+
+So a scene file is a sweep of one case, and a sweep file whose lists each hold one value is
+a scene. A field given both ways (`thickness` and `sweep.thicknesses`) is refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tactileskin import validate
+from tactileskin.errors import ParameterError
+
+# Scene field -> the sweep list that varies it
+AXES = {"thickness": "thicknesses", "material": "materials", "indenter": "indenters",
+        "depth": "depths", "braille_text": "braille_texts"}
+MESH_FIELDS = ("mesh_size", "refinement")
+
+
+@dataclass
+class SceneFile:
+    """The parsed file: `fields` (Scene fields as written), `quality` (or None) and `axes`
+    ({sweep list name: values}, as sweep.load_spec returns them)."""
+
+    fields: dict = field(default_factory=dict)
+    quality: str | None = None
+    axes: dict = field(default_factory=dict)
+    path: str = ""
+
+
+def read(path: str | Path | None) -> SceneFile:
+    """Parse a scene or sweep file (None: an empty one). ParameterError names the bad key."""
+    if path is None:
+        return SceneFile()
+    from tactileskin.params import read_toml
+
+    data = read_toml(path, "scene file")
+    top = {k: v for k, v in data.items() if k not in ("scene", "sweep")}
+    scene_tab = validate.table(data.get("scene", {}), "[scene]")
+    both = sorted(set(top) & set(scene_tab))
+    if both:
+        raise ParameterError(f"scene field {both[0]}", str(path), "given once (top level or [scene], not both)")
+    fields = {**top, **scene_tab}
+    quality = fields.pop("quality", None)
+    if quality is not None:
+        from tactileskin.presets import check_quality
+
+        check_quality(quality)
+    axes = _sweep_lists(data["sweep"]) if "sweep" in data else {}
+    for f, ax in AXES.items():
+        if f in fields and ax in axes:
+            raise ParameterError(f"scene field {f}", str(path), f"either {f} or sweep.{ax}, not both")
+    if fields:
+        from tactileskin.scene import Scene
+
+        Scene.from_dict(fields)  # unknown or invalid fields fail here, naming the field
+    return SceneFile(fields, quality, axes, str(path))
+
+
+def _sweep_lists(table) -> dict:
+    """The [sweep] lists, checked as sweep.load_spec checks them."""
+    from tactileskin.sweep import MAX_AXIS_VALUES, _SPEC_LISTS, check_braille_dims
+
+    sw = validate.table(table, "[sweep]")
+    validate.known_keys(sw, _SPEC_LISTS, "sweep")
+    spec = {}
+    for k, v in sw.items():
+        name = f"sweep.{k}"
+        if _SPEC_LISTS[k] == "numbers":
+            spec[k] = validate.number_list(v, name, MAX_AXIS_VALUES, min_len=1)
+        elif _SPEC_LISTS[k] == "dims":
+            spec[k] = check_braille_dims(v, name)
+        else:
+            spec[k] = validate.string_list(v, name, MAX_AXIS_VALUES, min_len=1)
+    return spec
+
+
+def single_scene_fields(sf: SceneFile, command: str = "solve") -> dict:
+    """The file's Scene fields for one scene: each sweep list must hold one value (its
+    field is then that value); more is a ParameterError that points to `sweep`."""
+    out = dict(sf.fields)
+    inverse = {v: k for k, v in AXES.items()}
+    for ax, values in sf.axes.items():
+        values = list(values)
+        if len(values) != 1:
+            raise ParameterError(f"sweep.{ax}", values, f"one value for `{command}` (one scene)",
+                                 f"this file is a sweep of {len(values)} values: run "
+                                 f"`tactileskin sweep --scene {sf.path}`, or the Python tactileskin.sweep()")
+        if ax == "braille_dims":
+            out["dim"] = values[0]
+        else:
+            out[inverse[ax]] = values[0]
+    return out
+
+
+def apply_quality(scene, quality: str | None, overrides: dict):
+    """`scene` at the quality preset of its dimension (if any), then the explicit mesh
+    fields in `overrides` (mesh_size, refinement) over it."""
+    if quality is not None:
+        from tactileskin.planner import with_quality
+
+        scene = with_quality(scene, quality)
+    mesh = {k: v for k, v in overrides.items() if k in MESH_FIELDS and v is not None}
+    return scene.replace(**mesh) if mesh else scene

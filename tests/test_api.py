@@ -1,0 +1,112 @@
+"""The top-level Python API: ts.Scene, ts.solve, ts.sweep, lazy imports, Result repr."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tactileskin as ts
+from tactileskin import presets
+from tactileskin.results import Result
+
+
+def test_import_tactileskin_loads_no_heavy_library():
+    code = ("import sys, tactileskin as ts; ts.__version__; "
+            "print(sorted(m for m in ('numpy', 'scipy', 'pandas', 'dask', 'skfem', 'numba', 'matplotlib') "
+            "if m in sys.modules))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip() == "[]"
+
+
+def test_help_of_scene_documents_every_field_with_unit_and_range():
+    doc = ts.Scene.__doc__
+    for f in dataclasses.fields(ts.Scene):
+        line = next((ln for ln in doc.splitlines() if ln.startswith(f"{f.name} (")), None)
+        assert line is not None, f.name
+        assert "undocumented" not in doc.split(line, 1)[1].splitlines()[1], f.name
+    assert "thickness (mm)" in doc and "rate (mm/s)" in doc and "[0.01, 5]" in doc
+
+
+def test_result_repr_is_one_short_line():
+    s = np.linspace(0, 8, 2000)
+    r = Result(s=s, pressure=np.exp(-s), contact_x=s, contact_pressure=s, reaction=1.5,
+               stats={"dofs": 1234}, scene={"thickness": 1.0, "material": "silicone", "indenter": "flat", "dim": 2})
+    text = repr(r)
+    assert "\n" not in text and len(text) < 300
+    assert "t1-silicone-flat-2d" in text and "peak=1 MPa" in text and "2000 profile points" in text
+
+
+def test_solve_takes_fields_and_a_quality_preset():
+    r = ts.solve(thickness=1.0, material="silicone", quality="preview")
+    size, ref = presets.mesh(2, "preview")
+    assert (r.scene["mesh_size"], r.scene["refinement"]) == (size, ref)
+    assert r.peak > 0 and r.status == "ok"
+
+
+def test_sweep_returns_dataframes_equal_to_the_csv_and_parquet_files(tmp_path):
+    pd = pytest.importorskip("pandas")
+    out = tmp_path / "sw"
+    grid = {"thickness": [1.0], "material": "silicone", "indenter": ["flat", "curved"]}
+    df, prof = ts.sweep(grid, quality="preview", out=out, serial=True, profiles=True, report=False)
+    assert list(df.case) == ["t1-silicone-flat-2d", "t1-silicone-curved-2d"]
+    assert (df.status == "ok").all() and (df.peak_mpa > 0).all()
+    with open(out / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [float(r["peak_mpa"]) for r in rows] == pytest.approx(list(df.peak_mpa), rel=1e-12)
+    pq = pd.read_parquet(out / "results.parquet")
+    assert list(pq.case) == list(df.case) and np.array_equal(pq.peak_mpa, df.peak_mpa)
+    pp = pd.read_parquet(out / "profiles.parquet")
+    assert len(pp) == len(prof) and np.array_equal(pp.pressure_mpa, prof.pressure_mpa)
+    # the peak of each long-form profile is the metric of its row
+    for case, g in prof.groupby("case"):
+        assert g.pressure_mpa.max() == pytest.approx(float(df.set_index("case").peak_mpa[case]), rel=1e-9)
+    # a rerun reads every case from the cache (out/cache) and gives the same numbers
+    again = ts.sweep(grid, quality="preview", out=out, serial=True, report=False)
+    assert np.array_equal(again.peak_mpa, df.peak_mpa)
+
+
+def test_sweep_default_cache_follows_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv("TACTILESKIN_CACHE", str(tmp_path / "c"))
+    assert ts.default_cache_dir() == tmp_path / "c"
+    monkeypatch.delenv("TACTILESKIN_CACHE")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "x"))
+    assert ts.default_cache_dir() == tmp_path / "x" / "tactileskin"
+
+
+def test_sweep_grid_forms_agree(tmp_path):
+    f = tmp_path / "grid.toml"
+    f.write_text('quality = "preview"\n[sweep]\nthicknesses = [1.0, 2.0]\nindenters = ["flat"]\n'
+                 'materials = ["silicone"]\n')
+    from_file = ts.scenes(str(f))
+    from_dict = ts.scenes({"thickness": [1.0, 2.0], "indenter": "flat", "material": ["silicone"]},
+                          quality="preview")
+    assert from_file == from_dict and len(from_file) == 2
+    with pytest.raises(ts.ParameterError, match="grid"):
+        ts.scenes(42)
+
+
+@pytest.mark.slow
+def test_parallel_sweep_in_a_script_without_main_guard(tmp_path):
+    """Dask starts its workers by spawn, which re-runs the main script: without the guard each
+    worker would start a sweep of its own. ts.sweep keeps the script from being re-run."""
+    script = tmp_path / "noguard.py"
+    script.write_text(textwrap.dedent(f"""
+        import tactileskin as ts
+        df = ts.sweep({{"thickness": [1.0], "indenter": "flat", "material": "silicone"}},
+                      quality="preview", workers=1, cache={str(tmp_path / 'cache')!r})
+        print("RUNS", len(df), df.status[0])
+    """))
+    src = str(Path(ts.__file__).resolve().parents[1])  # this checkout's package, from any cwd
+    env = {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=400,
+                       cwd=tmp_path, env=env)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.count("RUNS") == 1 and "RUNS 1 ok" in r.stdout

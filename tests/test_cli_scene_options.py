@@ -1,0 +1,101 @@
+"""One set of scene options and one TOML layout for `solve`, `mesh` and `sweep` (no solving)."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tactileskin import presets
+from tactileskin.cli import main
+from tactileskin.cli._common import PHYSICS_KEYS, SCENE_KEYS, scene_from_options
+from tactileskin.cli.build import command as build_cmd
+from tactileskin.cli.mesh import command as mesh_cmd
+from tactileskin.cli.solve import command as solve_cmd
+from tactileskin.cli.sweep import command as sweep_cmd
+from tactileskin.cli.sweep import scenes_from_options
+from tactileskin.errors import ParameterError
+from tactileskin.scene import Scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _opts(cmd) -> dict:
+    return {p.name: p for p in cmd.params}
+
+
+def _scene_opts(**kw) -> dict:
+    return {k: kw.get(k) for k in SCENE_KEYS + PHYSICS_KEYS}
+
+
+def test_the_scene_options_are_the_same_on_solve_mesh_and_sweep():
+    solve, mesh, sweep = _opts(solve_cmd), _opts(mesh_cmd), _opts(sweep_cmd)
+    for name in SCENE_KEYS:
+        flags = [tuple(sorted(o[name].opts)) for o in (solve, mesh, sweep)]
+        assert len(set(flags)) == 1, (name, flags)
+    for name in PHYSICS_KEYS:  # they do not change a mesh, so `mesh` does not offer them
+        assert name in solve and name in sweep and name not in mesh
+
+
+def test_out_has_the_short_form_everywhere():
+    for cmd in (solve_cmd, mesh_cmd, sweep_cmd, build_cmd):
+        outs = [p for p in cmd.params if "--out" in p.opts]
+        assert outs and "-o" in outs[0].opts, cmd.name
+
+
+def test_quality_on_solve_sets_the_preset_and_mesh_size_overrides_it():
+    size, ref = presets.mesh(2, "preview")
+    sc = scene_from_options(_scene_opts(thickness=1.0, quality="preview"))
+    assert (sc.mesh_size, sc.refinement) == (size, ref)
+    sc = scene_from_options(_scene_opts(thickness=1.0, quality="preview", mesh_size=0.77))
+    assert (sc.mesh_size, sc.refinement) == (0.77, ref)
+
+
+def test_a_one_case_sweep_file_is_a_scene_file(tmp_path):
+    f = tmp_path / "sweep.toml"
+    f.write_text('quality = "preview"\n[scene]\nmaterial = "polyurethane"\n'
+                 '[sweep]\nthicknesses = [2.0]\nindenters = ["curved"]\n')
+    sc = scene_from_options(_scene_opts(scene_file=str(f)))
+    expect = Scene(thickness=2.0, material="polyurethane", indenter="curved")
+    size, ref = presets.mesh(2, "preview")
+    assert sc == expect.replace(mesh_size=size, refinement=ref)
+    # and the same file as a sweep gives that one case
+    assert scenes_from_options(_scene_opts(scene_file=str(f))) == [sc]
+
+
+def test_a_scene_file_is_a_sweep_of_one_case_and_options_override_it(tmp_path):
+    f = tmp_path / "scene.toml"
+    Scene(thickness=2.0, material="polyurethane", indenter="flat", rate=2.0).to_toml(f)
+    scenes = scenes_from_options(_scene_opts(scene_file=str(f)))
+    assert len(scenes) == 1 and scenes[0].thickness == 2.0 and scenes[0].rate == 2.0
+    scenes = scenes_from_options(_scene_opts(scene_file=str(f), thickness="1,3", elastic=True,
+                                             refinement=2.5, dim="3"))
+    assert [s.thickness for s in scenes] == [1.0, 3.0]
+    assert all(s.dim == 3 and not s.viscoelastic and s.refinement == 2.5 and s.rate == 2.0 for s in scenes)
+
+
+def test_solve_refuses_a_sweep_file_of_several_cases_and_says_what_to_run(tmp_path, capsys):
+    f = tmp_path / "grid.toml"
+    f.write_text("[sweep]\nthicknesses = [1.0, 3.0]\n")
+    assert main(["solve", "--scene", str(f), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "sweep.thicknesses" in err and "tactileskin sweep --scene" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_field_given_twice_or_a_bad_quality_in_a_file_is_refused(tmp_path):
+    f = tmp_path / "both.toml"
+    f.write_text("thickness = 2.0\n[sweep]\nthicknesses = [1.0, 3.0]\n")
+    with pytest.raises(ParameterError, match="thickness"):
+        scenes_from_options(_scene_opts(scene_file=str(f)))
+    f.write_text('quality = "ultra"\n')
+    with pytest.raises(ParameterError, match="quality"):
+        scene_from_options(_scene_opts(scene_file=str(f)))
+
+
+def test_dev_without_arguments_prints_its_usage_and_succeeds():
+    r = subprocess.run([str(ROOT / "dev")], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0 and "./dev run" in r.stdout
+    r = subprocess.run([str(ROOT / "dev"), "nonsense"], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "nonsense" in r.stderr
