@@ -197,7 +197,10 @@ def test_newton_picks_the_method(slab3d):
 
 def test_3d_solve_with_reuse_matches_direct(slab3d):
     """The whole Newton path with a reused factorisation: same answer to the Newton tolerance,
-    no more Newton iterations."""
+    and at most 10 % more Newton iterations (the Krylov solves stop at 0.1 |R|, an inexact
+    Newton step; the contact multipliers are updated inside Newton once the residual falls
+    below a threshold, which an inexact step can reach one iteration later: 31 against 30
+    here, where the exact-step path used to tie)."""
     from tactileskin.fe import model_for_scene, run
     from tactileskin.fe.solver import SolverOptions
     from tactileskin.mesh.slab3d import build_slab_mesh
@@ -211,7 +214,7 @@ def test_3d_solve_with_reuse_matches_direct(slab3d):
         out[method] = (model.u.copy(), st.newton_iterations, model._linsolve)
     (ud, nd, ld), (ur, nr, lr) = out["direct"], out["reuse"]
     assert lr.method == "reuse" and lr.krylov_iterations > 0 and lr.factorizations < ld.factorizations
-    assert nr <= nd
+    assert nr <= 1.1 * nd
     assert np.linalg.norm(ur - ud) <= 1e-6 * np.linalg.norm(ud)
 
 
