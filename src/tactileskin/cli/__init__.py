@@ -33,6 +33,7 @@ COMMANDS = {
     "solve": "solve",
     "sweep": "sweep",
     "film": "film",
+    "export": "export",
 }
 
 

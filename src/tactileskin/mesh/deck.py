@@ -208,7 +208,8 @@ def _rows(fh, values, per_line: int = 16, fmt=str) -> None:
 
 
 def _num(v: float) -> str:
-    return f"{float(v):.15g}"
+    """Shortest text that reads back as the same double (coordinates round-trip exactly)."""
+    return repr(float(v))
 
 
 def material_lines(material, *, viscoelastic: bool, dialect: str) -> str:
@@ -285,8 +286,14 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     w("*HEADING\n")
     w(f"tactileskin {scene.label()}: plane strain, units mm s N MPa, per mm of depth ({dialect})\n")
     w("**\n** Skin\n")
-    w("*NODE, NSET=skin_nodes\n")
-    for i, p in enumerate(pts):
+    # one *NODE block for the skin and the indenter (readers such as meshio keep only one)
+    ref = n_nodes + 1
+    if dialect == "abaqus":
+        ipts, icells = np.array([[0.0, ind.y0]]), None  # the rigid body's reference node
+    else:
+        ipts, icells = indenter_strip(ind, x_lo, x_hi, h_fine)
+    w("*NODE\n")
+    for i, p in enumerate(np.concatenate([pts, ipts])):
         w(f"{i + 1}, {_num(p[0])}, {_num(p[1])}\n")
     w(f"*ELEMENT, TYPE={etype}, ELSET=skin\n")
     for i, c in enumerate(cells):
@@ -306,21 +313,18 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
 
     w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, moves by -"
       + _num(depth) + " mm over " + _num(T) + " s\n")
-    ref = n_nodes + 1
     if dialect == "abaqus":
         segs = analytic_segments(ind, x_lo, x_hi)
-        w(f"*NODE, NSET=indenter_ref\n{ref}, 0., {_num(ind.y0)}\n")
+        w(f"*NSET, NSET=indenter_ref\n{ref}\n")
         w("*SURFACE, TYPE=SEGMENTS, NAME=indenter_face\n")
         for s in segs:
             w(", ".join([s[0]] + [_num(v) for v in s[1:]]) + "\n")
         w("*RIGID BODY, ANALYTICAL SURFACE=indenter_face, REF NODE=indenter_ref\n")
         moved, n_ind = "indenter_ref", 0
     else:
-        ipts, icells = indenter_strip(ind, x_lo, x_hi, h_fine)
         n_ind = len(ipts)
-        w("*NODE, NSET=indenter_nodes\n")
-        for i, p in enumerate(ipts):
-            w(f"{ref + i}, {_num(p[0])}, {_num(p[1])}\n")
+        w("*NSET, NSET=indenter_nodes, GENERATE\n")
+        w(f"{ref}, {ref + n_ind - 1}, 1\n")
         w("*ELEMENT, TYPE=CPE4, ELSET=indenter\n")
         for i, c in enumerate(icells):
             w(f"{n_cells + 1 + i}, " + ", ".join(str(ref + int(v)) for v in c) + "\n")
@@ -441,6 +445,10 @@ def parse_deck(text: str) -> dict:
                 ids.append(int(r[0]))
             if "ELSET" in prm:
                 out["elsets"].setdefault(prm["ELSET"], []).extend(ids)
+        elif kw == "NSET" and "GENERATE" in prm:
+            for r in rows:
+                a, b, step = (int(v) for v in (r + ["1"])[:3])
+                out["nsets"].setdefault(prm["NSET"], []).extend(range(a, b + 1, step))
         elif kw == "NSET":
             out["nsets"].setdefault(prm["NSET"], []).extend(int(v) for r in rows for v in r)
         elif kw == "ELSET":
