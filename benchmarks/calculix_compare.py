@@ -26,6 +26,7 @@ import numpy as np
 
 from tactileskin import fileio
 from tactileskin.fe import solve
+from tactileskin.materials import get_material
 from tactileskin.mesh import build_mesh
 from tactileskin.mesh.deck import deck_text
 from tactileskin.planner import with_quality
@@ -81,11 +82,13 @@ def run_ccx(deck: str, workdir: Path, timeout: float = 1800.0) -> dict:
             "iterations": sum(int(r.split()[3]) for r in sta.splitlines()[2:] if len(r.split()) > 3)}
 
 
-def compare(thickness: float, quality: str, material: str = "polyurethane") -> dict:
+def compare(thickness: float, quality: str, penalty_factor: float = 10.0, material: str = "polyurethane") -> dict:
     scene = with_quality(Scene(thickness=thickness, material=material, indenter="flat",
                                viscoelastic=False), quality)
     sm = build_mesh(scene)
-    deck = deck_text(scene, sm, "calculix")
+    hf = get_material(material).hyperfoam
+    penalty = penalty_factor * max(hf.K0, hf.mu0) / sm.sizes["fine"]  # the deck's default is factor 10
+    deck = deck_text(scene, sm, "calculix", penalty=penalty)
     with tempfile.TemporaryDirectory(prefix="tsk_ccx_") as tmp:
         work = Path(tmp)
         ccx = run_ccx(deck.text, work)
@@ -103,18 +106,20 @@ def compare(thickness: float, quality: str, material: str = "polyurethane") -> d
     s_ccx, P_ccx = s_ccx[order], P_ccx[order]
     copen = np.array([v[0] for v in contact.values()])
     cpress = np.array([v[3] for v in contact.values()])
-    row = {"scene": scene.label(), "mesh": f"{scene.mesh_size:g}/{scene.refinement:g} ({quality})",
+    row = {"scene": scene.label(), "depth": scene.indentation, "mesh": f"{scene.mesh_size:g}/{scene.refinement:g} ({quality})",
            "cells": deck.n_skin_cells, "nodes": deck.n_skin_nodes, "ccx": ccx,
            "ccx_peak": float(P_ccx.max()), "ccx_peak_s": float(s_ccx[np.argmax(P_ccx)]),
            "ccx_force": float(-totals["INDENTER_NODES"][1]), "ccx_bone_fy": float(totals["BONE_INTERFACE"][1]),
            "ccx_penetration": float(max(0.0, -copen.min())), "ccx_cpress_max": float(cpress.max()),
-           "penalty": deck.info["penalty_mpa_per_mm"], "ts": {}}
+           "penalty": deck.info["penalty_mpa_per_mm"], "penalty_factor": penalty_factor,
+           "profile_ccx": (s_ccx, P_ccx), "ts": {}}
     for form in ("mixed", "displacement"):
         c0 = time.process_time()
         res = solve(scene.replace(formulation=form), mesh=sm)
         cpu = time.process_time() - c0
         p_at = np.interp(res.s, s_ccx, P_ccx)
-        row["ts"][form] = {"peak": float(res.peak), "peak_s": float(res.s[np.argmax(res.pressure)]),
+        k = int(np.argmax(np.abs(res.pressure - p_at)))
+        row["ts"][form] = {"max_diff_s": float(res.s[k]), "profile": (res.s, res.pressure),"peak": float(res.peak), "peak_s": float(res.s[np.argmax(res.pressure)]),
                            "force": float(res.reaction), "cpu_s": cpu,
                            "max_diff": float(np.max(np.abs(res.pressure - p_at))),
                            "rms_diff": float(np.sqrt(np.mean((res.pressure - p_at) ** 2))),
@@ -133,36 +138,59 @@ def markdown(rows: list[dict]) -> str:
          "stresses (extrapolated from the integration points and averaged over the elements at each node, "
          ".frd) against tactileskin's bone profile (fe.recovery.PointFit); differences are max / rms over the "
          "bone samples of |P_ts - P_ccx| with ccx interpolated linearly in s.", "",
-         "| case | mesh | code | peak P (MPa) | at s (mm) | indenter force (N/mm) | max / rms diff (MPa) | CPU (s) |",
+         "| case | mesh | code | peak P (MPa) | at s (mm) | indenter force (N/mm) | max diff (MPa) at s (mm) / rms | CPU (s) |",
          "|---|---|---|---:|---:|---:|---:|---:|"]
     for r in rows:
         c = r["ccx"]
-        L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells | CalculiX | {r['ccx_peak']:.4f} | "
+        L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells | CalculiX, penalty {r['penalty']:.0f} MPa/mm "
+                 f"({r['penalty_factor']:g} K0/h), penetration {r['ccx_penetration'] * 1e3:.2f} um = "
+                 f"{100 * r['ccx_penetration'] / r['depth']:.2f} % of the travel | {r['ccx_peak']:.4f} | "
                  f"{r['ccx_peak_s']:.2f} | {r['ccx_force']:.4f} | - | {c['cpu_s']:.1f} "
                  f"({c['increments']} incr., {c['iterations']} it.) |")
         for form, t in r["ts"].items():
             dpk = 100.0 * (t["peak"] / r["ccx_peak"] - 1.0)
             dF = 100.0 * (t["force"] / r["ccx_force"] - 1.0)
             L.append(f"| | | tactileskin {form} | {t['peak']:.4f} ({dpk:+.1f} %) | {t['peak_s']:.2f} | "
-                     f"{t['force']:.4f} ({dF:+.1f} %) | {t['max_diff']:.4f} / {t['rms_diff']:.4f} | "
+                     f"{t['force']:.4f} ({dF:+.1f} %) | {t['max_diff']:.4f} at {t['max_diff_s']:.2f} / {t['rms_diff']:.4f} | "
                      f"{t['cpu_s']:.1f} ({t['newton']} Newton) |")
-    L += ["", "CalculiX contact: linear penalty " + ", ".join(
-        f"{r['penalty']:.0f} MPa/mm (largest penetration {r['ccx_penetration'] * 1e3:.2f} um, "
-        f"{100 * r['ccx_penetration'] / float(r['scene'].split('-')[0][1:]) / 0.2:.2f} % of the travel; "
-        f"max contact pressure {r['ccx_cpress_max']:.3f} MPa)" for r in rows) + "."]
     return "\n".join(L) + "\n"
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(rows), figsize=(4.2 * len(rows), 3.4), squeeze=False)
+    for ax, r in zip(axes[0], rows):
+        s, p = r["profile_ccx"]
+        ax.plot(s, p, "o", ms=3, color="#0072B2", label="CalculiX (nodal)")
+        for (form, t), c in zip(r["ts"].items(), ("#D55E00", "#009E73")):
+            ax.plot(*t["profile"], "-", color=c, lw=1.2, label=f"tactileskin {form}")
+        ax.set(title=f"{r['scene']} {r['mesh']}, {r['penalty_factor']:g} K0/h", xlabel="s along the bone (mm)",
+               ylabel="bone pressure P (MPa)", xlim=(0, 8))
+        ax.title.set_fontsize(8)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    with fileio.atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", type=float, nargs="+", default=[3.0])
-    ap.add_argument("--quality", default="preview")
+    ap.add_argument("--quality", nargs="+", default=["preview"])
+    ap.add_argument("--penalty-factor", type=float, nargs="+", default=[10.0],
+                    help="CalculiX contact slope in units of K0 / h_fine")
     ap.add_argument("--out", type=Path, default=OUT)
     a = ap.parse_args(argv)
     if shutil.which("ccx") is None:
         print("ccx not found: apt-get install calculix-ccx", file=sys.stderr)
         return 2
-    rows = [compare(t, a.quality) for t in a.thickness]
+    rows = [compare(t, q, f) for q in a.quality for t in a.thickness for f in a.penalty_factor]
+    plot(rows, a.out.with_suffix(".png"))
     text = markdown(rows)
     print(text)
     if a.out.exists() and "\n## Findings" in a.out.read_text():  # keep the hand-written analysis

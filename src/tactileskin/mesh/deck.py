@@ -251,6 +251,13 @@ class Deck:
     info: dict = field(default_factory=dict)
 
 
+def _check_dim(dim: int) -> None:
+    if dim != 2:
+        raise ParameterError("dim", dim, "2 (the deck is the plane-strain half section)",
+                             "a 3D deck needs a meshed 3D indenter; `tactileskin mesh --dim 3 -o x.inp` "
+                             "writes the 3D mesh with its sets")
+
+
 def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | None = None,
               penalty: float | None = None, increments: int = 20) -> Deck:
     """The input deck of a 2D scene on its mesh. viscoelastic: default the scene's;
@@ -262,9 +269,7 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
 
     if dialect not in DIALECTS:
         raise ParameterError("dialect", dialect, "one of " + ", ".join(DIALECTS))
-    if scene.dim != 2 or skinmesh.dim != 2:
-        raise ParameterError("dim", scene.dim, "2 (the deck is the plane-strain half section)",
-                             "a 3D deck needs a meshed indenter; export the 3D mesh alone with `mesh -o x.inp`")
+    _check_dim(scene.dim if scene.dim != 2 else skinmesh.dim)
     if not (isinstance(increments, int) and 1 <= increments <= 10000):
         raise ParameterError("increments", increments, "an integer in [1, 10000]")
     mat = get_material(scene.material)
@@ -389,8 +394,7 @@ def write_deck(scene, path, skinmesh=None, dialect: str = "abaqus", **kw) -> Dec
     from tactileskin import fileio
 
     if skinmesh is None:
-        if scene.dim != 2:
-            deck_text(scene, type("M", (), {"dim": scene.dim})(), dialect)  # raises the dim error
+        _check_dim(scene.dim)  # before meshing
         from tactileskin.mesh import build_mesh
 
         skinmesh = build_mesh(scene)
