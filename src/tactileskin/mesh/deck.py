@@ -278,7 +278,6 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     etype, pts, cells = abaqus_cells(skinmesh)
     n_nodes, n_cells = len(pts), len(cells)
     T, depth = scene.duration, scene.indentation
-    sec = skinmesh.section if skinmesh.section is not None else scene.section()
     x_lo = _x_lo(ind)
     x_hi = min(0.5 * ind.width, float(pts[:, 0].max()) + 1.0)
     h_fine = float(skinmesh.sizes.get("fine", scene.mesh_size / scene.refinement))
