@@ -35,6 +35,7 @@ COMMANDS = {
     "film": "film",
     "array": "array",
     "material": "material",
+    "export": "export",
 }
 
 

@@ -1,0 +1,30 @@
+"""`tactileskin export`: a scene as an Abaqus or CalculiX input deck (.inp)."""
+
+from __future__ import annotations
+
+import click
+
+from tactileskin.cli._common import scene_from_options, scene_options
+
+
+@click.command("export")
+@scene_options
+@click.option("--out", "-o", type=click.Path(dir_okay=False), required=True, help="Deck to write (.inp).")
+@click.option("--dialect", type=click.Choice(["abaqus", "calculix"]), default="abaqus", show_default=True,
+              help="abaqus: analytical rigid indenter, *VISCOELASTIC Prony, hard contact; calculix: "
+                   "meshed indenter, instantaneous hyperfoam (ccx has no Prony), penalty contact.")
+def command(out, dialect, scene_opts):
+    """Write the 2D scene (mesh, sets, surfaces, material, supports, indenter, contact, step)
+    as an input deck for Abaqus/Standard or CalculiX (units mm, s, N, MPa; per mm of depth)."""
+    from rich.console import Console
+    from rich.markup import escape
+
+    from tactileskin.errors import ParameterError
+    from tactileskin.mesh.deck import write_deck
+
+    if not out.lower().endswith(".inp"):
+        raise ParameterError("--out", out, "a file name ending in .inp")
+    scene = scene_from_options(scene_opts, "export")  # --elastic: leave out the Prony series
+    deck = write_deck(scene, out, dialect=dialect)
+    Console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes, "
+                    f"{'viscoelastic' if deck.info['viscoelastic'] else 'elastic'} {dialect} deck")
