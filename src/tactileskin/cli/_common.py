@@ -31,6 +31,9 @@ def scene_options(f):
         click.option("--mesh-size", type=float, default=None, help="Global element size (mm)."),
         click.option("--refinement", type=float, default=None, help="Global/refined size ratio."),
         click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
+        click.option("--skin", type=str, default=None, help="Skin geometry: fingertip (default) or pad."),
+        click.option("--pad-width", type=float, default=None, help="Pad: x extent of the whole pad (mm)."),
+        click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm)."),
     ]
     for o in reversed(opts):
         f = o(f)
