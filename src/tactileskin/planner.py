@@ -221,6 +221,8 @@ def truncated_scene(scene: Scene, keep_s: float | None = None) -> Scene | None:
     section is not longer than that (nothing to cut)."""
     keep = WINDOW_S + TRUNCATION_MARGIN + scene.thickness if keep_s is None else keep_s
     keep = check_range("keep_s", keep, 0.0, None, lo_open=True, unit="mm")
+    if scene.skin != "fingertip":  # only the fingertip's section is truncated (at a nail angle)
+        return None
     section = scene.section()
     if keep >= section.interface_length - 0.5:
         return None

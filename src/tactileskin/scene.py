@@ -19,6 +19,7 @@ from tactileskin import presets as _presets
 from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
 from tactileskin.geometry.indenters import registry as _indenters
+from tactileskin.skins import registry as _skins
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
 # not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: contact
@@ -51,6 +52,10 @@ def default_mesh(dim: int, indenter) -> tuple[float, float]:
 # `scene.indenter.value` and `IndenterKind.FLAT` keep working; the kind objects answer
 # everything else (`Scene.indenter_kind`).
 IndenterKind = Enum("IndenterKind", [(n.upper(), n) for n in _indenters.names()], type=str)
+
+
+# Scene fields that belong to one skin (skins.*.scene_params)
+SKIN_FIELDS = ("fingertip", "pad_width", "pad_length")
 
 
 class Formulation(str, Enum):
@@ -102,6 +107,11 @@ class Scene:
     indenter_radius: float | None = None   # sphere, cylinder (mm)
     indenter_axis: str | None = None       # cylinder: "z" (along the finger, default) or "x"
     indenter_file: str | None = None       # file: closed STL/OBJ/PLY/OFF or STEP surface (mm)
+    # the skin geometry (tactileskin.skins: "fingertip", the paper's; "pad", a flat pad on a board)
+    # and its parameters (None: not given; a skin that does not read one refuses it)
+    skin: str = "fingertip"
+    pad_width: float | None = None         # pad: x extent of the whole pad (mm)
+    pad_length: float | None = None        # pad: z extent (mm)
 
     def __post_init__(self):
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
@@ -115,8 +125,15 @@ class Scene:
         set_("dim", validate.integer(self.dim, "dim", "2 or 3"))
         set_("order", validate.integer(self.order, "order", "1 or 2"))
         set_("fingertip", _fingertip_overrides(self.fingertip))
-        ft = self.fingertip_model()
-        set_("thickness", ft.check_thickness(self.thickness))
+        set_("skin", validate.string(self.skin, "skin", "a skin name"))
+        skin = self.skin_kind
+        for name in SKIN_FIELDS:
+            if getattr(self, name) not in (None, ()) and name not in skin.scene_params:
+                takers = [k for k in _skins.names() if name in _skins.get(k).scene_params]
+                raise ParameterError(name, getattr(self, name), f"only with skin = {' or '.join(takers)}",
+                                     f"the {skin.name} skin does not take it")
+        for name, value in skin.check_scene(self).items():  # thickness and the skin's own fields
+            set_(name, value)
         set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, 0.6, lo_open=True))
         if self.depth is not None:
             set_("depth", check_range("depth", self.depth, 0.0, 0.6 * self.thickness, lo_open=True, unit="mm"))
@@ -175,7 +192,18 @@ class Scene:
         return Fingertip.from_params(**dict(self.fingertip))
 
     def section(self):
-        return self.fingertip_model().section(self.thickness)
+        """The skin's 2D section (curves, top, arc length s along the bonded surface)."""
+        return self.skin_kind.section(self)
+
+    @property
+    def skin_kind(self):
+        """The skin class (tactileskin.skins: section, mesh, sensor coordinates, parts)."""
+        return _skins.get(self.skin)
+
+    @property
+    def sample_length(self) -> float:
+        """z extent of the 3D model and of the indenter plates (mm)."""
+        return self.skin_kind.sample_length(self)
 
     @property
     def indenter_kind(self):
@@ -186,6 +214,12 @@ class Scene:
         """A changed copy. Changing `dim` or `indenter` re-derives mesh defaults left at
         default; changing `indenter` drops kind parameters the new kind does not read."""
         new_dim = changes.get("dim", self.dim)
+        new_skin = changes.get("skin", self.skin)
+        if new_skin != self.skin:
+            reads = _skins.get(new_skin).scene_params
+            for name in SKIN_FIELDS:
+                if name not in changes and name not in reads:
+                    changes[name] = () if name == "fingertip" else None
         new_ind = changes.get("indenter", self.indenter)
         if new_ind != self.indenter:
             reads = _indenters.get(new_ind).scene_params
@@ -209,6 +243,8 @@ class Scene:
                 v = v.value
             if f.name == "fingertip":
                 v = dict(v)
+            if f.name == "skin" and v == "fingertip":  # the default: absent, so keys stay as they were
+                continue
             if f.name == "sensors":  # none: absent, so that scenes without sensors keep their keys
                 v = [lay.to_dict() for lay in v] or None
             if v is None:
@@ -238,7 +274,7 @@ class Scene:
         return self.indenter_kind.label(self)
 
     def label(self) -> str:
-        return f"t{self.thickness:g}-{self.material}-{self.indenter_label()}-{self.dim}d"
+        return f"{self.skin_kind.label(self)}t{self.thickness:g}-{self.material}-{self.indenter_label()}-{self.dim}d"
 
     def to_toml(self, path: str | Path) -> None:
         import tomli_w

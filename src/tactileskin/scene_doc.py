@@ -39,6 +39,10 @@ FIELDS: dict[str, tuple[str, str, str]] = {
     "indenter_axis": ("-", "'z' (along the finger, 2D-exact) or 'x' (3D); cylinder only", "cylinder axis"),
     "indenter_file": ("mm", "a closed STL/OBJ/PLY/OFF or STEP surface in mm; 'file' indenter only",
                       "the user's indenter surface"),
+    "skin": ("-", "a registered skin: 'fingertip' (the paper's) or 'pad' (tactileskin.skins)",
+             "the skin geometry"),
+    "pad_width": ("mm", "[1, 500]; pad only (default 20)", "x extent of the whole pad"),
+    "pad_length": ("mm", "[1, 500]; pad only (default 20)", "z extent of the pad (3D block)"),
 }
 
 

@@ -233,8 +233,8 @@ class FlatCoordinates:
 
 
 def coordinates_for(scene):
-    """The skin coordinates of a scene (the fingertip section today)."""
-    return SectionCoordinates(scene.section())
+    """The skin coordinates of a scene (the skin's answer: skins.*.coordinates)."""
+    return scene.skin_kind.coordinates(scene)
 
 
 # --- sites: the resolved points ---------------------------------------------------------------
@@ -355,7 +355,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
 def sites_for(scene, z_range=None) -> Sites:
     """Sites of a scene's layouts (validated against its skin; z_range: the 3D slab's z)."""
     if z_range is None and scene.dim == 3:
-        L = scene.fingertip_model().sample_length
+        L = scene.sample_length
         z_range = (-0.5 * L, 0.5 * L)
     return resolve(scene.sensors, coordinates_for(scene), scene.dim, z_range)
 

@@ -207,6 +207,7 @@ _ID_FIELDS = (
     (lambda s: s.braille_standard, lambda s: s.braille_standard),
     (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
     (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name),  # two files, one name
+    (lambda s: (s.pad_width, s.pad_length), lambda s: s.skin_kind.label(s).rstrip("-") or s.skin),
 )
 
 

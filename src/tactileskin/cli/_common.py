@@ -15,7 +15,8 @@ QUALITIES = ("preview", "default", "fine")
 # Scene options every scene command takes (geometry and mesh), then the loading and material
 # ones of the commands that solve. `grid=True` (sweep): the axis options take lists.
 SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text", "braille_standard",
-              "indenter_radius", "indenter_axis", "indenter_file", "depth", "dim", "quality", "mesh_size", "refinement", "order")
+              "indenter_radius", "indenter_axis", "indenter_file", "skin", "pad_width", "pad_length",
+              "depth", "dim", "quality", "mesh_size", "refinement", "order")
 PHYSICS_KEYS = ("rate", "formulation", "elastic")
 
 
@@ -60,6 +61,9 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         click.option("--refinement", type=float, default=None,
                      help="Global / refined element size ratio; overrides --quality."),
         click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default 2)."),
+        click.option("--skin", type=str, default=None, help="Skin geometry: fingertip (default) or pad."),
+        click.option("--pad-width", type=float, default=None, help="Pad: x extent of the whole pad (mm)."),
+        click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm)."),
     ]
     if physics:
         opts += [
@@ -84,7 +88,7 @@ def _field_changes(opts: dict) -> dict:
     """Scene-field changes of the single-valued options (None: not given)."""
     ch = {k: opts.get(k) for k in ("thickness", "material", "indenter", "braille_text", "braille_standard",
                                     "indenter_radius", "indenter_axis", "indenter_file",
-                                    "depth", "rate", "formulation")}
+                                    "skin", "pad_width", "pad_length", "depth", "rate", "formulation")}
     if opts.get("dim") is not None:
         ch["dim"] = int(opts["dim"])
     if opts.get("order") is not None:

@@ -19,7 +19,12 @@ import click
 @click.option("--braille-standard", type=str, default="standard_american", show_default=True,
               help="Braille standard name (data/geometry/braille.toml).")
 @click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
-def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds):
+@click.option("--skin", type=click.Choice(["fingertip", "pad"]), default="fingertip", show_default=True,
+              help="Skin geometry: the paper's fingertip or a flat pad (--pad-width, --pad-length).")
+@click.option("--pad-width", type=float, default=None, help="Pad: x extent (mm); default 20.")
+@click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm); default 20.")
+def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
+            pad_width=None, pad_length=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -34,7 +39,16 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
 
     console = Console()
     t = default_thickness() if thickness is None else thickness
-    Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
+    pad = {}
+    if skin == "pad":
+        from tactileskin.scene import Scene
+
+        sc = Scene(skin="pad", thickness=t, pad_width=pad_width, pad_length=pad_length)  # validates
+        pad = dict(pad_width=sc.pad_width, pad_length=sc.pad_length)
+    elif pad_width is not None or pad_length is not None:
+        raise click.UsageError("--pad-width and --pad-length need --skin pad")
+    else:
+        Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
     resolve_indenters(indenter)
 
     t0 = time.perf_counter()
@@ -43,12 +57,20 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         from tactileskin.geometry.parts import build_parts
 
         check_target(Path(out_dir).absolute())  # refuse a folder of other files before the work
-        parts = build_parts(t, indenters=indenter, braille_text=braille_text,
-                            braille_standard=braille_standard, molds=not no_molds)
+        if pad:
+            from tactileskin.skins import get
+
+            parts = get("pad").build_parts(t, molds=not no_molds, **pad)
+            parts += build_parts(default_thickness(), indenters=indenter, braille_text=braille_text,
+                                 braille_standard=braille_standard, fingertip=False, molds=False)
+        else:
+            parts = build_parts(t, indenters=indenter, braille_text=braille_text,
+                                braille_standard=braille_standard, molds=not no_molds)
     t1 = time.perf_counter()
     with console.status(f"writing {len(parts)} parts to {escape(str(out_dir))}..."):
         manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
-                                                          braille_standard=braille_standard, molds=not no_molds))
+                                                          braille_standard=braille_standard, molds=not no_molds,
+                                                          **({"skin": "pad", **pad} if pad else {})))
     t2 = time.perf_counter()
 
     table = Table(title=escape(f"t = {t:g} mm -> {out_dir}/<part>.stl, .step"))

@@ -68,7 +68,7 @@ def material_law(law):
 
 
 def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
-    """The Model of a scene (fingertip skin, bone and nail fixed, symmetry x = 0, indenter)."""
+    """The Model of a scene (the skin's bonded boundaries fixed, symmetry x = 0, indenter)."""
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.materials import get_material
 
@@ -81,7 +81,9 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     prony = mat.prony if scene.viscoelastic and mat.prony.n_terms else None
     m = scene.dim
     allc = tuple(range(m))
-    bcs = [Dirichlet("bone_interface", allc), Dirichlet("nail_edge", allc), Dirichlet("symmetry", (0,))]
+    # the skin's bonded surfaces are fixed (fingertip: bone and nail; pad: the board)
+    bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries]
+    bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
     contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate)

@@ -233,6 +233,27 @@ class Section:
         """y of the outer contour on the symmetry line (first touch of a centred indenter)."""
         return self.fingertip.height
 
+    # --- answers for mesh sizing (the skins.base section contract) ----------------------
+    @property
+    def half_width(self) -> float:
+        """x extent of the outer contour (the widest the contact zone can be)."""
+        return self.fingertip.half_width
+
+    @property
+    def min_radius_of_curvature(self) -> float:
+        return self.fingertip.min_radius_of_curvature
+
+    def contact_radius(self, indenter) -> float:
+        """Radius of the contour's top, a^2/b, for the indenter's contact-size estimate."""
+        return self.fingertip.half_width ** 2 / self.fingertip.height
+
+    def outer_length_to_x(self, x_end: float) -> float:
+        """Arc length of the outer contour from the top (x = 0) to x = x_end."""
+        ft = self.fingertip
+        u = np.linspace(0.0, np.arcsin(min(x_end / ft.half_width, 1.0)), 400)
+        p = ft.outer(u)
+        return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
+
     def area(self) -> float:
         """Area of the skin half-section (mm^2), by the shoelace formula on dense polylines."""
         poly = self.polygon(4000)

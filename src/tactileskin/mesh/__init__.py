@@ -17,12 +17,6 @@ def build_mesh(scene, *, cell: str = "tri", **overrides) -> SkinMesh:
     """Mesh the skin of `scene`. Keyword overrides (mesh_size, refinement, order) take
     precedence over the scene's fields without changing it. cell="quad" gives a 2D
     all-quadrilateral mesh (MeshQuad2, 9-node) instead of triangles."""
-    if scene.dim == 2:
-        from tactileskin.mesh.section2d import build_section_mesh
-
-        return build_section_mesh(scene, cell=cell, **overrides)
-    if cell != "tri":
+    if cell not in ("tri", "quad") or (cell == "quad" and scene.dim == 3):
         raise ParameterError("cell", cell, "'tri' in 3D (tetrahedra); 'quad' is 2D only")
-    from tactileskin.mesh.slab3d import build_slab_mesh
-
-    return build_slab_mesh(scene, **overrides)
+    return scene.skin_kind.build_mesh(scene, cell=cell, **overrides)

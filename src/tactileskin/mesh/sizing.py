@@ -80,10 +80,9 @@ def contact_halfwidth(scene, section) -> float:
     to the skin."""
     from tactileskin.geometry.indenters import indenter_for_scene
 
-    ft = section.fingertip
-    r_top = ft.half_width ** 2 / ft.height
-    w = indenter_for_scene(scene, warn=False).contact_halfwidth(scene.indentation, r_top)
-    return min(w, ft.half_width)
+    ind = indenter_for_scene(scene, warn=False)
+    w = ind.contact_halfwidth(scene.indentation, section.contact_radius(ind))
+    return min(w, section.half_width)
 
 
 def contact_zrange(scene, length: float, z_symmetric: bool) -> tuple[float, float]:
@@ -95,13 +94,6 @@ def contact_zrange(scene, length: float, z_symmetric: bool) -> tuple[float, floa
     if zr is None:
         return z0, z1  # e.g. plate and cylinder along z touch along the whole slab
     return max(z0, zr[0]), min(z1, zr[1])
-
-
-def _arc_length_to_x(ft, x_end: float) -> float:
-    """Arc length of the outer contour from the top (x = 0) to x = x_end."""
-    u = np.linspace(0.0, np.arcsin(min(x_end / ft.half_width, 1.0)), 400)
-    p = ft.outer(u)
-    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
 
 
 def _size_at(d, p: "SizePlan", layer: float):
@@ -172,7 +164,6 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
     """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
     fine = coarse / ratio
     t = section.thickness
-    ft = section.fingertip
     w = contact_halfwidth(scene, section)
     roi = min(ROI_S, section.interface_length)
     trans = (coarse - fine) / GROWTH
@@ -182,8 +173,8 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
     # estimate: the coarse background plus, for each refined curve, the excess of h^-dim in
     # a one-sided strip as deep as the skin; the contact strip runs to the end of the box
     # transition, the ROI strip widens on the bone's convex side and spreads around its end.
-    l_out = _arc_length_to_x(ft, w + trans)
-    kappa = 1.0 / max(ft.min_radius_of_curvature - t, 0.1 * t)
+    l_out = section.outer_length_to_x(w + trans)
+    kappa = 1.0 / max(section.min_radius_of_curvature - t, 0.1 * t)
     lz = 1.0
     if dim == 3:
         lz = 0.5 * length if z_symmetric else length

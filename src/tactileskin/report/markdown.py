@@ -30,6 +30,7 @@ def at_paper_conditions(scene) -> bool:
     d = Scene()
     return (math.isclose(scene.indentation, 0.2 * scene.thickness, rel_tol=1e-9)
             and scene.rate == d.rate and scene.viscoelastic and not scene.fingertip
+            and scene.skin == d.skin
             and scene.braille_standard == d.braille_standard)
 
 

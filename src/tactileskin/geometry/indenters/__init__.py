@@ -64,7 +64,7 @@ def make_indenter(kind, *, y0: float | None = None, dim: int = 2, row: int | Non
 def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> Indenter:
     """The scene's indenter; its lowest point initially touches the skin top on x = 0."""
     return make_indenter(scene.indenter, y0=scene.section().top, dim=scene.dim, row=row,
-                         sample_length=scene.fingertip_model().sample_length, warn=warn,
+                         sample_length=scene.sample_length, warn=warn,
                          **scene_kind_params(scene))
 
 
@@ -83,7 +83,7 @@ def first_contact_travel(scene, samples: int = 4000) -> float:
     Braille text without a dot near the centre touches later, or only with its base plate."""
     ind = indenter_for_scene(scene, warn=False)
     sec = scene.section()
-    pts = sec.fingertip.outer(np.linspace(0.0, sec.u_outer_end, samples))
+    pts = sec.outer_points(samples)
     if scene.dim == 3:
         pts = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in ind.contact_planes()])
     g, _ = ind.gap(pts, 0.0)

@@ -1,0 +1,71 @@
+"""Printable parts of the flat pad (skins.pad): the pad itself and its two-part casting mold.
+
+Frame as the solver's: the pad is x in [-W/2, W/2], y in [0, t] (y = 0 the board side),
+z in [-L/2, L/2]. The mold casts the pad face down:
+- lower part: a block whose pocket is exactly the pad, open at the split plane y = 0 (its
+  floor is the pad's outer surface, so that face comes out as smooth as the print);
+  four alignment pins stand on the split face;
+- upper part (lid): a plate over y < 0 with the pin holes, a sprue at the pad's centre and an
+  air vent near each end. The sensor board, if it is to be bonded while curing, replaces the
+  lid (same footprint). Wall, pin and sprue sizes from data/geometry/molds.toml.
+"""
+
+from __future__ import annotations
+
+import build123d as bd
+
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.molds import MoldParams, _vertical_cylinder
+from tactileskin.geometry.parts import Part
+from tactileskin.geometry.solids import box, check_solid, occ_guard
+
+
+def pad_solid(width: float, length: float, thickness: float) -> bd.Solid:
+    w, z = 0.5 * width, 0.5 * length
+    return box(-w, w, 0.0, thickness, -z, z)
+
+
+def pad_mold(width: float, length: float, thickness: float, mp: MoldParams | None = None):
+    """(lower part with the pocket and pins, lid with sprue and vents)."""
+    mp = mp or MoldParams.from_params()
+    w, z = 0.5 * width, 0.5 * length
+    if mp.pour_diameter >= width or mp.pour_diameter >= length:
+        raise ParameterError("molds.pour.pour_diameter", mp.pour_diameter, f"< {min(width, length):g} mm (the pad)")
+    if not 0.5 * mp.vent_diameter <= mp.vent_inset <= z:
+        raise ParameterError("molds.pour.vent_inset", mp.vent_inset, f"[{0.5 * mp.vent_diameter:g}, {z:g}] mm")
+    hole = mp.pin_diameter + mp.pin_clearance
+    xp = w + mp.wall + 0.5 * hole
+    A, Z = xp + 0.5 * hole + mp.pin_flange, z + mp.wall
+    lid = max(mp.wall, mp.pin_height + mp.pin_depth_clearance + 1.0)  # the pin holes stay blind
+    pins = [(sx * xp, sz * z) for sx in (-1, 1) for sz in (-1, 1)]
+    p = dict(width=width, length=length, thickness=thickness, wall=mp.wall)
+    with occ_guard("building the pad mold", **p):
+        cavity = pad_solid(width, length, thickness)
+        pin_solids = [_vertical_cylinder(x, zz, -mp.pin_height, 0.0, mp.pin_diameter) for x, zz in pins]
+        lower = box(-A, A, 0.0, thickness + mp.wall, -Z, Z).cut(cavity).fuse(*pin_solids).clean()
+        holes = [_vertical_cylinder(x, zz, -(mp.pin_height + mp.pin_depth_clearance), 0.0, hole) for x, zz in pins]
+        zv = z - mp.vent_inset
+        holes += [_vertical_cylinder(0.0, 0.0, -lid - 1.0, 0.0, mp.pour_diameter)]
+        holes += [_vertical_cylinder(0.0, s * zv, -lid - 1.0, 0.0, mp.vent_diameter) for s in (-1, 1)]
+        upper = box(-A, A, -lid, 0.0, -Z, Z).cut(*holes).clean()
+    return check_solid(lower, "pad mold lower part", **p), check_solid(upper, "pad mold lid", **p)
+
+
+def build_pad_parts(thickness: float, width: float, length: float, *, molds: bool = True) -> list[Part]:
+    """The pad and (molds=True) its mold parts; the sizes are validated like a Scene's."""
+    from tactileskin.skins.pad import SIZE, THICKNESS
+    from tactileskin.errors import check_range
+
+    t = check_range("thickness", thickness, *THICKNESS, unit="mm")
+    width = check_range("pad_width", width, *SIZE, unit="mm")
+    length = check_range("pad_length", length, *SIZE, unit="mm")
+    fp = dict(skin="pad", thickness=t, pad_width=width, pad_length=length)
+    with occ_guard("building the pad", **fp):
+        pad = check_solid(pad_solid(width, length, t), "pad", **fp)
+    parts = [Part("skin", f"flat pad {width:g} x {length:g} x {t:g} mm (cast in the mold)", pad, fp)]
+    if molds:
+        mp = MoldParams.from_params()
+        lower, upper = pad_mold(width, length, t, mp)
+        parts.append(Part("mold_lower", "pad mold, lower part (pocket = the pad, pins)", lower, fp))
+        parts.append(Part("mold_upper", "pad mold, lid (sprue, vents; or the sensor board)", upper, fp))
+    return parts

@@ -1,0 +1,66 @@
+"""The skin contract: what a skin geometry answers for the Scene, the meshers and the solver.
+
+A skin is a class (no instances: every answer is a function of the Scene) with
+- `name`, `order` (listing order), `scene_params` (the Scene fields it reads besides
+  `thickness`; a Scene refuses them with another skin) and `check_scene(scene) -> dict`
+  (ParameterError naming the field and its valid range; returns normalised values);
+- `section(scene)`: its 2D section as curves and coordinates (the `Section` duck type of
+  geometry.fingertip: `thickness`, `top` (y of the outer surface on x = 0, where indenters
+  start), `interface_length` (bonded surface from x = 0), `s_of_point(points)`,
+  `point_at_s(s)`, `outer_points(n)`, `area()`, and for mesh sizing `half_width` (x extent
+  of the outer surface), `contact_radius(indenter)`, `outer_length_to_x(x)`,
+  `min_radius_of_curvature`);
+- `sample_length(scene)`: the z extent of the 3D model (and the indenter plates);
+- `coordinates(scene)`: the sensor coordinates (`frame(s, depth)`, `thickness`, `s_max`);
+- `fixed_boundaries`: the boundary names held fixed (bonded to rigid parts). Every skin mesh
+  names `bone_interface` (the bonded surface: the pressure path), `outer_surface` (contact),
+  `symmetry` (x = 0) and, in 3D, `end_front` / `end_back` (z = +-L/2; `end_back` is z = 0
+  when the indenter is z-symmetric); other names are free surfaces unless listed here;
+- `build_mesh(scene, **overrides) -> SkinMesh` (gmsh, imported inside);
+- `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
+- `label(scene)`: the prefix of case labels ("" for the paper's fingertip).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+
+class Skin:
+    name: ClassVar[str] = ""
+    order: ClassVar[int] = 9
+    scene_params: ClassVar[tuple[str, ...]] = ()
+    fixed_boundaries: ClassVar[tuple[str, ...]] = ("bone_interface",)
+    boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
+
+    @classmethod
+    def boundaries_3d(cls) -> tuple[str, ...]:
+        return cls.boundaries_2d + ("end_front", "end_back")
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        raise NotImplementedError
+
+    @classmethod
+    def section(cls, scene):
+        raise NotImplementedError
+
+    @classmethod
+    def sample_length(cls, scene) -> float:
+        raise NotImplementedError
+
+    @classmethod
+    def coordinates(cls, scene):
+        raise NotImplementedError
+
+    @classmethod
+    def build_mesh(cls, scene, *, cell: str = "tri", **overrides):
+        raise NotImplementedError
+
+    @classmethod
+    def build_parts(cls, thickness: float, *, molds: bool = True, **params) -> list:
+        raise NotImplementedError
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return cls.name + "-"

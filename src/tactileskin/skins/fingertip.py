@@ -1,0 +1,64 @@
+"""fingertip: the paper's skin, an elliptical half section over bone and nail (geometry.fingertip),
+as a plane-strain section (2D) or its extrusion along the finger (3D slab)."""
+
+from __future__ import annotations
+
+from tactileskin.skins.base import Skin
+from tactileskin.skins.registry import register
+
+
+@register
+class FingertipSkin(Skin):
+    name = "fingertip"
+    order = 0
+    scene_params = ("fingertip",)
+    fixed_boundaries = ("bone_interface", "nail_edge")
+    boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
+
+    @classmethod
+    def model(cls, scene):
+        from tactileskin.geometry.fingertip import Fingertip
+
+        return Fingertip.from_params(**dict(scene.fingertip))
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        return {"thickness": cls.model(scene).check_thickness(scene.thickness)}
+
+    @classmethod
+    def section(cls, scene):
+        return cls.model(scene).section(scene.thickness)
+
+    @classmethod
+    def sample_length(cls, scene) -> float:
+        return cls.model(scene).sample_length
+
+    @classmethod
+    def coordinates(cls, scene):
+        from tactileskin.sensors import SectionCoordinates
+
+        return SectionCoordinates(cls.section(scene))
+
+    @classmethod
+    def build_mesh(cls, scene, *, cell: str = "tri", **overrides):
+        from tactileskin.errors import ParameterError
+
+        if scene.dim == 2:
+            from tactileskin.mesh.section2d import build_section_mesh
+
+            return build_section_mesh(scene, cell=cell, **overrides)
+        if cell != "tri":
+            raise ParameterError("cell", cell, "'tri' in 3D (tetrahedra); 'quad' is 2D only")
+        from tactileskin.mesh.slab3d import build_slab_mesh
+
+        return build_slab_mesh(scene, **overrides)
+
+    @classmethod
+    def build_parts(cls, thickness, *, molds=True, **params):
+        from tactileskin.geometry.parts import build_parts
+
+        return build_parts(thickness, molds=molds, **params)
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return ""  # the paper's case labels stay as they were

@@ -1,0 +1,131 @@
+"""pad: a flat pad of width x length x thickness bonded to a rigid board (the most common
+tactile-skin build).
+
+Frame: the board is the plane y = 0 (the bonded surface, `bone_interface`), the free top is
+y = t (`outer_surface`, where indenters start), x across the pad (the models keep x >= 0, with
+`symmetry` on x = 0), z along it (z in [-L/2, L/2]). The free side x = W/2 is `side` (and in
+3D the free ends z = +-L/2 are `end_front` / `end_back`). s along the bonded surface is x, so
+a 2D section is exact for an indenter uniform along z (plane strain) and the sensor frames are
+flat (`sensors.FlatCoordinates`: depth along -y).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, check_range
+from tactileskin.skins.base import Skin
+from tactileskin.skins.registry import register
+
+DEFAULT_WIDTH = 20.0    # mm, x extent of the whole pad
+DEFAULT_LENGTH = 20.0   # mm, z extent
+THICKNESS = (0.1, 50.0)  # mm
+SIZE = (1.0, 500.0)      # mm, width and length
+FLAT_RADIUS = 1e6        # mm: "radius" of the flat top for contact-size estimates
+
+
+@dataclass(frozen=True)
+class PadSection:
+    """The pad's half section x in [0, W/2], y in [0, t] (the `Section` duck type of
+    geometry.fingertip, see skins.base)."""
+
+    width: float
+    thickness: float
+    length: float = DEFAULT_LENGTH
+
+    @property
+    def half_width(self) -> float:
+        return 0.5 * self.width
+
+    @property
+    def top(self) -> float:
+        return self.thickness
+
+    @property
+    def interface_length(self) -> float:
+        return self.half_width
+
+    @property
+    def min_radius_of_curvature(self) -> float:
+        return math.inf
+
+    def contact_radius(self, indenter) -> float:
+        """Radius for the indenter kind's contact-size estimate: on a flat top the indenter's
+        own curvature (cylinder, sphere) sets it; plates touch the whole width."""
+        r = getattr(indenter, "radius", None)
+        return float(r) if r else FLAT_RADIUS
+
+    def outer_length_to_x(self, x: float) -> float:
+        return float(min(max(x, 0.0), self.half_width))
+
+    def s_of_point(self, points) -> np.ndarray:
+        pts = np.atleast_2d(np.asarray(points, float))
+        return np.clip(pts[:, 0], 0.0, self.half_width)
+
+    def point_at_s(self, s) -> np.ndarray:
+        s = np.asarray(s, float)
+        if np.any((s < -1e-9) | (s > self.half_width + 1e-9)):
+            raise ParameterError("s", f"{np.min(s):g}..{np.max(s):g}",
+                                 f"[0, {self.half_width:g}] mm along the bonded surface")
+        return np.stack([s, np.zeros_like(s)], axis=-1)
+
+    def outer_points(self, n: int = 200) -> np.ndarray:
+        x = np.linspace(0.0, self.half_width, n)
+        return np.column_stack([x, np.full(n, self.thickness)])
+
+    def interface_points(self, n: int = 200) -> np.ndarray:
+        x = np.linspace(0.0, self.half_width, n)
+        return np.column_stack([x, np.zeros(n)])
+
+    def area(self) -> float:
+        return self.half_width * self.thickness
+
+
+@register
+class PadSkin(Skin):
+    name = "pad"
+    order = 1
+    scene_params = ("pad_width", "pad_length")
+    fixed_boundaries = ("bone_interface",)
+    boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "side")
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        w = DEFAULT_WIDTH if scene.pad_width is None else scene.pad_width
+        length = DEFAULT_LENGTH if scene.pad_length is None else scene.pad_length
+        return {"thickness": check_range("thickness", scene.thickness, *THICKNESS, unit="mm"),
+                "pad_width": check_range("pad_width", w, *SIZE, unit="mm"),
+                "pad_length": check_range("pad_length", length, *SIZE, unit="mm")}
+
+    @classmethod
+    def section(cls, scene) -> PadSection:
+        return PadSection(float(scene.pad_width), float(scene.thickness), float(scene.pad_length))
+
+    @classmethod
+    def sample_length(cls, scene) -> float:
+        return float(scene.pad_length)
+
+    @classmethod
+    def coordinates(cls, scene):
+        from tactileskin.sensors import FlatCoordinates
+
+        return FlatCoordinates(top=scene.thickness, thickness=scene.thickness, half_width=0.5 * scene.pad_width)
+
+    @classmethod
+    def build_mesh(cls, scene, *, cell: str = "tri", **overrides):
+        from tactileskin.mesh.pad import build_pad_mesh
+
+        return build_pad_mesh(scene, cell=cell, **overrides)
+
+    @classmethod
+    def build_parts(cls, thickness, *, molds=True, pad_width=DEFAULT_WIDTH, pad_length=DEFAULT_LENGTH, **_):
+        from tactileskin.geometry.pad_parts import build_pad_parts
+
+        return build_pad_parts(thickness, pad_width, pad_length, molds=molds)
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return f"pad{scene.pad_width:g}x{scene.pad_length:g}-"
