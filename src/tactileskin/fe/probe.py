@@ -81,14 +81,26 @@ def stress_sampler(model, point_data: dict):
     from the nodal components sxx, syy, szz, sxy[, syz, sxz] of `point_data` (fe.output's
     result fields; missing shear components, as in plane strain, are zero)."""
 
-    def sample(points):
-        from tactileskin.fe.output import STRESS_COMPONENTS
+    from tactileskin.errors import TactileSkinError
+    from tactileskin.fe.output import FIELD_UNITS, STRESS_COMPONENTS
 
+    # a field is named bare (sxx) or with its unit (sxx_MPa, as in result.vtu)
+    keys = {n: next((k for k in (n, f"{n}_{FIELD_UNITS.get(n, '')}") if k in point_data), None)
+            for n in STRESS_COMPONENTS}
+    # only the out-of-plane shears may be absent (plane strain: zero); anything else missing
+    # would read as a silent zero stress
+    needed = [n for n in STRESS_COMPONENTS if n not in ("syz", "sxz") or model.m == 3]
+    missing = [n for n in needed if keys[n] is None]
+    if missing:
+        raise TactileSkinError(f"stress fields {missing} not in the result's point data "
+                               f"(has {sorted(point_data)})")
+
+    def sample(points):
         M = interpolation_matrix(model, points)
         sig = np.zeros((M.shape[0], 3, 3))
         for name, (i, j) in STRESS_COMPONENTS.items():
-            if name in point_data:
-                v = M @ np.asarray(point_data[name], float)
+            if keys[name] is not None:
+                v = M @ np.asarray(point_data[keys[name]], float)
                 sig[:, i, j] = sig[:, j, i] = v
         return sig
 
