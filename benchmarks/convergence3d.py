@@ -262,6 +262,7 @@ def write_presets(path: Path, key: str, study: dict) -> None:
     cases = data.setdefault("cases3d", {})
     ref = study["reference"]
     cases[key] = {
+        "plan": study["levels"][-1].get("plan", "strip"),
         "reference_peak": ref["value"], "reference_method": ref["method"],
         "observed_order": ref["order"],
         "levels": [{"mesh_size": d["mesh_size"], "refinement": d["refinement"], "dofs": d["dofs"],

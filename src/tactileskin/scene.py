@@ -20,8 +20,9 @@ from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
-# not reused (2: bone pressure from the boundary fit, second-order QLV update)
-SCHEMA_VERSION = 2
+# not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: 3D Braille
+# meshes refined locally at the dots, mesh.sizing.local_plan)
+SCHEMA_VERSION = 3
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
@@ -35,12 +36,14 @@ SCHEMA_VERSION = 2
 # 3D: chosen by the convergence study benchmarks/convergence3d.py).
 DEFAULT_MESH = {2: _presets.mesh(2, "default"), 3: _presets.mesh(3, "default")}
 DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
+# 3D Braille: (coarse size, coarse / fine ratio) of the local plan (mesh.sizing.local_plan)
+DEFAULT_MESH_BRAILLE_3D = _presets.mesh(3, "default", braille=True)
 
 
 def default_mesh(dim: int, indenter) -> tuple[float, float]:
     """(mesh_size, refinement) a scene of this dimension and indenter gets by default."""
-    if dim == 2 and IndenterKind(indenter) is IndenterKind.BRAILLE:
-        return DEFAULT_MESH_BRAILLE_2D
+    if IndenterKind(indenter) is IndenterKind.BRAILLE and dim in (2, 3):
+        return DEFAULT_MESH_BRAILLE_2D if dim == 2 else DEFAULT_MESH_BRAILLE_3D
     return DEFAULT_MESH[dim]
 
 
