@@ -22,8 +22,13 @@ levels to --presets (default: the package's src/tactileskin/data/presets.json, "
 keyed by case; other cases and the presets themselves are kept: tactileskin.presets reads
 the preset errors from there).
 
+Levels are meshed with the mesher's local plan at the dots (mesh.sizing.local_plan:
+mesh_size is the far size, refinement the coarse / fine ratio at the dots); --plan strip
+solves the former plan (fine = mesh_size / refinement over the whole contact strip and bone
+ROI) for comparisons.
+
     PYTHONPATH=src .venv/bin/python benchmarks/convergence3d.py --thickness 1 --material silicone \
-        --text "" --levels "1.2/2,0.85/2,0.6/2" [--out benchmarks/results/convergence3d.md]
+        --text "" --levels "1.6/8,1.2/8,0.8/8" [--out benchmarks/results/convergence3d.md]
 """
 
 from __future__ import annotations
@@ -279,7 +284,7 @@ def main(argv=None) -> int:
     ap.add_argument("--thickness", type=float, default=1.0)
     ap.add_argument("--material", default="silicone")
     ap.add_argument("--text", default="", help='Braille text ("" single dot, "\\u283f" full cell)')
-    ap.add_argument("--levels", default="1.2/2,0.85/2,0.6/2")
+    ap.add_argument("--levels", default="1.6/8,1.2/8,0.8/8")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "convergence3d.md")
     ap.add_argument("--presets", type=Path, default=PRESETS)
     ap.add_argument("--raw", type=Path, default=HERE / "results" / "convergence3d_levels")
