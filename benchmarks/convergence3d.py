@@ -22,8 +22,13 @@ levels to --presets (default: the package's src/tactileskin/data/presets.json, "
 keyed by case; other cases and the presets themselves are kept: tactileskin.presets reads
 the preset errors from there).
 
+Levels are meshed with the mesher's local plan at the dots (mesh.sizing.local_plan:
+mesh_size is the far size, refinement the coarse / fine ratio at the dots); --plan strip
+solves the former plan (fine = mesh_size / refinement over the whole contact strip and bone
+ROI) for comparisons.
+
     PYTHONPATH=src .venv/bin/python benchmarks/convergence3d.py --thickness 1 --material silicone \
-        --text "" --levels "1.2/2,0.85/2,0.6/2" [--out benchmarks/results/convergence3d.md]
+        --text "" --levels "1.6/8,1.2/8,0.8/8" [--out benchmarks/results/convergence3d.md]
 """
 
 from __future__ import annotations
@@ -147,22 +152,25 @@ def level_name(h: float, r: float) -> str:
     return f"{h:g}_{r:g}"
 
 
-def solve_level(t: float, material: str, text: str, h: float, r: float, out: Path) -> None:
-    """Solve one level and write its numbers and bone map to `out` (JSON)."""
+def solve_level(t: float, material: str, text: str, h: float, r: float, out: Path,
+                plan: str = "local") -> None:
+    """Solve one level and write its numbers and bone map to `out` (JSON). plan "local": the
+    mesher's local refinement at the dots (sizing.local_plan); "strip": the former plan."""
     from tactileskin.fe import solve
     from tactileskin.fileio import atomic_write_json
+    from tactileskin.mesh.slab3d import build_slab_mesh
     from tactileskin.scene import Scene
 
     scene = Scene(dim=3, indenter="braille", thickness=t, material=material, braille_text=text,
                   mesh_size=h, refinement=r)
     c0, w0 = time.process_time(), time.perf_counter()
-    res = solve(scene)
+    res = solve(scene, build_slab_mesh(scene, local=plan == "local"))
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     bm = res.bone_map
     mpk, ms, mz = bm.peak()
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
-        "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
+        "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),
@@ -174,11 +182,17 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     })
 
 
+def raw_name(t: float, material: str, text: str, h: float, r: float, plan: str) -> str:
+    key = case_key(t, material, text).replace(chr(0x2801), "dot").replace(chr(0x283f), "cell")
+    return f"{key}_{level_name(h, r)}{'' if plan == 'strip' else '_' + plan}.json"
+
+
 def run_level(args, h: float, r: float, raw_dir: Path) -> dict:
-    path = raw_dir / f"{case_key(args.thickness, args.material, args.text).replace(chr(0x2801), 'dot').replace(chr(0x283f), 'cell')}_{level_name(h, r)}.json"
+    path = raw_dir / raw_name(args.thickness, args.material, args.text, h, r, args.plan)
     if not path.exists() or args.force:
         cmd = [sys.executable, __file__, "--one", f"{h:g}/{r:g}", "--thickness", str(args.thickness),
-               "--material", args.material, "--text", args.text, "--raw", str(raw_dir)]
+               "--material", args.material, "--text", args.text, "--raw", str(raw_dir),
+               "--plan", args.plan]
         print(f"[{time.strftime('%H:%M:%S')}] solving {h:g}/{r:g} ...", flush=True)
         subprocess.run(cmd, check=True, env=dict(os.environ, PYTHONPATH=str(ROOT / "src")))
     return json.loads(path.read_text(encoding="utf-8")) | {"raw": path.name}
@@ -253,6 +267,7 @@ def write_presets(path: Path, key: str, study: dict) -> None:
     cases = data.setdefault("cases3d", {})
     ref = study["reference"]
     cases[key] = {
+        "plan": study["levels"][-1].get("plan", "strip"),
         "reference_peak": ref["value"], "reference_method": ref["method"],
         "observed_order": ref["order"],
         "levels": [{"mesh_size": d["mesh_size"], "refinement": d["refinement"], "dofs": d["dofs"],
@@ -269,19 +284,20 @@ def main(argv=None) -> int:
     ap.add_argument("--thickness", type=float, default=1.0)
     ap.add_argument("--material", default="silicone")
     ap.add_argument("--text", default="", help='Braille text ("" single dot, "\\u283f" full cell)')
-    ap.add_argument("--levels", default="1.2/2,0.85/2,0.6/2")
+    ap.add_argument("--levels", default="1.6/8,1.2/8,0.8/8")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "convergence3d.md")
     ap.add_argument("--presets", type=Path, default=PRESETS)
     ap.add_argument("--raw", type=Path, default=HERE / "results" / "convergence3d_levels")
     ap.add_argument("--force", action="store_true", help="solve levels already in --raw again")
+    ap.add_argument("--plan", choices=("local", "strip"), default="local",
+                    help="size plan: local refinement at the dots (default) or the former strip plan")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     args.raw.mkdir(parents=True, exist_ok=True)
     if args.one:
         h, r = parse_levels(args.one)[0]
-        key = case_key(args.thickness, args.material, args.text)
-        name = key.replace(chr(0x2801), "dot").replace(chr(0x283f), "cell")
-        solve_level(args.thickness, args.material, args.text, h, r, args.raw / f"{name}_{level_name(h, r)}.json")
+        solve_level(args.thickness, args.material, args.text, h, r,
+                    args.raw / raw_name(args.thickness, args.material, args.text, h, r, args.plan), args.plan)
         return 0
     levels = [run_level(args, h, r, args.raw) for h, r in parse_levels(args.levels)]
     if len(levels) < 3:

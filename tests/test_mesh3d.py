@@ -138,3 +138,86 @@ def test_cell_estimate_is_upper_side_3d(slab_t3):
     # below the actual count nor exceed it 2x (measured 1.0-1.5x for sizes <= the thickness)
     r = slab_t3.sizes["estimate"] / slab_t3.mesh.nelements
     assert 1.0 <= r <= 2.0, r
+
+
+# --- local refinement of 3D Braille slabs (sizing.local_plan) ---------------------------------
+
+LOCAL = {"mesh_size": 1.2, "refinement": 4.0}  # fine 0.3 mm at the dot: ~10k dofs, ~1-2 s
+
+
+def _edges_near(sm, name, centre, radius):
+    """Median edge length of the `name` facets whose centroid is within radius of centre."""
+    m = sm.mesh
+    f = m.facets[:, sm.boundaries[name]]
+    d = np.linalg.norm(m.p[:, f].mean(axis=1) - np.asarray(centre, float)[:, None], axis=0)
+    sel = f[:, d < radius]
+    e = np.concatenate([np.linalg.norm(m.p[:, sel[i]] - m.p[:, sel[(i + 1) % 3]], axis=0) for i in range(3)])
+    return float(np.median(e)), sel.shape[1]
+
+
+@pytest.fixture(scope="module")
+def dot_t1():
+    return build_mesh(Scene(thickness=1.0, dim=3, indenter="braille", braille_text=""), **LOCAL)
+
+
+def test_local_plan_is_fine_under_the_dot_and_coarse_far_away(dot_t1):
+    sizes, t = dot_t1.sizes, 1.0
+    fine, coarse = sizes["fine"], sizes["coarse"]
+    assert fine == pytest.approx(LOCAL["mesh_size"] / LOCAL["refinement"])
+    assert sizes["patches"] and sizes["bone_patches"] and sizes["strip"] == 0.0  # depth 0.2 < dot height
+    (x, y, z, r, h), = sizes["patches"]
+    assert (x, z, h) == (0.0, 0.0, fine)
+    # the ball centres are the dot's contact point on the outer surface and the bone point under it
+    out = dot_t1.mesh.p[:, np.unique(dot_t1.mesh.facets[:, dot_t1.boundaries["outer_surface"]])]
+    assert np.min(np.linalg.norm(out - np.array([[x], [y], [z]]), axis=0)) < 0.5 * fine
+    xb, yb, zb, rb, hb = sizes["bone_patches"][0]
+    assert yb == pytest.approx(y - t)
+    # gmsh meets the field to ~20 % (edges of a Delaunay mesh scatter around the target size);
+    # far from the dot (z = 5 mm, 3.5 mm beyond the ball) the size is the coarse one, capped
+    # by gmsh at about the skin thickness
+    near_out, n_out = _edges_near(dot_t1, "outer_surface", (0, y, 0), 0.6)
+    near_bone, n_bone = _edges_near(dot_t1, "bone_interface", (0, yb, 0), 1.0)
+    far_out, _ = _edges_near(dot_t1, "outer_surface", (0, y, 5.0), 1.0)
+    far_bone, _ = _edges_near(dot_t1, "bone_interface", (0, yb, 5.0), 1.0)
+    assert near_out < 1.2 * fine and near_bone < 1.2 * hb and n_out > 5 and n_bone > 10
+    assert far_out > 0.75 * min(coarse, 2 * t) and far_bone > 0.75 * min(coarse, 2 * t)
+
+
+def test_local_plan_has_fewer_dofs_than_the_strip_plan_at_equal_fine_size(dot_t1):
+    strip = build_mesh(Scene(thickness=1.0, dim=3, indenter="braille", braille_text=""), local=False, **LOCAL)
+    assert strip.sizes["fine"] == dot_t1.sizes["fine"] and not strip.sizes["patches"]
+    # the strip plan refines the whole contact strip and 6 mm of bone along the 10 mm half slab
+    assert dot_t1.mesh.nelements < 0.6 * strip.mesh.nelements
+    r = dot_t1.sizes["estimate"] / dot_t1.mesh.nelements
+    assert 1.0 <= r <= 2.0, r  # the local plan's estimate is upper-side too
+
+
+def test_local_plan_covers_every_dot_of_a_cell_and_the_plate_strip_when_it_touches():
+    from tactileskin.geometry import braille
+    from tactileskin.mesh import sizing
+
+    sc = Scene(thickness=3.0, dim=3, indenter="braille", braille_text="\u283f")
+    sec = sc.section()
+    p = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True, **LOCAL)
+    xz = braille.dot_centres("\u283f", "standard_american")
+    # quarter slab x >= 0, z >= 0: the dots inside it plus the mirror dots whose balls reach it
+    inside = {(round(x, 6), round(z, 6)) for x, z in xz if x >= 0 and z >= 0}
+    got = {(round(b[0], 6), round(b[2], 6)) for b in p.patches}
+    assert inside <= got and len(inside) == 2
+    assert all(x < 0 or z < 0 for x, z in got - inside)
+    # t = 3: depth 0.6 mm > dot height 0.48 mm: the base plate touches along the slab
+    assert sc.indentation > braille.get_standard("standard_american").height
+    assert p.strip == pytest.approx(np.sqrt(p.fine * p.coarse)) and p.contact_x > 0
+    # the bone size grows with t / dot diameter (the bone imprint's length scale)
+    assert p.bone_patches[0][4] == pytest.approx(p.fine * 3.0 / 1.44)
+
+
+@pytest.mark.parametrize("indenter", ["flat", "curved"])
+def test_flat_and_curved_keep_the_strip_plan(indenter):
+    from tactileskin.mesh import sizing
+
+    sc = Scene(thickness=3.0, dim=3, indenter=indenter)
+    sec = sc.section()
+    kw = dict(dim=3, length=sec.fingertip.sample_length, z_symmetric=True, **LOCAL)
+    assert sizing.plan(sc, sec, **kw) == sizing.plan(sc, sec, local=False, **kw)
+    assert not sizing.plan(sc, sec, **kw).patches

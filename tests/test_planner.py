@@ -122,6 +122,8 @@ def test_quality_presets_order_cost_and_error():
     errs = [QUALITY[q]["peak_error"] for q in ("preview", "default", "fine")]
     assert errs == sorted(errs, reverse=True)
     s3 = with_quality(sc.replace(dim=3, indenter="braille"), "fine")  # 3D: the 3D preset
-    assert (s3.mesh_size, s3.refinement) == QUALITY["fine"]["mesh3d"]
+    assert (s3.mesh_size, s3.refinement) == QUALITY["fine"]["braille_mesh3d"]
+    f3 = with_quality(sc.replace(dim=3), "fine")  # flat / curved 3D: the strip plan's preset
+    assert (f3.mesh_size, f3.refinement) == QUALITY["fine"]["mesh3d"]
     with pytest.raises(ParameterError, match="quality"):
         with_quality(sc, "ultra")

@@ -11,7 +11,7 @@ import pytest
 from tactileskin import presets
 from tactileskin.errors import ParameterError
 from tactileskin.planner import QUALITY, with_quality
-from tactileskin.scene import DEFAULT_MESH, Scene
+from tactileskin.scene import DEFAULT_MESH, Scene, default_mesh
 
 _spec = importlib.util.spec_from_file_location(
     "convergence3d", Path(__file__).resolve().parents[1] / "benchmarks" / "convergence3d.py")
@@ -25,6 +25,8 @@ def test_preset_file_has_three_levels_per_dim_with_finite_errors():
         assert set(presets.QUALITIES) <= set(data[dim])
         fine_sizes = [presets.mesh(int(dim), q)[0] / presets.mesh(int(dim), q)[1] for q in presets.QUALITIES]
         assert fine_sizes == sorted(fine_sizes, reverse=True)  # preview coarsest, fine finest
+        fine_b = [presets.mesh(int(dim), q, True)[0] / presets.mesh(int(dim), q, True)[1] for q in presets.QUALITIES]
+        assert fine_b == sorted(fine_b, reverse=True)
     for q in presets.QUALITIES:
         assert math.isfinite(QUALITY[q]["peak_error"])
         e = presets.preset_errors(q)
@@ -45,10 +47,13 @@ def test_3d_cases_in_the_file_are_consistent():
 def test_with_quality_applies_the_dimensions_preset():
     s3 = Scene(dim=3, thickness=1.0, indenter="braille")
     for q in presets.QUALITIES:
-        assert (with_quality(s3, q).mesh_size, with_quality(s3, q).refinement) == presets.mesh(3, q)
+        assert (with_quality(s3, q).mesh_size, with_quality(s3, q).refinement) == presets.mesh(3, q, braille=True)
+        f3 = with_quality(s3.replace(indenter="flat"), q)
+        assert (f3.mesh_size, f3.refinement) == presets.mesh(3, q)
         s2 = with_quality(s3.replace(dim=2), q)
         assert (s2.mesh_size, s2.refinement) == presets.mesh(2, q, braille=True)
-    assert (s3.mesh_size, s3.refinement) == DEFAULT_MESH[3] == presets.mesh(3, "default")
+    assert (s3.mesh_size, s3.refinement) == default_mesh(3, "braille") == presets.mesh(3, "default", braille=True)
+    assert DEFAULT_MESH[3] == presets.mesh(3, "default")
     assert presets.mesh(3, "preview") != presets.mesh(3, "fine")
     with pytest.raises(ParameterError, match="quality"):
         with_quality(s3, "ultra")

@@ -76,4 +76,8 @@ def test_braille_2d_default_mesh_is_finer():
     assert Scene().replace(indenter="braille") == b              # defaults re-derived
     assert b.replace(indenter="flat") == Scene()
     assert Scene(mesh_size=0.4).replace(indenter="braille").mesh_size == 0.4
-    assert Scene(indenter="braille", dim=3).mesh_size == DEFAULT_MESH[3][0]
+    from tactileskin.scene import DEFAULT_MESH_BRAILLE_3D
+
+    b3 = Scene(indenter="braille", dim=3)
+    assert (b3.mesh_size, b3.refinement) == DEFAULT_MESH_BRAILLE_3D  # the local plan's sizes
+    assert b3.replace(indenter="flat") == Scene(dim=3)

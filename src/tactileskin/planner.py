@@ -154,7 +154,8 @@ class Plan:
 # (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md): preview
 # -0.12..-3.18 %, default -0.10..-0.47 %, fine +0.03..-0.17 %, every preset reading low;
 # against 5-level series the t = 1 cases read lower still (preset_accuracy_fit_t1.md).
-# 3D ("mesh3d"): the levels of the 3D convergence study (benchmarks/convergence3d.py,
+# 3D: "mesh3d" for flat / curved (the strip plan), "braille_mesh3d" for Braille (the local
+# plan at the dots, mesh.sizing.local_plan); the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
 # benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
 # "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
@@ -168,7 +169,8 @@ def _quality_table() -> dict[str, dict]:
         e3 = presets.preset_errors(q)
         out[q] = {"mesh": presets.mesh(2, q), "braille_mesh": presets.mesh(2, q, braille=True),
                   "peak_error": float(presets.load()["2"][q]["peak_error"]),
-                  "mesh3d": presets.mesh(3, q), "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
+                  "mesh3d": presets.mesh(3, q), "braille_mesh3d": presets.mesh(3, q, braille=True),
+                  "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
                   "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"]),
                   "cases3d_reference": tuple(e3["reference_in"])}
     return out
@@ -182,10 +184,10 @@ def quality_mesh(quality: str, indenter, dim: int = 2) -> tuple[float, float]:
     if quality not in QUALITY:
         raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
     q = QUALITY[quality]
-    if dim == 3:
-        return q["mesh3d"]
     from tactileskin.geometry.indenters import get_kind
 
+    if dim == 3:
+        return q["braille_mesh3d"] if get_kind(indenter).name == "braille" else q["mesh3d"]
     return q["braille_mesh"] if get_kind(indenter).fine_2d_mesh else q["mesh"]
 
 

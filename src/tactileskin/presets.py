@@ -2,8 +2,10 @@
 tactileskin/data/presets.json (importlib.resources): the one place the preset sizes and
 their measured errors live (scene.default_mesh and planner.QUALITY read it).
 
-File layout: "2" and "3" map each preset to its mesh ([mesh_size, refinement]); 2D also has
-"braille_mesh" and the "peak_error" measured by benchmarks/preset_accuracy.py. "cases3d"
+File layout: "2" and "3" map each preset to its mesh ([mesh_size, refinement]) and its
+"braille_mesh" (2D: finer at the dot; 3D: the local plan's sizes, mesh.sizing.local_plan:
+coarse size and coarse / fine ratio at the dots); 2D also has the "peak_error" measured by
+benchmarks/preset_accuracy.py. "cases3d"
 holds the 3D convergence study (benchmarks/convergence3d.py writes it): per case (thickness,
 material, dot pattern) each level's dofs, relative peak error against the reference, map L2
 against the finest level and CPU time. A 3D preset's errors are the worst over the cases
@@ -43,7 +45,8 @@ def check_quality(quality: str) -> str:
 
 
 def mesh(dim: int, quality: str, braille: bool = False) -> tuple[float, float]:
-    """(mesh_size, refinement) of a preset; 2D Braille has its own (finer) mesh."""
+    """(mesh_size, refinement) of a preset; Braille has its own (2D: finer at the dot; 3D: the
+    local plan's coarse size and ratio)."""
     q = load()[str(int(dim))][check_quality(quality)]
     m = q["braille_mesh"] if braille and "braille_mesh" in q else q["mesh"]
     return float(m[0]), float(m[1])
@@ -59,7 +62,7 @@ def preset_errors(quality: str) -> dict:
     case keys whose levels do not include this preset's mesh, "reference_in": cases where this
     level is the finest, i.e. the reference (error 0 by construction, not a measurement)}.
     Errors are None when no case measured the level."""
-    h, r = mesh(3, quality)
+    h, r = mesh(3, quality, braille=True)  # the study's cases are Braille
     peak, l2, seen, missing, ref = [], [], [], [], []
     for key, case in load().get("cases3d", {}).items():
         lv = [v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)]

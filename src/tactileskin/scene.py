@@ -23,7 +23,8 @@ from tactileskin.skins import registry as _skins
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
 # not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: contact
-# penetration tolerance relative to the facet size, multipliers updated within Newton)
+# penetration tolerance relative to the facet size, multipliers updated within Newton, and 3D
+# Braille meshes refined locally at the dots, mesh.sizing.local_plan)
 SCHEMA_VERSION = 3
 
 
@@ -38,12 +39,17 @@ SCHEMA_VERSION = 3
 # 3D: chosen by the convergence study benchmarks/convergence3d.py).
 DEFAULT_MESH = {2: _presets.mesh(2, "default"), 3: _presets.mesh(3, "default")}
 DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
+# 3D Braille: (coarse size, coarse / fine ratio) of the local plan (mesh.sizing.local_plan)
+DEFAULT_MESH_BRAILLE_3D = _presets.mesh(3, "default", braille=True)
 
 
 def default_mesh(dim: int, indenter) -> tuple[float, float]:
     """(mesh_size, refinement) a scene of this dimension and indenter gets by default (the
-    kind says whether its 2D section needs the finer preset)."""
-    if dim == 2 and _indenters.get(indenter).fine_2d_mesh:
+    kind says whether its 2D section needs the finer preset; 3D Braille is refined at the dots)."""
+    kind = _indenters.get(indenter)
+    if dim == 3 and kind.name == "braille":
+        return DEFAULT_MESH_BRAILLE_3D
+    if dim == 2 and kind.fine_2d_mesh:
         return DEFAULT_MESH_BRAILLE_2D
     return DEFAULT_MESH[dim]
 

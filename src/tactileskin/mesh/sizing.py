@@ -68,6 +68,14 @@ class SizePlan:
     roi_layer: float                   # distance from the ROI kept at the fine size
     transition: float                  # (coarse - fine) / growth: distance from fine to coarse
     estimate: int                      # estimated cell count (upper side)
+    # 3D Braille (local plan, `local_plan`): balls (x, y, z, radius, size) around each dot's
+    # contact point on the outer surface and around the bone point under it; inside a ball the
+    # size is `size` within the surface layer, graded by `growth` to `coarse` outside. `fine`
+    # and the contact strip / ROI above then hold the base plate's contact strip (size
+    # `fine`, equal to `coarse` when the plate does not touch).
+    patches: tuple = ()
+    bone_patches: tuple = ()
+    strip: float = 0.0                 # local plan: size on the plate strip and bone ROI (0: none)
 
     def as_dict(self) -> dict:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -117,9 +125,10 @@ def _strip(p: "SizePlan", layer: float, depth: float, dim: int, cap: bool = Fals
 
 def plan(scene, section, *, mesh_size: float | None = None, refinement: float | None = None,
          dim: int = 2, length: float | None = None, z_symmetric: bool = False,
-         order: int | None = None) -> SizePlan:
+         order: int | None = None, local: bool = True) -> SizePlan:
     """Sizes for `section`; raises ParameterError if a size is not positive or the estimated
-    dofs (cells of `dim`, element `order`, default the scene's) exceed MAX_DOFS[dim]."""
+    dofs (cells of `dim`, element `order`, default the scene's) exceed MAX_DOFS[dim].
+    local=False: the strip plan for 3D Braille too (the former plan, for comparisons)."""
     coarse = scene.mesh_size if mesh_size is None else mesh_size
     ratio = scene.refinement if refinement is None else refinement
     coarse = check_range("mesh_size", coarse, 0.0, None, lo_open=True, unit="mm")
@@ -127,7 +136,8 @@ def plan(scene, section, *, mesh_size: float | None = None, refinement: float | 
     if dim == 3 and length is None:
         raise ParameterError("length", length, "> 0 mm (slab length along z)")
     order = scene.order if order is None else order
-    layout = functools.partial(_layout, scene, section, dim=dim, length=length, z_symmetric=z_symmetric)
+    layout = functools.partial(_layout, scene, section, dim=dim, length=length, z_symmetric=z_symmetric,
+                               local=local)
     p = layout(coarse, ratio)
     dofs = estimate_dofs(p.estimate, dim, order)
     cap = MAX_DOFS[dim]
@@ -160,8 +170,10 @@ def _smallest_size(fits, too_small: float, largest: float = 5.0) -> float | None
 
 
 def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: float | None,
-            z_symmetric: bool) -> SizePlan:
+            z_symmetric: bool, local: bool = True) -> SizePlan:
     """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
+    if dim == 3 and local and scene.indenter.value == "braille":
+        return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric)
     fine = coarse / ratio
     t = section.thickness
     w = contact_halfwidth(scene, section)
@@ -191,6 +203,84 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
     return dataclasses.replace(p, estimate=n)
 
 
+# 3D Braille, local plan (issue 13, benchmarks/results/convergence3d.md): refining the whole
+# contact strip and bone ROI at mesh_size / refinement spent most dofs on skin far from the
+# dots while the pressure fall-off under each dot stayed under-resolved. The local plan puts
+# the refined size only in balls around each dot's contact point (radius PATCH_RADIUS dot
+# base radii: the contact radius is at most the base radius) and around the bone point under
+# it (radius base radius + thickness: the bone imprint spreads over ~t; the measured spans are
+# 0.9 mm at t = 1, 2.2 mm at t = 3), graded by GROWTH_3D to the coarse size. On the bone the
+# size is scaled by max(1, t / base diameter): the bone field's length scale is the larger of
+# the dot and the skin thickness.
+GROWTH_3D = 0.35
+PATCH_RADIUS = 1.25
+
+
+def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_symmetric: bool) -> SizePlan:
+    """Local size plan of a 3D Braille slab: fine = coarse / ratio at the dots' contact patches
+    and (scaled with t) on the bone under them; if the indentation exceeds the dot height the
+    base plate touches along the whole slab, and that strip and the bone ROI get the geometric
+    mean of the fine and coarse sizes (`strip`)."""
+    from tactileskin.geometry import braille
+
+    std = braille.get_standard(scene.braille_standard)
+    a0 = std.base_radius
+    fine = coarse / ratio
+    t = section.thickness
+    ft = section.fingertip
+    g = GROWTH_3D
+    bone_fine = min(coarse, fine * max(1.0, t / (2.0 * a0)))
+    r_patch, r_bone = PATCH_RADIUS * a0, a0 + t
+    z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
+    lz = z1 - z0
+    patches, bones = [], []
+    excess = 0.0
+    for x, z in braille.dot_centres(scene.braille_text, std):
+        u = math.asin(min(abs(x) / ft.half_width, 1.0)) * (1.0 if x >= 0 else -1.0)
+        po, n = ft.outer(u), ft.outer_normal(u)
+        pb = po - t * n
+        for balls, c, r, h, layer in ((patches, po, r_patch, fine, OUTER_LAYER * fine),
+                                      (bones, pb, r_bone, bone_fine, ROI_LAYER * bone_fine)):
+            if c[0] < -r or z < z0 - r or z > z1 + r:
+                continue  # the ball misses the meshed part (x >= 0, z0 <= z <= z1)
+            balls.append((float(c[0]), float(c[1]), float(z), float(r), float(h)))
+            ext = r + (coarse - h) / g
+            frac = (min(1.0, 0.5 + c[0] / (2.0 * ext)) * min(1.0, 0.5 + (z - z0) / (2.0 * ext))
+                    * min(1.0, 0.5 + (z1 - z) / (2.0 * ext)))
+            excess += max(frac, 0.0) * _ball_excess(min(coarse, t), min(h, t), r, layer, t, g)
+    strip = 0.0
+    w = 0.0
+    if scene.indentation > std.height:
+        strip = math.sqrt(fine * coarse)
+        r_top = ft.half_width ** 2 / ft.height
+        w = min(1.5 * math.sqrt(2.0 * r_top * (scene.indentation - std.height)), ft.half_width)
+    s_fine = strip if strip else coarse
+    roi = min(ROI_S, section.interface_length)
+    p = SizePlan(coarse, fine, g, w, (z0, z1), OUTER_LAYER * s_fine, roi, ROI_LAYER * s_fine,
+                 (coarse - s_fine) / g, 0, tuple(patches), tuple(bones), strip)
+    if strip:
+        pe = dataclasses.replace(p, coarse=min(coarse, t), fine=min(strip, t))
+        kappa = 1.0 / max(ft.min_radius_of_curvature - t, 0.1 * t)
+        excess += lz * (_arc_length_to_x(ft, w + p.transition) * _strip(pe, p.outer_layer, t, 3)
+                        + roi * _strip(pe, p.roi_layer, t, 3, kappa=kappa)
+                        + (_strip(pe, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
+    n = int(_CELLS_PER_UNIT[3] * (_area(section) * lz / min(coarse, t) ** 3 + excess))
+    return dataclasses.replace(p, estimate=n)
+
+
+def _ball_excess(coarse: float, h: float, r: float, layer: float, depth: float, g: float) -> float:
+    """Integral of size^-3 - coarse^-3 over a ball's refined layer: size = the larger of the
+    surface threshold (h within `layer` of the surface, growing by g per mm of depth) and the
+    ball's (h within lateral distance r of the centre, growing by g beyond), to `depth`."""
+    rho = np.linspace(0.0, r + max(coarse - h, 0.0) / g, 301)
+    d = np.linspace(0.0, depth, 301)
+    hd = np.minimum(coarse, h + g * np.maximum(d - layer, 0.0))
+    hr = np.minimum(coarse, h + g * np.maximum(rho - r, 0.0))
+    size = np.maximum(hr[:, None], hd[None, :])
+    ex = np.maximum(size ** -3.0 - coarse ** -3.0, 0.0)
+    return float(np.trapezoid(np.trapezoid(ex, d, axis=1) * 2.0 * np.pi * rho, rho))
+
+
 def _area(section) -> float:
     a = section.__dict__.get("_sizing_area")
     if a is None:  # Section is frozen; cache the 4000-point shoelace area beside it
@@ -205,6 +295,8 @@ def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
     surface (3D) tags."""
     f = gmsh.model.mesh.field
     key = "CurvesList" if dim == 2 else "SurfacesList"
+    if p.patches or p.bone_patches:
+        return _apply_local(gmsh, p, outer, interface_roi)
 
     def threshold(tags, layer, sampling):
         dist = f.add("Distance")
@@ -248,3 +340,68 @@ def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.MeshSizeMax", p.coarse)
     gmsh.option.setNumber("Mesh.MeshSizeMin", p.fine)
+
+
+def _options(gmsh, p: SizePlan, smallest: float) -> None:
+    # the fields alone decide the size
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", p.coarse)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", smallest)
+
+
+def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int]) -> None:
+    """Fields of a local plan: per ball, Max(surface threshold, ball) (fine only near the
+    surface and inside the ball, graded outside both); Min over the balls and, if the plate
+    touches, the strip's box and the bone ROI at size `strip`."""
+    f = gmsh.model.mesh.field
+    smallest = min([b[4] for b in p.patches + p.bone_patches] + [p.strip or p.coarse])
+    sampling = int(min(200, max(60, 2.0 * 10.0 / smallest)))
+    dists = {}
+
+    def distance(tags):
+        key = tuple(tags)
+        if key not in dists:
+            dist = f.add("Distance")
+            f.setNumbers(dist, "SurfacesList", list(tags))
+            f.setNumber(dist, "Sampling", sampling)
+            dists[key] = dist
+        return dists[key]
+
+    def threshold(tags, size, layer):
+        thr = f.add("Threshold")
+        f.setNumber(thr, "InField", distance(tags))
+        f.setNumber(thr, "SizeMin", size)
+        f.setNumber(thr, "SizeMax", p.coarse)
+        f.setNumber(thr, "DistMin", layer)
+        f.setNumber(thr, "DistMax", layer + (p.coarse - size) / p.growth)
+        return thr
+
+    parts = []
+    for balls, tags, layers in ((p.patches, outer, OUTER_LAYER), (p.bone_patches, interface_roi, ROI_LAYER)):
+        thr = {}
+        for x, y, z, r, h in balls:
+            if h not in thr:
+                thr[h] = threshold(tags, h, layers * h)
+            ball = f.add("Ball")
+            for k, v in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", r), ("VIn", h),
+                         ("VOut", p.coarse), ("Thickness", (p.coarse - h) / p.growth)):
+                f.setNumber(ball, k, v)
+            mx = f.add("Max")
+            f.setNumbers(mx, "FieldsList", [thr[h], ball])
+            parts.append(mx)
+    if p.strip:
+        near_outer = threshold(outer, p.strip, p.outer_layer)
+        box = f.add("Box")
+        for k, v in (("VIn", p.strip), ("VOut", p.coarse), ("XMin", -1.0), ("XMax", p.contact_x),
+                     ("YMin", -1e3), ("YMax", 1e3), ("ZMin", p.contact_z[0] - 1.0),
+                     ("ZMax", p.contact_z[1] + 1.0), ("Thickness", p.transition)):
+            f.setNumber(box, k, v)
+        contact = f.add("Max")
+        f.setNumbers(contact, "FieldsList", [near_outer, box])
+        parts += [contact, threshold(interface_roi, p.strip, p.roi_layer)]
+    mn = f.add("Min")
+    f.setNumbers(mn, "FieldsList", parts)
+    f.setAsBackgroundMesh(mn)
+    _options(gmsh, p, smallest)

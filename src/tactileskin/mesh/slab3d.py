@@ -37,8 +37,11 @@ def x_symmetric(scene) -> bool:
 
 def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
                     refinement: float | None = None, order: int | None = None,
-                    length: float | None = None, use_z_symmetry: bool = True) -> SkinMesh:
-    """Mesh the 3D slab of `scene` (P2 tetrahedra with curved faces by default)."""
+                    length: float | None = None, use_z_symmetry: bool = True,
+                    local: bool = True) -> SkinMesh:
+    """Mesh the 3D slab of `scene` (P2 tetrahedra with curved faces by default). Braille:
+    local refinement at the dots (sizing.local_plan); local=False refines the whole contact
+    strip and bone ROI instead (the former plan, kept for comparisons)."""
     section = scene.section() if section is None else section
     order = scene.order if order is None else order
     length = section.fingertip.sample_length if length is None else length
@@ -47,7 +50,7 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
         logger.warning("the indenter (braille_text=%r) is not symmetric about x = 0, but the slab "
                        "is the half x >= 0 with a symmetry plane there", scene.braille_text)
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3,
-                       length=length, z_symmetric=zsym, order=order)
+                       length=length, z_symmetric=zsym, order=order, local=local)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"thickness": section.thickness, "order": order, "length": length, "z_symmetric": zsym,
               **plan.as_dict()}
