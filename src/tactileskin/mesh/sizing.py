@@ -172,7 +172,8 @@ def _smallest_size(fits, too_small: float, largest: float = 5.0) -> float | None
 def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: float | None,
             z_symmetric: bool, local: bool = True) -> SizePlan:
     """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
-    if dim == 3 and local and scene.indenter.value == "braille":
+    # the local plan places its balls on the fingertip's contour; other skins keep the strip plan
+    if dim == 3 and local and scene.indenter.value == "braille" and getattr(scene, "skin", "fingertip") == "fingertip":
         return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric)
     fine = coarse / ratio
     t = section.thickness
