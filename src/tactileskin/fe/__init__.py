@@ -165,7 +165,7 @@ def _run_history(scene, model, section, program, options, progress):
     full = max((g.target for g in program if g.kind == "force"), default=1.0)
     d_exp = scene.depth_fraction * scene.thickness
     ev, stats, hist = run_program(model, program, options, d_max=scene.max_travel,
-                                  d_guess=lambda F: d_exp * min(1.0, F / full), progress=progress,
+                                  d_guess=lambda F: d_exp * min(1.0, F / full), record=record, progress=progress,
                                   on_segment=on_segment)
     if not best:  # every ramp ended below zero force: report the final state
         on_segment(0, program[0], ev)

@@ -196,6 +196,11 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
                 force_inc = ForceIncrement(lambda t, Fh=Fh: Fh, d_max, d_guess, f_start=f_now,
                                            slope=force_inc.slope if force_inc is not None else None)
                 increment = force_inc
+        # the rate of S0 jumps at a segment boundary (ramp -> hold): the parabola through the
+        # last three states would carry the ramp into the hold (measured: the reaction fell
+        # 2.7x too far in the first hold increment, then rose); start each segment with the chord
+        if hasattr(model.history, "dt_prev"):
+            model.history.dt_prev = None
         log.info("loading segment %d: %s (t %.4g -> %.4g s)", i, seg.describe(), t0, T)
         ev, stats = run(model, T, opts, history=True, record=rec, progress=progress, increment=increment,
                         stats=stats)
