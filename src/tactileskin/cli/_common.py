@@ -27,6 +27,10 @@ def scene_options(f):
                      help="Closed STL/OBJ/PLY/OFF or STEP surface (mm) of a 'file' indenter."),
         click.option("--depth", type=float, default=None, help="Indentation depth (mm); default 20% of t."),
         click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
+        # loading (tactileskin.loading): force control; holds and releases via [[loading]] in --scene
+        click.option("--force", type=float, default=None,
+                     help="Force control: target reaction (N in 3D, N/mm in 2D) instead of --depth."),
+        click.option("--force-rate", type=float, default=None, help="Force rate (N/s, N/mm/s in 2D) for --force."),
         click.option("--dim", type=click.Choice(["2", "3"]), default=None, help="2D section or 3D slab."),
         click.option("--mesh-size", type=float, default=None, help="Global element size (mm)."),
         click.option("--refinement", type=float, default=None, help="Global/refined size ratio."),
