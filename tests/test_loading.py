@@ -139,3 +139,18 @@ def test_unreachable_force_is_an_error(mesh):
     # a travel limit of 0.05 mm carries ~3e-3 N/mm here: 1 N/mm cannot be reached
     with pytest.raises(ConvergenceError, match="not reached"):
         run_program(model, [Segment("force", 1.0, time=1.0)], d_max=0.05, d_guess=lambda F: 0.02)
+
+
+def test_sweep_over_forces(tmp_path):
+    from tactileskin.sweep import case_ids, expand_grid, load_spec
+
+    spec = tmp_path / "sweep.toml"
+    spec.write_text("[sweep]\nthicknesses = [1, 2]\nmaterials = ['silicone']\nindenters = ['curved']\n"
+                    "forces = [0.1, 0.2]\n[scene]\nviscoelastic = false\n")
+    sp = load_spec(spec)
+    scenes = expand_grid(base=sp.pop("base"), **sp)
+    assert sorted((s.thickness, s.force) for s in scenes) == [(1, 0.1), (1, 0.2), (2, 0.1), (2, 0.2)]
+    ids = case_ids(scenes)
+    assert len(set(ids)) == 4 and any(i.endswith("F0.2") for i in ids)
+    with pytest.raises(ParameterError, match="forces"):
+        expand_grid(thicknesses=[1], materials=["silicone"], indenters=["curved"], depths=[0.2], forces=[0.1])

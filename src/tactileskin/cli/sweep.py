@@ -83,6 +83,7 @@ def command(out, config, thickness, material, indenter, depth, braille_text, bra
         depths=parse_values(depth, "depth") if depth else spec.get("depths", (None,)),
         braille_texts=tuple(braille_text) if braille_text else spec.get("braille_texts", ("",)),
         braille_dims=BRAILLE_DIM_CHOICES[braille_dim] if braille_dim else spec.get("braille_dims"),
+        forces=spec.get("forces", (None,)),  # [sweep] forces = [...] (force control)
     )
     # the preset per scene (it depends on the indenter and dim), --mesh-size over it
     scenes = expand_grid(base=base, quality=quality,
