@@ -154,3 +154,20 @@ def test_sweep_over_forces(tmp_path):
     assert len(set(ids)) == 4 and any(i.endswith("F0.2") for i in ids)
     with pytest.raises(ParameterError, match="forces"):
         expand_grid(thicknesses=[1], materials=["silicone"], indenters=["curved"], depths=[0.2], forces=[0.1])
+
+
+def test_cli_solve_force_and_history(tmp_path, capsys):
+    import json
+
+    from tactileskin.cli import main
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text("thickness = 2\nindenter = 'curved'\nmesh_size = 0.6\nrefinement = 2\nviscoelastic = false\n"
+                     "force = 0.05\n[[loading]]\nhold = 0.5\n[[loading]]\ndepth = 0.0\nrate = 1.0\n")
+    assert main(["solve", "--scene", str(scene), "--out", str(tmp_path / "o")]) == 0
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert abs(s["loading"]["reached_force"] - 0.05) <= 1e-4 * 0.05 and s["status"] == "ok"
+    assert (tmp_path / "o" / "history.csv").is_file()
+    capsys.readouterr()
+    assert main(["solve", "--force", "0.1", "--depth", "0.3", "--out", str(tmp_path / "b")]) == 2
+    assert "depth" in capsys.readouterr().err and not (tmp_path / "b").exists()
