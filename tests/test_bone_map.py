@@ -125,7 +125,7 @@ def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
 
     _, res, _, _ = plane_strain
     out = res.write(tmp_path / "r")
-    assert {p.name for p in out.iterdir()} == set(OWN_NAMES) - {"sensors.csv"}  # a scene without sensors
+    assert {p.name for p in out.iterdir()} == set(OWN_NAMES) - {"sensors.csv", "history.csv"}  # no sensors, one segment
     bm = read_bone_map(out / "bone_map.csv", section_z=res.bone_map.section_z)
     np.testing.assert_allclose(bm.s, res.bone_map.s, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(bm.z, res.bone_map.z, rtol=1e-9, atol=1e-12)
