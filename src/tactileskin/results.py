@@ -167,6 +167,9 @@ class Result:
     scene: dict | None = None
     bone_map: BoneMap | None = None
     sensors: object | None = None  # sensors.SensorReadings of the scene's sensor layouts
+    # force control / a loading history (fe.solve): control, target and reached force, the
+    # profile's state (peak load: time, travel, reaction) and the final state; None: a plain ramp
+    loading: dict | None = None
 
     def __post_init__(self):
         for name in ("s", "pressure", "contact_x", "contact_pressure"):
@@ -230,6 +233,7 @@ class Result:
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
             **self._map_summary(),
+            **({"loading": self.loading} if self.loading is not None else {}),
             **(self.sensors.summary() if self.sensors is not None else {}),
             **({"scene": self.scene} if self.scene else {}),
         }
@@ -280,6 +284,13 @@ class Result:
             fileio.atomic_write_text(directory / "sensors.csv", self.sensors.to_csv())
         else:
             _remove(directory / "sensors.csv")
+        if self.loading is not None and self.history:
+            cols = ["t", "d", "reaction", "peak_mpa", "segment"]
+            fileio.atomic_write_text(directory / "history.csv", _csv(
+                ["t_s", "travel_mm", "reaction", "peak_bone_pressure_mpa", "segment"],
+                *[np.array([h.get(c, np.nan) for h in self.history], float) for c in cols]))
+        else:
+            _remove(directory / "history.csv")
         # last: a folder with a summary.json holds a complete result
         fileio.atomic_write_json(directory / "summary.json", self.summary())
         return directory
@@ -287,7 +298,7 @@ class Result:
 
 # the file names Result.write owns in a folder
 OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
-             "sensors.csv", "result.pvd", "result_steps")
+             "sensors.csv", "history.csv", "result.pvd", "result_steps")
 
 
 def _remove(path: Path) -> None:

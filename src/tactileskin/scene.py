@@ -118,6 +118,11 @@ class Scene:
     skin: str = "fingertip"
     pad_width: float | None = None         # pad: x extent of the whole pad (mm)
     pad_length: float | None = None        # pad: z extent (mm)
+    # loading (tactileskin.loading; None / () not given, absent from to_dict so keys are unchanged)
+    force: float | None = None             # force control: target reaction (N in 3D, N/mm in 2D)
+    force_rate: float | None = None        # N/s (N/mm/s); None: load_time
+    load_time: float | None = None         # s to reach `force`; None: depth_fraction * t / rate
+    loading: tuple = field(default_factory=tuple)  # loading.Segment after the first ramp, TOML [[loading]]
 
     def __post_init__(self):
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
@@ -180,17 +185,67 @@ class Scene:
             sensors.sites_for(self)  # raises ParameterError for a sensor outside the skin
         else:
             set_("sensors", ())
+        self._check_loading(set_)
+
+    def _check_loading(self, set_) -> None:
+        from tactileskin import loading
+
+        if self.force is not None:
+            if self.depth is not None:
+                raise ParameterError("depth", self.depth, "not with force (force control finds the travel)",
+                                     "give depth or force")
+            set_("force", check_range("force", self.force, 0.0, loading.MAX_FORCE, lo_open=True,
+                                      unit="N (N/mm in 2D)"))
+        for name in ("force_rate", "load_time"):
+            if getattr(self, name) is not None and self.force is None:
+                raise ParameterError(name, getattr(self, name), "only with force")
+        if self.force_rate is not None and self.load_time is not None:
+            raise ParameterError("force_rate", self.force_rate, "force_rate or load_time, not both")
+        if self.force_rate is not None:
+            set_("force_rate", check_range("force_rate", self.force_rate, 1e-6, 1e6, unit="N/s (N/mm/s in 2D)"))
+        if self.load_time is not None:
+            set_("load_time", check_range("load_time", self.load_time, 0.0, loading.MAX_TIME, lo_open=True,
+                                          unit="s"))
+        set_("loading", loading.segments_from(self.loading or [], max_depth=self.max_travel,
+                                              default_rate=self.rate) if self.loading else ())
+        loading.check_program(self.program())
 
     # --- derived -----------------------------------------------------------------------
     @property
     def indentation(self) -> float:
-        """Final indentation depth (mm)."""
-        return self.depth if self.depth is not None else self.depth_fraction * self.thickness
+        """Largest prescribed indentation depth (mm): depth or depth_fraction * t and the
+        depths of `loading`; under force control depth_fraction * t is the expected travel
+        that sizes the mesh's contact zone."""
+        first = self.depth if self.depth is not None else self.depth_fraction * self.thickness
+        return max([first] + [g.target for g in self.loading if g.kind == "depth"])
 
     @property
     def duration(self) -> float:
-        """Loading time (s) at the scene's rate, from first touch to full depth."""
-        return self.indentation / self.rate
+        """Time (s) of the first ramp (from first touch to the depth at `rate`, or to the force)."""
+        if self.force is not None:
+            if self.force_rate is not None:
+                return self.force / self.force_rate
+            if self.load_time is not None:
+                return self.load_time
+            return self.depth_fraction * self.thickness / self.rate
+        return (self.depth if self.depth is not None else self.depth_fraction * self.thickness) / self.rate
+
+    @property
+    def max_travel(self) -> float:
+        """Largest travel (mm) a depth may ask or force control may reach: 0.6 t."""
+        return 0.6 * self.thickness
+
+    def program(self) -> list:
+        """The loading history as a list of loading.Segment: the first ramp (depth at rate, or
+        force in `duration`) then `loading`."""
+        from tactileskin.loading import Segment
+
+        if self.force is not None:
+            first = Segment("force", self.force, time=self.duration)
+        else:
+            first = Segment("depth", self.depth if self.depth is not None else self.depth_fraction * self.thickness,
+                            rate=self.rate)
+        return [first, *self.loading]
 
     def fingertip_model(self):
         from tactileskin.geometry.fingertip import Fingertip
@@ -253,6 +308,8 @@ class Scene:
                 continue
             if f.name == "sensors":  # none: absent, so that scenes without sensors keep their keys
                 v = [lay.to_dict() for lay in v] or None
+            if f.name == "loading":  # likewise: absent unless the history has more segments
+                v = [g.to_dict() for g in v] or None
             if v is None:
                 continue
             d[f.name] = v

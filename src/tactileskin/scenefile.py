@@ -23,7 +23,7 @@ from tactileskin.errors import ParameterError
 
 # Scene field -> the sweep list that varies it
 AXES = {"thickness": "thicknesses", "material": "materials", "indenter": "indenters",
-        "depth": "depths", "braille_text": "braille_texts"}
+        "depth": "depths", "braille_text": "braille_texts", "force": "forces"}
 MESH_FIELDS = ("mesh_size", "refinement")
 
 

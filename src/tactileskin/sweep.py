@@ -87,6 +87,7 @@ def expand_grid(
     braille_dims: Sequence[int] | None = None,
     quality: str | None = None,
     overrides: dict | None = None,
+    forces: Sequence[float | None] = (None,),
 ) -> list[Scene]:
     """Cartesian product of the sweep axes; Braille texts apply to Braille indenters only.
 
@@ -96,14 +97,20 @@ def expand_grid(
     has base.dim (as without the axis).
     quality: a planner quality preset applied to each scene after its indenter and dim are
     set (planner.with_quality), then `overrides` (Scene fields such as mesh_size, which
-    override the preset)."""
+    override the preset).
+    forces: force-control targets (N, N/mm in 2D; "same press, different skin"), an axis
+    instead of depths (None: the depth axis)."""
     base = base or Scene()
     for name, axis in (("thicknesses", thicknesses), ("materials", materials), ("indenters", indenters),
-                       ("depths", depths), ("braille_texts", braille_texts), ("braille_dims", braille_dims)):
+                       ("depths", depths), ("braille_texts", braille_texts), ("braille_dims", braille_dims),
+                       ("forces", forces)):
         if isinstance(axis, (str, bytes)):  # would iterate as one-letter values
             raise ParameterError(name, axis, "a sequence of values, not a string")
+    if any(f is not None for f in forces) and any(d is not None for d in depths):
+        raise ParameterError("forces", list(forces), "either forces or depths, not both",
+                             "a case is pressed to a depth or to a force")
     dims = check_braille_dims(braille_dims) if braille_dims is not None else (base.dim,)
-    n = (len(thicknesses) * len(materials) * len(indenters) * len(depths)
+    n = (len(thicknesses) * len(materials) * len(indenters) * len(depths) * len(forces)
          * max(len(braille_texts), 1) * len(dims))
     if n > MAX_CASES:
         raise ParameterError("sweep grid", f"{n} cases", f"at most {MAX_CASES} cases",
@@ -114,7 +121,7 @@ def expand_grid(
         quality_mesh(quality, base.indenter)  # an unknown preset fails before any scene
     scenes: list[Scene] = []
     seen: set[str] = set()
-    for t, m, ind, d in itertools.product(thicknesses, materials, indenters, depths):
+    for t, m, ind, d, f in itertools.product(thicknesses, materials, indenters, depths, forces):
         kind = get_kind(ind)  # validates the name
         braille = "braille_text" in kind.scene_params  # the kind reads the texts axis
         own = dims if kind.section_2d == "ridge" else (base.dim,)
@@ -122,7 +129,8 @@ def expand_grid(
             own = (3,)  # no 2D model of this kind: its cases are 3D
         for text in (braille_texts if braille else ("",)):
             for dim in own:
-                s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim)
+                fc = {} if f is None else {"force": f}
+                s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim, **fc)
                 if quality is not None:
                     s = with_quality(s, quality)
                 if overrides:
@@ -155,7 +163,7 @@ def check_materials(names: Iterable[str]) -> None:
 
 
 MAX_AXIS_VALUES = 1000  # values per sweep axis, as parse_values allows
-_SPEC_LISTS = {"thicknesses": "numbers", "depths": "numbers", "materials": "strings",
+_SPEC_LISTS = {"thicknesses": "numbers", "depths": "numbers", "forces": "numbers", "materials": "strings",
                "indenters": "strings", "braille_texts": "strings", "braille_dims": "dims"}
 
 
@@ -198,6 +206,7 @@ def _base_id(sc: Scene) -> str:
 # Fields outside the base id that change a result, with the suffix naming each value.
 _ID_FIELDS = (
     (lambda s: round(s.indentation, 9), lambda s: f"d{s.indentation:.4g}"),
+    (lambda s: s.force, lambda s: "F" + ("-" if s.force is None else f"{s.force:g}")),
     (lambda s: s.rate, lambda s: f"r{s.rate:g}"),
     (lambda s: s.mesh_size, lambda s: f"h{s.mesh_size:g}"),
     (lambda s: s.refinement, lambda s: f"ref{s.refinement:g}"),

@@ -17,7 +17,7 @@ QUALITIES = ("preview", "default", "fine")
 SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text", "braille_standard",
               "indenter_radius", "indenter_axis", "indenter_file", "skin", "pad_width", "pad_length",
               "depth", "dim", "quality", "mesh_size", "refinement", "order")
-PHYSICS_KEYS = ("rate", "formulation", "elastic")
+PHYSICS_KEYS = ("rate", "force", "force_rate", "formulation", "elastic")
 
 
 def scene_options(f=None, *, grid: bool = False, physics: bool = True):
@@ -68,6 +68,11 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
     if physics:
         opts += [
             click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
+            # loading (tactileskin.loading): force control; holds and releases via [[loading]] in --scene
+            click.option("--force", type=float, default=None,
+                         help="Force control: target reaction (N in 3D, N/mm in 2D) instead of --depth."),
+            click.option("--force-rate", type=float, default=None,
+                         help="Force rate (N/s, N/mm/s in 2D) for --force."),
             click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
             click.option("--elastic", is_flag=True, default=None,
                          help="Ignore viscoelasticity (the Prony series)."),
@@ -88,7 +93,8 @@ def _field_changes(opts: dict) -> dict:
     """Scene-field changes of the single-valued options (None: not given)."""
     ch = {k: opts.get(k) for k in ("thickness", "material", "indenter", "braille_text", "braille_standard",
                                     "indenter_radius", "indenter_axis", "indenter_file",
-                                    "skin", "pad_width", "pad_length", "depth", "rate", "formulation")}
+                                    "skin", "pad_width", "pad_length", "depth", "rate", "force", "force_rate",
+                                    "formulation")}
     if opts.get("dim") is not None:
         ch["dim"] = int(opts["dim"])
     if opts.get("order") is not None:

@@ -76,6 +76,13 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
     else:
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
+    if "loading" in s:
+        lo, unit = s["loading"], "N" if scene.dim == 3 else "N/mm"
+        if lo.get("target_force") is not None:
+            t.add_row("force control", f"{lo['reached_force']:.5g} {unit} (target {lo['target_force']:.5g}) "
+                      f"at travel {lo['profile_travel_mm']:.4g} mm")
+        t.add_row("profile state", f"peak load, t = {lo['profile_t_s']:.4g} s; final: t = {lo['final']['t_s']:.4g} s, "
+                  f"travel {lo['final']['travel_mm']:.4g} mm, reaction {lo['final']['reaction']:.4g} {unit}")
     if "peak_sensor_pressure_mpa" in s:
         t.add_row("sensors / peak sensor P", f"{s['sensors']} / {s['peak_sensor_pressure_mpa']:.4g} MPa "
                   f"({s['peak_sensor_id']})")

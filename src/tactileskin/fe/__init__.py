@@ -140,6 +140,61 @@ def read_sensors(scene, model, result, *, z_symmetric: bool = False):
     return sensors.read(sites, sampler)
 
 
+def _run_history(scene, model, section, program, options, progress):
+    """Run a force-controlled or multi-segment loading history (fe.loading.run_program).
+    The Result is the peak-load state: the end of the depth or force ramp with the largest
+    reaction (a hold or a release never replaces it, so a full release does not report an
+    open contact); `Result.loading` adds the target and reached force, the travel, that
+    state's time and the final state, and `Result.history` the time series (history.csv)."""
+    from tactileskin.fe.loading import run_program
+    from tactileskin.fe.output import bone_peak
+
+    multi = len(program) > 1
+    peak_of = bone_peak(model) if multi else None
+    best = {}
+
+    def record(model, ev):
+        return {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
+
+    def on_segment(i, seg, ev):
+        F = float(reaction(model, ev)[1])
+        if seg.kind != "hold" and (not best or F > best["reaction"]):
+            best.update(reaction=F, t=model.t, d=model.d, segment=i,
+                        result=make_result(model, ev, _StatsView(), s_of_point=section.s_of_point,
+                                           scene=scene.to_dict()))
+
+    # a travel guess for the first force increment: the scene's expected travel at the full force
+    full = max((g.target for g in program if g.kind == "force"), default=1.0)
+    d_exp = scene.depth_fraction * scene.thickness
+    ev, stats, hist = run_program(model, program, options, d_max=scene.max_travel,
+                                  d_guess=lambda F: d_exp * min(1.0, F / full), record=record, progress=progress,
+                                  on_segment=on_segment)
+    if not best:  # every ramp ended below zero force: report the final state
+        on_segment(0, program[0], ev)
+    res = best["result"]
+    for k in ("increments", "newton_iterations", "cutbacks", "uzawa_iterations", "force_trials"):
+        res.stats[k] = getattr(stats, k)
+    res.history = [dict(h) for h in hist] if multi else []
+    last = hist[-1] if hist else {}
+    res.loading = {
+        "control": program[0].kind, "segments": [g.to_dict() for g in program],
+        "target_force": scene.force, "reached_force": best["reaction"] if scene.force is not None else None,
+        "profile_state": "peak load",
+        "profile_t_s": best["t"], "profile_travel_mm": best["d"], "profile_reaction": best["reaction"],
+        "final": {"t_s": float(model.t), "travel_mm": float(model.d),
+                  "reaction": float(last.get("reaction", reaction(model, ev)[1])),
+                  **({"peak_mpa": last["peak_mpa"]} if "peak_mpa" in last else {})},
+    }
+    return res, ev, stats
+
+
+class _StatsView:
+    """Zero counters for make_result at an intermediate state (the run's totals are set after)."""
+    increments = newton_iterations = cutbacks = uzawa_iterations = 0
+    wall_s = 0.0
+    history = ()
+
+
 def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | None = None,
           progress=None):
     """Indent the scene's skin from first touch to its full depth at its rate; return a Result.
@@ -168,10 +223,16 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1]),
                 "displacement": model.u.reshape(-1, model.m).copy()}
 
+    program = scene.program()
     with blas_threads():
-        ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
+        if len(program) == 1 and program[0].kind == "depth":
+            ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
+            res = None
+        else:
+            res, ev, stats = _run_history(scene, model, section, program, options, progress)
     t2 = time.perf_counter()
-    res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
+    if res is None:
+        res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
     if scene.sensors:
         res.sensors = read_sensors(scene, model, res, z_symmetric=bool(getattr(sm, "z_symmetric", False)))
     stats.wall_s = time.perf_counter() - t0

@@ -176,6 +176,11 @@ class Model:
 
         self.history = (Prony.elastic() if prony is None else prony).history((E, Q, 3, 3), qlv_order)
         self.t = 0.0
+        # loading (fe.loading): the travel as a function of time (None: contact.rate * t), or
+        # under force control the fixed trial travel of the increment being solved
+        self.travel_path: Callable | None = None
+        self.travel_fixed: float | None = None
+        self.d = 0.0  # committed travel (mm)
 
     # -- helpers ------------------------------------------------------------------------------
     def _law(self, C: np.ndarray, tangent: bool) -> tuple:
@@ -203,7 +208,14 @@ class Model:
         return np.concatenate(dofs), np.concatenate(vals)
 
     def travel(self, t: float) -> float:
-        return self.contact.rate * t if self.contact is not None else 0.0
+        """Indenter travel d (mm) at time t (force control: the trial travel)."""
+        if self.contact is None:
+            return 0.0
+        if self.travel_fixed is not None:
+            return float(self.travel_fixed)
+        if self.travel_path is not None:
+            return float(self.travel_path(t))
+        return self.contact.rate * t
 
     def qlv(self, dt: float):
         """(gamma, decay, gain, back) of the Prony update for a step dt from the committed
@@ -284,6 +296,7 @@ class Model:
     def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
         self.history.commit(ev.S0, dt)
         self.u = u.copy()
+        self.d = self.travel(t)
         self.t = t
         if self.surface is not None and ev.contact is not None:
             self.surface.lam_prev = self.surface.lam

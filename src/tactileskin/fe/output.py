@@ -269,6 +269,17 @@ def arc_length(points: np.ndarray) -> np.ndarray:
     return s
 
 
+def bone_peak(model: Model, path: str = "bone_interface"):
+    """ev -> the largest mean pressure (MPa) at the path's nodes, for a time history: 2D by the
+    profile's PointFit, 3D by the nodal L2 projection (the bone map's field); set up once."""
+    sd = model.facet_scalar_dofs(path)
+    if model.m == 2:
+        fit = PointFit(model, model.basis.doflocs[:, sd].T)
+        return lambda ev: float(np.max(fit.values(kernels.mean_pressure(model.stress(ev)))))
+    pj = Projector(model)
+    return lambda ev: float(np.max(pj.project(kernels.mean_pressure(model.stress(ev)))[sd]))
+
+
 def law_state(ev: Evaluation, sig: np.ndarray) -> dict:
     """Extremes of the state the material law saw, for tactileskin.quality: `min_J` (the
     smallest volume ratio at a quadrature point; the mixed formulation's law sees the

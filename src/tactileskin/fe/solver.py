@@ -100,6 +100,7 @@ class Stats:
     newton_iterations: int = 0
     uzawa_iterations: int = 0
     factorizations: int = 0
+    force_trials: int = 0       # force control: increment solves at trial travels (fe.loading)
     wall_s: float = 0.0
     history: list = field(default_factory=list)
 
@@ -403,13 +404,19 @@ class IncrementInfo:
 
 
 def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: bool = False,
-        record: callable = None, progress: callable = None) -> tuple[Evaluation, Stats]:
+        record: callable = None, progress: callable = None, increment: callable = None,
+        stats: Stats | None = None) -> tuple[Evaluation, Stats]:
     """Integrate from the committed state at model.t to time T; returns the last evaluation.
-    progress: called with an IncrementInfo after each converged increment."""
+    progress: called with an IncrementInfo after each converged increment. increment: the
+    increment solver (model, u, t, dt, opts, stats) -> (u, evaluation, iterations), by
+    default Newton + Uzawa at the travel model.travel(t) (fe.loading.ForceIncrement finds
+    the travel of a target force); it raises _Failure to cut back. stats: continue these
+    (a loading history runs one segment after the other)."""
     opts = opts or SolverOptions()
-    stats = Stats()
-    newton_seen = 0
-    t0 = time.perf_counter()
+    stats = stats if stats is not None else Stats()
+    solve_increment = increment or _solve_increment
+    newton_seen = stats.newton_iterations
+    t0 = time.perf_counter() - stats.wall_s
     t = model.t
     span = T - t
     dt = opts.dt0_fraction * span
@@ -426,7 +433,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
         # from the last converged (softer) state converges; an extrapolated start that
         # overshoots into compression does not (measured on the 1 mm silicone case).
         try:
-            unew, ev, its = _solve_increment(model, u, t + dt, dt, opts, stats)
+            unew, ev, its = solve_increment(model, u, t + dt, dt, opts, stats)
         except _Failure as f:
             stats.cutbacks += 1
             log.info("increment t=%.5g dt=%.3g failed (%s); cutting back", t + dt, dt, f.why)

@@ -31,7 +31,8 @@ def at_paper_conditions(scene) -> bool:
     return (math.isclose(scene.indentation, 0.2 * scene.thickness, rel_tol=1e-9)
             and scene.rate == d.rate and scene.viscoelastic and not scene.fingertip
             and scene.skin == d.skin
-            and scene.braille_standard == d.braille_standard)
+            and scene.braille_standard == d.braille_standard
+            and getattr(scene, "force", None) is None and not getattr(scene, "loading", ()))
 
 
 BRAILLE_MODELS = {2: "2D ridge", 3: "3D dots"}

@@ -47,6 +47,9 @@ def collect(outcomes, cache):
                                        ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "min_J",
                                         "max_abs_stress_mpa", "dofs", "increments",
                                         "newton_iterations", "wall_s")})
+            lo = rec.summary.get("loading")
+            if lo:  # force control / a history: the travel of the reported (peak-load) state
+                row["depth_mm"] = lo.get("profile_travel_mm", row["depth_mm"])
         rows.append(row)
     return records, rows, failures
 

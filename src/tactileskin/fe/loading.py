@@ -1,0 +1,215 @@
+"""Loading histories in the solver: displacement control, force control, holds, releases.
+
+`run_program(model, program, ...)` runs the segments of a `tactileskin.loading` history one
+after the other through `fe.solver.run`: a depth segment moves the travel linearly from where
+it is (`Model.travel_path`), a force segment makes the reaction follow a linear ramp from
+its current value, a hold keeps the last control's value while time passes (the QLV stress
+relaxes at fixed travel; the indenter creeps at fixed force).
+
+Force control (`ForceIncrement`): per increment the travel d is the unknown of the scalar
+equation F(d) = F*(t), F the indenter's vertical reaction of the converged increment at
+travel d, solved by a safeguarded secant (Illinois regula falsi once a bracket is found)
+around the unchanged displacement-controlled increment solve. Why not the bordered system
+(u and d together, with the force equation): every trial is then the proven increment solve
+(line search, sticky active set, Uzawa updates, its own failure handling), while in one
+bordered Newton the force equation inherits the active-set and multiplier kinks of the
+contact (its derivative jumps as points enter contact) and a diverging iterate would need
+the safeguards redone for d. F(d) is monotone for a stable skin, so a bracketed scalar
+root is safe, and the secant slope of the last increment predicts the next travel: on the
+2D coarse meshes 2-4 trial solves per increment (stats force_trials).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from tactileskin.errors import ConvergenceError
+from tactileskin.fe.solver import Stats, _Failure, _solve_increment, run
+
+log = logging.getLogger(__name__)
+
+FORCE_RTOL = 1e-4   # |F - F*| <= FORCE_RTOL |F*|: the contact tolerance (1e-4 h) moves F by ~3e-5 F
+MAX_TRIALS = 16
+
+
+def vertical_reaction(model, ev) -> float:
+    """The indenter's vertical force on the skin = the vertical reaction of the fixed
+    boundaries (N in 3D, N/mm in plane strain), as Result.reaction."""
+    from tactileskin.fe.output import reaction
+
+    return float(reaction(model, ev)[1])
+
+
+class ForceIncrement:
+    """Increment solver for fe.solver.run(increment=) under force control: finds the travel
+    d at which the reaction equals target(t) to FORCE_RTOL.
+
+    d_max: largest travel allowed (the skin's capacity for this history: a target not reached
+    there raises ConvergenceError); d_guess(F): a travel for the first trial when no slope is
+    known yet."""
+
+    def __init__(self, target, d_max: float, d_guess, *, f_start: float = 0.0, slope: float | None = None,
+                 rtol: float = FORCE_RTOL):
+        self.target, self.d_max, self.d_guess, self.rtol = target, float(d_max), d_guess, rtol
+        self.f_committed, self.slope = float(f_start), slope
+        self.reached = float(f_start)
+
+    def __call__(self, model, u0, t, dt, opts, stats: Stats):
+        F = float(self.target(t))
+        tol = max(self.rtol * abs(F), 1e-12)
+        d0, f0 = model.d, self.f_committed
+        if self.slope and self.slope > 0:
+            d = d0 + (F - f0) / self.slope
+        else:
+            d = self.d_guess(F) if d0 == 0.0 else d0 * max(F, 1e-300) / max(f0, 1e-300)
+        d = min(max(d, 0.0), self.d_max)
+        lo = hi = None            # (d, f) with f < 0 / f > 0
+        pts = []                  # converged trials (d, f, u, ev, its)
+        fails = 0
+        try:
+            for _ in range(MAX_TRIALS):
+                model.travel_fixed = d
+                # from the converged trial nearest below d, else the committed state (a trial at
+                # a deeper travel is a bad start: its surface overlaps the indenter)
+                below = [p for p in pts if p[0] <= d]
+                start = max(below, key=lambda p: p[0])[2] if below else u0
+                stats.force_trials += 1
+                try:
+                    u, ev, its = _solve_increment(model, start, t, dt, opts, stats)
+                except _Failure as e:
+                    # too deep for this step (lock-up) or a too large jump: step back towards lo
+                    fails += 1
+                    log.debug("force control: travel %.6g mm failed (%s)", d, e.why)
+                    if fails > 3 or lo is None and d <= 1e-9:
+                        raise _Failure(f"force control: no converged state reaches {F:.6g} "
+                                       f"(failed at travel {d:.6g} mm: {e.why})", e.diag) from None
+                    lo_d = lo[0] if lo is not None else (d0 if d0 < d else 0.0)
+                    if hi is None or d < hi[0]:
+                        hi = (d, math.inf)
+                    d = 0.5 * (lo_d + d)
+                    continue
+                f = vertical_reaction(model, ev) - F
+                log.debug("force control: travel %.8g mm, reaction %.8g (target %.8g)", d, f + F, F)
+                pts.append((d, f, u, ev, its))
+                if abs(f) <= tol:
+                    return self._accept(model, d, f + F, d0, u, ev, its, pts)
+                if f < 0:
+                    lo = (d, f)
+                else:
+                    hi = (d, f)
+                d = self._next(d, f, lo, hi, pts, F, model)
+        finally:
+            model.travel_fixed = None
+        raise _Failure(f"force control: reaction not within {tol:.3g} of {F:.6g} after {MAX_TRIALS} trial travels",
+                       {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts]})
+
+    def _next(self, d, f, lo, hi, pts, F, model) -> float:
+        # the secant through the last two trials (near the root F(d) is smooth: superlinear),
+        # kept inside the bracket once there is one (else bisection)
+        k = None
+        if len(pts) >= 2 and pts[-1][0] != pts[-2][0]:
+            k = (pts[-1][1] - pts[-2][1]) / (pts[-1][0] - pts[-2][0])
+        if lo is not None and hi is not None:
+            w = hi[0] - lo[0]
+            x = d - f / k if k and k > 0 else 0.5 * (lo[0] + hi[0])
+            if not (lo[0] + 0.01 * w <= x <= hi[0] - 0.01 * w):
+                x = 0.5 * (lo[0] + hi[0]) if not math.isfinite(hi[1]) else \
+                    lo[0] - lo[1] * w / (hi[1] - lo[1])
+                x = min(max(x, lo[0] + 0.1 * w), hi[0] - 0.1 * w)
+            return x
+        # no bracket yet: secant through the last two trials (or the committed slope, or the
+        # chord from first touch), stepping at most 2x the distance already covered
+        if k is not None and k > 0:
+            pass
+        elif self.slope and self.slope > 0:
+            k = self.slope
+        else:
+            k = (f + F) / d if d > 0 and f + F > 0 else 0.0
+        if f < 0:  # below the target: deeper
+            if d >= self.d_max * (1 - 1e-12):
+                raise ConvergenceError(
+                    f"force {F:.6g} not reached: the reaction is {f + F:.6g} at the largest travel "
+                    f"{self.d_max:.6g} mm (0.6 x thickness); the skin cannot carry this force within "
+                    "its depth range", {"force": F, "reached": f + F, "travel_mm": d})
+            step = -f / k if k > 0 else d
+            return min(d + min(step, 2.0 * max(d - model.d, 1e-3 * self.d_max)), self.d_max)
+        step = -f / k if k > 0 else -0.5 * d
+        return max(d + max(step, -0.5 * d), 0.0)
+
+    def _accept(self, model, d, Freached, d0, u, ev, its, pts):
+        # the next increment's predictor: the local slope dF/dd of the last two trials (the
+        # chord over the increment under-estimates a stiffening contact and overshoots)
+        near = sorted(pts, key=lambda p: abs(p[0] - d))[:2]
+        if len(near) == 2 and near[0][0] != near[1][0]:
+            self.slope = (near[0][1] - near[1][1]) / (near[0][0] - near[1][0])
+        elif d != d0:
+            self.slope = (Freached - self.f_committed) / (d - d0)
+        if self.slope is not None and self.slope <= 0:
+            self.slope = None
+        self.f_committed = self.reached = Freached
+        self.travel = d
+        model.travel_path = (lambda t, d=d: d)  # run() commits this travel (travel_fixed is cleared)
+        return u, ev, its
+
+
+def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None, progress=None,
+                on_segment=None):
+    """Run the segments of a loading history (tactileskin.loading.Segment list) from the
+    model's committed state; returns (last evaluation, Stats, per-increment records).
+
+    on_segment(index, segment, ev): called after each segment (e.g. to keep the peak-load
+    state's result). Each record: t, travel d, reaction, segment index (+ record(model, ev))."""
+    stats = Stats()
+    control, f_now, force_inc = None, 0.0, None
+    ev = None
+    for i, seg in enumerate(program):
+        t0 = model.t
+
+        def rec(model, ev, i=i):
+            r = {"segment": i, "d": float(model.d), "reaction": vertical_reaction(model, ev)}
+            if record is not None:
+                r.update(record(model, ev))
+            return r
+
+        increment = None
+        if seg.kind == "depth":
+            d0, d1 = model.d, seg.target
+            T = t0 + seg.duration(d0)
+            model.travel_path = (lambda t, d0=d0, d1=d1, t0=t0, T=T: d0 + (d1 - d0) * min(1.0, (t - t0) / (T - t0)))
+            control = "depth"
+        elif seg.kind == "force":
+            F0, F1 = f_now, seg.target
+            T = t0 + seg.duration(F0)
+            force_inc = ForceIncrement(lambda t, F0=F0, F1=F1, t0=t0, T=T: F0 + (F1 - F0) * min(1.0, (t - t0) / (T - t0)),
+                                       d_max, d_guess, f_start=f_now,
+                                       slope=force_inc.slope if force_inc is not None else None)
+            increment, control = force_inc, "force"
+        else:  # hold
+            T = t0 + seg.time
+            if control == "depth":
+                model.travel_path = (lambda t, d=model.d: d)
+            else:
+                Fh = f_now
+                force_inc = ForceIncrement(lambda t, Fh=Fh: Fh, d_max, d_guess, f_start=f_now,
+                                           slope=force_inc.slope if force_inc is not None else None)
+                increment = force_inc
+        # the rate of S0 jumps at a segment boundary (ramp -> hold): the parabola through the
+        # last three states would carry the ramp into the hold (measured: the reaction fell
+        # 2.7x too far in the first hold increment, then rose); start each segment with the chord
+        if hasattr(model.history, "dt_prev"):
+            model.history.dt_prev = None
+        log.info("loading segment %d: %s (t %.4g -> %.4g s)", i, seg.describe(), t0, T)
+        ev, stats = run(model, T, opts, history=True, record=rec, progress=progress, increment=increment,
+                        stats=stats)
+        f_now = vertical_reaction(model, ev)
+        if increment is not None:
+            f_now = increment.reached
+        if not np.isfinite(f_now):
+            raise ConvergenceError(f"non-finite reaction after loading segment {i}", {"segment": i})
+        if on_segment is not None:
+            on_segment(i, seg, ev)
+    model.travel_path = (lambda t, d=model.d: d)
+    return ev, stats, stats.history
