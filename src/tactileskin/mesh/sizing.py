@@ -262,7 +262,7 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     if strip:
         pe = dataclasses.replace(p, coarse=min(coarse, t), fine=min(strip, t))
         kappa = 1.0 / max(ft.min_radius_of_curvature - t, 0.1 * t)
-        excess += lz * (_arc_length_to_x(ft, w + p.transition) * _strip(pe, p.outer_layer, t, 3)
+        excess += lz * (section.outer_length_to_x(w + p.transition) * _strip(pe, p.outer_layer, t, 3)
                         + roi * _strip(pe, p.roi_layer, t, 3, kappa=kappa)
                         + (_strip(pe, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
     n = int(_CELLS_PER_UNIT[3] * (_area(section) * lz / min(coarse, t) ** 3 + excess))
