@@ -70,7 +70,7 @@ def configure(model, variant: str) -> SolverOptions:
         kw = {}
         for item in variant[4:].split("/"):
             k, v = item.split("=")
-            kw[k] = type(getattr(SolverOptions(), k))(eval(v))
+            kw[k] = type(getattr(SolverOptions(), k))(float(v))
         return SolverOptions(**kw)
     elif variant != "now":
         raise SystemExit(f"unknown variant {variant!r}")
