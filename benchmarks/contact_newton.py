@@ -9,6 +9,8 @@ one case after the other in one process, one thread, under a contact variant:
   tol=X      the defaults with an absolute penetration tolerance of X mm (e.g. tol=1e-6,
              the reference the tolerance study compares with)
   rel=X      the defaults with the penetration tolerance X * (contact facet size)
+  pred       the defaults with the secant increment predictor (SolverOptions.predictor)
+  set:k=v/.. the defaults with SolverOptions fields set (e.g. set:predictor=1/stick_after=1)
 
 Prints per case: dofs, increments, Newton iterations (per increment), cutbacks, Uzawa
 updates, peak, CPU s of the solve and the per-phase wall times (Result.stats['phases_s']);
@@ -42,7 +44,8 @@ ALL = [f"t{t:g}-{m}-{i}" for t in PAPER_THICKNESSES for m in PAPER_MATERIALS for
 # the solver before issue 13's contact work: Uzawa by fresh Newton solves, multipliers
 # carried over unchanged, sticky from the second iterate, releases checked at |R| <= 1e-3
 BEFORE = dict(uzawa_inline=False, predict_multipliers=False, stick_after=1, release_rtol=1e-3)
-OPTION_VARIANTS = {"before": BEFORE}
+# the secant increment predictor (SolverOptions.predictor)
+OPTION_VARIANTS = {"before": BEFORE, "pred": dict(predictor=True)}
 PHASES = ("setup", "residual", "tangent", "contact", "factor", "solve", "recovery", "other")
 
 
@@ -63,6 +66,12 @@ def configure(model, variant: str) -> SolverOptions:
         return SolverOptions(**BEFORE)
     elif variant in OPTION_VARIANTS:
         return SolverOptions(**OPTION_VARIANTS[variant])
+    elif variant.startswith("set:"):  # set:name=value/name=value (SolverOptions fields)
+        kw = {}
+        for item in variant[4:].split("/"):
+            k, v = item.split("=")
+            kw[k] = type(getattr(SolverOptions(), k))(float(v))
+        return SolverOptions(**kw)
     elif variant != "now":
         raise SystemExit(f"unknown variant {variant!r}")
     return SolverOptions()
@@ -83,6 +92,7 @@ def solve(scene: Scene, mesh, variant: str):
     res.stats["phases_s"] = fe.phases(model, mesh=0.0, setup=t_setup, recovery=time.perf_counter() - t2,
                                       total=total)
     res.stats["reaction"] = float(reaction(model, ev)[1])
+    res.stats["predictor_fallbacks"] = stats.predictor_fallbacks
     return res
 
 
@@ -115,7 +125,7 @@ def main() -> None:
             row = {"case": label, "variant": v, "dofs": st["dofs"], "increments": st["increments"],
                    "newton": st["newton_iterations"], "cutbacks": st["cutbacks"],
                    "uzawa": st["uzawa_iterations"], "peak": r.peak, "cpu": cpu, "phases": ph,
-                   "reaction": st["reaction"]}
+                   "reaction": st["reaction"], "fallbacks": st["predictor_fallbacks"]}
             rows.append(row)
             print(f"| {label} | {v} | {st['dofs']} | {st['increments']} | {st['newton_iterations']} | "
                   f"{st['newton_iterations'] / max(st['increments'], 1):.1f} | {st['cutbacks']} | "
@@ -127,7 +137,8 @@ def main() -> None:
         inc = sum(r["increments"] for r in rs)
         new = sum(r["newton"] for r in rs)
         print(f"{v}: {len(rs)} cases, {inc} increments, {new} Newton ({new / max(inc, 1):.2f}/increment), "
-              f"{sum(r['cutbacks'] for r in rs)} cutbacks, {sum(r['uzawa'] for r in rs)} Uzawa, "
+              f"{sum(r['cutbacks'] for r in rs)} cutbacks, {sum(r['fallbacks'] for r in rs)} predictor fallbacks, "
+              f"{sum(r['uzawa'] for r in rs)} Uzawa, "
               f"solve CPU {sum(r['cpu'] for r in rs):.1f} s; phases "
               + ", ".join(f"{k} {sum(r['phases'].get(k, 0.0) for r in rs):.1f}" for k in PHASES))
     if a.json:

@@ -24,8 +24,10 @@ from tactileskin.skins import registry as _skins
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
 # not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: contact
 # penetration tolerance relative to the facet size, multipliers updated within Newton, and 3D
-# Braille meshes refined locally at the dots, mesh.sizing.local_plan)
-SCHEMA_VERSION = 3
+# Braille meshes refined locally at the dots, mesh.sizing.local_plan; 4: contact points held
+# off the first Newton step of an increment, earlier multiplier updates: other increment
+# sequences, peaks within 0.06 %)
+SCHEMA_VERSION = 4
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

@@ -171,6 +171,9 @@ class Model:
         # committed state
         E, Q = self.w.shape
         self.u = np.zeros(self.ndof)
+        # the committed state before the last commit and that increment's length (the
+        # solver's secant predictor extrapolates from them)
+        self.u_prev, self.dt_prev = None, None
         # the viscoelastic state belongs to the material's Prony series (any law inside it)
         from tactileskin.materials.prony import Prony
 
@@ -295,6 +298,7 @@ class Model:
 
     def commit(self, ev: Evaluation, u: np.ndarray, t: float, dt: float) -> None:
         self.history.commit(ev.S0, dt)
+        self.u_prev, self.dt_prev = self.u, dt
         self.u = u.copy()
         self.d = self.travel(t)
         self.t = t
