@@ -8,8 +8,8 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   user's material file: editing the file changes the key, renaming or moving it does not;
 - the bytes of every geometry parameter file (`params.geometry_digest()`: fingertip,
   indenters, Braille standards, molds);
-- the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL), not
-  their paths;
+- the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL) and the
+  skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION` and the package version.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
@@ -85,6 +85,9 @@ def cache_key(scene: Scene) -> str:
     files = scene.indenter_kind.cache_content(scene)
     if files:  # only kinds that read files add the key (the others' keys stay as they were)
         payload["indenter_files"] = files
+    skin_files = scene.skin_kind.cache_content(scene)
+    if skin_files:  # likewise a user's skin file (skins.file)
+        payload["skin_files"] = skin_files
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
@@ -115,6 +118,8 @@ def _scene_fields(scene: Scene) -> dict:
     d.pop("material")  # its content is in the key; the file may have been renamed
     for name in scene.indenter_kind.cache_content(scene):
         d.pop(name, None)  # likewise an indenter file: its bytes are in the key, not its path
+    for name in scene.skin_kind.cache_content(scene):
+        d.pop(name, None)  # and a skin file
     return d
 
 

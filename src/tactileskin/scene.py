@@ -63,7 +63,8 @@ IndenterKind = Enum("IndenterKind", [(n.upper(), n) for n in _indenters.names()]
 
 
 # Scene fields that belong to one skin (skins.*.scene_params)
-SKIN_FIELDS = ("fingertip", "pad_width", "pad_length")
+SKIN_FIELDS = ("fingertip", "pad_width", "pad_length", "skin_file", "skin_bonded", "skin_outer",
+               "dome_length", "dome_tip")
 
 
 class Formulation(str, Enum):
@@ -120,6 +121,11 @@ class Scene:
     skin: str = "fingertip"
     pad_width: float | None = None         # pad: x extent of the whole pad (mm)
     pad_length: float | None = None        # pad: z extent (mm)
+    skin_file: str | None = None           # file: a .msh (named groups) or STEP skin solid (mm)
+    skin_bonded: str | None = None         # file: .msh bonded group name(s); STEP: a face rule
+    skin_outer: str | None = None          # file: .msh contact-surface group name(s)
+    dome_length: float | None = None       # dome: length of the finger before its dome (mm)
+    dome_tip: float | None = None          # dome: semi-axis of the dome along the finger (mm)
     # loading (tactileskin.loading; None / () not given, absent from to_dict so keys are unchanged)
     force: float | None = None             # force control: target reaction (N in 3D, N/mm in 2D)
     force_rate: float | None = None        # N/s (N/mm/s); None: load_time
@@ -139,6 +145,10 @@ class Scene:
         set_("order", validate.integer(self.order, "order", "1 or 2"))
         set_("fingertip", _fingertip_overrides(self.fingertip))
         set_("skin", validate.string(self.skin, "skin", "a skin name"))
+        for name in ("skin_file", "skin_bonded", "skin_outer"):
+            if getattr(self, name) is not None:
+                v = getattr(self, name)
+                set_(name, validate.string(str(v) if isinstance(v, Path) else v, name, "a string"))
         skin = self.skin_kind
         for name in SKIN_FIELDS:
             if getattr(self, name) not in (None, ()) and name not in skin.scene_params:

@@ -49,6 +49,15 @@ FIELDS: dict[str, tuple[str, str, str]] = {
              "the skin geometry"),
     "pad_width": ("mm", "[1, 500]; pad only (default 20)", "x extent of the whole pad"),
     "pad_length": ("mm", "[1, 500]; pad only (default 20)", "z extent of the pad (3D block)"),
+    "skin_file": ("mm", "a gmsh .msh with named physical groups or a STEP solid, 0.1 mm to 1 m; file only",
+                  "the user's skin geometry (fixes dim and thickness)"),
+    "skin_bonded": ("-", ".msh: physical-group name(s), comma-separated; STEP: 'normal:-y[:TOL_DEG]' or "
+                    "'plane:y=0'; file only", "the bonded (fixed) surface"),
+    "skin_outer": ("-", ".msh: physical-group name(s); default outer_surface, else the free rest; file only",
+                   "the contact surface"),
+    "dome_length": ("mm", "[1, 200]; dome only (default 10)", "finger length before its dome (3D)"),
+    "dome_tip": ("mm", "[2, 50]; dome only (default the section's half width)",
+                 "semi-axis of the dome along the finger"),
 }
 
 

@@ -16,7 +16,7 @@ QUALITIES = ("preview", "default", "fine")
 # ones of the commands that solve. `grid=True` (sweep): the axis options take lists.
 SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text", "braille_standard",
               "indenter_radius", "indenter_axis", "indenter_file", "skin", "pad_width", "pad_length",
-              "depth", "dim", "quality", "mesh_size", "refinement", "order")
+              "skin_file", "depth", "dim", "quality", "mesh_size", "refinement", "order")
 PHYSICS_KEYS = ("rate", "force", "force_rate", "formulation", "elastic")
 
 
@@ -61,7 +61,10 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         click.option("--refinement", type=float, default=None,
                      help="Global / refined element size ratio; overrides --quality."),
         click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default 2)."),
-        click.option("--skin", type=str, default=None, help="Skin geometry: fingertip (default) or pad."),
+        click.option("--skin", type=str, default=None,
+                     help="Skin geometry: fingertip (default), pad, dome (rounded 3D tip) or file."),
+        click.option("--skin-file", type=str, default=None,
+                     help="File skin: a gmsh .msh with named groups or a STEP solid (mm); implies --skin file."),
         click.option("--pad-width", type=float, default=None, help="Pad: x extent of the whole pad (mm)."),
         click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm)."),
     ]
@@ -93,8 +96,10 @@ def _field_changes(opts: dict) -> dict:
     """Scene-field changes of the single-valued options (None: not given)."""
     ch = {k: opts.get(k) for k in ("thickness", "material", "indenter", "braille_text", "braille_standard",
                                     "indenter_radius", "indenter_axis", "indenter_file",
-                                    "skin", "pad_width", "pad_length", "depth", "rate", "force", "force_rate",
-                                    "formulation")}
+                                    "skin", "pad_width", "pad_length", "skin_file", "depth", "rate",
+                                    "force", "force_rate", "formulation")}
+    if ch.get("skin_file") is not None and ch.get("skin") is None:
+        ch["skin"] = "file"
     if opts.get("dim") is not None:
         ch["dim"] = int(opts["dim"])
     if opts.get("order") is not None:

@@ -83,7 +83,8 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     allc = tuple(range(m))
     # the skin's bonded surfaces are fixed (fingertip: bone and nail; pad: the board)
     bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries]
-    bcs.append(Dirichlet("symmetry", (0,)))
+    if "symmetry" in mesh.boundaries:  # a user's full (not halved) skin has none
+        bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
     contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate)

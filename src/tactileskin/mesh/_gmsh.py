@@ -17,7 +17,7 @@ import threading
 
 import numpy as np
 
-from tactileskin.errors import MeshError
+from tactileskin.errors import MeshError, TactileSkinError
 
 logger = logging.getLogger(__name__)
 _LOCK = threading.Lock()
@@ -50,7 +50,7 @@ def session(name: str, params: dict):
             gmsh.model.add(name)
             try:
                 yield gmsh
-            except MeshError:
+            except TactileSkinError:  # MeshError, or a ParameterError on the user's file
                 raise
             except Exception as e:  # gmsh raises plain Exception
                 log = [m for m in gmsh.logger.get() if m.startswith(("Error", "Warning"))][-5:]

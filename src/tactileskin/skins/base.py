@@ -18,7 +18,8 @@ A skin is a class (no instances: every answer is a function of the Scene) with
   when the indenter is z-symmetric); other names are free surfaces unless listed here;
 - `build_mesh(scene, **overrides) -> SkinMesh` (gmsh, imported inside);
 - `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
-- `label(scene)`: the prefix of case labels ("" for the paper's fingertip).
+- `label(scene)`: the prefix of case labels ("" for the paper's fingertip);
+- `cache_content(scene)`: digests of files it reads, for cache.cache_key (a user's skin file).
 """
 
 from __future__ import annotations
@@ -60,6 +61,12 @@ class Skin:
     @classmethod
     def build_parts(cls, thickness: float, *, molds: bool = True, **params) -> list:
         raise NotImplementedError
+
+    @classmethod
+    def cache_content(cls, scene) -> dict:
+        """{scene field: digest} of files the skin reads (their bytes enter cache.cache_key, their
+        paths do not)."""
+        return {}
 
     @classmethod
     def label(cls, scene) -> str:

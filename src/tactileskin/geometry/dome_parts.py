@@ -1,0 +1,89 @@
+"""A 3D fingertip with a rounded tip (skins.dome): solids and printable parts (build123d).
+
+The outer surface is the paper's elliptical section (semi-axes a along x, b along y) extruded
+along the finger for z in [-L, 0] and closed for z > 0 by a half ellipsoid (semi-axis c along
+z); the rigid bone is the same shape with every semi-axis reduced by the skin thickness t
+(a - t, b - t, c - t), so the skin is t thick at the pulp (x = 0, y = b), the sides and the tip.
+`half=True` keeps x >= 0 (the half model the solver meshes, symmetry plane x = 0).
+
+Parts: the skin (cast), the bone core (printed, the mold's insert) and a two-part mold split at
+y = 0 (a block minus the outer body), every part checked closed (solids.check_solid; the STLs
+by trimesh in export.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import build123d as bd
+
+from tactileskin.geometry.solids import box, check_solid, occ_guard
+
+MOLD_WALL = 3.0  # mm around the outer body
+BONE_STEM = 5.0  # mm of bone core beyond the skin's end z = -L (held by the mold)
+
+
+def _one(shape) -> bd.Solid:
+    """The single solid of a boolean's result (build123d returns a Shape or a ShapeList)."""
+    solids = shape.solids()
+    return solids[0] if len(solids) == 1 else shape
+
+
+def body(a: float, b: float, c: float, length: float, *, extra: float = 0.0) -> bd.Solid:
+    """The elliptic cylinder z in [-length - extra, 0] closed by a half ellipsoid for z > 0."""
+    ell = bd.Face(bd.Wire([bd.Edge.make_ellipse(a, b, plane=bd.Plane.XY.offset(-length - extra))]))
+    cyl = bd.Solid.extrude(ell, bd.Vector(0, 0, length + extra))
+    cap = bd.scale(bd.Solid.make_sphere(1.0), by=(a, b, c))
+    cap = _one(cap.intersect(box(-a - 1, a + 1, -b - 1, b + 1, 0.0, c + 1)))
+    return _one(cyl.fuse(cap).clean())
+
+
+def skin_solid(a, b, c, length, t, *, half: bool = False) -> bd.Solid:
+    """The skin: the outer body minus the bone (x >= 0 only if `half`)."""
+    p = dict(a=a, b=b, c=c, length=length, thickness=t)
+    with occ_guard("building the dome skin", **p):
+        s = _one(body(a, b, c, length).cut(body(a - t, b - t, c - t, length, extra=1.0)))
+        if half:
+            s = _one(s.intersect(box(0.0, a + 1, -b - 1, b + 1, -length - 1, c + 1)))
+        return check_solid(_one(s.clean()), "dome skin", **p)
+
+
+def bone_solid(a, b, c, length, t) -> bd.Solid:
+    p = dict(a=a, b=b, c=c, length=length, thickness=t)
+    with occ_guard("building the dome bone core", **p):
+        return check_solid(body(a - t, b - t, c - t, length, extra=BONE_STEM), "dome bone core", **p)
+
+
+def skin_volume(a, b, c, length, t, *, half: bool = False) -> float:
+    """Analytic skin volume (mm^3): the elliptic annulus times L plus the two half ellipsoids."""
+    ai, bi, ci = a - t, b - t, c - t
+    v = math.pi * (a * b - ai * bi) * length + 2.0 / 3.0 * math.pi * (a * b * c - ai * bi * ci)
+    return 0.5 * v if half else v
+
+
+def mold(a, b, c, length, t):
+    """(lower, upper) mold halves split at y = 0: a block around the outer body minus it; the
+    bone core rests in the half-round seats its stem leaves at z < -L."""
+    p = dict(a=a, b=b, c=c, length=length, thickness=t)
+    A, B = a + MOLD_WALL, b + MOLD_WALL
+    z0, z1 = -length - BONE_STEM, c + MOLD_WALL
+    with occ_guard("building the dome mold", **p):
+        cavity = _one(body(a, b, c, length).fuse(body(a - t, b - t, c - t, length, extra=BONE_STEM)))
+        lower = _one(box(-A, A, -B, 0.0, z0, z1).cut(cavity).clean())
+        upper = _one(box(-A, A, 0.0, B, z0, z1).cut(cavity).clean())
+    return check_solid(lower, "dome mold lower half", **p), check_solid(upper, "dome mold upper half", **p)
+
+
+def build_dome_parts(thickness: float, a: float, b: float, c: float, length: float, *, molds: bool = True):
+    from tactileskin.geometry.parts import Part
+
+    fp = dict(skin="dome", thickness=thickness, half_width=a, height=b, dome_tip=c, dome_length=length)
+    parts = [Part("skin", f"rounded fingertip skin, t = {thickness:g} mm (cast)",
+                  skin_solid(a, b, c, length, thickness), fp),
+             Part("bone_core", "rigid bone core (printed; the mold's insert)",
+                  bone_solid(a, b, c, length, thickness), fp)]
+    if molds:
+        lower, upper = mold(a, b, c, length, thickness)
+        parts += [Part("mold_lower", "dome mold, lower half (y < 0)", lower, fp),
+                  Part("mold_upper", "dome mold, upper half (y > 0, the pulp)", upper, fp)]
+    return parts

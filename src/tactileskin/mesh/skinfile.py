@@ -1,0 +1,316 @@
+"""A user's skin geometry from a file (skins.file): a gmsh .msh with named physical groups, or a
+STEP solid meshed here with its bonded faces chosen by a rule. Also the OCC-solid mesher of the
+built-in 3D skins that are CAD solids (skins.dome).
+
+.msh: read by gmsh itself (any .msh version; scikit-fem's meshio import drops second-order
+boundary tags, see mesh._gmsh), one cell type (triangles in 2D, tetrahedra in 3D, order 1 or
+2; the scene's order is made by gmsh's `setOrder`), the boundaries by physical-group name:
+the bonded surface(s) (`skin_bonded`, comma-separated names; default the first of
+`BONDED_NAMES` present), the contact surface (`skin_outer`; default the first of
+`OUTER_NAMES`, else every boundary facet not otherwise named), `symmetry` if present (then
+the model is the half x >= 0), other groups kept by name (free).
+
+STEP: one closed solid (gmsh's OCC importer, target unit mm), meshed with P2 tetrahedra
+curved onto the CAD (size `mesh_size`, `mesh_size / refinement` in a ball around the top
+point where indenters start). Each CAD face is one group; a face is bonded when every
+facet satisfies the rule `skin_bonded`: "normal:-y" (outward normal within 10 degrees of
+-y; "normal:+x:5" for another axis and tolerance) or "plane:y=0" (every vertex on that plane
+within 1e-6 of the part size); every other face is `outer_surface`.
+
+Units: a part whose bounding box is smaller than 0.1 mm or larger than 1 m is refused (a
+file in metres or micrometres).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import logging
+import re
+import time
+from pathlib import Path
+
+import numpy as np
+
+from tactileskin.errors import MeshError, ParameterError
+from tactileskin.mesh import _gmsh
+from tactileskin.mesh.skinmesh import SkinMesh, check_quality, jacobian_ratio
+
+logger = logging.getLogger(__name__)
+
+MSH_SUFFIXES = (".msh",)
+STEP_SUFFIXES = (".step", ".stp")
+BONDED_NAMES = ("bone_interface", "bonded", "board", "bone", "base", "fixed")
+OUTER_NAMES = ("outer_surface", "outer", "contact", "skin_surface", "top")
+SIZE_RANGE = (0.1, 1000.0)  # mm: the largest bounding-box side of a plausible skin
+DEFAULT_RULE = "normal:-y"
+RULE_FORMS = "'normal:-y' (optionally ':TOL_DEG'), 'normal:+x', ... or 'plane:y=0' (x, y or z)"
+_VALID_FILE = "a gmsh .msh with named physical groups or a STEP (.step/.stp) of the skin solid, in mm"
+
+
+def file_digest(path) -> str:
+    """SHA-256 of the file's bytes (ParameterError naming `skin_file` if it cannot be read)."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError as e:
+        raise ParameterError("skin_file", str(path), _VALID_FILE, f"cannot read it: {e.strerror or e}") from None
+
+
+def file_kind(path) -> str:
+    suffix = Path(str(path)).suffix.lower()
+    if suffix in MSH_SUFFIXES:
+        return "msh"
+    if suffix in STEP_SUFFIXES:
+        return "step"
+    raise ParameterError("skin_file", str(path), _VALID_FILE, f"unknown suffix {suffix!r}")
+
+
+def _names(value) -> tuple[str, ...]:
+    if value is None:
+        return ()
+    return tuple(n.strip() for n in str(value).split(",") if n.strip())
+
+
+def check_units(path, lo, hi) -> None:
+    """Refuse a part whose largest bounding-box side is outside SIZE_RANGE (mm)."""
+    ext = float(np.max(np.asarray(hi, float) - np.asarray(lo, float)))
+    if not SIZE_RANGE[0] <= ext <= SIZE_RANGE[1]:
+        hint = ("it looks like metres or inches-as-metres: scale it to mm" if ext < SIZE_RANGE[0]
+                else "it looks like micrometres: scale it to mm")
+        raise ParameterError("skin_file", f"{path} (largest side {ext:.4g} mm)",
+                             f"a skin between {SIZE_RANGE[0]:g} mm and {SIZE_RANGE[1] / 1000:g} m in size (units mm)",
+                             hint)
+
+
+# --- .msh ---------------------------------------------------------------------------------------
+def _physical_groups(gmsh, dim: int) -> dict[str, list[int]]:
+    out = {}
+    for d, tag in gmsh.model.getPhysicalGroups(dim):
+        name = gmsh.model.getPhysicalName(d, tag) or f"#{tag}"
+        out.setdefault(name, []).extend(int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, tag))
+    return out
+
+
+def _cell_type(gmsh, path, dim: int) -> int:
+    """The one gmsh cell type of dimension `dim` (MeshError for mixed or unsupported types)."""
+    types = [int(t) for t in gmsh.model.mesh.getElementTypes(dim)]
+    names = [gmsh.model.mesh.getElementProperties(t)[0] for t in types]
+    ok = {2: (_gmsh.TRI3, _gmsh.TRI6), 3: (_gmsh.TET4, _gmsh.TET10)}[dim]
+    if len(types) != 1:
+        raise MeshError(f"skin_file {path}: mixed element types ({', '.join(names)}); "
+                        f"one type of {'triangle' if dim == 2 else 'tetrahedron'} (order 1 or 2) is supported")
+    if types[0] not in ok:
+        raise MeshError(f"skin_file {path}: {names[0]} cells are not supported; "
+                        f"{'triangles' if dim == 2 else 'tetrahedra'} of order 1 or 2 are")
+    return types[0]
+
+
+def _pick(groups: dict, given: tuple[str, ...], defaults: tuple[str, ...], field: str, path) -> list[str]:
+    found = ", ".join(sorted(groups)) or "none"
+    if given:
+        missing = [n for n in given if n not in groups]
+        if missing:
+            raise ParameterError(field, ",".join(given), f"physical groups of {Path(str(path)).name} (found: {found})",
+                                 f"no group named {missing[0]!r}")
+        return list(given)
+    return [n for n in defaults if n in groups][:1]
+
+
+def load_msh(path, *, bonded=None, outer=None, order: int | None = None):
+    """(SkinMesh, group names) of a gmsh .msh file; see the module docstring."""
+    path = Path(path)
+    params = {"skin_file": str(path)}
+    t0 = time.perf_counter()
+    with _gmsh.session("skinfile", params) as gmsh:
+        try:
+            gmsh.merge(str(path))
+        except Exception as e:
+            raise ParameterError("skin_file", str(path), _VALID_FILE, f"gmsh cannot read it: {e}") from None
+        dim = 3 if len(gmsh.model.mesh.getElementTypes(3)) else 2 if len(gmsh.model.mesh.getElementTypes(2)) else 0
+        if dim == 0:
+            raise MeshError(f"skin_file {path}: no triangles or tetrahedra (a surface or line mesh only?)")
+        _, xyz, _ = gmsh.model.mesh.getNodes()
+        xyz = xyz.reshape(-1, 3)
+        check_units(path, xyz.min(axis=0), xyz.max(axis=0))
+        if dim == 2 and np.ptp(xyz[:, 2]) > 1e-9 * np.ptp(xyz[:, :2]):
+            raise MeshError(f"skin_file {path}: a 2D mesh must lie in the plane z = const (x-y section)")
+        file_order = 2 if _cell_type(gmsh, path, dim) in (_gmsh.TRI6, _gmsh.TET10) else 1
+        groups = _physical_groups(gmsh, dim - 1)
+        found = ", ".join(sorted(groups)) or "none"
+        bnames = _pick(groups, _names(bonded), BONDED_NAMES, "skin_bonded", path)
+        if not bnames:
+            raise ParameterError("skin_bonded", bonded, f"a physical group of {path.name} (found: {found})",
+                                 "name the bonded surface(s): skin_bonded = 'NAME'")
+        onames = _pick(groups, _names(outer), OUTER_NAMES, "skin_outer", path)
+        order = file_order if order is None else order
+        if order != file_order:
+            gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)
+            gmsh.model.mesh.setOrder(order)
+        rename = {**{n: "bone_interface" for n in bnames}, **{n: "outer_surface" for n in onames}}
+        ents: dict[str, list[int]] = {}
+        for name, tags in groups.items():
+            ents.setdefault(rename.get(name, name), []).extend(tags)
+        mesh, boundaries = _gmsh.to_skfem(gmsh, dim, order, ents)
+    if "outer_surface" not in boundaries:  # no contact group named: the rest of the boundary
+        named = np.concatenate([boundaries[n] for n in ("bone_interface", "symmetry") if n in boundaries])
+        rest = np.setdiff1d(mesh.boundary_facets(), named)
+        if not rest.size:
+            raise MeshError(f"skin_file {path}: no free boundary left for the contact surface")
+        boundaries["outer_surface"] = rest
+    mesh = dataclasses.replace(mesh, _boundaries=boundaries) if dim == 3 else mesh.with_boundaries(boundaries)
+    quality = {"elements": int(mesh.nelements), "nodes": int(mesh.doflocs.shape[1]),
+               "vertices": int(mesh.nvertices), "min_scaled_jacobian": jacobian_ratio(mesh),
+               "wall_s": time.perf_counter() - t0}
+    check_quality(quality, {})
+    return SkinMesh(mesh=mesh, boundaries=boundaries, dim=dim, quality=quality), sorted(groups)
+
+
+# --- OCC solids (STEP files, built-in CAD skins) ------------------------------------------------
+def parse_rule(rule):
+    """('normal', axis vector, tol_deg) or ('plane', axis index, value) of a bonded-face rule."""
+    text = DEFAULT_RULE if rule is None else str(rule).strip().lower()
+    m = re.fullmatch(r"normal:([+-]?)([xyz])(?::([0-9.]+))?", text)
+    if m:
+        v = np.zeros(3)
+        v["xyz".index(m.group(2))] = -1.0 if m.group(1) == "-" else 1.0
+        tol = float(m.group(3)) if m.group(3) else 10.0
+        if not 0.0 < tol < 90.0:
+            raise ParameterError("skin_bonded", rule, "a tolerance in (0, 90) degrees")
+        return "normal", v, tol
+    m = re.fullmatch(r"plane:([xyz])=([-+0-9.e]+)", text)
+    if m:
+        try:
+            return "plane", "xyz".index(m.group(1)), float(m.group(2))
+        except ValueError:
+            pass
+    raise ParameterError("skin_bonded", rule, f"a rule for the STEP's bonded faces: {RULE_FORMS}")
+
+
+def outward_normals(mesh, facets) -> np.ndarray:
+    """(n, 3) outward unit normals of boundary facets of a tetrahedral mesh (straight facets)."""
+    p, t = mesh.p, mesh.t
+    v = p[:, mesh.facets[:, facets]]                      # (3, 3 vertices, n)
+    n = np.cross((v[:, 1] - v[:, 0]).T, (v[:, 2] - v[:, 0]).T)
+    inside = p[:, t[:, mesh.f2t[0, facets]]].mean(axis=1).T - v[:, 0].T
+    n *= np.where(np.sum(n * inside, axis=1) > 0, -1.0, 1.0)[:, None]
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def classify_by_rule(mesh, faces: dict[int, np.ndarray], rule, size: float) -> list[int]:
+    """The CAD faces (tag -> facet indices) that satisfy the bonded-face rule."""
+    kind, a, b = parse_rule(rule)
+    hits = []
+    for tag, f in faces.items():
+        if kind == "normal":
+            ok = np.all(outward_normals(mesh, f) @ a >= np.cos(np.radians(b)))
+        else:
+            ok = np.all(np.abs(mesh.p[a, mesh.facets[:, f]] - b) <= 1e-6 * size)
+        if ok:
+            hits.append(tag)
+    return hits
+
+
+def mesh_occ(gmsh, path_label, *, mesh_size: float, fine: float, centre, radius: float, order: int,
+             classify) -> tuple[object, dict, dict]:
+    """Mesh the single OCC volume of the current gmsh model with P`order` tetrahedra (curved
+    onto the CAD), fine (size `fine`) in a ball of `radius` around `centre`; `classify(mesh,
+    faces)` maps {CAD face tag: facet indices} to {boundary name: [face tags]}. Returns
+    (skfem mesh, boundaries, quality)."""
+    vols = gmsh.model.getEntities(3)
+    faces = [t for _, t in gmsh.model.getBoundary(vols, oriented=False)]
+    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", min(fine, mesh_size))
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 12)  # curved faces: <= 30 degrees per cell
+    ball = gmsh.model.mesh.field.add("Ball")
+    for k, v in zip(("XCenter", "YCenter", "ZCenter"), centre):
+        gmsh.model.mesh.field.setNumber(ball, k, float(v))
+    gmsh.model.mesh.field.setNumber(ball, "Radius", radius)
+    gmsh.model.mesh.field.setNumber(ball, "Thickness", radius)
+    gmsh.model.mesh.field.setNumber(ball, "VIn", fine)
+    gmsh.model.mesh.field.setNumber(ball, "VOut", mesh_size)
+    gmsh.model.mesh.field.setAsBackgroundMesh(ball)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.Algorithm3D", 10)
+    gmsh.model.mesh.generate(3)
+    quality = _gmsh.shape_quality(gmsh, 3)
+    if order == 2:
+        gmsh.option.setNumber("Mesh.SecondOrderLinear", 0)  # mid-nodes on the CAD surfaces
+        gmsh.model.mesh.setOrder(2)
+    mesh, per_face = _gmsh.to_skfem(gmsh, 3, order, {f"face{f}": [f] for f in faces})
+    by_tag = {f: per_face[f"face{f}"] for f in faces}
+    names = classify(mesh, by_tag)
+    boundaries = {n: np.unique(np.concatenate([by_tag[f] for f in tags])) for n, tags in names.items() if tags}
+    mesh = dataclasses.replace(mesh, _boundaries=boundaries)
+    quality.update(elements=int(mesh.nelements), nodes=int(mesh.doflocs.shape[1]),
+                   vertices=int(mesh.nvertices), min_scaled_jacobian=jacobian_ratio(mesh))
+    logger.info("%s: %d cells, %d nodes, min SICN %.3f", path_label, quality["elements"], quality["nodes"],
+                quality["min_sicn"])
+    return mesh, boundaries, quality
+
+
+def _import_step(gmsh, path: Path) -> None:
+    gmsh.option.setString("Geometry.OCCTargetUnit", "MM")
+    gmsh.option.setNumber("Geometry.OCCBoundsUseStl", 1)
+    try:
+        gmsh.model.occ.importShapes(str(path))
+    except Exception as e:
+        raise ParameterError("skin_file", str(path), _VALID_FILE, f"gmsh cannot import it: {e}") from None
+    gmsh.model.occ.synchronize()
+    nvol, nface = len(gmsh.model.getEntities(3)), len(gmsh.model.getEntities(2))
+    if nvol != 1:
+        raise ParameterError("skin_file", str(path), "a STEP of one closed solid",
+                             f"it holds {nvol} solids and {nface} faces"
+                             + (" (an open shell: the solid is not closed)" if nvol == 0 else ""))
+    check_units(path, *np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2))
+
+
+def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float = 1.0, order: int = 2,
+              centre=None, radius: float | None = None) -> SkinMesh:
+    """Mesh a STEP skin solid (module docstring); `centre`, `radius`: the fine ball (default
+    around the top of the bounding box on x = z = 0, a fifth of the part's size); mesh_size
+    None: an eighth of the part's size."""
+    path = Path(path)
+    parse_rule(bonded)  # a bad rule fails before any CAD work
+    params = {"skin_file": str(path), "mesh_size": mesh_size, "refinement": refinement, "order": order}
+    t0 = time.perf_counter()
+    with _gmsh.session("skinstep", params) as gmsh:
+        _import_step(gmsh, path)
+        lo, hi = np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2)
+        size = float(np.max(hi - lo))
+        mesh_size = size / 8.0 if mesh_size is None else mesh_size
+        centre = (0.0, hi[1], 0.0) if centre is None else centre
+        radius = 0.2 * size if radius is None else radius
+
+        def classify(mesh, faces):
+            hits = classify_by_rule(mesh, faces, bonded, size)
+            if not hits:
+                kind = parse_rule(bonded)[0]
+                raise ParameterError("skin_bonded", bonded or DEFAULT_RULE,
+                                     f"a rule that some of the {len(faces)} faces of {path.name} satisfy ({RULE_FORMS})",
+                                     f"no face matches the {kind} rule")
+            return {"bone_interface": hits, "outer_surface": [f for f in faces if f not in hits]}
+
+        mesh, boundaries, quality = mesh_occ(gmsh, f"STEP skin {path.name}", mesh_size=mesh_size,
+                                             fine=mesh_size / refinement, centre=centre, radius=radius,
+                                             order=order, classify=classify)
+    if "outer_surface" not in boundaries:
+        raise ParameterError("skin_bonded", bonded, "a rule that leaves a free outer surface",
+                             "every face of the solid matched it")
+    quality["wall_s"] = time.perf_counter() - t0
+    check_quality(quality, {"coarse": mesh_size})
+    return SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality)
+
+
+def refine_top(path, top) -> np.ndarray:
+    """The top point of a STEP's outer surface, from a mesh node near it: the closest CAD point
+    to a point above it (the surface is horizontal at its highest point)."""
+    with _gmsh.session("skinstep-top", {"skin_file": str(path)}) as gmsh:
+        _import_step(gmsh, Path(path))
+        best = np.asarray(top, float)
+        probe = best + np.array([0.0, 1.0, 0.0])
+        for _, f in gmsh.model.getEntities(2):
+            p = np.asarray(gmsh.model.getClosestPoint(2, f, probe)[0])
+            if np.linalg.norm(p - best) < 1e-2 * max(1.0, abs(best).max()) and p[1] > best[1]:
+                best = p
+    return best

@@ -1,0 +1,164 @@
+"""dome: a 3D fingertip with a rounded tip (not an extrusion). The paper's elliptical section
+(semi-axes a = half_width, b = height of data/geometry/fingertip.toml) runs along the finger
+for z in [-dome_length, 0] and is closed for z > 0 by a half ellipsoid of semi-axis `dome_tip`
+along z; the rigid bone inside is the same shape with every semi-axis reduced by t
+(geometry/dome_parts.py). 3D only; the half x >= 0 is meshed (gmsh from the build123d/OCC
+solid, P2 tetrahedra curved onto the CAD) with `bone_interface` (the bone for z <= 0, fixed;
+the bone map's surface), `bone_tip` (the bone under the dome, fixed), `outer_surface`,
+`symmetry` (x = 0) and `end_back` (z = -dome_length, free).
+
+Indenters start on the pulp line (x = 0, y = b), centred on z = 0 where the dome begins: a
+sphere or a Braille dot there presses half on the finger and half on the dome. s is the arc
+length along the bone's ellipse (a - t, b - t) from its top, by the angle of (x, y) (so it
+also parametrises the bone under the dome); the 3D profile's section plane is z = 0. Sensor
+layouts are refused (no sensor frames yet).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, check_range
+from tactileskin.skins.base import Skin
+from tactileskin.skins.registry import register
+
+DEFAULT_LENGTH = 10.0
+LENGTH = (1.0, 200.0)
+TIP = (2.0, 50.0)
+
+
+def _axes():
+    from tactileskin import params
+
+    sec = params.load("fingertip")["section"]
+    return float(sec["half_width"]), float(sec["height"])
+
+
+@dataclass(frozen=True)
+class DomeSection:
+    """The mid-plane (z = 0) section: the `Section` duck type (skins.base)."""
+
+    a: float
+    b: float
+    c: float
+    length: float
+    thickness: float
+
+    @property
+    def top(self) -> float:
+        return self.b
+
+    @property
+    def half_width(self) -> float:
+        return self.a
+
+    @property
+    def min_radius_of_curvature(self) -> float:
+        return min(self.b ** 2 / self.a, self.a ** 2 / self.b, self.c ** 2 / self.b)
+
+    def contact_radius(self, indenter) -> float:
+        r = getattr(indenter, "radius", None)
+        return float(r) if r else self.a ** 2 / self.b
+
+    def outer_length_to_x(self, x: float) -> float:
+        return float(x)
+
+    def _table(self):
+        ai, bi = self.a - self.thickness, self.b - self.thickness
+        u = np.linspace(0.0, math.pi, 4001)
+        ds = np.hypot(ai * np.cos(u), bi * np.sin(u))
+        s = np.concatenate([[0.0], np.cumsum(0.5 * (ds[1:] + ds[:-1]) * np.diff(u))])
+        return u, s, ai, bi
+
+    @property
+    def interface_length(self) -> float:
+        return float(self._table()[1][-1])
+
+    def s_of_point(self, points) -> np.ndarray:
+        pts = np.atleast_2d(np.asarray(points, float))
+        u, s, ai, bi = self._table()
+        ang = np.arctan2(np.abs(pts[:, 0]) / ai, pts[:, 1] / bi)
+        return np.where(pts[:, 0] < -1e-9 * ai, -1.0, 1.0) * np.interp(ang, u, s)  # x = 0 (to rounding): s >= 0
+
+    def point_at_s(self, s) -> np.ndarray:
+        u, st, ai, bi = self._table()
+        s = np.asarray(s, float)
+        if np.any((np.abs(s) > st[-1] + 1e-9)):
+            raise ParameterError("s", f"{np.min(s):g}..{np.max(s):g}", f"[-{st[-1]:.4g}, {st[-1]:.4g}] mm")
+        ang = np.interp(np.abs(s), st, u)
+        return np.stack([np.sign(s) * ai * np.sin(ang), bi * np.cos(ang)], axis=-1)
+
+    def outer_points(self, n: int = 200) -> np.ndarray:
+        u = np.linspace(0.0, math.pi, n)
+        return np.column_stack([self.a * np.sin(u), self.b * np.cos(u)])
+
+    def area(self) -> float:
+        return 0.5 * math.pi * (self.a * self.b - (self.a - self.thickness) * (self.b - self.thickness))
+
+
+@register
+class DomeSkin(Skin):
+    name = "dome"
+    order = 2
+    scene_params = ("dome_length", "dome_tip")
+    fixed_boundaries = ("bone_interface", "bone_tip")
+    boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "bone_tip")
+
+    @classmethod
+    def check_scene(cls, scene) -> dict:
+        a, b = _axes()
+        length = DEFAULT_LENGTH if scene.dome_length is None else scene.dome_length
+        c = a if scene.dome_tip is None else scene.dome_tip
+        c = check_range("dome_tip", c, *TIP, unit="mm")
+        tmax = 0.5 * min(a, b, c)
+        return {"thickness": check_range("thickness", scene.thickness, 0.3, tmax, unit="mm"),
+                "dome_length": check_range("dome_length", length, *LENGTH, unit="mm"),
+                "dome_tip": c, "dim": _dim3(scene), "sensors": _no_sensors(scene)}
+
+    @classmethod
+    def section(cls, scene) -> DomeSection:
+        a, b = _axes()
+        return DomeSection(a, b, float(scene.dome_tip), float(scene.dome_length), float(scene.thickness))
+
+    @classmethod
+    def sample_length(cls, scene) -> float:
+        return 2.0 * max(float(scene.dome_length), float(scene.dome_tip)) + 2.0
+
+    @classmethod
+    def coordinates(cls, scene):
+        raise ParameterError("sensors", "a layout", "none with skin = dome", "the dome skin has no sensor frames yet")
+
+    @classmethod
+    def build_mesh(cls, scene, *, cell: str = "tri", mesh_size=None, refinement=None, order=None, **_):
+        from tactileskin.mesh.dome import build_dome_mesh
+
+        if cell != "tri":
+            raise ParameterError("cell", cell, "'tri' (tetrahedra) for the dome")
+        return build_dome_mesh(scene, mesh_size=mesh_size, refinement=refinement, order=order)
+
+    @classmethod
+    def build_parts(cls, thickness, *, molds=True, dome_length=DEFAULT_LENGTH, dome_tip=None, **_):
+        from tactileskin.geometry.dome_parts import build_dome_parts
+        from tactileskin.scene import Scene
+
+        sc = Scene(skin="dome", thickness=thickness, dome_length=dome_length, dome_tip=dome_tip)
+        sec = sc.section()
+        return build_dome_parts(sc.thickness, sec.a, sec.b, sec.c, sec.length, molds=molds)
+
+    @classmethod
+    def label(cls, scene) -> str:
+        return f"dome{scene.dome_length:g}c{scene.dome_tip:g}-"
+
+
+def _dim3(scene) -> int:
+    return 3  # a rounded tip is 3D (Scene's default dim 2 becomes 3)
+
+
+def _no_sensors(scene):
+    if scene.sensors:
+        raise ParameterError("sensors", f"{len(scene.sensors)} layout(s)", "none with skin = dome",
+                             "the dome skin has no sensor frames yet")
+    return scene.sensors

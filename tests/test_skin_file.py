@@ -1,0 +1,166 @@
+"""A user's skin from a file (skins.file, mesh.skinfile): a .msh with named groups solves like the
+built-in pad on the same mesh; a STEP solid is meshed with its bonded faces by a rule; the cache
+key follows the file's bytes; clear errors for missing groups, open solids, wrong units."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from tactileskin import cache
+from tactileskin.errors import MeshError, ParameterError
+from tactileskin.fe import solve
+from tactileskin.mesh import build_mesh
+from tactileskin.scene import Scene
+
+PAD = dict(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, indenter="flat",
+           depth_fraction=0.03, viscoelastic=False, mesh_size=0.8, refinement=1.0)
+
+
+def _gmsh_block(path, w=4.0, t=2.0, names=("bonded", "outer_surface"), dim=3, order=1, mixed=False):
+    """A block x in [0, w], y in [0, t] (z in [0, w] in 3D) written by gmsh with physical groups:
+    the bottom names[0], the top names[1], x = 0 `symmetry`, the rest `sides`."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("block")
+        occ = gmsh.model.occ
+        if dim == 3:
+            occ.addBox(0, 0, 0, w, t, w)
+        elif mixed:  # two halves, one of them recombined into quadrilaterals
+            occ.fragment([(2, occ.addRectangle(0, 0, 0, w / 2, t))], [(2, occ.addRectangle(w / 2, 0, 0, w / 2, t))])
+        else:
+            occ.addRectangle(0, 0, 0, w, t)
+        occ.synchronize()
+        groups = {names[0]: [], names[1]: [], "symmetry": [], "sides": []}
+        for _, f in gmsh.model.getEntities(dim - 1):
+            c = occ.getCenterOfMass(dim - 1, f)
+            if gmsh.model.getAdjacencies(dim - 1, f)[0].size > 1:
+                continue  # the interface between the halves
+            key = (names[0] if abs(c[1]) < 1e-9 else names[1] if abs(c[1] - t) < 1e-9
+                   else "symmetry" if abs(c[0]) < 1e-9 else "sides")
+            groups[key].append(f)
+        for name, ents in groups.items():
+            if name and ents:
+                gmsh.model.addPhysicalGroup(dim - 1, ents, name=name)
+        gmsh.model.addPhysicalGroup(dim, [e for _, e in gmsh.model.getEntities(dim)], name="skin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
+        if mixed:
+            gmsh.model.mesh.setRecombine(2, gmsh.model.getEntities(2)[0][1])
+        gmsh.model.mesh.generate(dim)
+        gmsh.model.mesh.setOrder(order)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def test_msh_of_the_pad_mesh_solves_like_the_pad(tmp_path):
+    """Same mesh -> same answer: the pad's own mesh written as .msh and read back as a file skin
+    gives the same reaction and bone profile (to 1e-10: only node numbering differs, and the
+    solver's stopping tests are relative to 1e-10 or tighter)."""
+    pad = Scene(**PAD)
+    sm = build_mesh(pad)
+    path = sm.write(tmp_path / "pad.msh")
+    user = Scene(skin="file", skin_file=str(path), indenter="flat", depth_fraction=0.03, viscoelastic=False)
+    assert user.dim == 2 and user.thickness == pytest.approx(2.0, abs=1e-12)
+    assert user.section().top == pytest.approx(2.0, abs=1e-12)
+    um = build_mesh(user)
+    assert set(um.boundaries) >= {"bone_interface", "outer_surface", "symmetry", "side"}
+    assert um.measure() == pytest.approx(sm.measure(), rel=1e-12)
+    a, b = solve(pad, mesh=sm), solve(user, mesh=um)
+    assert b.reaction == pytest.approx(a.reaction, rel=1e-10)
+    assert np.allclose(b.s, a.s, atol=1e-12)
+    assert np.allclose(b.pressure, a.pressure, rtol=0, atol=1e-10 * np.abs(a.pressure).max())
+
+
+def test_gmsh_written_block_maps_common_names_and_elevates_order(tmp_path):
+    path = _gmsh_block(tmp_path / "block.msh", names=("board", "top"))
+    sc = Scene(skin="file", skin_file=str(path), indenter="sphere", indenter_radius=2.0, depth=0.1,
+               viscoelastic=False)
+    assert sc.dim == 3 and sc.thickness == pytest.approx(2.0, abs=1e-12)  # the file fixes them
+    sm = build_mesh(sc)  # order 1 in the file, P2 for the scene (straight mid-nodes)
+    assert sm.order == 2 and sm.measure() == pytest.approx(32.0, rel=1e-12)
+    assert sm.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-12)
+    assert sm.boundary_measure("outer_surface") == pytest.approx(16.0, rel=1e-12)
+    assert sm.boundary_measure("sides") == pytest.approx(3 * 8.0, rel=1e-12)  # x = 4, z = 0, z = 4
+    with pytest.raises(ParameterError, match=r"skin_bonded.*found: board, sides, symmetry, top"):
+        Scene(skin="file", skin_file=str(path), skin_bonded="bottom")
+    with pytest.raises(ParameterError, match=r"skin_outer.*no group named 'contact'"):
+        Scene(skin="file", skin_file=str(path), skin_outer="contact")
+    with pytest.raises(ParameterError, match="thickness.*measured"):
+        Scene(skin="file", skin_file=str(path), thickness=1.5)
+    with pytest.raises(ParameterError, match="sensors.*none with skin = file"):
+        Scene(skin="file", skin_file=str(path), sensors=[{"kind": "points", "s": [0.5], "depth": 0.5}])
+
+
+def test_no_bonded_group_wrong_units_and_mixed_cells(tmp_path):
+    nob = _gmsh_block(tmp_path / "nob.msh", names=("bottom", "top"))
+    with pytest.raises(ParameterError, match=r"skin_bonded.*found: bottom, sides, symmetry, top"):
+        Scene(skin="file", skin_file=str(nob))
+    metres = _gmsh_block(tmp_path / "m.msh", w=0.004, t=0.002)
+    with pytest.raises(ParameterError, match=r"skin_file.*0.1 mm and 1 m.*metres"):
+        Scene(skin="file", skin_file=str(metres))
+    mixed = _gmsh_block(tmp_path / "mixed.msh", dim=2, mixed=True)
+    with pytest.raises(MeshError, match="mixed element types"):
+        Scene(skin="file", skin_file=str(mixed))
+
+
+def test_cache_key_follows_bytes_not_path(tmp_path):
+    a = _gmsh_block(tmp_path / "a.msh", dim=2)
+    b = tmp_path / "sub" / "b.msh"
+    b.parent.mkdir()
+    shutil.copy(a, b)
+    ka = cache.cache_key(Scene(skin="file", skin_file=str(a)))
+    assert cache.cache_key(Scene(skin="file", skin_file=str(b))) == ka  # moved: same key
+    _gmsh_block(b, dim=2, w=5.0)
+    assert cache.cache_key(Scene(skin="file", skin_file=str(b))) != ka  # edited: new key
+
+
+def _step_block(path, w=4.0, t=2.0, open_=False):
+    import build123d as bd
+
+    box = bd.Box(w, t, w, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    shape = bd.Shell(box.faces()[:-1]) if open_ else box
+    bd.export_step(shape, str(path))
+    return path
+
+
+def test_step_block_bonded_by_rule(tmp_path):
+    path = _step_block(tmp_path / "block.step")
+    sc = Scene(skin="file", skin_file=str(path), indenter="sphere", indenter_radius=2.0, depth=0.1,
+               mesh_size=1.0, refinement=1.0)
+    assert sc.dim == 3 and sc.thickness == pytest.approx(2.0, abs=1e-9)
+    assert sc.section().top == pytest.approx(2.0, abs=1e-9)
+    sm = build_mesh(sc)
+    assert sm.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-9)  # the face y = 0
+    assert sm.boundary_measure("outer_surface") == pytest.approx(16.0 + 4 * 8.0, rel=1e-9)
+    assert "symmetry" not in sm.boundaries  # a full model
+    plane = build_mesh(sc.replace(skin_bonded="plane:y=0"))
+    assert plane.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-9)
+    with pytest.raises(ParameterError, match="skin_bonded.*no face matches"):
+        Scene(skin="file", skin_file=str(path), skin_bonded="plane:y=-1")
+    with pytest.raises(ParameterError, match="skin_bonded.*rule"):
+        Scene(skin="file", skin_file=str(path), skin_bonded="bottom")
+
+
+def test_open_step_is_refused(tmp_path):
+    path = _step_block(tmp_path / "open.step", open_=True)
+    with pytest.raises(ParameterError, match="skin_file.*one closed solid.*not closed"):
+        Scene(skin="file", skin_file=str(path))
+
+
+def test_step_block_solves_like_the_pad_block(tmp_path):
+    """A STEP block (full model, no symmetry) bonded at y = 0 by the default rule and pressed by
+    a flat plate carries 4x the force of the pad's quarter block of the same size; different
+    meshes of the same size h = 1 mm (measured 2.5e-4 apart), so 1e-3."""
+    import build123d as bd
+
+    path = tmp_path / "block.step"
+    bd.export_step(bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)), str(path))
+    kw = dict(indenter="flat", depth_fraction=0.03, viscoelastic=False, mesh_size=1.0, refinement=1.0)
+    full = solve(Scene(skin="file", skin_file=str(path), **kw))
+    quarter = solve(Scene(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, dim=3, **kw))
+    assert full.reaction == pytest.approx(4.0 * quarter.reaction, rel=1e-3)
