@@ -55,20 +55,22 @@ TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin
 # "\u283f": the full cell); a key without pattern means the single dot. The planner's cost
 # is |peak|. Filled from benchmarks/results/braille_2d_vs_3d.md (see there for meshes and
 # caveats).
-# Source: benchmarks/braille_2d_vs_3d.py --contact-rule 2 (2026-11-22; 3D quarter slab, P2
-# tets, mesh_size 1.0 / refinement 2, profile on z = 0) against the 2D ridge on the same
-# nominal mesh; the 2D `default`-quality comparison is in the note. The 3D meshes are
-# coarse (the 2D peak moves by 27-37 % from this mesh to `default` at t = 1), so these are
-# the size of the effect, not 1 % numbers: the ridge doubles (t = 1) to triples (t = 3)
-# the peak of a dot. Not measured: the t = 3 full cell, polyurethane.
+# Source (2026-11-23): the 3D reference is the finest level of the local-plan convergence
+# study (benchmarks/results/convergence3d.md: 0.8 / 8 at t = 1, 1.2 / 8 at t = 3; peaks
+# 0.038148, 0.052799, 0.023361 MPa for the dot, 0.019166 for the cell), the 2D ridge the
+# `default` preset (0.10264, 0.14841, 0.07188, 0.04801 MPa): the ridge reads 2.5-3.1 times
+# the bone pressure of a real dot. The t = 3 full cell is the earlier coarse measurement
+# (benchmarks/braille_2d_vs_3d.py --contact-rule 2, 3D mesh 1.0 / 2, 2D on the same mesh).
+# Not measured: t = 5, polyurethane at t = 3.
 MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
-    (1.0, "silicone", "\u2801"): {"peak": 1.138, "span": 0.203,
-                                  "note": "coarse 3D; vs 2D default quality: peak +193%, span -6.7%"},
-    (1.0, "silicone", "\u283f"): {"peak": 0.932, "span": 0.041,
-                                  "note": "coarse 3D; vs 2D default quality: peak +168%, span -2.3%"},
-    (3.0, "silicone", "\u2801"): {"peak": 1.787, "span": -0.056,
-                                  "note": "coarse 3D; vs 2D default quality: peak +207%, span -9.3%"},
-    # 2026-11-22 18:21 UTC rerun on the library contact rule (braille_2d_vs_3d.md, last table)
+    (1.0, "silicone", "\u2801"): {"peak": 1.690, "span": -0.015,
+                                  "note": "3D converged (local plan, finest level) vs 2D default"},
+    (1.0, "polyurethane", "\u2801"): {"peak": 1.811, "span": 0.028,
+                                      "note": "3D converged (local plan, finest level) vs 2D default"},
+    (1.0, "silicone", "\u283f"): {"peak": 1.505, "span": -0.000,
+                                  "note": "3D finest level (peak not shown converged to 2 %) vs 2D default"},
+    (3.0, "silicone", "\u2801"): {"peak": 2.077, "span": -0.081,
+                                  "note": "3D converged (local plan, finest level) vs 2D default"},
     (3.0, "silicone", "\u283f"): {"peak": 1.178, "span": 0.013,
                                   "note": "coarse 3D; vs 2D default quality: peak +132%, span -0.6%"},
 }
