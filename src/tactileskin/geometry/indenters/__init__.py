@@ -17,14 +17,13 @@ from tactileskin.geometry.indenters import registry
 from tactileskin.geometry.indenters.base import KIND_FIELDS, Indenter, hertz_halfwidth  # noqa: F401
 from tactileskin.geometry.indenters.registry import get as get_kind  # noqa: F401
 
-registry._load()
+KINDS = registry.names()  # imports every kind module
 from tactileskin.geometry.indenters.braille import BrailleIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.cylinder import CurvedIndenter, CylinderIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.file import FileIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.flat import FlatIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.sphere import SphereIndenter  # noqa: E402,F401
 
-KINDS = registry.names()
 PAPER_KINDS = tuple(k for k in KINDS if get_kind(k).paper)
 
 
