@@ -19,12 +19,16 @@ import click
 @click.option("--braille-standard", type=str, default="standard_american", show_default=True,
               help="Braille standard name (data/geometry/braille.toml).")
 @click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
-@click.option("--skin", type=click.Choice(["fingertip", "pad"]), default="fingertip", show_default=True,
-              help="Skin geometry: the paper's fingertip or a flat pad (--pad-width, --pad-length).")
+@click.option("--skin", type=click.Choice(["fingertip", "pad", "dome"]), default="fingertip", show_default=True,
+              help="Skin geometry: the paper's fingertip, a flat pad (--pad-width, --pad-length) or a "
+                   "finger with a rounded tip (--dome-length, --dome-tip).")
 @click.option("--pad-width", type=float, default=None, help="Pad: x extent (mm); default 20.")
 @click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm); default 20.")
+@click.option("--dome-length", type=float, default=None, help="Dome: finger length before the dome (mm); default 10.")
+@click.option("--dome-tip", type=float, default=None,
+              help="Dome: semi-axis of the dome along the finger (mm); default the section's half width.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
-            pad_width=None, pad_length=None):
+            pad_width=None, pad_length=None, dome_length=None, dome_tip=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -40,13 +44,20 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     console = Console()
     t = default_thickness() if thickness is None else thickness
     pad = {}
+    if skin != "pad" and (pad_width is not None or pad_length is not None):
+        raise click.UsageError("--pad-width and --pad-length need --skin pad")
+    if skin != "dome" and (dome_length is not None or dome_tip is not None):
+        raise click.UsageError("--dome-length and --dome-tip need --skin dome")
     if skin == "pad":
         from tactileskin.scene import Scene
 
         sc = Scene(skin="pad", thickness=t, pad_width=pad_width, pad_length=pad_length)  # validates
         pad = dict(pad_width=sc.pad_width, pad_length=sc.pad_length)
-    elif pad_width is not None or pad_length is not None:
-        raise click.UsageError("--pad-width and --pad-length need --skin pad")
+    elif skin == "dome":
+        from tactileskin.scene import Scene
+
+        sc = Scene(skin="dome", thickness=t, dome_length=dome_length, dome_tip=dome_tip)  # validates
+        pad = dict(dome_length=sc.dome_length, dome_tip=sc.dome_tip)
     else:
         Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
     resolve_indenters(indenter)
@@ -60,7 +71,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         if pad:
             from tactileskin.skins import get
 
-            parts = get("pad").build_parts(t, molds=not no_molds, **pad)
+            parts = get(skin).build_parts(t, molds=not no_molds, **pad)
             parts += build_parts(default_thickness(), indenters=indenter, braille_text=braille_text,
                                  braille_standard=braille_standard, fingertip=False, molds=False)
         else:
@@ -70,7 +81,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     with console.status(f"writing {len(parts)} parts to {escape(str(out_dir))}..."):
         manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
                                                           braille_standard=braille_standard, molds=not no_molds,
-                                                          **({"skin": "pad", **pad} if pad else {})))
+                                                          **({"skin": skin, **pad} if pad else {})))
     t2 = time.perf_counter()
 
     table = Table(title=escape(f"t = {t:g} mm -> {out_dir}/<part>.stl, .step"))
