@@ -13,18 +13,27 @@ import click
               help="Skin thickness (mm); default from data/geometry/fingertip.toml.")
 @click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
               help="Output folder (replaced only if empty or a previous build).")
-@click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "all", "none"]), default="all",
-              show_default=True, help="Which indenter(s) to make.")
+@click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "sphere", "cylinder", "all", "none"]),
+              default="all", show_default=True,
+              help="Which indenter(s) to make ('all': the paper's flat, curved and braille).")
+@click.option("--indenter-radius", type=float, default=None, help="Sphere or cylinder indenter radius (mm).")
+@click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
+              help="Cylinder indenter axis: z along the finger (default) or x across it.")
 @click.option("--braille-text", type=str, default="", help="Text for the Braille indenter (default: one dot).")
 @click.option("--braille-standard", type=str, default="standard_american", show_default=True,
               help="Braille standard name (data/geometry/braille.toml).")
 @click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
-@click.option("--skin", type=click.Choice(["fingertip", "pad"]), default="fingertip", show_default=True,
-              help="Skin geometry: the paper's fingertip or a flat pad (--pad-width, --pad-length).")
+@click.option("--skin", type=click.Choice(["fingertip", "pad", "dome"]), default="fingertip", show_default=True,
+              help="Skin geometry: the paper's fingertip, a flat pad (--pad-width, --pad-length) or a "
+                   "finger with a rounded tip (--dome-length, --dome-tip).")
 @click.option("--pad-width", type=float, default=None, help="Pad: x extent (mm); default 20.")
 @click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm); default 20.")
+@click.option("--dome-length", type=float, default=None, help="Dome: finger length before the dome (mm); default 10.")
+@click.option("--dome-tip", type=float, default=None,
+              help="Dome: semi-axis of the dome along the finger (mm); default the section's half width.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
-            pad_width=None, pad_length=None):
+            pad_width=None, pad_length=None, dome_length=None, dome_tip=None, indenter_radius=None,
+            indenter_axis=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -40,16 +49,29 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     console = Console()
     t = default_thickness() if thickness is None else thickness
     pad = {}
+    if skin != "pad" and (pad_width is not None or pad_length is not None):
+        raise click.UsageError("--pad-width and --pad-length need --skin pad")
+    if skin != "dome" and (dome_length is not None or dome_tip is not None):
+        raise click.UsageError("--dome-length and --dome-tip need --skin dome")
     if skin == "pad":
         from tactileskin.scene import Scene
 
         sc = Scene(skin="pad", thickness=t, pad_width=pad_width, pad_length=pad_length)  # validates
         pad = dict(pad_width=sc.pad_width, pad_length=sc.pad_length)
-    elif pad_width is not None or pad_length is not None:
-        raise click.UsageError("--pad-width and --pad-length need --skin pad")
+    elif skin == "dome":
+        from tactileskin.scene import Scene
+
+        sc = Scene(skin="dome", thickness=t, dome_length=dome_length, dome_tip=dome_tip)  # validates
+        pad = dict(dome_length=sc.dome_length, dome_tip=sc.dome_tip)
     else:
         Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
     resolve_indenters(indenter)
+    if indenter_radius is not None and indenter not in ("sphere", "cylinder"):
+        raise click.UsageError("--indenter-radius needs --indenter sphere or cylinder")
+    if indenter_axis is not None and indenter != "cylinder":
+        raise click.UsageError("--indenter-axis needs --indenter cylinder")
+    ind_params = {k: v for k, v in (("indenter_radius", indenter_radius), ("indenter_axis", indenter_axis))
+                  if v is not None}
 
     t0 = time.perf_counter()
     with console.status("building solids (build123d)..."):
@@ -60,17 +82,18 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         if pad:
             from tactileskin.skins import get
 
-            parts = get("pad").build_parts(t, molds=not no_molds, **pad)
+            parts = get(skin).build_parts(t, molds=not no_molds, **pad)
             parts += build_parts(default_thickness(), indenters=indenter, braille_text=braille_text,
-                                 braille_standard=braille_standard, fingertip=False, molds=False)
+                                 braille_standard=braille_standard, fingertip=False, molds=False,
+                                 indenter_params=ind_params)
         else:
             parts = build_parts(t, indenters=indenter, braille_text=braille_text,
-                                braille_standard=braille_standard, molds=not no_molds)
+                                braille_standard=braille_standard, molds=not no_molds, indenter_params=ind_params)
     t1 = time.perf_counter()
     with console.status(f"writing {len(parts)} parts to {escape(str(out_dir))}..."):
         manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
-                                                          braille_standard=braille_standard, molds=not no_molds,
-                                                          **({"skin": "pad", **pad} if pad else {})))
+                                                          braille_standard=braille_standard, molds=not no_molds, **ind_params,
+                                                          **({"skin": skin, **pad} if pad else {})))
     t2 = time.perf_counter()
 
     table = Table(title=escape(f"t = {t:g} mm -> {out_dir}/<part>.stl, .step"))

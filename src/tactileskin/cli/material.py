@@ -33,8 +33,14 @@ def list_() -> None:
               help="Poisson ratio of the test (default: incompressible; hyperfoam needs it).")
 @click.option("--terms", type=int, default=None, help="Terms of yeoh (1-3), ogden or hyperfoam (1-3).")
 @click.option("--name", default=None, help="Material name (default: the CSV's name).")
-def fit(data, law, out, nu, terms, name):
-    """Fit LAW to the uniaxial test in DATA (CSV: stretch or strain, nominal_stress_mpa).
+@click.option("--test", "test", type=click.Choice(["uniaxial", "indentation"]), default="uniaxial", show_default=True,
+              help="uniaxial: stretch-stress; indentation: depth_mm, force_n of a sphere on a bonded layer.")
+@click.option("--radius", type=float, default=None, help="Indentation: sphere radius R (mm).")
+@click.option("--thickness", type=float, default=None, help="Indentation: layer thickness t (mm), bonded to a rigid base.")
+def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness=None):
+    """Fit LAW to the uniaxial test in DATA (CSV: stretch or strain, nominal_stress_mpa), or
+    with --test indentation to a sphere indentation of a bonded layer (CSV: depth_mm, force_n;
+    Hertz with the bonded-layer correction of Dimitriadis et al. 2002, neo_hookean only).
 
     Prints the parameters and the fit quality (R^2, RMSE, max relative error) and writes a
     material file usable as --material OUT or Scene(material="OUT")."""
@@ -53,6 +59,28 @@ def fit(data, law, out, nu, terms, name):
         if not ours:
             raise ParameterError("--out", out, "a new file or one this command wrote",
                                  "it exists and was not written by tactileskin material fit")
+    if test == "indentation":
+        from tactileskin.materials.indentation import fit_indentation, read_indentation_csv
+
+        if radius is None or thickness is None:
+            raise ParameterError("--radius/--thickness", None, "both given (mm) with --test indentation")
+        if nu is not None or terms is not None:
+            raise ParameterError("--nu/--terms", nu if nu is not None else terms, "not given with --test indentation",
+                                 "the bonded-layer correction is for an incompressible layer")
+        d, F = read_indentation_csv(data)
+        f = fit_indentation(law, d, F, radius=radius, thickness=thickness)
+        q = f.quality
+        source = (f"fit of {law} to {Path(data).name} (sphere indentation, R = {radius:g} mm, bonded layer t = "
+                  f"{thickness:g} mm, Hertz with the Dimitriadis 2002 bonded correction, {q['n_points']} points, "
+                  f"chi <= {q['chi_max']:.3g}): E = {f.E:.5g} MPa, R^2 = {q['r2']:.5f}, RMSE = {q['rmse_n']:.3g} N, "
+                  f"max relative error {100 * q['max_rel_err']:.2f} %")
+        fileio.atomic_write_text(outp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
+        click.echo(f.describe())
+        click.echo(f"wrote {out}")
+        return
+    if radius is not None or thickness is not None:
+        raise ParameterError("--radius/--thickness", radius if radius is not None else thickness,
+                             "only with --test indentation")
     lam, P = read_uniaxial_csv(data)
     f = fit_law(law, lam, P, nu=nu, terms=terms)
     q = f.quality

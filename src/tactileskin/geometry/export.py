@@ -53,7 +53,30 @@ def write_stl(shape, path: Path, tolerance: float = STL_TOLERANCE,
         return False
     writer = StlAPI_Writer()
     writer.ASCIIMode = False
-    return bool(writer.Write(shape.wrapped, str(path)))
+    if not writer.Write(shape.wrapped, str(path)):
+        return False
+    drop_pole_facets(Path(path))
+    return True
+
+
+def drop_pole_facets(path: Path) -> int:
+    """Rewrite the STL without facets that have two coincident corners; return their number.
+
+    OCC meshes a surface pole (a scaled sphere's tip, e.g. the dome's cap) through its
+    degenerate edge and leaves a zero-area triangle there whose collapsed edge is unmatched,
+    so the STL is not watertight although the surface is closed. Such a facet carries no
+    area and its two other edges are each other's twin, so dropping it changes no surface
+    and no volume. A file without one is left untouched (byte for byte)."""
+    mesh = trimesh.load(str(path), force="mesh")  # merges exactly coincident vertices
+    f = mesh.faces
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    n = int(np.count_nonzero(~keep))
+    if n:
+        mesh.update_faces(keep)
+        mesh.remove_unreferenced_vertices()
+        fileio.atomic_write_bytes(path, mesh.export(file_type="stl"))
+        log.info("%s: dropped %d zero-area pole facet(s)", path.name, n)
+    return n
 
 
 def check_stl(path: Path, what: str = "", parameters: dict | None = None) -> trimesh.Trimesh:

@@ -10,6 +10,7 @@ the absolute stress residuals, i.e. it minimises the RMSE the report states):
   Newton), with kappa from nu (hyperfoam: nu is its own parameter).
 Quality: R^2, RMSE (MPa) and the largest relative error over the points whose |stress| is
 at least 5 % of the largest (relative error near zero stress means nothing).
+Indentation tests (sphere on a bonded layer, depth-force): materials/indentation.py.
 Bad data (fewer points than parameters + 3, NaN/inf, stretch <= 0, stretch not strictly
 monotone, no point away from stretch 1) raise `FitDataError` naming the column and what
 is wrong.
@@ -235,23 +236,7 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
     column (nominal_stress_mpa | stress_mpa | nominal_stress | stress; MPa), or from two
     unnamed numeric columns (stretch, stress)."""
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_CSV_BYTES + 1)
-    except FileNotFoundError:
-        raise FitDataError("data", str(path), "an existing CSV file") from None
-    except OSError as e:
-        raise FitDataError("data", str(path), "a readable CSV file", e.strerror or str(e)) from None
-    if len(raw) > MAX_CSV_BYTES:
-        raise FitDataError("data", str(path), f"a CSV of at most {MAX_CSV_BYTES >> 20} MiB")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        raise FitDataError("data", str(path), "a UTF-8 text CSV") from None
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
-    rows = [r for r in rows if not r[0].lstrip().startswith("#")]
-    if not rows:
-        raise FitDataError("data", str(path), "a CSV with rows of stretch and stress")
+    rows = _csv_rows(path, "stretch and stress")
     head = [c.strip().lower() for c in rows[0]]
 
     def col(names):
@@ -277,6 +262,53 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
             raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", "two numbers (stretch, stress)") from None
     lam = np.array(lam)
     return (1.0 + lam if strain else lam), np.array(P)
+
+
+def _csv_rows(path: Path, what: str) -> list[list[str]]:
+    """The non-empty, non-comment rows of a UTF-8 CSV of at most MAX_CSV_BYTES."""
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_CSV_BYTES + 1)
+    except FileNotFoundError:
+        raise FitDataError("data", str(path), "an existing CSV file") from None
+    except OSError as e:
+        raise FitDataError("data", str(path), "a readable CSV file", e.strerror or str(e)) from None
+    if len(raw) > MAX_CSV_BYTES:
+        raise FitDataError("data", str(path), f"a CSV of at most {MAX_CSV_BYTES >> 20} MiB")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise FitDataError("data", str(path), "a UTF-8 text CSV") from None
+    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
+    rows = [r for r in rows if not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise FitDataError("data", str(path), f"a CSV with rows of {what}")
+    return rows
+
+
+def read_columns(path, xnames, ynames, xlabel: str, ylabel: str) -> tuple[np.ndarray, np.ndarray]:
+    """Two numeric columns from a CSV: named by a header (the first of `xnames` / `ynames`
+    found) or the first two unnamed columns."""
+    path = Path(path)
+    rows = _csv_rows(path, f"{xlabel} and {ylabel}")
+    head = [c.strip().lower() for c in rows[0]]
+    if _is_number(rows[0][0]):
+        ix, iy, body, first = 0, 1, rows, 1
+    else:
+        ix = next((head.index(n) for n in xnames if n in head), None)
+        iy = next((head.index(n) for n in ynames if n in head), None)
+        if ix is None or iy is None:
+            raise FitDataError("data header", ",".join(head), f"a {xlabel} column ({' | '.join(xnames)}) and a "
+                                                             f"{ylabel} column ({' | '.join(ynames)})")
+        body, first = rows[1:], 2
+    x, y = [], []
+    for n, r in enumerate(body, start=first):
+        try:
+            x.append(float(r[ix]))
+            y.append(float(r[iy]))
+        except (ValueError, IndexError):
+            raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", f"two numbers ({xlabel}, {ylabel})") from None
+    return np.array(x), np.array(y)
 
 
 def _is_number(s) -> bool:

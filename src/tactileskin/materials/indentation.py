@@ -1,0 +1,139 @@
+"""Fit a law's small-strain shear modulus to a spherical indentation test on a bonded layer.
+
+A rigid sphere of radius R indents by d a layer of thickness t bonded to a rigid base. For an
+incompressible layer, Dimitriadis et al. 2002 (Biophys. J. 82:2798, eq. 13, bonded sample,
+nu = 0.5) give the Hertz force with a finite-thickness correction:
+
+    F = 16 E / 9 * R^(1/2) d^(3/2) * (1 + 1.133 chi + 1.283 chi^2 + 0.769 chi^3 + 0.0975 chi^4),
+    chi = sqrt(R d) / t,   E = 3 mu (incompressible).
+
+Validity (refused outside, `FitDataError` naming the row): chi <= 1 (the series was derived
+for a contact radius sqrt(R d) below the thickness), and d / R <= 0.1 (Hertz: a small
+contact radius against R, a/R <= 0.32, where the neo-Hookean force stays within a few % of
+the linear one), so d / t = chi^2 t / R as well. F is linear in E, so the fit is the closed
+least-squares E = sum(F g) / sum(g^2) (g = F / E above); it minimises the RMSE it reports.
+Only the small-strain modulus is identifiable in this range: the fitted law is neo-Hookean
+(mu = E / 3) with the bulk modulus of fit.NU_INCOMPRESSIBLE; laws with more parameters are
+refused. Pure numpy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tactileskin.errors import ParameterError, check_range
+from tactileskin.materials.fit import REL_FLOOR, NU_INCOMPRESSIBLE, FitDataError
+
+__all__ = ["IndentationFit", "bonded_sphere_force", "fit_indentation", "read_indentation_csv",
+           "CHI_MAX", "DEPTH_OVER_RADIUS_MAX"]
+
+CHI_MAX = 1.0                 # sqrt(R d) / t: contact radius below the thickness
+DEPTH_OVER_RADIUS_MAX = 0.1   # Hertz: small contact radius against R
+COEFFS = (1.0, 1.133, 1.283, 0.769, 0.0975)  # Dimitriadis 2002, bonded, nu = 0.5
+LAWS = ("neo_hookean",)
+
+
+def bonded_sphere_force(E, depth, radius, thickness):
+    """Force (N) of the corrected Hertz law above (E in MPa, lengths in mm)."""
+    d = np.asarray(depth, float)
+    chi = np.sqrt(radius * d) / thickness
+    poly = np.polynomial.polynomial.polyval(chi, COEFFS)
+    return 16.0 * E / 9.0 * np.sqrt(radius) * d ** 1.5 * poly
+
+
+@dataclass
+class IndentationFit:
+    law: object
+    E: float
+    depth: np.ndarray
+    force: np.ndarray
+    predicted: np.ndarray
+    radius: float
+    thickness: float
+    quality: dict = field(default_factory=dict)
+
+    def material(self, name: str, source: str = ""):
+        from tactileskin.materials.presets import Material
+        from tactileskin.materials.prony import Prony
+
+        return Material(name=name, law=self.law, prony=Prony.elastic(), source=source)
+
+    def describe(self) -> str:
+        q = self.quality
+        return (f"{self.law.law}: {self.law.to_dict()} (E = {self.E:.5g} MPa); R^2 = {q['r2']:.5f}, "
+                f"RMSE = {q['rmse_n']:.3g} N, max relative error {100 * q['max_rel_err']:.2f} % "
+                f"({q['n_points']} points, sphere R = {self.radius:g} mm on a bonded layer t = "
+                f"{self.thickness:g} mm, chi <= {q['chi_max']:.3g})")
+
+
+def check_indentation(depth, force, radius, thickness):
+    R = check_range("radius", radius, 0.0, 1e4, lo_open=True, unit="mm")
+    t = check_range("thickness", thickness, 0.0, 1e4, lo_open=True, unit="mm")
+    try:
+        d = np.asarray(depth, float).ravel()
+        F = np.asarray(force, float).ravel()
+    except (TypeError, ValueError):
+        raise FitDataError("data", "non-numeric values", "numbers (depth mm, force N)") from None
+    if d.shape != F.shape:
+        raise FitDataError("force", f"{F.size} values", f"{d.size} values (one per depth)")
+    if d.size < 3:
+        raise FitDataError("data", f"{d.size} points", ">= 3 points")
+    for name, x in (("depth", d), ("force", F)):
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise FitDataError(name, f"non-finite value at row {bad[0] + 1}", "finite numbers")
+    if np.any(d <= 0.0):
+        i = int(np.flatnonzero(d <= 0.0)[0])
+        raise FitDataError("depth", f"{d[i]:g} at row {i + 1}", "> 0 mm (depth from first contact)")
+    dmax = min(DEPTH_OVER_RADIUS_MAX * R, CHI_MAX ** 2 * t * t / R)
+    over = np.flatnonzero(d > dmax)
+    if over.size:
+        i = int(over[0])
+        chi = np.sqrt(R * d[i]) / t
+        raise FitDataError("depth", f"{d[i]:g} mm at row {i + 1} (d/R = {d[i] / R:.3g}, chi = sqrt(R d)/t = {chi:.3g})",
+                           f"<= {dmax:.4g} mm for R = {R:g} mm, t = {t:g} mm (d/R <= {DEPTH_OVER_RADIUS_MAX:g}, "
+                           f"chi <= {CHI_MAX:g})",
+                           "outside the range of the bonded-layer Hertz correction; drop the deeper points")
+    return d, F, R, t
+
+
+def fit_indentation(law: str, depth, force, *, radius: float, thickness: float) -> IndentationFit:
+    """Fit `law` (neo_hookean) to (depth mm, force N) of a sphere of `radius` on a bonded
+    layer of `thickness` (see the module docstring for the formula and its range)."""
+    from tactileskin.materials.fit import _quality
+    from tactileskin.materials.laws import get_law
+
+    if law not in LAWS:
+        get_law(law)  # an unknown name gets the registry's error
+        raise ParameterError("law", law, " or ".join(LAWS) + " for an indentation fit",
+                             "indentation in the Hertz range identifies the small-strain modulus only")
+    d, F, R, t = check_indentation(depth, force, radius, thickness)
+    g = bonded_sphere_force(1.0, d, R, t)
+    E = float(np.dot(F, g) / np.dot(g, g))
+    if not E > 0.0:
+        raise FitDataError("force", f"fitted E = {E:g} MPa", "forces that give a positive modulus",
+                           "force in N, positive in compression")
+    from tactileskin.materials.neo_hookean import NeoHookean
+
+    mat = NeoHookean.from_fit(np.array([E / 3.0]), NU_INCOMPRESSIBLE)
+    pred = E * g
+    q = _quality(F, pred, 1)
+    q["rmse_n"] = q.pop("rmse_mpa")
+    q["chi_max"] = float(np.sqrt(R * d.max()) / t)
+    q["rel_floor"] = REL_FLOOR
+    return IndentationFit(law=mat, E=E, depth=d, force=F, predicted=pred, radius=R, thickness=t, quality=q)
+
+
+_DEPTH = ("depth_mm", "depth", "indentation_mm", "indentation")
+_FORCE = ("force_n", "force")
+
+
+def read_indentation_csv(path) -> tuple[np.ndarray, np.ndarray]:
+    """(depth mm, force N) from a CSV with a header naming a depth column (depth_mm | depth |
+    indentation_mm | indentation) and a force column (force_n | force), or two unnamed
+    numeric columns (depth, force)."""
+    from tactileskin.materials.fit import read_columns
+
+    return read_columns(path, _DEPTH, _FORCE, "depth", "force")

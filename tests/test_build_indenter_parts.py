@@ -1,0 +1,93 @@
+"""`tactileskin build --indenter sphere|cylinder`: the printable sphere and cylinder indenters
+are closed STL volumes whose volume matches their closed form (solids.sphere_indenter,
+solids.cylinder_indenter: working body + mounting stem + stem-root fillet)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+import trimesh
+
+from tactileskin import params
+from tactileskin.cli import main
+from tactileskin.geometry.export import STL_TOLERANCE
+from tactileskin.geometry.fingertip import Fingertip
+from tactileskin.geometry.indenters import make_indenter
+
+
+def _stem_volume(ind) -> float:
+    """Stem cylinder plus the fillet ring at its root (Pappus: the corner region between the
+    square rf x rf and the fillet's quarter circle, revolved about the stem axis)."""
+    rf = float(params.load("indenters")["stem"]["fillet"])
+    r = 0.5 * ind.stem_diameter
+    area = rf * rf * (1.0 - math.pi / 4.0)
+    xbar = rf * (5.0 / 6.0 - math.pi / 4.0) / (1.0 - math.pi / 4.0)  # centroid off the stem wall
+    return math.pi * r * r * ind.stem_length + 2.0 * math.pi * (r + xbar) * area
+
+
+def _sphere_volume(ind) -> float:
+    """Plate (2.4 R square, from 0.95 R to 2.2 R above the lowest point) plus the ball's cap of
+    height h = 0.95 R under it: pi h^2 (3R - h) / 3."""
+    R = ind.radius
+    h = 0.95 * R
+    return (2.4 * R) ** 2 * 1.25 * R + math.pi * h * h * (3 * R - h) / 3.0 + _stem_volume(ind)
+
+
+def _cylinder_volume(ind) -> float:
+    """(chord x back thickness + the circular segment of that chord) x the length along the axis."""
+    R, w = ind.radius, ind.chord
+    theta = 2.0 * math.asin(w / (2.0 * R))
+    segment = 0.5 * R * R * (theta - math.sin(theta))
+    along = ind.length if ind.axis == "z" else ind.width
+    return (w * ind.back_thickness + segment) * along + _stem_volume(ind)
+
+
+@pytest.mark.parametrize("argv, kind, opts", [
+    (["--indenter", "sphere", "--indenter-radius", "5"], "sphere", dict(indenter_radius=5.0)),
+    (["--indenter", "cylinder", "--indenter-radius", "8", "--indenter-axis", "x"], "cylinder",
+     dict(indenter_radius=8.0, indenter_axis="x")),
+    (["--indenter", "cylinder", "--indenter-radius", "20"], "cylinder", dict(indenter_radius=20.0)),
+])
+def test_sphere_and_cylinder_parts_are_closed_with_the_closed_form_volume(tmp_path, argv, kind, opts):
+    """Chordal bound: vertices on the exact CAD surfaces, no facet more than STL_TOLERANCE off
+    them, so |V_stl - V| <= tol * area (measured well inside it)."""
+    out = tmp_path / "out"
+    assert main(["build", "--out", str(out), "--no-molds", *argv]) == 0
+    man = json.loads((out / "manifest.json").read_text())
+    e = {p["name"]: p for p in man["parts"]}[f"indenter_{kind}"]
+    assert e["parameters"]["radius"] == opts["indenter_radius"]
+    ft = Fingertip.from_params()
+    ind = make_indenter(kind, y0=ft.section(2.0).top, dim=3, sample_length=ft.sample_length, **opts)
+    exact = _sphere_volume(ind) if kind == "sphere" else _cylinder_volume(ind)
+    m = trimesh.load(str(out / e["stl"]), force="mesh")
+    assert m.is_watertight and m.is_winding_consistent and m.is_volume
+    assert abs(m.volume - exact) <= STL_TOLERANCE * m.area, (m.volume, exact, STL_TOLERANCE * m.area)
+    assert _precise_volume(ind.solid()) == pytest.approx(exact, rel=1e-7)  # the CAD solid is exact
+
+
+def _precise_volume(shape) -> float:
+    """OCC's volume integral to 1e-9 (build123d's `.volume` uses the default precision, which
+    is off by up to ~6e-4 on a spherical cap)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape.wrapped, props, 1e-9, False, False)
+    return props.Mass()
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--indenter", "sphere"], ["indenter_radius", "required"]),
+    (["--indenter", "sphere", "--indenter-radius", "-1"], ["indenter_radius=-1", "mm"]),
+    (["--indenter", "flat", "--indenter-radius", "3"], ["--indenter-radius", "sphere or cylinder"]),
+    (["--indenter", "sphere", "--indenter-radius", "3", "--indenter-axis", "x"], ["--indenter-axis", "cylinder"]),
+])
+def test_bad_indenter_options_are_one_line_errors(tmp_path, capsys, argv, words):
+    assert main(["build", "--out", str(tmp_path / "out"), "--no-molds", *argv]) == 2
+    cap = capsys.readouterr()
+    err = " ".join(cap.err.split())
+    assert all(w in err for w in words), err
+    assert "Traceback" not in cap.err + cap.out
+    assert list(tmp_path.iterdir()) == []
