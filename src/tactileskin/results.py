@@ -344,7 +344,10 @@ def _pad3(v) -> np.ndarray:
 def _meshio_mesh(fields: dict, point_data: dict | None = None):
     """The meshio.Mesh of `fields` (fe.output.vtk_fields): the cells with cell data
     `boundary_id` 0, then each named boundary's facets with its id; its field data
-    {name: [id, dim]} names the ids (as gmsh and meshio keep them)."""
+    {name: [id, dim]} names the ids (as gmsh and meshio keep them). The facet fields of
+    fields["facet_data"] ({field: {boundary: (F,) values}}, e.g. contact_pressure_MPa on
+    outer_surface) are cell data, zero on the other cells; not with a `point_data` override
+    (the increments of result.pvd, which hold the displacement only)."""
     import meshio  # only when writing files (keeps the solver import light)
 
     pts = _pad3(fields["points"])
@@ -356,8 +359,12 @@ def _meshio_mesh(fields: dict, point_data: dict | None = None):
         blocks.append((ctype, np.asarray(conn)))
         ids.append(np.full(len(conn), k, np.int32))
         field_data[name] = np.array([k, pts.shape[1] - 1 if ctype == "triangle" else 1], np.int32)
-    return meshio.Mesh(pts, blocks, point_data=pdata, cell_data={"boundary_id": ids} if len(blocks) > 1 else {},
-                       field_data=field_data)
+    cell_data = {"boundary_id": ids} if len(blocks) > 1 else {}
+    names = [None] + sorted(fields.get("boundaries", {}))
+    for fname, per_boundary in (fields.get("facet_data") or {}).items() if point_data is None else ():
+        cell_data[fname] = [np.asarray(per_boundary[n], float) if n in per_boundary else np.zeros(len(b[1]))
+                            for n, b in zip(names, blocks)]
+    return meshio.Mesh(pts, blocks, point_data=pdata, cell_data=cell_data, field_data=field_data)
 
 
 def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None:

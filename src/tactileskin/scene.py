@@ -23,8 +23,9 @@ from tactileskin.skins import registry as _skins
 
 # bump when a field's meaning or the solver's answer for it changes, so cached results are
 # not reused (2: bone pressure from the boundary fit, second-order QLV update; 3: contact
-# penetration tolerance relative to the facet size, multipliers updated within Newton)
-SCHEMA_VERSION = 3
+# penetration tolerance relative to the facet size, multipliers updated within Newton;
+# 4: result.vtu carries the contact pressure on the outer surface)
+SCHEMA_VERSION = 4
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
