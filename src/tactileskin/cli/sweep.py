@@ -14,7 +14,7 @@ from tactileskin.errors import ParameterError
 # the names a sweep writes into OUT (a folder of an earlier version holding only these is ours)
 OWN_NAMES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md", "cache",
              *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
-               for ext in ("png", "svg")))
+               for ext in ("png", "svg")), "metrics_vs_thickness.pdf")
 _RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
 

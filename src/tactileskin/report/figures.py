@@ -2,7 +2,7 @@
 and the designer's figure: peak, span and AUC against thickness, one line per indenter and
 material (metrics_vs_thickness), the one a thickness is chosen from.
 
-Each figure is written as PNG and SVG (text kept as text). Sizes follow the grid: panels wrap
+Each figure is written as PNG and SVG (text kept as text), the designer's figure also as PDF. Sizes follow the grid: panels wrap
 into rows of at most MAX_COLUMNS, so 11 thicknesses give a block, not a strip. Colours are
 the Okabe-Ito palette (safe for the common colour-vision deficiencies), told apart by line
 style and marker too. matplotlib runs on the Agg backend (no display).
@@ -22,6 +22,10 @@ INDENTER_ORDER = ("flat", "curved", "braille")
 COLOURS = {"flat": "#0072B2", "curved": "#D55E00", "braille": "#009E73"}
 MATERIAL_MARKERS = ("o", "s", "^", "D", "v", "P")
 MAX_COLUMNS = 4
+FORMATS = ("png", "svg")  # raster for the report, vector (text kept as text)
+# the designer's figure also as PDF; for the paper figures a PDF would add about as much as
+# their SVG (2 s CPU over the five figures of an 18-case sweep, ~8 % of `./dev run`)
+DESIGN_FORMATS = FORMATS + ("pdf",)
 
 
 def _plt():
@@ -31,6 +35,7 @@ def _plt():
     import matplotlib.pyplot as plt
 
     plt.rcParams["svg.fonttype"] = "none"  # SVG text stays text (searchable, editable)
+    plt.rcParams["pdf.fonttype"] = 3       # matplotlib default: subset Type 3 fonts (text stays text)
     return plt
 
 
@@ -40,9 +45,9 @@ def _grid(n: int, max_cols: int = MAX_COLUMNS) -> tuple[int, int]:
     return -(-n // cols), cols
 
 
-def _save(fig, out: Path, stem: str) -> list[Path]:
+def _save(fig, out: Path, stem: str, formats=FORMATS) -> list[Path]:
     paths = []
-    for ext in ("png", "svg"):
+    for ext in formats:
         p = out / f"{stem}.{ext}"
         buf = io.BytesIO()
         fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")
@@ -198,7 +203,7 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     if handles:
         fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 3), fontsize=8)
     fig.suptitle("Bone-pressure metrics against skin thickness", fontsize=10)
-    return _save(fig, out, "metrics_vs_thickness")
+    return _save(fig, out, "metrics_vs_thickness", DESIGN_FORMATS)
 
 
 def all_figures(records, rows, out: Path) -> list[Path]:
