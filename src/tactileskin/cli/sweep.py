@@ -83,7 +83,8 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
             outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
                                  on_event=on_event)
         wall = time.perf_counter() - t0
-        paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
+        with console.status("writing results, figures and report"):  # transient; nothing off a terminal
+            paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
     nsus = sum(1 for r in paths.get("rows", []) if result_quality.kind(r.get("status", "")) == "suspect")
     console.print(f"report: {escape(str(paths['report']))}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "
