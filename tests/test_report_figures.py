@@ -53,7 +53,7 @@ def test_metrics_against_thickness_plots_each_series_in_thickness_order(tmp_path
     recs, rows = _grid()
     rows.append(dict(rows[0], thickness_mm=9.0, status="failed: x", peak_mpa=None))  # left out
     got = {}
-    monkeypatch.setattr(figures, "_save", lambda fig, out, stem, *a: got.setdefault(stem, fig) and [])
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
     figures.thickness_figure(rows, tmp_path)
     fig = got["metrics_vs_thickness"]
     for ax, (metric, _) in zip(fig.axes, figures.METRICS):
@@ -69,7 +69,7 @@ def test_metrics_against_thickness_plots_each_series_in_thickness_order(tmp_path
 def test_compared_panels_share_their_y_axis(tmp_path, monkeypatch):
     recs, rows = _grid()
     got = {}
-    monkeypatch.setattr(figures, "_save", lambda fig, out, stem, *a: got.setdefault(stem, fig) and [])
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
     figures.all_figures(recs, rows, tmp_path)
     for stem in ("fig10_profiles", "fig11_peak"):
         axes = [a for a in got[stem].axes if a.get_visible()]

@@ -26,6 +26,7 @@ FORMATS = ("png", "svg")  # raster for the report, vector (text kept as text)
 # the designer's figure also as PDF; for the paper figures a PDF would add about as much as
 # their SVG (2 s CPU over the five figures of an 18-case sweep, ~8 % of `./dev run`)
 DESIGN_FORMATS = FORMATS + ("pdf",)
+DESIGN_STEMS = ("metrics_vs_thickness",)
 
 
 def _plt():
@@ -45,9 +46,9 @@ def _grid(n: int, max_cols: int = MAX_COLUMNS) -> tuple[int, int]:
     return -(-n // cols), cols
 
 
-def _save(fig, out: Path, stem: str, formats=FORMATS) -> list[Path]:
+def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
-    for ext in formats:
+    for ext in DESIGN_FORMATS if stem in DESIGN_STEMS else FORMATS:
         p = out / f"{stem}.{ext}"
         buf = io.BytesIO()
         fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")
@@ -203,7 +204,7 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     if handles:
         fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 3), fontsize=8)
     fig.suptitle("Bone-pressure metrics against skin thickness", fontsize=10)
-    return _save(fig, out, "metrics_vs_thickness", DESIGN_FORMATS)
+    return _save(fig, out, "metrics_vs_thickness")
 
 
 def all_figures(records, rows, out: Path) -> list[Path]:
