@@ -39,3 +39,23 @@ def test_only_the_file_indenter_uses_trimesh():
     assert r.stdout.strip() == "False"
     users = sorted(p.name for p in Path(pkg.__path__[0]).glob("*.py") if "trimesh" in p.read_text())
     assert users == ["file.py"]
+
+
+@pytest.mark.slow
+def test_the_main_job_runs_without_pyvista(tmp_path):
+    """pyvista/VTK (566 MB) is the optional `render` extra: a sweep with its report, figures
+    and Fig. 9 render (matplotlib) runs with `import pyvista` and `import vtk` failing, and
+    Result.to_pyvista() then names the extra to install."""
+    out = tmp_path / "o"
+    code = (
+        "import sys\n"
+        "for m in ('pyvista', 'vtk', 'vtkmodules'): sys.modules[m] = None\n"
+        "from tactileskin.cli import main\n"
+        f"rc = main(['sweep', '-t', '1', '-i', 'flat', '-m', 'polyurethane', '--quality', 'preview', "
+        f"'--serial', '-o', {str(out)!r}])\n"
+        "assert not any(m in sys.modules and sys.modules[m] is not None for m in ('pyvista', 'vtk'))\n"
+        "sys.exit(rc)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert (out / "fig9_t1-polyurethane-flat-2d.png").is_file() and (out / "report.md").is_file()
+    assert "WARNING" not in r.stderr and "render" not in r.stderr

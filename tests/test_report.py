@@ -77,3 +77,25 @@ def test_render_is_coloured_by_pressure(tmp_path):
     img = np.asarray(Image.open(png).convert("RGB")).reshape(-1, 3)
     # jet colours both ends of the range: a saturated blue and a saturated red must appear
     assert np.any((img[:, 2] > 120) & (img[:, 0] < 60)) and np.any((img[:, 0] > 120) & (img[:, 2] < 60))
+
+
+def test_a_grid_without_paper_claims_says_so_instead_of_a_table():
+    """Flat only at 2 and 4 mm: no paper claim is about those skins (the paper's are 1, 3,
+    5 mm and three indenters), so no table of n/a rows and no 'not run' 1 mm peak check."""
+    from tactileskin.report.markdown import NO_CLAIM, NO_PAIRS, build_report
+
+    recs, rows = _records({("polyurethane", 2.0, "flat"): (0.4, 3.0), ("polyurethane", 4.0, "flat"): (0.3, 2.0)})
+    for r, rec in zip(rows, recs):
+        r.update(case=f"t{r['thickness_mm']:g}", depth_mm=rec.scene.indentation, reaction_n_per_mm=0.1)
+    assert paper_checks(rows, recs) == []
+    md = build_report(rows, recs, [], [], [], 1.0, scenes=[r.scene for r in recs])
+    assert NO_CLAIM in md and NO_PAIRS in md
+    assert "| paper says |" not in md and "not run" not in md and "Known causes" not in md
+
+
+def test_only_the_claims_of_the_run_cases_are_checked():
+    recs, rows = _records({("silicone", 1.0, "flat"): (0.5, 3.0), ("silicone", 3.0, "flat"): (0.3, 2.0)})
+    claims = [c["claim"] for c in paper_checks(rows, recs)]
+    # the 1 mm silicone flat peak and the span trend over 1 -> 3 mm; nothing about
+    # polyurethane, Braille, 5 mm or discrimination (one indenter)
+    assert claims == ["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm", "silicone, flat: span shrinks as the skin thickens"]

@@ -40,8 +40,13 @@ def test_figures_of_eleven_thicknesses_are_blocks_not_strips(tmp_path):
             w, h = Image.open(p).size
             # before: one row of 11 panels, 4716 x 460 px; now wrapped at MAX_COLUMNS
             assert w <= 2600 and w / h < 4.5, (p.name, w, h)
-        else:
+        elif p.suffix == ".svg":
             assert "<text" in p.read_text()  # SVG with text, not outlined glyphs
+        else:  # the designer's figure as PDF, its labels as font text
+            assert p.name == "metrics_vs_thickness.pdf"
+            data = p.read_bytes()
+            assert data[:5] == b"%PDF-" and b"/Font" in data
+    assert sum(p.suffix == ".pdf" for p in paths) == 1
 
 
 def test_metrics_against_thickness_plots_each_series_in_thickness_order(tmp_path, monkeypatch):

@@ -12,6 +12,7 @@ cell reuses the finished cases. The cache is `out/cache` when `out` is given, el
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import sys
 from pathlib import Path
@@ -137,6 +138,10 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         claim_dir(Path(out), "sweep", own_names=_own_names(out), what="out")
     with _script_not_rerun():
         outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
+    failed = [oc for oc in outcomes if oc.status == "failed"]
+    if failed:  # the rows say which and why; a notebook user should not miss that some did
+        logging.getLogger(__name__).warning("%d of %d cases failed (status and error columns): %s",
+                                            len(failed), len(outcomes), ", ".join(oc.case for oc in failed))
     if out is not None:
         from tactileskin.report.outputs import write_outputs
 

@@ -88,3 +88,21 @@ def _range_text(lo, hi, lo_open, hi_open, unit):
     if hi is not None:
         return f"{'<' if hi_open else '<='} {fmt_bound(hi)}{u}"
     return "a finite number" + (f" ({unit})" if unit else "")
+
+
+class MissingDependency(TactileSkinError, ImportError):
+    """An optional package is not installed; the message names it and the extra to install."""
+
+    def __init__(self, package: str, needed_for: str, extra: str = "render"):
+        self.package, self.extra = package, extra
+        super().__init__(f"{package} is not installed; {needed_for} needs it: "
+                         f"pip install 'tactileskin[{extra}]'")
+
+
+def require_pyvista(needed_for: str):
+    """The pyvista module, or MissingDependency naming the extra that installs it."""
+    try:
+        import pyvista
+    except ImportError:
+        raise MissingDependency("pyvista", needed_for) from None
+    return pyvista

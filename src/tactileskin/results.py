@@ -253,6 +253,38 @@ class Result:
         """'ok' or 'suspect: <reasons>' (tactileskin.quality)."""
         return self.summary()["status"]
 
+    def plot(self, path=None, *, ax=None):
+        """A matplotlib figure of the result: the bone profile P(s) (3D: on the section plane,
+        with the maximum over z, beside the map P(s, z)). Returns (figure, axes); `ax`: draw
+        the profile into these axes (2D); `path`: also save it (.png, .svg or .pdf by suffix).
+        Writes no file unless `path` is given."""
+        from tactileskin.report.result_plot import plot_result
+
+        return plot_result(self, path, ax=ax)
+
+    def to_pyvista(self):
+        """The result as a pyvista.UnstructuredGrid, the content of result.vtu: the reference
+        mesh with the nodal fields named with their unit (`displacement_mm` is the active
+        vectors: grid.warp_by_vector() gives the deformed skin), the named boundaries as
+        facet cells with cell data `boundary_id` (0: the skin), their names in field data.
+        Needs pyvista (pip install 'tactileskin[render]'); raises MissingDependency without."""
+        from tactileskin.errors import MissingDependency, require_pyvista
+
+        if self.fields is None:
+            raise ParameterError("result fields", None, "a result with its mesh fields (Result.fields)",
+                                 hint="a result read back from a summary has no mesh")
+        pv = require_pyvista("Result.to_pyvista()")
+        mesh = _meshio_mesh(self.fields)
+        try:
+            grid = pv.from_meshio(mesh)
+        except ImportError as e:  # pragma: no cover - a broken VTK install
+            raise MissingDependency("vtk", "Result.to_pyvista()") from e
+        for name, v in mesh.field_data.items():
+            grid.field_data[name] = v
+        if "displacement_mm" in grid.point_data:
+            grid.point_data.active_vectors_name = "displacement_mm"
+        return grid
+
     def write(self, directory) -> Path:
         """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
         displacement_mm and the other fields named with their unit, boundaries by name);
@@ -320,10 +352,13 @@ def _pad3(v) -> np.ndarray:
     return v
 
 
-def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None:
-    """One .vtu of `fields` (fe.output.vtk_fields): the cells with cell data `boundary_id` 0,
-    then each named boundary's facets with its id, and field data {name: [id, dim]}, the
-    names of the ids (as gmsh and meshio keep them)."""
+def _meshio_mesh(fields: dict, point_data: dict | None = None):
+    """The meshio.Mesh of `fields` (fe.output.vtk_fields): the cells with cell data
+    `boundary_id` 0, then each named boundary's facets with its id; its field data
+    {name: [id, dim]} names the ids (as gmsh and meshio keep them). The facet fields of
+    fields["facet_data"] ({field: {boundary: (F,) values}}, e.g. contact_pressure_MPa on
+    outer_surface) are cell data, zero on the other cells; not with a `point_data` override
+    (the increments of result.pvd, which hold the displacement only)."""
     import meshio  # only when writing files (keeps the solver import light)
 
     pts = _pad3(fields["points"])
@@ -335,8 +370,18 @@ def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None
         blocks.append((ctype, np.asarray(conn)))
         ids.append(np.full(len(conn), k, np.int32))
         field_data[name] = np.array([k, pts.shape[1] - 1 if ctype == "triangle" else 1], np.int32)
-    mesh = meshio.Mesh(pts, blocks, point_data=pdata, cell_data={"boundary_id": ids} if len(blocks) > 1 else {},
-                       field_data=field_data)
+    cell_data = {"boundary_id": ids} if len(blocks) > 1 else {}
+    names = [None] + sorted(fields.get("boundaries", {}))
+    for fname, per_boundary in (fields.get("facet_data") or {}).items() if point_data is None else ():
+        cell_data[fname] = [np.asarray(per_boundary[n], float) if n in per_boundary else np.zeros(len(b[1]))
+                            for n, b in zip(names, blocks)]
+    return meshio.Mesh(pts, blocks, point_data=pdata, cell_data=cell_data, field_data=field_data)
+
+
+def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None:
+    """One .vtu of `fields` (see `_meshio_mesh`), the boundary names kept as VTK field data."""
+    mesh = _meshio_mesh(fields, point_data)
+    field_data = mesh.field_data
     with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
         mesh.write(tmp, file_format="vtu")
         if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it

@@ -26,8 +26,9 @@ from tactileskin.skins import registry as _skins
 # penetration tolerance relative to the facet size, multipliers updated within Newton, and 3D
 # Braille meshes refined locally at the dots, mesh.sizing.local_plan; 4: contact points held
 # off the first Newton step of an increment, earlier multiplier updates: other increment
-# sequences, peaks within 0.06 %)
-SCHEMA_VERSION = 4
+# sequences, peaks within 0.06 %; 5: result.vtu carries the contact pressure on the outer
+# surface)
+SCHEMA_VERSION = 5
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

@@ -51,6 +51,9 @@ class _LazyGroup(click.Group):
         return importlib.import_module(f"tactileskin.cli.{mod}").command
 
 
+QUIET_LIBRARIES = ("skfem", "distributed", "numba", "matplotlib", "PIL")
+
+
 @click.group(cls=_LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
 @click.version_option(package_name="tactileskin")
@@ -61,6 +64,10 @@ def cli(verbose: int) -> None:
     """
     level = logging.WARNING - 10 * min(verbose, 2)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    # -v shows tactileskin's steps (cut-backs, meshes, solves); the libraries' own info
+    # lines (scikit-fem's "Initializing finished", Dask's) only with -vv
+    for name in QUIET_LIBRARIES:
+        logging.getLogger(name).setLevel(logging.WARNING if verbose < 2 else logging.DEBUG)
 
 
 def _on_sigterm(signum, frame):

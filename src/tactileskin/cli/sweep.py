@@ -14,7 +14,7 @@ from tactileskin.errors import ParameterError
 # the names a sweep writes into OUT (a folder of an earlier version holding only these is ours)
 OWN_NAMES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md", "cache",
              *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
-               for ext in ("png", "svg")))
+               for ext in ("png", "svg")), "metrics_vs_thickness.pdf")
 _RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
 
@@ -83,7 +83,8 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
             outcomes = run_sweep(scenes, cache, scheduler=scheduler, workers=workers, serial=serial,
                                  on_event=on_event)
         wall = time.perf_counter() - t0
-        paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
+        with console.status("writing results, figures and report"):  # transient; nothing off a terminal
+            paths = write_outputs(out, outcomes, cache, wall, render=not no_render)
     nfail = len(paths["failures"])
     nsus = sum(1 for r in paths.get("rows", []) if result_quality.kind(r.get("status", "")) == "suspect")
     console.print(f"report: {escape(str(paths['report']))}  ({len(scenes) - nfail - nsus}/{len(scenes)} ok, "

@@ -297,12 +297,27 @@ FIELD_UNITS = {"pressure": "MPa", "displacement": "mm", "sxx": "MPa", "syy": "MP
 _VTK_FACET = {2: "line", 3: "triangle"}
 
 
-def vtk_fields(model: Model, fields: dict, history=()) -> dict:
+def contact_facet_pressure(model: Model, ev: Evaluation) -> np.ndarray | None:
+    """(F,) nominal contact pressure of each facet of the contact boundary (in the order of
+    model.boundaries[contact.boundary]): the facet's mean of the multipliers lambda_N (force
+    per reference area) over its quadrature points, int lambda_N dA0 / A0, so that the sum
+    of value x reference area over the facets is the contact force's magnitude (ParaView's
+    Integrate Variables on the outer_surface cells of result.vtu). None without contact."""
+    if model.surface is None or ev.contact is None:
+        return None
+    lam = np.maximum(np.asarray(ev.contact[1], float), 0.0)  # no adhesion (as contact.csv)
+    w = model.surface.w
+    return (w * lam).sum(axis=1) / w.sum(axis=1)
+
+
+def vtk_fields(model: Model, fields: dict, history=(), contact_pressure: np.ndarray | None = None) -> dict:
     """The result.vtu content: the reference (undeformed) node positions, the nodal fields
     named with their unit (displacement_mm, pressure_MPa, sxx_MPa, ...; ParaView's Warp By
     Vector on displacement_mm shows the deformed skin), the named boundaries as facet cells
     (linear, on the vertices) with their name in field data, and the displacement of every
-    increment of `history` (entries with "t" and "displacement") for result.pvd."""
+    increment of `history` (entries with "t" and "displacement") for result.pvd.
+    `contact_pressure` (`contact_facet_pressure`) becomes the facet field
+    contact_pressure_MPa of the contact boundary's cells ("facet_data")."""
     cells = model.sdofs
     X = model.basis.doflocs.T
     mesh, b = model.mesh, model.basis
@@ -319,6 +334,8 @@ def vtk_fields(model: Model, fields: dict, history=()) -> dict:
         "boundaries": boundaries,
         "steps": steps,
         "reference": True,
+        "facet_data": ({"contact_pressure_MPa": {model.contact.boundary: np.asarray(contact_pressure, float)}}
+                       if contact_pressure is not None else {}),
     }
 
 
@@ -368,7 +385,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     for name, v in fields.items():
         if not np.all(np.isfinite(v)):
             raise ConvergenceError(f"non-finite nodal field {name!r}", {"field": name})
-    vtk = vtk_fields(model, fields, stats.history)
+    vtk = vtk_fields(model, fields, stats.history, contact_facet_pressure(model, ev))
     st = {"dofs": int(model.ndof), "free_dofs": int(len(model.free)), "elements": int(len(model.sdofs)),
           "increments": stats.increments, "newton_iterations": stats.newton_iterations,
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,

@@ -495,7 +495,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
         model.commit(ev, unew, t + dt, dt)
         t += dt
         stats.increments += 1
-        log.info("increment %d: t = %.5g s (dt %.3g), %d Newton iterations", stats.increments, t, dt, its)
+        log.debug("increment %d: t = %.5g s (dt %.3g), %d Newton iterations", stats.increments, t, dt, its)
         if history:
             stats.history.append({"t": t, **(record(model, ev) if record else {})})
         if progress is not None:

@@ -2,7 +2,7 @@
 and the designer's figure: peak, span and AUC against thickness, one line per indenter and
 material (metrics_vs_thickness), the one a thickness is chosen from.
 
-Each figure is written as PNG and SVG (text kept as text). Sizes follow the grid: panels wrap
+Each figure is written as PNG and SVG (text kept as text), the designer's figure also as PDF. Sizes follow the grid: panels wrap
 into rows of at most MAX_COLUMNS, so 11 thicknesses give a block, not a strip. Colours are
 the Okabe-Ito palette (safe for the common colour-vision deficiencies), told apart by line
 style and marker too. matplotlib runs on the Agg backend (no display).
@@ -22,6 +22,11 @@ INDENTER_ORDER = ("flat", "curved", "braille")
 COLOURS = {"flat": "#0072B2", "curved": "#D55E00", "braille": "#009E73"}
 MATERIAL_MARKERS = ("o", "s", "^", "D", "v", "P")
 MAX_COLUMNS = 4
+FORMATS = ("png", "svg")  # raster for the report, vector (text kept as text)
+# the designer's figure also as PDF; for the paper figures a PDF would add about as much as
+# their SVG (2 s CPU over the five figures of an 18-case sweep, ~8 % of `./dev run`)
+DESIGN_FORMATS = FORMATS + ("pdf",)
+DESIGN_STEMS = ("metrics_vs_thickness",)
 
 
 def _plt():
@@ -31,6 +36,7 @@ def _plt():
     import matplotlib.pyplot as plt
 
     plt.rcParams["svg.fonttype"] = "none"  # SVG text stays text (searchable, editable)
+    plt.rcParams["pdf.fonttype"] = 3       # matplotlib default: subset Type 3 fonts (text stays text)
     return plt
 
 
@@ -42,7 +48,7 @@ def _grid(n: int, max_cols: int = MAX_COLUMNS) -> tuple[int, int]:
 
 def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
-    for ext in ("png", "svg"):
+    for ext in DESIGN_FORMATS if stem in DESIGN_STEMS else FORMATS:
         p = out / f"{stem}.{ext}"
         buf = io.BytesIO()
         fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")

@@ -112,7 +112,7 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
             if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
                 try:
                     name = re.sub(r"[^A-Za-z0-9._=,\[\]-]", "_", rec.case)
-                    renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case))
+                    renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case, scene=sc))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
                     log.warning("render of %s failed: %s", rec.case, e)
     report = build_report(rows, records, failures, figures, renders, wall_s,
