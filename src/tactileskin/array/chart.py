@@ -36,6 +36,7 @@ PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm 
 GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
 SETS = ("paper", "letters")
+SKINS = ("pad", "fingertip")
 
 
 @dataclass(frozen=True)
@@ -56,6 +57,7 @@ class ChartConfig:
     mesh_size: float = 1.2                 # 3D single-dot solves
     refinement: float = 2.0
     standard: str = "standard_american"
+    skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
 
     def __post_init__(self):
         for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
@@ -72,6 +74,8 @@ class ChartConfig:
         bad = [s for s in self.sets if s not in SETS]
         if bad:
             raise ParameterError("set", bad[0], " or ".join(SETS))
+        if self.skin not in SKINS:
+            raise ParameterError("skin", self.skin, " or ".join(SKINS))
         bad = [c for c in self.letters if c not in LETTERS]
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct letters a-z")
@@ -86,14 +90,15 @@ class ChartConfig:
 def dot_scene(thickness, material, cfg: ChartConfig, text: str = ""):
     from tactileskin.scene import Scene
 
-    return Scene(dim=3, indenter="braille", thickness=thickness, material=material, braille_text=text,
-                 braille_standard=cfg.standard, mesh_size=cfg.mesh_size, refinement=cfg.refinement)
+    return Scene(dim=3, skin=cfg.skin, indenter="braille", thickness=thickness, material=material,
+                 braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
+                 refinement=cfg.refinement)
 
 
-def section_scene(thickness, material, indenter):
+def section_scene(thickness, material, indenter, skin="fingertip"):
     from tactileskin.scene import Scene
 
-    return Scene(dim=2, indenter=indenter, thickness=thickness, material=material)
+    return Scene(dim=2, skin=skin, indenter=indenter, thickness=thickness, material=material)
 
 
 def solve_cached(scenes, cache, on_event=None) -> dict:
@@ -171,7 +176,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot = dot_scene(t, material, cfg)
-            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if "paper" in cfg.sets else {}
+            sec2 = {k: section_scene(t, material, k, cfg.skin) for k in ("flat", "curved")} if "paper" in cfg.sets else {}
             say(f"{material} t = {t:g} mm: solving (cached cases are read)")
             recs = solve_cached([dot, *sec2.values()], cache,
                                 on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))

@@ -1,12 +1,15 @@
 """Braille characters' sensor maps by superposing single-dot responses.
 
 In the linear limit the map of a character is the sum of the single-dot response
-P1(s - s_k, z - z_k) over its raised dots k. The skin slab is uniform along z (exact
-translation in z away from the sample's ends); across the finger the dot at face
-coordinate x_k is placed at the bone arc length s_k of the bone point on the skin's inward
-normal under x_k (the surface is curved, so the translation in s is approximate: an
-off-centre dot meets a skin that has dropped away; `validate` measures what this and the
-contact nonlinearity cost against full solves).
+P1(s - s_k, z - z_k) over its raised dots k. On the flat pad (skins.pad) the translation is
+exact in x and z away from the pad's edges (s = x). On the fingertip the slab is uniform
+along z; across the finger the dot at face coordinate x_k is placed at the bone arc length
+s_k of the bone point on the skin's inward normal under x_k (the surface is curved, so the
+translation in s is approximate: an off-centre dot meets a skin that has dropped away).
+What remains is the contact nonlinearity and, under depth control, the dots' interaction
+(a neighbour's load lowers the skin under a dot, so each dot of a cell carries less than
+a lone dot): `validate` measures it against full solves, and `scaled` is the one-number
+correction fitted on them.
 """
 
 from __future__ import annotations
@@ -26,7 +29,9 @@ def bone_s_under(x, section) -> np.ndarray:
     """Bone arc length s of the interface point on the inward normal through the skin's outer
     point at lateral position x (signed like x)."""
     x = np.asarray(x, float)
-    ft = section.fingertip
+    ft = getattr(section, "fingertip", None)
+    if ft is None:  # a flat skin: s is x
+        return x.copy()
     u = np.arcsin(np.clip(np.abs(x) / ft.half_width, 0.0, 1.0))
     s = section.s_of_point(section.interface(u))
     return np.sign(x) * s.reshape(x.shape)
