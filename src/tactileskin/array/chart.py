@@ -118,6 +118,23 @@ def bone_map_of(record) -> BoneMap:
     return mirrored(read_bone_map(record.path / "bone_map.csv"))
 
 
+def surface_deflection(record, top: float):
+    """w(dx, dz): the downward deflection of the free surface y = `top` of a single-dot solve
+    (its result.vtu; a half or quarter model is mirrored by |dx|, |dz|), linear between the
+    surface nodes, 0 beyond the modelled surface."""
+    import meshio
+    from scipy.interpolate import LinearNDInterpolator
+
+    try:
+        m = meshio.read(record.path / "result.vtu")
+    except (OSError, ValueError) as e:
+        raise TactileSkinError(f"cannot read the single-dot result {record.path}: {e}") from None
+    X, u = m.points, m.point_data["displacement_mm"]
+    on = np.abs(X[:, 1] - top) <= 1e-6 * max(top, 1.0)
+    f = LinearNDInterpolator(np.abs(X[on][:, [0, 2]]), -u[on, 1], fill_value=0.0)
+    return lambda dx, dz: f(np.abs(np.asarray(dx, float)), np.abs(np.asarray(dz, float)))
+
+
 def extruded(s, p, z) -> BoneMap:
     """A plane-strain profile P(s) (s >= 0) as a map uniform along z, mirrored to s < 0."""
     s, p = np.asarray(s, float), np.asarray(p, float)
@@ -257,8 +274,21 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
 
 
 def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None) -> list[dict]:
-    """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row each."""
+    """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
+    text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
+    lone dot's surface deflection, surrogate.interaction_weights), "sum x a" (one scale a per
+    thickness fitted by least squares on these same maps: an in-sample fit).
+    On the fingertip (a half model) an x-asymmetric text is refused: it would be solved
+    mirrored."""
+    from tactileskin.geometry.braille import dot_centres
+
     say = progress or (lambda msg: None)
+    if cfg.skin == "fingertip":
+        for x in texts:
+            xs = np.sort(np.round(dot_centres(x, cfg.standard)[:, 0], 9))
+            if not np.allclose(xs, -xs[::-1]):
+                raise ParameterError("validate text", x, "a text mirror-symmetric about x = 0 on the fingertip "
+                                     "(its half model would solve the mirrored text; use skin pad)")
     rows = []
     for t in thicknesses:
         dot = dot_scene(t, material, cfg)
@@ -267,7 +297,16 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         recs = solve_cached([dot, *fulls], cache,
                             on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
         kernel = bone_map_of(recs[dot])
-        for x, sc in zip(texts, fulls):
-            err = surrogate.validate(kernel, read_bone_map(recs[sc].path / "bone_map.csv"), x, dot.section(), cfg.standard)
-            rows.append({"material": material, "thickness_mm": t, "text": x, **err})
+        sec = dot.section()
+        refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
+        defl = surface_deflection(recs[dot], sec.top) if cfg.skin == "pad" else None
+        scale = surrogate.fit_scale(kernel, refs, sec, cfg.standard)
+        for x in texts:
+            ref = refs[x]
+            models = {"sum": {}, f"sum x {scale:.3f}": {"scale": scale}}
+            if defl is not None:
+                models["interaction"] = {"deflection": defl}
+            for name, kw in models.items():
+                err = surrogate.validate(kernel, ref, x, sec, cfg.standard, **kw)
+                rows.append({"material": material, "thickness_mm": t, "text": x, "model": name, **err})
     return rows

@@ -55,7 +55,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     surrogate's validation."""
     cfg = chart.config
     lines = ["## Sensor-array design chart", "",
-             f"Sensor plane: the bone surface (the paper's film), map P(s, z) of 3D single-dot solves "
+             f"Skin: {cfg.skin}. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
              f"(mesh {cfg.mesh_size:g} / {cfg.refinement:g}); flat and curved: 2D bone profiles extruded "
              f"along z. Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
              f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
@@ -86,12 +86,14 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     lines += ["", f"(a set counts as discriminated at accuracy >= {GOOD:g}, at the lowest noise level)", ""]
     if validation:
         lines += ["### Surrogate validation (superposition of single-dot responses against full 3D solves)", "",
-                  "| material | t (mm) | text | rel. L2 | max error / peak | peak error | within 5 % |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| material | t (mm) | text | model | rel. L2 | max error / peak | peak error | within 5 % |",
+                  "|---|---|---|---|---|---|---|---|"]
         for r in validation:
-            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r['rel_l2']:.1%} | "
+            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r.get('model', 'sum')} | {r['rel_l2']:.1%} | "
                          f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%} | {'yes' if r['within_tolerance'] else 'no'} |")
-        lines.append("")
+        lines += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
+                  "surface deflection under depth control (surrogate.interaction_weights); sum x a = one "
+                  "factor per thickness fitted on these same solves (in-sample).", ""]
     return "\n".join(lines)
 
 
