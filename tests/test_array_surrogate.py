@@ -104,3 +104,28 @@ def test_fingertip_validation_refuses_an_x_asymmetric_text_and_the_skin_is_check
     with pytest.raises(ParameterError, match="skin"):
         chart.ChartConfig(skin="glove")
     assert chart.ChartConfig().skin == "pad"
+
+
+def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch):
+    """compute() on analytic maps (no solve): which skin each set's scenes use, the letters
+    told apart by a fine array, and the plate note when the depth reaches the dot height."""
+    from types import SimpleNamespace
+
+    asked = []
+    grid = np.linspace(-8, 8, 161)
+
+    def fake_solve(scenes, cache, on_event=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    cfg = chart.ChartConfig(thicknesses=(1.0, 3.0), pitches=(0.5,), noise_fs=(0.01,), letters="abcr",
+                            n_train=4, n_test=4, template_grid=2)
+    ch = chart.compute(cfg, cache=None)
+    skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
+    assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
+                     (2, "curved", "fingertip")}
+    assert ch.accuracy("silicone", 1.0, "letters", 0.5, 0.01) >= 0.95  # separable dots at 0.5 mm pitch
+    # t = 3: depth 0.6 mm > the dot height 0.48 mm: flagged; t = 1 (0.2 mm) is not
+    assert len(ch.notes) == 1 and ch.notes[0].startswith("t = 3 mm")

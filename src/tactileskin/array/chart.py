@@ -3,12 +3,14 @@
 Per material and thickness the stimulus maps come from map sources (today: the bone
 surface, the paper's sensor film):
 
-- "paper": the paper's three indenters: flat and curved (their 2D plane-strain bone profile
-  extruded along z; exact for an indenter uniform along the finger, away from the slab
-  ends) and one Braille dot (the 3D bone map of the single-dot solve).
+- "paper": the paper's three indenters on the paper's fingertip: flat and curved (their 2D
+  plane-strain bone profile extruded along z; exact for an indenter uniform along the finger,
+  away from the slab ends) and one Braille dot (the 3D bone map of the single-dot solve).
 - "letters": the 26 letters a-z as cells (digits share the masks of a-j), each the
   superposition of the single-dot response at its dots in the frame of the full cell
-  (surrogate.py; its error against full solves is stated by `validate_surrogate`).
+  (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
+  `skin` (default the flat pad, where a dot's response translates exactly; on the
+  fingertip the translation across the curved finger is approximate).
 
 Solves go through the sweep's result cache (run_sweep), so a rerun only reads files.
 Each (material, thickness, set, pitch) gets one draw of offsets; every noise level reads
@@ -28,6 +30,7 @@ from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
 from tactileskin.array.sampler import ArraySpec, Readout
 from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.geometry.braille import get_standard
 from tactileskin.results import BoneMap, read_bone_map
 
 log = logging.getLogger(__name__)
@@ -87,10 +90,10 @@ class ChartConfig:
 
 # --- map sources ----------------------------------------------------------------------------
 
-def dot_scene(thickness, material, cfg: ChartConfig, text: str = ""):
+def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str | None = None):
     from tactileskin.scene import Scene
 
-    return Scene(dim=3, skin=cfg.skin, indenter="braille", thickness=thickness, material=material,
+    return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
                  braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
                  refinement=cfg.refinement)
 
@@ -142,12 +145,15 @@ def extruded(s, p, z) -> BoneMap:
     return mirrored(BoneMap(s, np.asarray(z, float), np.tile(p[idx], (len(z), 1))))
 
 
-def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig) -> dict:
-    """{set: {name: BoneMap}} for one material and thickness."""
+def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None) -> dict:
+    """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
+    single dot on cfg.skin, `section` its section), the paper set's dot `paper_kernel` (the
+    fingertip's; default `kernel`)."""
     out = {}
     if "paper" in cfg.sets:
-        out["paper"] = {name: extruded(*profiles[name], kernel.z) for name in ("flat", "curved")}
-        out["paper"]["braille"] = kernel
+        pk = kernel if paper_kernel is None else paper_kernel
+        out["paper"] = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")}
+        out["paper"]["braille"] = pk
     if "letters" in cfg.sets:
         from tactileskin.geometry.braille import LETTERS as MASKS
 
@@ -165,6 +171,7 @@ class Chart:
     confusions: dict = field(default_factory=dict)  # (material, t, set, pitch, noise) -> {method: matrix}
     labels: dict = field(default_factory=dict)      # set -> class names
     cutoffs: list = field(default_factory=list)     # per (material, t): the single dot's measured cut-off
+    notes: list = field(default_factory=list)       # what makes a part of the chart suspect
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
@@ -192,19 +199,31 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     chart = Chart(cfg)
     for material in cfg.materials:
         for t in cfg.thicknesses:
-            dot = dot_scene(t, material, cfg)
-            sec2 = {k: section_scene(t, material, k, cfg.skin) for k in ("flat", "curved")} if "paper" in cfg.sets else {}
+            # letters on cfg.skin; the paper set (flat, curved, dot) on the paper's fingertip, where
+            # its 2D sections are exact (a plate wider than the pad has no converged solve there)
+            dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
+            pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
+            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if pdot else {}
             say(f"{material} t = {t:g} mm: solving (cached cases are read)")
-            recs = solve_cached([dot, *sec2.values()], cache,
+            recs = solve_cached([x for x in (dot, pdot) if x is not None] + list(sec2.values()), cache,
                                 on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
-            kernel = bone_map_of(recs[dot])
+            kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
+            height = get_standard(cfg.standard).height
+            if dot is not None and dot.indentation >= height:
+                note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm reaches the dot height {height:g} mm, so "
+                        "the Braille plate presses the skin too: the dot kernel holds the plate's load and the "
+                        "letters' superposition counts it once per dot (not valid)")
+                log.warning(note)
+                chart.notes.append(note)
             profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
-            row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
-            kc = _cutoff(kernel.s, row, halfspace)
-            chart.cutoffs.append({"material": material, "thickness_mm": t, "peak_mpa": float(kernel.pressure.max()),
-                                  "kc_rad_per_mm": kc, "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
-                                  "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
-            sets = stimulus_maps(kernel, dot.section(), profiles, cfg)
+            for sc, kernel in kernels.items():
+                row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
+                kc = _cutoff(kernel.s, row, halfspace)
+                chart.cutoffs.append({"material": material, "thickness_mm": t, "skin": sc.skin,
+                                      "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
+                                      "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
+                                      "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
+            sets = stimulus_maps(kernels.get(dot), dot and dot.section(), profiles, cfg, kernels.get(pdot))
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())
