@@ -68,7 +68,7 @@ def solve_each(scenes, cache_dir: str, timeout: float) -> list[str]:
             msg = f"{sc.label()}: not solved within {timeout:g} s"
         print(msg, flush=True)
         lines.append(msg)
-    return lines"""
+    return lines
 
 
 def main() -> None:
@@ -78,18 +78,20 @@ def main() -> None:
     ap.add_argument("--validate-thickness", default="1")
     ap.add_argument("--texts", default="⠿,l,r")
     ap.add_argument("--mesh", default="1.2,4", help="3D mesh size, refinement")
+    ap.add_argument("--sets", default="paper,letters")
     ap.add_argument("--solve-timeout", type=float, default=900.0)
     ap.add_argument("--cache", default="/tmp/tactileskin_array_cache")
     a = ap.parse_args()
     ts = tuple(float(x) for x in a.thickness.split(","))
     ms, rf = (float(x) for x in a.mesh.split(","))
-    cfg = ChartConfig(thicknesses=ts, skin=a.skin, mesh_size=ms, refinement=rf)
+    cfg = ChartConfig(thicknesses=ts, skin=a.skin, mesh_size=ms, refinement=rf, sets=tuple(a.sets.split(",")))
     cache = ResultCache(a.cache)
     texts = [x for x in a.texts.split(",") if x]
     vts = [float(x) for x in a.validate_thickness.split(",") if x]
     from tactileskin.array.chart import dot_scene
     ws, cs = time.perf_counter(), time.process_time()
-    solves = solve_each([dot_scene(t, "silicone", cfg) for t in ts]
+    solves = solve_each([dot_scene(t, "silicone", cfg, skin=k) for t in ts
+                         for k, set_ in (("fingertip", "paper"), (a.skin, "letters")) if set_ in cfg.sets]
                         + [dot_scene(t, "silicone", cfg, x) for t in vts for x in ["", *texts]], a.cache, a.solve_timeout)
     ws = time.perf_counter() - ws
     w0, c0 = time.perf_counter(), time.process_time()
@@ -112,7 +114,7 @@ def main() -> None:
     write_figures(chart, out)
     log = "\n".join(f"- {x}" for x in solves) or "- none (all read from the cache)"
     text = ("# Sensor-array design chart (coarse 3D mesh)\n\n"
-            f"Command: `PYTHONPATH=src python benchmarks/array_chart.py --skin {a.skin} --thickness {a.thickness} "
+            f"Command: `PYTHONPATH=src python benchmarks/array_chart.py --skin {a.skin} --sets {a.sets} --thickness {a.thickness} "
             f"--validate-thickness {a.validate_thickness} --texts {a.texts} --mesh {a.mesh}`. 3D solves "
             f"{ws:.0f} s wall (each in a subprocess, one at a time, on a shared 2-core machine), then chart "
             f"{w1 - w0:.0f} s wall ({c1 - c0:.0f} s CPU; the 2D flat/curved sections solved in it if not cached), "
