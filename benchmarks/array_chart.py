@@ -71,6 +71,21 @@ def solve_each(scenes, cache_dir: str, timeout: float) -> list[str]:
     return lines
 
 
+def convergence(rows) -> str:
+    """The validation of the sample at other meshes (size, refinement of kernel and full solves)."""
+    if not rows:
+        return ""
+    out = ["### The validation's mesh dependence", "",
+           "| mesh (size, ref.) | t (mm) | text | model | rel. L2 | max error / peak | peak error |", "|---|---|---|---|---|---|---|"]
+    for r in sorted(rows, key=lambda r: (r.get("text", ""), r.get("model", ""), float(r["mesh"].split(",")[1]))):
+        if "error" in r:
+            out.append(f"| {r['mesh']} | | | | not solved: {r['error'][:80]} | | |")
+        else:
+            out.append(f"| {r['mesh']} | {r['thickness_mm']:g} | {r['text']} | {r['model']} | {r['rel_l2']:.1%} | "
+                       f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%} |")
+    return "\n".join(out) + "\n\n"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--skin", default="pad")
@@ -79,6 +94,8 @@ def main() -> None:
     ap.add_argument("--texts", default="⠿,l,r")
     ap.add_argument("--mesh", default="1.2,4", help="3D mesh size, refinement")
     ap.add_argument("--sets", default="paper,letters")
+    ap.add_argument("--also-mesh", default="1.2,2;1.2,6", help="other meshes ('size,ref;...') for the validation's convergence")
+    ap.add_argument("--also-texts", default="⠿")
     ap.add_argument("--solve-timeout", type=float, default=900.0)
     ap.add_argument("--cache", default="/tmp/tactileskin_array_cache")
     a = ap.parse_args()
@@ -107,6 +124,19 @@ def main() -> None:
     rows = []
     for t in vts:
         rows += validate_surrogate([t], "silicone", texts, cfg, cache, progress=print)
+    conv = []
+    import dataclasses
+    for m in [x for x in a.also_mesh.split(";") if x]:
+        ms2, rf2 = (float(v) for v in m.split(","))
+        cfg2 = dataclasses.replace(cfg, mesh_size=ms2, refinement=rf2)
+        tx2 = [x for x in a.also_texts.split(",") if x]
+        solves += solve_each([dot_scene(t, "silicone", cfg2, x) for t in vts for x in ["", *tx2]], a.cache,
+                             a.solve_timeout)
+        try:
+            conv += [{**r, "mesh": m} for t in vts for r in validate_surrogate([t], "silicone", tx2, cfg2, cache)]
+        except Exception as e:  # a solve that did not finish: say so in the table
+            conv.append({"mesh": m, "error": str(e)})
+    conv += [{**r, "mesh": f"{ms:g},{rf:g}"} for r in rows if r["text"] in a.also_texts.split(",")]
     w2, c2 = time.perf_counter(), time.process_time()
     out = HERE / "array_chart"
     fileio.make_dirs(out)
@@ -119,7 +149,7 @@ def main() -> None:
             f"{ws:.0f} s wall (each in a subprocess, one at a time, on a shared 2-core machine), then chart "
             f"{w1 - w0:.0f} s wall ({c1 - c0:.0f} s CPU; the 2D flat/curved sections solved in it if not cached), "
             f"validation {w2 - w1:.0f} s wall. Figures and CSV: benchmarks/results/array_chart/.\n\n"
-            f"3D solves of this run:\n\n{log}\n\n" + markdown(chart, rows) + "\n" + CAVEATS)
+            f"3D solves of this run:\n\n{log}\n\n" + markdown(chart, rows) + "\n" + convergence(conv) + CAVEATS)
     fileio.atomic_write_text(HERE / "array_chart.md", text)
     print(text)
 
