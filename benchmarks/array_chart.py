@@ -86,6 +86,21 @@ def convergence(rows) -> str:
     return "\n".join(out) + "\n\n"
 
 
+def verdict(rows) -> str:
+    """Which surrogate model meets the issue's tolerance on every validated text."""
+    models = sorted({r["model"] for r in rows})
+    ok = [m for m in models if all(r["within_tolerance"] for r in rows if r["model"] == m)]
+    worst = {m: max(r["max_abs_over_peak"] for r in rows if r["model"] == m) for m in models}
+    text = ("### Verdict on the surrogate\n\n"
+            + (f"Within 5 % of the peak on every validated text: {', '.join(ok)}.\n\n" if ok else
+               "No surrogate model is within 5 % of the peak on every validated text (worst max error / peak: "
+               + ", ".join(f"{m} {v:.1%}" for m, v in worst.items())
+               + "): the letters chart above is indicative only; a letters chart that meets the issue's tolerance "
+               "needs full solves of the letters (or a mesh at which the validation passes; see the mesh "
+               "dependence table).\n\n"))
+    return text
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--skin", default="pad")
@@ -149,7 +164,8 @@ def main() -> None:
             f"{ws:.0f} s wall (each in a subprocess, one at a time, on a shared 2-core machine), then chart "
             f"{w1 - w0:.0f} s wall ({c1 - c0:.0f} s CPU; the 2D flat/curved sections solved in it if not cached), "
             f"validation {w2 - w1:.0f} s wall. Figures and CSV: benchmarks/results/array_chart/.\n\n"
-            f"3D solves of this run:\n\n{log}\n\n" + markdown(chart, rows) + "\n" + convergence(conv) + CAVEATS)
+            f"3D solves of this run:\n\n{log}\n\n" + markdown(chart, rows) + "\n" + convergence(conv)
+            + verdict(rows) + CAVEATS)
     fileio.atomic_write_text(HERE / "array_chart.md", text)
     print(text)
 
