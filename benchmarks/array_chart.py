@@ -35,6 +35,10 @@ CAVEATS = """### Caveats
 - The letters set rests on the superposition surrogate, whose error against full solves is in
   the validation table above: where it exceeds 5 % of the peak the letters chart is indicative
   only.
+- Only t = 1 on the pad: at the scenes' depth (20 % of t) a t = 3 skin is indented 0.6 mm, past
+  the dot height (0.48 mm, American standard): the Braille plate then loads the pad too and a
+  single-dot kernel would count the plate once per dot (compute() flags this in Chart.notes).
+  A t >= 2.4 mm letters chart needs a depth below the dot height (a fixed depth or force).
 - Flat and curved are 2D plane-strain profiles extruded along z: they differ from the dot in
   magnitude by an order, so the paper set is told apart at any pitch while magnitude is read.
 """
