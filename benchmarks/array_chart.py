@@ -90,6 +90,29 @@ def convergence(rows) -> str:
     return "\n".join(out) + "\n\n"
 
 
+def pitch_note(chart) -> str:
+    """What the chart says about the paper's 0.75 mm rule: the coarsest pitch that still reads
+    the letters, per thickness and noise, beside the measured Nyquist pitch of the dot."""
+    from tactileskin.array.chart import GOOD
+
+    cfg, out = chart.config, ["### On the paper's 0.75 mm rule", ""]
+    if "letters" not in cfg.sets:
+        return ""
+    for c in chart.cutoffs:
+        if c.get("skin") != cfg.skin:
+            continue
+        t = c["thickness_mm"]
+        best = {n: max([p for p in cfg.pitches if chart.accuracy(c["material"], t, "letters", p, n) >= GOOD],
+                       default=float("nan")) for n in cfg.noise_fs}
+        out.append(f"- {c['material']}, t = {t:g} mm on the {cfg.skin}: the single dot's Nyquist pitch "
+                   f"{c['nyquist_pitch_mm']:.2f} mm (half-space {c['halfspace_nyquist_pitch_mm']:.2f} mm); the "
+                   "coarsest pitch reading the letters at >= 0.95: " + ", ".join(
+                       f"{v:g} mm at noise {n:g}" for n, v in best.items()) + ". So 0.75 mm is enough here, "
+                   "and coarser arrays also read the letters at low noise (the rule reads a dot, the "
+                   "classifier a whole cell); the paper's rule is for its fingertip.")
+    return "\n".join(out) + "\n\n"
+
+
 def verdict(rows) -> str:
     """Which surrogate model meets the issue's tolerance on every validated text."""
     models = sorted({r["model"] for r in rows})
@@ -169,7 +192,7 @@ def main() -> None:
             f"{w1 - w0:.0f} s wall ({c1 - c0:.0f} s CPU; the 2D flat/curved sections solved in it if not cached), "
             f"validation {w2 - w1:.0f} s wall. Figures and CSV: benchmarks/results/array_chart/.\n\n"
             f"3D solves of this run:\n\n{log}\n\n" + markdown(chart, rows) + "\n" + convergence(conv)
-            + verdict(rows) + CAVEATS)
+            + verdict(rows) + pitch_note(chart) + CAVEATS)
     fileio.atomic_write_text(HERE / "array_chart.md", text)
     print(text)
 
