@@ -56,3 +56,76 @@ def test_chart_config_refuses_bad_values():
     with pytest.raises(ParameterError):
         chart.ChartConfig(sets=("nope",))
     assert chart.ChartConfig().spec(0.5).n == 17
+
+
+PAD = Scene(skin="pad", thickness=1.0).section()
+
+
+def test_on_the_pad_a_dot_is_translated_exactly_to_its_face_position():
+    grid = np.linspace(-6, 6, 481)
+    kernel = maps.on_grid(_gauss(), grid, grid)
+    centres = surrogate.cell_centres(braille.LETTERS["r"])   # x-asymmetric: 3 dots left, 1 right
+    assert np.array_equal(surrogate.bone_s_under(centres[:, 0], PAD), centres[:, 0])
+    got = surrogate.superpose(kernel, centres, PAD)
+    expect = maps.on_grid(lambda s, z: sum(_gauss(a, b)(s, z) for a, b in centres), grid, grid)
+    assert np.max(np.abs(got.pressure - expect.pressure)) < 4e-3  # four dots x 1e-3 (bilinear, h = 0.025)
+
+
+def test_interaction_weights_closed_forms():
+    c = np.array([[-1.25, 0.0], [1.25, 0.0]])
+    w0, heave = 0.2, 0.01
+    alone = surrogate.interaction_weights(c, lambda dx, dz: np.where((dx == 0) & (dz == 0), w0, 0.0))
+    assert np.allclose(alone, 1.0)  # no interaction: each dot carries a lone dot's load
+    # the surface heaves by `heave` at the neighbour: w0 f1 - heave f2 = w0 -> f = w0 / (w0 - heave)
+    up = surrogate.interaction_weights(c, lambda dx, dz: np.where((dx == 0) & (dz == 0), w0, -heave))
+    assert np.allclose(up, w0 / (w0 - heave)) and np.all(up > 1)
+    with pytest.raises(ParameterError):
+        surrogate.interaction_weights(c, lambda dx, dz: np.zeros_like(dx))
+
+
+def test_fit_scale_recovers_a_known_factor_and_weights_scale_the_sum():
+    grid = np.linspace(-6, 6, 241)
+    kernel = maps.on_grid(_gauss(), grid, grid)
+    fulls = {}
+    for text in ("l", "r"):
+        c = braille.dot_centres(text)
+        s = surrogate.superpose(kernel, c, PAD, weights=np.full(len(c), 1.3))
+        fulls[text] = s
+    assert surrogate.fit_scale(kernel, fulls, PAD) == pytest.approx(1.3, rel=1e-12)
+    err = surrogate.validate(kernel, fulls["r"], "r", PAD, scale=1.3)
+    assert err["max_abs_over_peak"] < 1e-12 and err["within_tolerance"]
+    assert not surrogate.validate(kernel, fulls["r"], "r", PAD)["within_tolerance"]  # 1 / 1.3: 23 % off
+
+
+def test_fingertip_validation_refuses_an_x_asymmetric_text_and_the_skin_is_checked():
+    cfg = chart.ChartConfig(skin="fingertip")
+    with pytest.raises(ParameterError, match="mirror-symmetric"):
+        chart.validate_surrogate([1.0], "silicone", ["l", "r"], cfg, cache=None)
+    with pytest.raises(ParameterError, match="skin"):
+        chart.ChartConfig(skin="glove")
+    assert chart.ChartConfig().skin == "pad"
+
+
+def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch):
+    """compute() on analytic maps (no solve): which skin each set's scenes use, the letters
+    told apart by a fine array, and the plate note when the depth reaches the dot height."""
+    from types import SimpleNamespace
+
+    asked = []
+    grid = np.linspace(-8, 8, 161)
+
+    def fake_solve(scenes, cache, on_event=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    cfg = chart.ChartConfig(thicknesses=(1.0, 3.0), pitches=(0.5,), noise_fs=(0.01,), letters="abcr",
+                            n_train=4, n_test=4, template_grid=2)
+    ch = chart.compute(cfg, cache=None)
+    skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
+    assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
+                     (2, "curved", "fingertip")}
+    assert ch.accuracy("silicone", 1.0, "letters", 0.5, 0.01) >= 0.95  # separable dots at 0.5 mm pitch
+    # t = 3: depth 0.6 mm > the dot height 0.48 mm: flagged; t = 1 (0.2 mm) is not
+    assert len(ch.notes) == 1 and ch.notes[0].startswith("t = 3 mm")

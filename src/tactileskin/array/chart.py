@@ -3,12 +3,14 @@
 Per material and thickness the stimulus maps come from map sources (today: the bone
 surface, the paper's sensor film):
 
-- "paper": the paper's three indenters: flat and curved (their 2D plane-strain bone profile
-  extruded along z; exact for an indenter uniform along the finger, away from the slab
-  ends) and one Braille dot (the 3D bone map of the single-dot solve).
+- "paper": the paper's three indenters on the paper's fingertip: flat and curved (their 2D
+  plane-strain bone profile extruded along z; exact for an indenter uniform along the finger,
+  away from the slab ends) and one Braille dot (the 3D bone map of the single-dot solve).
 - "letters": the 26 letters a-z as cells (digits share the masks of a-j), each the
   superposition of the single-dot response at its dots in the frame of the full cell
-  (surrogate.py; its error against full solves is stated by `validate_surrogate`).
+  (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
+  `skin` (default the flat pad, where a dot's response translates exactly; on the
+  fingertip the translation across the curved finger is approximate).
 
 Solves go through the sweep's result cache (run_sweep), so a rerun only reads files.
 Each (material, thickness, set, pitch) gets one draw of offsets; every noise level reads
@@ -28,6 +30,7 @@ from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
 from tactileskin.array.sampler import ArraySpec, Readout
 from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.geometry.braille import get_standard
 from tactileskin.results import BoneMap, read_bone_map
 
 log = logging.getLogger(__name__)
@@ -36,6 +39,7 @@ PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm 
 GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
 SETS = ("paper", "letters")
+SKINS = ("pad", "fingertip")
 
 
 @dataclass(frozen=True)
@@ -56,6 +60,7 @@ class ChartConfig:
     mesh_size: float = 1.2                 # 3D single-dot solves
     refinement: float = 2.0
     standard: str = "standard_american"
+    skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
 
     def __post_init__(self):
         for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
@@ -72,6 +77,8 @@ class ChartConfig:
         bad = [s for s in self.sets if s not in SETS]
         if bad:
             raise ParameterError("set", bad[0], " or ".join(SETS))
+        if self.skin not in SKINS:
+            raise ParameterError("skin", self.skin, " or ".join(SKINS))
         bad = [c for c in self.letters if c not in LETTERS]
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct letters a-z")
@@ -83,17 +90,18 @@ class ChartConfig:
 
 # --- map sources ----------------------------------------------------------------------------
 
-def dot_scene(thickness, material, cfg: ChartConfig, text: str = ""):
+def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str | None = None):
     from tactileskin.scene import Scene
 
-    return Scene(dim=3, indenter="braille", thickness=thickness, material=material, braille_text=text,
-                 braille_standard=cfg.standard, mesh_size=cfg.mesh_size, refinement=cfg.refinement)
+    return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
+                 braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
+                 refinement=cfg.refinement)
 
 
-def section_scene(thickness, material, indenter):
+def section_scene(thickness, material, indenter, skin="fingertip"):
     from tactileskin.scene import Scene
 
-    return Scene(dim=2, indenter=indenter, thickness=thickness, material=material)
+    return Scene(dim=2, skin=skin, indenter=indenter, thickness=thickness, material=material)
 
 
 def solve_cached(scenes, cache, on_event=None) -> dict:
@@ -113,6 +121,23 @@ def bone_map_of(record) -> BoneMap:
     return mirrored(read_bone_map(record.path / "bone_map.csv"))
 
 
+def surface_deflection(record, top: float):
+    """w(dx, dz): the downward deflection of the free surface y = `top` of a single-dot solve
+    (its result.vtu; a half or quarter model is mirrored by |dx|, |dz|), linear between the
+    surface nodes, 0 beyond the modelled surface."""
+    import meshio
+    from scipy.interpolate import LinearNDInterpolator
+
+    try:
+        m = meshio.read(record.path / "result.vtu")
+    except (OSError, ValueError) as e:
+        raise TactileSkinError(f"cannot read the single-dot result {record.path}: {e}") from None
+    X, u = m.points, m.point_data["displacement_mm"]
+    on = np.abs(X[:, 1] - top) <= 1e-6 * max(top, 1.0)
+    f = LinearNDInterpolator(np.abs(X[on][:, [0, 2]]), -u[on, 1], fill_value=0.0)
+    return lambda dx, dz: f(np.abs(np.asarray(dx, float)), np.abs(np.asarray(dz, float)))
+
+
 def extruded(s, p, z) -> BoneMap:
     """A plane-strain profile P(s) (s >= 0) as a map uniform along z, mirrored to s < 0."""
     s, p = np.asarray(s, float), np.asarray(p, float)
@@ -120,12 +145,15 @@ def extruded(s, p, z) -> BoneMap:
     return mirrored(BoneMap(s, np.asarray(z, float), np.tile(p[idx], (len(z), 1))))
 
 
-def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig) -> dict:
-    """{set: {name: BoneMap}} for one material and thickness."""
+def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None) -> dict:
+    """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
+    single dot on cfg.skin, `section` its section), the paper set's dot `paper_kernel` (the
+    fingertip's; default `kernel`)."""
     out = {}
     if "paper" in cfg.sets:
-        out["paper"] = {name: extruded(*profiles[name], kernel.z) for name in ("flat", "curved")}
-        out["paper"]["braille"] = kernel
+        pk = kernel if paper_kernel is None else paper_kernel
+        out["paper"] = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")}
+        out["paper"]["braille"] = pk
     if "letters" in cfg.sets:
         from tactileskin.geometry.braille import LETTERS as MASKS
 
@@ -143,6 +171,7 @@ class Chart:
     confusions: dict = field(default_factory=dict)  # (material, t, set, pitch, noise) -> {method: matrix}
     labels: dict = field(default_factory=dict)      # set -> class names
     cutoffs: list = field(default_factory=list)     # per (material, t): the single dot's measured cut-off
+    notes: list = field(default_factory=list)       # what makes a part of the chart suspect
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
@@ -170,19 +199,31 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     chart = Chart(cfg)
     for material in cfg.materials:
         for t in cfg.thicknesses:
-            dot = dot_scene(t, material, cfg)
-            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if "paper" in cfg.sets else {}
+            # letters on cfg.skin; the paper set (flat, curved, dot) on the paper's fingertip, where
+            # its 2D sections are exact (a plate wider than the pad has no converged solve there)
+            dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
+            pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
+            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if pdot else {}
             say(f"{material} t = {t:g} mm: solving (cached cases are read)")
-            recs = solve_cached([dot, *sec2.values()], cache,
+            recs = solve_cached([x for x in (dot, pdot) if x is not None] + list(sec2.values()), cache,
                                 on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
-            kernel = bone_map_of(recs[dot])
+            kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
+            height = get_standard(cfg.standard).height
+            if dot is not None and dot.indentation >= height:
+                note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm reaches the dot height {height:g} mm, so "
+                        "the Braille plate presses the skin too: the dot kernel holds the plate's load and the "
+                        "letters' superposition counts it once per dot (not valid)")
+                log.warning(note)
+                chart.notes.append(note)
             profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
-            row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
-            kc = _cutoff(kernel.s, row, halfspace)
-            chart.cutoffs.append({"material": material, "thickness_mm": t, "peak_mpa": float(kernel.pressure.max()),
-                                  "kc_rad_per_mm": kc, "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
-                                  "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
-            sets = stimulus_maps(kernel, dot.section(), profiles, cfg)
+            for sc, kernel in kernels.items():
+                row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
+                kc = _cutoff(kernel.s, row, halfspace)
+                chart.cutoffs.append({"material": material, "thickness_mm": t, "skin": sc.skin,
+                                      "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
+                                      "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
+                                      "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
+            sets = stimulus_maps(kernels.get(dot), dot and dot.section(), profiles, cfg, kernels.get(pdot))
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())
@@ -252,8 +293,21 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
 
 
 def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None) -> list[dict]:
-    """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row each."""
+    """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
+    text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
+    lone dot's surface deflection, surrogate.interaction_weights), "sum x a" (one scale a per
+    thickness fitted by least squares on these same maps: an in-sample fit).
+    On the fingertip (a half model) an x-asymmetric text is refused: it would be solved
+    mirrored."""
+    from tactileskin.geometry.braille import dot_centres
+
     say = progress or (lambda msg: None)
+    if cfg.skin == "fingertip":
+        for x in texts:
+            xs = np.sort(np.round(dot_centres(x, cfg.standard)[:, 0], 9))
+            if not np.allclose(xs, -xs[::-1]):
+                raise ParameterError("validate text", x, "a text mirror-symmetric about x = 0 on the fingertip "
+                                     "(its half model would solve the mirrored text; use skin pad)")
     rows = []
     for t in thicknesses:
         dot = dot_scene(t, material, cfg)
@@ -262,7 +316,16 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         recs = solve_cached([dot, *fulls], cache,
                             on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
         kernel = bone_map_of(recs[dot])
-        for x, sc in zip(texts, fulls):
-            err = surrogate.validate(kernel, read_bone_map(recs[sc].path / "bone_map.csv"), x, dot.section(), cfg.standard)
-            rows.append({"material": material, "thickness_mm": t, "text": x, **err})
+        sec = dot.section()
+        refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
+        defl = surface_deflection(recs[dot], sec.top) if cfg.skin == "pad" else None
+        scale = surrogate.fit_scale(kernel, refs, sec, cfg.standard)
+        for x in texts:
+            ref = refs[x]
+            models = {"sum": {}, f"sum x {scale:.3f}": {"scale": scale}}
+            if defl is not None:
+                models["interaction"] = {"deflection": defl}
+            for name, kw in models.items():
+                err = surrogate.validate(kernel, ref, x, sec, cfg.standard, **kw)
+                rows.append({"material": material, "thickness_mm": t, "text": x, "model": name, **err})
     return rows

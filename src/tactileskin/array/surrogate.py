@@ -1,12 +1,15 @@
 """Braille characters' sensor maps by superposing single-dot responses.
 
 In the linear limit the map of a character is the sum of the single-dot response
-P1(s - s_k, z - z_k) over its raised dots k. The skin slab is uniform along z (exact
-translation in z away from the sample's ends); across the finger the dot at face
-coordinate x_k is placed at the bone arc length s_k of the bone point on the skin's inward
-normal under x_k (the surface is curved, so the translation in s is approximate: an
-off-centre dot meets a skin that has dropped away; `validate` measures what this and the
-contact nonlinearity cost against full solves).
+P1(s - s_k, z - z_k) over its raised dots k. On the flat pad (skins.pad) the translation is
+exact in x and z away from the pad's edges (s = x). On the fingertip the slab is uniform
+along z; across the finger the dot at face coordinate x_k is placed at the bone arc length
+s_k of the bone point on the skin's inward normal under x_k (the surface is curved, so the
+translation in s is approximate: an off-centre dot meets a skin that has dropped away).
+What remains is the contact nonlinearity and, under depth control, the dots' interaction
+(a neighbour's load lowers the skin under a dot, so each dot of a cell carries less than
+a lone dot): `validate` measures it against full solves, and `scaled` is the one-number
+correction fitted on them.
 """
 
 from __future__ import annotations
@@ -26,7 +29,9 @@ def bone_s_under(x, section) -> np.ndarray:
     """Bone arc length s of the interface point on the inward normal through the skin's outer
     point at lateral position x (signed like x)."""
     x = np.asarray(x, float)
-    ft = section.fingertip
+    ft = getattr(section, "fingertip", None)
+    if ft is None:  # a flat skin: s is x
+        return x.copy()
     u = np.arcsin(np.clip(np.abs(x) / ft.half_width, 0.0, 1.0))
     s = section.s_of_point(section.interface(u))
     return np.sign(x) * s.reshape(x.shape)
@@ -42,10 +47,11 @@ def cell_centres(mask: int, standard="standard_american") -> np.ndarray:
     return full[[k for k in range(6) if mask >> k & 1]]
 
 
-def superpose(kernel: BoneMap, centres, section, s=None, z=None) -> BoneMap:
+def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None) -> BoneMap:
     """Map of the dots at face coordinates `centres` (k, 2) = (x, z): sum of the single-dot
     response `kernel` (a full map centred on the dot, see maps.mirrored) translated to each
-    (s_k, z_k). Evaluated on the grid s x z (default: the kernel's grid)."""
+    (s_k, z_k), times `weights` (k,) (default 1: each dot as a lone dot). Evaluated on the
+    grid s x z (default: the kernel's grid)."""
     centres = np.atleast_2d(np.asarray(centres, float))
     if centres.shape[1] != 2 or centres.shape[0] < 1:
         raise ParameterError("dot centres", centres.shape, "(k, 2) face coordinates (x, z)")
@@ -54,8 +60,25 @@ def superpose(kernel: BoneMap, centres, section, s=None, z=None) -> BoneMap:
     f = interpolator(kernel)
     S, Z = np.meshgrid(s, z)
     sk = bone_s_under(centres[:, 0], section)
-    P = sum(f(S - a, Z - b) for a, b in zip(sk, centres[:, 1]))
+    w = np.ones(len(centres)) if weights is None else np.asarray(weights, float)
+    P = sum(wk * f(S - a, Z - b) for wk, a, b in zip(w, sk, centres[:, 1]))
     return BoneMap(s, z, P, kernel.section_z)
+
+
+def interaction_weights(centres, deflection) -> np.ndarray:
+    """Loads of the dots of one character, in units of a lone dot's, under depth control in
+    the linear limit: a dot carrying load f_j deflects the surface by f_j w(dx, dz) (w: the
+    lone dot's surface deflection, downward positive; on a thin bonded layer the surface
+    heaves up around a dot, w < 0), and every dot must reach the lone dot's own deflection
+    w0 = w(0, 0): sum_j W_kj f_j = w0 with W_kj = w(c_k - c_j). `deflection(dx, dz)` takes
+    arrays."""
+    c = np.atleast_2d(np.asarray(centres, float))
+    d = c[:, None, :] - c[None, :, :]
+    W = np.asarray(deflection(d[..., 0], d[..., 1]), float)
+    w0 = float(np.mean(np.diag(W)))
+    if not (np.all(np.isfinite(W)) and w0 > 0):
+        raise ParameterError("deflection", f"w(0, 0) = {w0:g}", "a finite surface deflection, > 0 under the dot")
+    return np.linalg.solve(W, np.full(len(c), w0))
 
 
 def kernel_from(bone_map: BoneMap) -> BoneMap:
@@ -63,11 +86,31 @@ def kernel_from(bone_map: BoneMap) -> BoneMap:
     return mirrored(bone_map)
 
 
-def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american") -> dict:
+def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american",
+             deflection=None, scale: float = 1.0) -> dict:
     """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
-    quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres)."""
+    quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres);
+    with `deflection` the dots' loads from `interaction_weights`; all times
+    `scale`."""
     ref = mirrored(full)
-    approx = superpose(kernel, braille.dot_centres(text, standard), section, ref.s, ref.z)
+    c = braille.dot_centres(text, standard)
+    w = None if deflection is None else interaction_weights(c, deflection)
+    approx = superpose(kernel, c, section, ref.s, ref.z, weights=w)
+    approx = BoneMap(approx.s, approx.z, scale * approx.pressure, approx.section_z)
     err = relative_error(approx, ref)
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
     return err
+
+
+def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american") -> float:
+    """The one factor a minimising sum ||a S - P||^2 over the full solves `fulls`
+    ({text: map}) of the plain superpositions S: the cheapest correction of the sum."""
+    num = den = 0.0
+    for text, full in fulls.items():
+        ref = mirrored(full)
+        approx = superpose(kernel, braille.dot_centres(text, standard), section, ref.s, ref.z)
+        num += float(np.sum(approx.pressure * ref.pressure))
+        den += float(np.sum(approx.pressure ** 2))
+    if not den > 0:
+        raise ParameterError("surrogate", "zero superposition", "a kernel with a positive response")
+    return num / den

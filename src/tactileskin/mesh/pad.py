@@ -1,6 +1,8 @@
 """The flat pad (skins.pad), meshed by gmsh: 2D half section x in [0, W/2], y in [0, t]
 (plane strain), or the 3D block over z in [0, L/2] (z-symmetric indenter: `end_back` is the
-mid-plane) or [-L/2, L/2] (free ends). The same size plan and fields as the fingertip
+mid-plane) or [-L/2, L/2] (free ends). An indenter not mirror-symmetric about x = 0 (e.g. a
+Braille text with dots on one side only) gets the full width x in [-W/2, W/2] (no
+`symmetry` boundary, both sides `side`): a half model would solve its mirror image too. The same size plan and fields as the fingertip
 (mesh.sizing: fine under the contact, fine along the bonded surface for s <= ROI_S, graded).
 
 Boundaries: `bone_interface` (y = 0, bonded to the board), `outer_surface` (y = t), `symmetry`
@@ -26,23 +28,25 @@ NAMES_2D = ("bone_interface", "outer_surface", "symmetry", "side")
 NAMES_3D = NAMES_2D + ("end_front", "end_back")
 
 
-def _add_rectangle(gmsh, w2: float, t: float, roi_s: float) -> dict[str, list[int]]:
-    """The half section's curves (bottom split at x = roi_s when shorter than the pad)."""
+def _add_rectangle(gmsh, w2: float, t: float, roi_s: float, full: bool = False) -> dict[str, list[int]]:
+    """The section's curves: the half x in [0, w2] (left edge `symmetry`), or with `full` the
+    whole width [-w2, w2] (both edges `side`); the bottom split at |x| = roi_s when shorter
+    than the pad."""
     occ = gmsh.model.occ
-    p00, p10 = occ.addPoint(0, 0, 0), occ.addPoint(w2, 0, 0)
-    p11, p01 = occ.addPoint(w2, t, 0), occ.addPoint(0, t, 0)
-    if roi_s < w2 - 1e-9:
-        pr = occ.addPoint(roi_s, 0, 0)
-        roi, far = occ.addLine(p00, pr), occ.addLine(pr, p10)
-        bottom = [roi, far]
-    else:
-        roi = occ.addLine(p00, p10)
-        bottom = [roi]
-    side, top, sym = occ.addLine(p10, p11), occ.addLine(p11, p01), occ.addLine(p01, p00)
-    loop = occ.addCurveLoop([*bottom, side, top, sym])
+    x0 = -w2 if full else 0.0
+    p00, p10 = occ.addPoint(x0, 0, 0), occ.addPoint(w2, 0, 0)
+    p11, p01 = occ.addPoint(w2, t, 0), occ.addPoint(x0, t, 0)
+    cuts = [x for x in ((-roi_s,) if full else ()) + (roi_s,) if x0 + 1e-9 < x < w2 - 1e-9]
+    pts = [p00, *(occ.addPoint(x, 0, 0) for x in cuts), p10]
+    bottom = [occ.addLine(a, b) for a, b in zip(pts[:-1], pts[1:])]
+    # the ROI pieces: those between the cuts around x = 0 (all of it when nothing is cut)
+    xs = [x0, *cuts, w2]
+    roi = [c for c, a, b in zip(bottom, xs[:-1], xs[1:]) if a >= -roi_s - 1e-9 and b <= roi_s + 1e-9] or bottom
+    side, top, left = occ.addLine(p10, p11), occ.addLine(p11, p01), occ.addLine(p01, p00)
+    loop = occ.addCurveLoop([*bottom, side, top, left])
     surf = occ.addPlaneSurface([loop])
-    return {"bone_interface": bottom, "outer_surface": [top], "symmetry": [sym], "side": [side],
-            "interface_roi": [roi], "surface": [surf]}
+    edges = {"symmetry": [], "side": [side, left]} if full else {"symmetry": [left], "side": [side]}
+    return {"bone_interface": bottom, "outer_surface": [top], **edges, "interface_roi": roi, "surface": [surf]}
 
 
 def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refinement: float | None = None,
@@ -59,25 +63,25 @@ def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refin
     length = section.length
     xsym, zsym = indenter_symmetry(scene)
     zsym = zsym and use_z_symmetry and dim == 3
-    if not xsym:
-        logger.warning("the indenter is not symmetric about x = 0, but the pad model is the half x >= 0")
+    full = not xsym  # a half model with a symmetry plane would solve the mirrored indenter too
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=dim,
                        length=length if dim == 3 else None, z_symmetric=zsym, order=order)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"skin": "pad", "width": section.width, "thickness": t, "order": order, "cell": cell,
+              "full_width": full,
               **({"length": length, "z_symmetric": zsym} if dim == 3 else {}), **plan.as_dict()}
     logger.info("meshing the %dD pad: %s", dim, params)
     t0 = time.perf_counter()
     with _gmsh.session(f"pad{dim}d", params) as gmsh:
         occ = gmsh.model.occ
-        tags = _add_rectangle(gmsh, w2, t, plan.roi_s)
+        tags = _add_rectangle(gmsh, w2, t, plan.roi_s, full)
         if dim == 2:
             occ.synchronize()
-            groups = {n: tags[n] for n in NAMES_2D}
+            groups = {n: tags[n] for n in NAMES_2D if tags[n]}
             for name, ents in groups.items():
                 gmsh.model.addPhysicalGroup(1, ents, name=name)
             gmsh.model.addPhysicalGroup(2, tags["surface"], name="skin")
-            sizing.apply_fields(gmsh, plan, tags["outer_surface"], tags["interface_roi"], dim=2)
+            sizing.apply_fields(gmsh, plan, tags["outer_surface"], tags["interface_roi"], dim=2, full_width=full)
             if cell == "quad":
                 gmsh.option.setNumber("Mesh.Algorithm", 8)
                 gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 2)
@@ -97,16 +101,18 @@ def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refin
                 tol = 1e-9 * max(w2, t, length)
                 name = ("end_back" if abs(c[2] - z0) < tol else "end_front" if abs(c[2] - z1) < tol
                         else "bone_interface" if abs(c[1]) < tol else "outer_surface" if abs(c[1] - t) < tol
-                        else "symmetry" if abs(c[0]) < tol else "side" if abs(c[0] - w2) < tol else None)
+                        else "side" if abs(abs(c[0]) - w2) < tol else "symmetry" if abs(c[0]) < tol and not full
+                        else None)
                 if name is None:
                     raise MeshError(f"cannot identify pad face {f} (centre {c}) with {params}")
                 groups[name].append(f)
-                if name == "bone_interface" and c[0] < plan.roi_s:
+                if name == "bone_interface" and abs(c[0]) < plan.roi_s:
                     roi_faces.append(f)
+            groups = {k: v for k, v in groups.items() if v}
             for name, ents in groups.items():
                 gmsh.model.addPhysicalGroup(2, ents, name=name)
             gmsh.model.addPhysicalGroup(3, vol, name="skin")
-            sizing.apply_fields(gmsh, plan, groups["outer_surface"], roi_faces, dim=3)
+            sizing.apply_fields(gmsh, plan, groups["outer_surface"], roi_faces, dim=3, full_width=full)
             gmsh.option.setNumber("Mesh.Algorithm", 6)
             gmsh.option.setNumber("Mesh.Algorithm3D", 10)
         gmsh.model.mesh.generate(dim)

@@ -290,10 +290,12 @@ def _area(section) -> float:
     return a
 
 
-def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], dim: int) -> None:
+def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], dim: int,
+                 full_width: bool = False) -> None:
     """Install the size fields: Min(contact-surface threshold limited to the contact zone,
     threshold on the distance to the bone ROI); `outer`, `interface_roi`: curve (2D) or
-    surface (3D) tags."""
+    surface (3D) tags. `full_width`: the model spans x < 0 too (the contact zone is
+    |x| <= contact_x, not 0 <= x <= contact_x)."""
     f = gmsh.model.mesh.field
     key = "CurvesList" if dim == 2 else "SurfacesList"
     if p.patches or p.bone_patches:
@@ -320,7 +322,7 @@ def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
     box = f.add("Box")
     f.setNumber(box, "VIn", p.fine)
     f.setNumber(box, "VOut", p.coarse)
-    f.setNumber(box, "XMin", -1.0)
+    f.setNumber(box, "XMin", -p.contact_x if full_width else -1.0)
     f.setNumber(box, "XMax", p.contact_x)
     f.setNumber(box, "YMin", -1e3)
     f.setNumber(box, "YMax", 1e3)

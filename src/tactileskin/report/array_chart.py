@@ -55,7 +55,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     surrogate's validation."""
     cfg = chart.config
     lines = ["## Sensor-array design chart", "",
-             f"Sensor plane: the bone surface (the paper's film), map P(s, z) of 3D single-dot solves "
+             f"Skin: letters on the {cfg.skin}, the paper set on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
              f"(mesh {cfg.mesh_size:g} / {cfg.refinement:g}); flat and curved: 2D bone profiles extruded "
              f"along z. Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
              f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
@@ -64,10 +64,10 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"{cfg.template_grid}x{cfg.template_grid} offsets; `lda` in the CSV). "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
-             "| material | t (mm) | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
-             "|---|---|---|---|---|---|"]
+             "| material | t (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
+             "|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
-        lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
+        lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('skin', 'fingertip')} | {c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
                      f"{c['nyquist_pitch_mm']:.2f} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's section row (or of the half-space "
               "kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1.", ""]
@@ -81,17 +81,21 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                     lines.append(f"| {t:g} | {n:g} | " + " | ".join(
                         _cell(chart.accuracy(material, t, set_, p, n, method)) for p in cfg.pitches) + " |")
             lines.append("")
+    if getattr(chart, "notes", None):
+        lines += ["**Suspect:** " + n for n in chart.notes] + [""]
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
     lines += [f"| {v['material']} | {v['claim']} | {v['verdict']} | {v['evidence']} |" for v in verdicts(chart, method)]
     lines += ["", f"(a set counts as discriminated at accuracy >= {GOOD:g}, at the lowest noise level)", ""]
     if validation:
         lines += ["### Surrogate validation (superposition of single-dot responses against full 3D solves)", "",
-                  "| material | t (mm) | text | rel. L2 | max error / peak | peak error | within 5 % |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| material | t (mm) | text | model | rel. L2 | max error / peak | peak error | within 5 % |",
+                  "|---|---|---|---|---|---|---|---|"]
         for r in validation:
-            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r['rel_l2']:.1%} | "
+            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r.get('model', 'sum')} | {r['rel_l2']:.1%} | "
                          f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%} | {'yes' if r['within_tolerance'] else 'no'} |")
-        lines.append("")
+        lines += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
+                  "surface deflection under depth control (surrogate.interaction_weights); sum x a = one "
+                  "factor per thickness fitted on these same solves (in-sample).", ""]
     return "\n".join(lines)
 
 

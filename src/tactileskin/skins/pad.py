@@ -3,8 +3,9 @@ tactile-skin build).
 
 Frame: the board is the plane y = 0 (the bonded surface, `bone_interface`), the free top is
 y = t (`outer_surface`, where indenters start), x across the pad (the models keep x >= 0, with
-`symmetry` on x = 0), z along it (z in [-L/2, L/2]). The free side x = W/2 is `side` (and in
-3D the free ends z = +-L/2 are `end_front` / `end_back`). s along the bonded surface is x, so
+`symmetry` on x = 0, unless the indenter is not mirror-symmetric about x = 0: then the full
+width, see mesh.pad), z along it (z in [-L/2, L/2]). The free side x = W/2 is `side` (and in
+3D the free ends z = +-L/2 are `end_front` / `end_back`). s along the bonded surface is x (signed on a full-width model), so
 a 2D section is exact for an indenter uniform along z (plane strain) and the sensor frames are
 flat (`sensors.FlatCoordinates`: depth along -y).
 """
@@ -62,14 +63,15 @@ class PadSection:
         return float(min(max(x, 0.0), self.half_width))
 
     def s_of_point(self, points) -> np.ndarray:
+        """s = x, signed (a full-width model has x < 0; a half model only x >= 0)."""
         pts = np.atleast_2d(np.asarray(points, float))
-        return np.clip(pts[:, 0], 0.0, self.half_width)
+        return np.clip(pts[:, 0], -self.half_width, self.half_width)
 
     def point_at_s(self, s) -> np.ndarray:
         s = np.asarray(s, float)
-        if np.any((s < -1e-9) | (s > self.half_width + 1e-9)):
+        if np.any(np.abs(s) > self.half_width + 1e-9):
             raise ParameterError("s", f"{np.min(s):g}..{np.max(s):g}",
-                                 f"[0, {self.half_width:g}] mm along the bonded surface")
+                                 f"[-{self.half_width:g}, {self.half_width:g}] mm along the bonded surface")
         return np.stack([s, np.zeros_like(s)], axis=-1)
 
     def outer_points(self, n: int = 200) -> np.ndarray:
@@ -125,6 +127,14 @@ class PadSkin(Skin):
         from tactileskin.geometry.pad_parts import build_pad_parts
 
         return build_pad_parts(thickness, pad_width, pad_length, molds=molds)
+
+    @classmethod
+    def cache_content(cls, scene) -> dict:
+        """An x-asymmetric indenter is solved on the full width (mesh.pad): its key changes
+        from the half model's it once had; the symmetric scenes keep theirs."""
+        from tactileskin.geometry.indenters import indenter_symmetry
+
+        return {} if indenter_symmetry(scene)[0] else {"model": "full_width"}
 
     @classmethod
     def label(cls, scene) -> str:
