@@ -56,7 +56,7 @@ def read(path: str | Path | None) -> SceneFile:
         from tactileskin.presets import check_quality
 
         check_quality(quality)
-    axes = _sweep_lists(data["sweep"]) if "sweep" in data else {}
+    axes = sweep_lists(data["sweep"]) if "sweep" in data else {}
     for f, ax in AXES.items():
         if f in fields and ax in axes:
             raise ParameterError(f"scene field {f}", str(path), f"either {f} or sweep.{ax}, not both")
@@ -67,8 +67,8 @@ def read(path: str | Path | None) -> SceneFile:
     return SceneFile(fields, quality, axes, str(path))
 
 
-def _sweep_lists(table) -> dict:
-    """The [sweep] lists, checked as sweep.load_spec checks them."""
+def sweep_lists(table) -> dict:
+    """The [sweep] lists of a file, each checked (numbers, names or Braille dimensions)."""
     from tactileskin.sweep import MAX_AXIS_VALUES, _SPEC_LISTS, check_braille_dims
 
     sw = validate.table(table, "[sweep]")

@@ -177,17 +177,9 @@ def load_spec(path: str | Path) -> dict:
 
     data = read_toml(path, "sweep file")
     validate.known_keys(data, ("sweep", "scene"), "sweep file table")
-    sw = validate.table(data.get("sweep", {}), "[sweep]")
-    validate.known_keys(sw, _SPEC_LISTS, "sweep")
-    spec: dict = {}
-    for k, v in sw.items():
-        name = f"sweep.{k}"
-        if _SPEC_LISTS[k] == "numbers":
-            spec[k] = validate.number_list(v, name, MAX_AXIS_VALUES, min_len=1)
-        elif _SPEC_LISTS[k] == "dims":
-            spec[k] = check_braille_dims(v, name)
-        else:
-            spec[k] = validate.string_list(v, name, MAX_AXIS_VALUES, min_len=1)
+    from tactileskin.scenefile import sweep_lists
+
+    spec: dict = sweep_lists(data.get("sweep", {}))
     if "scene" in data:
         spec["base"] = Scene.from_dict(validate.table(data["scene"], "[scene]"))
     return spec
