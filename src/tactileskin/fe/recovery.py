@@ -40,7 +40,6 @@ class Projector:
         m = self.model
         if m.basis.Nbfun == self.basis.Nbfun:
             return None
-        X = m.basis.doflocs
         rows, cols, vals = [], [], []
         # each P2 node of each element: evaluate P1 shape functions there (reference coords)
         el2, el1 = m.sdofs, self.dofs

@@ -400,7 +400,7 @@ def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts
         return u, ev, its
     last_pen = np.inf
     for k in range(c.max_uzawa):
-        g, lamN = ev.contact[0], ev.contact[1]
+        lamN = ev.contact[1]
         act = lamN > 0
         pen = gap_error(ev)
         change = float(np.abs(lamN - lam).max() / max(lamN.max(), 1e-300)) if np.any(act) else 0.0
