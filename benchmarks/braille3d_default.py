@@ -1,0 +1,78 @@
+"""Time of the `default` 3D Braille solve (issue 13's speed target), one case per process.
+
+For each thickness (and text, material) solves Scene(dim=3, indenter="braille") at the
+scene defaults (the `default` 3D preset, data/presets.json) in a fresh subprocess and
+reports dofs, CPU s (time.process_time of the solve, one BLAS thread), wall s, increments,
+Newton iterations, peak and span, and the per-phase wall times; writes the table to
+benchmarks/results/braille3d_default.md.
+
+    .venv/bin/python benchmarks/braille3d_default.py [--thickness 1 3] [--text ""] [--material silicone]
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "benchmarks" / "results" / "braille3d_default.md"
+
+
+def one(t: float, text: str, material: str) -> dict:
+    from tactileskin.fe import solve
+    from tactileskin.scene import Scene
+
+    sc = Scene(dim=3, indenter="braille", thickness=t, material=material, braille_text=text)
+    c0, w0 = time.process_time(), time.perf_counter()
+    r = solve(sc)
+    return dict(t=t, text=text, material=material, mesh=[sc.mesh_size, sc.refinement], dofs=r.stats["dofs"],
+                cpu=time.process_time() - c0, wall=time.perf_counter() - w0, incr=r.stats["increments"],
+                newton=r.stats["newton_iterations"], peak=r.peak, span=r.span,
+                rss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                phases=r.stats.get("phases_s"))
+
+
+def table(rows: list[dict]) -> str:
+    out = ["| t mm | material | text | mesh | dofs | CPU s | wall s | incr. / Newton | peak MPa | span mm | RSS MB | phases (wall s) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        ph = ", ".join(f"{k} {v:.1f}" for k, v in (r.get("phases") or {}).items() if k != "total")
+        out.append(f"| {r['t']:g} | {r['material']} | {r['text'] or 'dot'} | {r['mesh'][0]:g} / {r['mesh'][1]:g} | "
+                   f"{r['dofs']:,} | {r['cpu']:.1f} | {r['wall']:.0f} | {r['incr']} / {r['newton']} | "
+                   f"{r['peak']:.5f} | {r['span']:.3f} | {r['rss_mb']:.0f} | {ph} |")
+    return "\n".join(out)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--thickness", type=float, nargs="+", default=[1.0, 3.0])
+    ap.add_argument("--text", default="")
+    ap.add_argument("--material", default="silicone")
+    ap.add_argument("--one", action="store_true", help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.one:
+        print(json.dumps(one(a.thickness[0], a.text, a.material)))
+        return 0
+    rows = []
+    for t in a.thickness:
+        cmd = [sys.executable, __file__, "--one", "--thickness", f"{t:g}", "--text", a.text, "--material", a.material]
+        p = subprocess.run(cmd, check=True, capture_output=True, text=True,
+                           env=dict(os.environ, PYTHONPATH=str(ROOT / "src")))
+        rows.append(json.loads(p.stdout.strip().splitlines()[-1]))
+        print(table(rows[-1:]).splitlines()[-1], flush=True)
+    from tactileskin.fileio import atomic_write_text
+
+    atomic_write_text(OUT, "# `default` 3D Braille solve times (benchmarks/braille3d_default.py)\n\n" + table(rows)
+                      + f"\n\nMeasured {_dt.date.today().isoformat()}; see the note below for the machine's load.\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
