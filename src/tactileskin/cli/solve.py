@@ -127,34 +127,33 @@ def solve_progress(label: str):
         yield show
 
 
-def _write_map_figure(res, path, label: str) -> None:
-    """bone_map.png of a 3D result; a 2D result removes one left by an earlier 3D solve."""
+def _write_figure(data, png, draw: str, title: str) -> None:
+    """png drawn by `draw` ("module:function", imported only when there is something to draw:
+    matplotlib stays out of a plain 2D solve) when the result has `data`; without it, a png
+    left there by an earlier solve is removed (the folder holds one result's files)."""
+    import importlib
+
     from tactileskin import fileio
 
-    png = path / "bone_map.png"
-    if res.bone_map is None:
+    if data is None:
         if png.is_file():
             with fileio.os_errors(png):
                 png.unlink()
         return
-    from tactileskin.report.bone_map import write_bone_map_figure
+    module, func = draw.split(":")
+    getattr(importlib.import_module(module), func)(data, png, title=title)
 
-    write_bone_map_figure(res.bone_map, png, title=f"bone pressure, {label}")
+
+def _write_map_figure(res, path, label: str) -> None:
+    """bone_map.png of a 3D result."""
+    _write_figure(res.bone_map, path / "bone_map.png", "tactileskin.report.bone_map:write_bone_map_figure",
+                  f"bone pressure, {label}")
 
 
 def _write_sensors_figure(res, path, label: str) -> None:
-    """sensors.png of a result with sensors; one without removes one left by an earlier solve."""
-    from tactileskin import fileio
-
-    png = path / "sensors.png"
-    if res.sensors is None:
-        if png.is_file():
-            with fileio.os_errors(png):
-                png.unlink()
-        return
-    from tactileskin.report.sensors import write_sensors_figure
-
-    write_sensors_figure(res.sensors, png, title=f"sensor readings, {label}")
+    """sensors.png of a result with sensors."""
+    _write_figure(res.sensors, path / "sensors.png", "tactileskin.report.sensors:write_sensors_figure",
+                  f"sensor readings, {label}")
 
 
 def _compare_2d(scene, s3, out) -> None:
