@@ -37,16 +37,17 @@ class ContactSurface:
         self.vdofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)   # (Fc, A*m)
         # tangent of the reference boundary (2D) to convert to current-area pressure
         self.lam = np.zeros(self.w.shape)
+        self.scale = np.ones(self.w.shape)  # per-point penalty factor (fe.solver raises it)
         self.shape = self.w.shape
 
     def displacement(self, u: np.ndarray) -> np.ndarray:
         U = u.reshape(-1, self.m)
         return np.einsum("fqa,fai->fqi", self.N, U[self.sdofs])
 
-    def evaluate(self, u, indenter, d: float, eps: float, lam_k: np.ndarray, tangent: bool,
+    def evaluate(self, u, indenter, d: float, eps, lam_k: np.ndarray, tangent: bool,
                  sticky: np.ndarray | None = None, curvature: bool = False):
         """Residual contribution (Fc, A*m), tangent blocks (Fc, A*m, A*m) or None, and the
-        point data (g, lambda_N, x, n).
+        point data (g, lambda_N, x, n). eps: the penalty (MPa/mm), a scalar or one per point.
 
         sticky (Fc, Qc) bool: points held active (the linear law lambda_k - eps g, which may
         turn slightly tensile) — the solver's guard against active-set cycling."""

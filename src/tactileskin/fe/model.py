@@ -196,6 +196,11 @@ class Model:
     def facet_scalar_dofs(self, name: str) -> np.ndarray:
         return np.unique(self.basis.get_dofs(self.boundaries[name]).all())
 
+    def penalty(self) -> np.ndarray:
+        """Penalty (MPa/mm) at each contact point: the contact's times the points' scale,
+        which the Uzawa loop raises where it contracts slowly (fe.solver)."""
+        return self.contact.penalty * self.surface.scale
+
     def surface_size(self) -> float:
         """Typical facet size on the contact boundary (mm)."""
         w = self.surface.w.sum(axis=1)
@@ -255,7 +260,7 @@ class Model:
             c = self.contact
             lam = self.surface.lam if lam_k is None else lam_k
             tc = time.perf_counter()
-            fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), c.penalty, lam, False,
+            fc, _, cinfo = self.surface.evaluate(u, c.indenter, self.travel(t), self.penalty(), lam, False,
                                                  sticky)
             self.timing["contact"] += time.perf_counter() - tc
             R += assemble_vector(self.ndof, self.surface.vdofs, fc)
@@ -285,7 +290,7 @@ class Model:
         if self.surface is not None:
             c = self.contact
             tc = time.perf_counter()
-            _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), c.penalty, ev._lam, True,
+            _, Kc, _ = self.surface.evaluate(ev._u, c.indenter, self.travel(ev._t), self.penalty(), ev._lam, True,
                                              ev._sticky,
                                              c.curvature_tangent if curvature is None else curvature)
             self.pattern.add(Kd, self.surface.vdofs, Kc)
