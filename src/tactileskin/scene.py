@@ -27,8 +27,9 @@ from tactileskin.skins import registry as _skins
 # Braille meshes refined locally at the dots, mesh.sizing.local_plan; 4: contact points held
 # off the first Newton step of an increment, earlier multiplier updates: other increment
 # sequences, peaks within 0.06 %; 5: result.vtu carries the contact pressure on the outer
-# surface)
-SCHEMA_VERSION = 5
+# surface; 6: contact penalty raised per point, other increment sequences on 3D dots past
+# travel 0.3 mm, peaks within 0.01 %)
+SCHEMA_VERSION = 6
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
