@@ -124,8 +124,39 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
                             n_train=4, n_test=4, template_grid=2)
     ch = chart.compute(cfg, cache=None)
     skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
+    # t = 3 also asks the blank plate on the pad (flat, 3D) at the plate's own depth
     assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
-                     (2, "curved", "fingertip")}
+                     (2, "curved", "fingertip"), (3, "flat", "pad")}
+    (blank,) = [sc for sc in asked if sc.indenter == "flat" and sc.dim == 3]
+    assert blank.thickness == 3.0 and blank.indentation == pytest.approx(0.6 - 0.48)
     assert ch.accuracy("silicone", 1.0, "letters", 0.5, 0.01) >= 0.95  # separable dots at 0.5 mm pitch
-    # t = 3: depth 0.6 mm > the dot height 0.48 mm: flagged; t = 1 (0.2 mm) is not
+    # t = 3: depth 0.6 mm > the dot height 0.48 mm: plate-aware letters, noted; t = 1 (0.2 mm) is not
     assert len(ch.notes) == 1 and ch.notes[0].startswith("t = 3 mm")
+    # with a depth cap below the dot height no scene of t = 3 passes it and no blank plate is asked
+    asked.clear()
+    ch = chart.compute(chart.ChartConfig(**{**cfg.__dict__, "max_depth": 0.4}), cache=None)
+    assert not ch.notes and not any(sc.indenter == "flat" and sc.dim == 3 for sc in asked)
+    depths = {(sc.thickness, round(sc.indentation, 9)) for sc in asked}
+    assert depths == {(1.0, 0.2), (3.0, 0.4)}  # t = 1 keeps its 20 %
+    assert [c["depth_mm"] for c in ch.cutoffs if c["thickness_mm"] == 3.0] == [0.4, 0.4]
+
+
+def test_plate_aware_superposition_counts_the_plate_once():
+    """A lone dot with its plate = plate + g; a cell = plate + sum of g translated: the
+    plate-aware model is exact, the plate-blind sum counts the plate once per dot."""
+    # h = 0.025: bilinear error per dot <= h^2/8 (|f_ss| + |f_zz|) = 1e-3 (w = 0.4), over a peak > 1.5
+    grid = np.linspace(-8, 8, 641)
+    plate = maps.on_grid(lambda s, z: np.full(np.shape(s), 0.5), grid, grid)
+    dot = maps.on_grid(lambda s, z: 0.5 + _gauss()(s, z), grid, grid)
+    k = surrogate.plate_kernel(dot, plate)
+    assert np.allclose(k.pressure, _gauss()(*np.meshgrid(grid, grid)))
+    sec = Scene(skin="pad", thickness=3.0).section()
+    text = "\u283f"
+    c = braille.dot_centres(text)
+    full = maps.on_grid(lambda s, z: 0.5 + sum(_gauss(a, b)(s, z) for a, b in c), grid, grid)
+    aware = surrogate.validate(k, full, text, sec, base=plate)
+    blind = surrogate.validate(dot, full, text, sec)
+    assert aware["max_abs_over_peak"] < 2e-3 and aware["within_tolerance"]
+    # six dots count the plate (0.5) six times: error 5 x 0.5 over the peak ~1.5
+    assert blind["max_abs_over_peak"] > 1.0
+    assert surrogate.fit_scale(k, {text: full}, sec, base=plate) == pytest.approx(1.0, abs=2e-3)
