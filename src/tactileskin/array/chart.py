@@ -96,6 +96,11 @@ class ChartConfig:
             return None
         return float(self.max_depth)
 
+    @property
+    def min_taxel(self) -> float:
+        """The smallest taxel side of the chart (mm)."""
+        return self.taxel_fraction * min(self.pitches)
+
     def spec(self, pitch: float) -> ArraySpec:
         n = int(np.floor(self.window / pitch + 1e-9)) + 1
         return ArraySpec(pitch=pitch, taxel=self.taxel_fraction * pitch, n=min(n, 200))
@@ -388,7 +393,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 models["interaction"] = (kernel, {"deflection": defl})
         for x in texts:
             for name, (k, kw) in models.items():
-                err = surrogate.validate(k, refs[x], x, sec, cfg.standard, **kw)
+                err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
                              **err})
     return rows

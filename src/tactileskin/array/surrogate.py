@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactileskin.array.maps import interpolator, mirrored, relative_error
+from tactileskin.array.maps import interpolator, mirrored, relative_error, taxel_averaged
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille
 from tactileskin.results import BoneMap
@@ -103,11 +103,13 @@ def kernel_from(bone_map: BoneMap) -> BoneMap:
 
 
 def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american",
-             deflection=None, scale: float = 1.0, base: BoneMap | None = None) -> dict:
+             deflection=None, scale: float = 1.0, base: BoneMap | None = None, taxel: float | None = None) -> dict:
     """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
     quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres);
     with `deflection` the dots' loads from `interaction_weights`; the dots' sum times
-    `scale`, plus `base` (the blank plate's map of the plate-aware model)."""
+    `scale`, plus `base` (the blank plate's map of the plate-aware model). With `taxel` (mm)
+    also the errors of both maps as read by taxels of that side (keys *_taxel): what the
+    finest array of a chart sees, blind to sub-taxel ripple."""
     ref = mirrored(full)
     c = braille.dot_centres(text, standard)
     w = None if deflection is None else interaction_weights(c, deflection)
@@ -118,6 +120,10 @@ def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="stand
     approx = BoneMap(approx.s, approx.z, P, approx.section_z)
     err = relative_error(approx, ref)
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
+    if taxel:
+        et = relative_error(taxel_averaged(approx, taxel), taxel_averaged(ref, taxel))
+        err.update({f"{k}_taxel": v for k, v in et.items()})
+        err["within_tolerance_taxel"] = et["max_abs_over_peak"] <= TOLERANCE
     return err
 
 
