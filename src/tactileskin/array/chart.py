@@ -58,8 +58,8 @@ class ChartConfig:
     n_test: int = 16
     template_grid: int = 4
     seed: int = 0
-    mesh_size: float = 1.2                 # 3D single-dot solves
-    refinement: float = 2.0
+    mesh_size: float = 1.2                 # 3D single-dot solves (local plan: fine = size / refinement
+    refinement: float = 8.0                # at the dot, the 3D Braille default preset)
     standard: str = "standard_american"
     skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
     # depth cap (mm): a thickness whose 20 % depth exceeds it is indented by max_depth instead (all
