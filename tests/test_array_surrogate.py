@@ -181,3 +181,37 @@ def test_taxel_average_keeps_a_linear_map_and_matches_the_box_average_of_a_gauss
     assert inner.size > 100 and np.ptp(inner) < 0.01
     with pytest.raises(ParameterError):
         maps.taxel_averaged(lin, 0.0)
+
+
+def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
+    """validate_surrogate at t = 3 (depth 0.6 mm > dot height): it asks the blank plate and
+    its plate-aware model reproduces a full map built as plate + dots, the plate-blind sum not."""
+    from types import SimpleNamespace
+
+    grid = np.linspace(-8, 8, 641)  # h = 0.025 (see test_plate_aware_superposition_counts_the_plate_once)
+    plate = maps.on_grid(lambda s, z: np.full(np.shape(s), 0.5), grid, grid)
+    lone = maps.on_grid(lambda s, z: 0.5 + _gauss()(s, z), grid, grid)
+    c = braille.dot_centres("l")
+    full = maps.on_grid(lambda s, z: 0.5 + sum(_gauss(a, b)(s, z) for a, b in c), grid, grid)
+    asked = []
+
+    def fake_solve(scenes, cache, on_event=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(scene=sc, path=tmp_path) for sc in scenes}
+
+    def bone(rec):
+        sc = rec.scene
+        return plate if sc.indenter == "flat" else lone if sc.braille_text == "" else full
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", bone)
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: full)
+    with pytest.raises(ParameterError):
+        chart.blank_scene(chart.dot_scene(1.0, "silicone", chart.ChartConfig()))  # 0.2 mm: no plate
+    rows = chart.validate_surrogate([3.0], "silicone", ["l"], chart.ChartConfig(), cache=None)
+    (blank,) = [sc for sc in asked if sc.indenter == "flat"]
+    assert blank.skin == "pad" and blank.dim == 3 and blank.indentation == pytest.approx(0.6 - 0.48)
+    by = {r["model"].split(" x ")[0]: r for r in rows}
+    assert set(by) == {"sum", "plate + sum"} and all(r["depth_mm"] == pytest.approx(0.6) for r in rows)
+    assert by["plate + sum"]["max_abs_over_peak"] < 2e-3 and by["plate + sum"]["within_tolerance_taxel"]
+    assert by["sum"]["max_abs_over_peak"] > 0.5  # three dots count the plate three times

@@ -137,7 +137,7 @@ def blank_scene(dot):
 
     d = dot.indentation - get_standard(dot.braille_standard).height
     if d <= 0:
-        raise ParameterError("depth", dot.indentation, f"> the dot height for a blank-plate solve")
+        raise ParameterError("depth", dot.indentation, "> the dot height for a blank-plate solve")
     if dot.skin == "pad":
         return Scene(dim=3, skin="pad", indenter="flat", thickness=dot.thickness, material=dot.material,
                      depth=d, rate=dot.rate, mesh_size=dot.mesh_size, refinement=1.0)
