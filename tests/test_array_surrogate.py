@@ -124,8 +124,94 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
                             n_train=4, n_test=4, template_grid=2)
     ch = chart.compute(cfg, cache=None)
     skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
+    # t = 3 also asks the blank plate on the pad (flat, 3D) at the plate's own depth
     assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
-                     (2, "curved", "fingertip")}
+                     (2, "curved", "fingertip"), (3, "flat", "pad")}
+    (blank,) = [sc for sc in asked if sc.indenter == "flat" and sc.dim == 3]
+    assert blank.thickness == 3.0 and blank.indentation == pytest.approx(0.6 - 0.48)
     assert ch.accuracy("silicone", 1.0, "letters", 0.5, 0.01) >= 0.95  # separable dots at 0.5 mm pitch
-    # t = 3: depth 0.6 mm > the dot height 0.48 mm: flagged; t = 1 (0.2 mm) is not
+    # t = 3: depth 0.6 mm > the dot height 0.48 mm: plate-aware letters, noted; t = 1 (0.2 mm) is not
     assert len(ch.notes) == 1 and ch.notes[0].startswith("t = 3 mm")
+    # with a depth cap below the dot height no scene of t = 3 passes it and no blank plate is asked
+    asked.clear()
+    ch = chart.compute(chart.ChartConfig(**{**cfg.__dict__, "max_depth": 0.4}), cache=None)
+    assert not ch.notes and not any(sc.indenter == "flat" and sc.dim == 3 for sc in asked)
+    depths = {(sc.thickness, round(sc.indentation, 9)) for sc in asked}
+    assert depths == {(1.0, 0.2), (3.0, 0.4)}  # t = 1 keeps its 20 %
+    assert [c["depth_mm"] for c in ch.cutoffs if c["thickness_mm"] == 3.0] == [0.4, 0.4]
+
+
+def test_plate_aware_superposition_counts_the_plate_once():
+    """A lone dot with its plate = plate + g; a cell = plate + sum of g translated: the
+    plate-aware model is exact, the plate-blind sum counts the plate once per dot."""
+    # h = 0.025: bilinear error per dot <= h^2/8 (|f_ss| + |f_zz|) = 1e-3 (w = 0.4), over a peak > 1.5
+    grid = np.linspace(-8, 8, 641)
+    plate = maps.on_grid(lambda s, z: np.full(np.shape(s), 0.5), grid, grid)
+    dot = maps.on_grid(lambda s, z: 0.5 + _gauss()(s, z), grid, grid)
+    k = surrogate.plate_kernel(dot, plate)
+    assert np.allclose(k.pressure, _gauss()(*np.meshgrid(grid, grid)))
+    sec = Scene(skin="pad", thickness=3.0).section()
+    text = "\u283f"
+    c = braille.dot_centres(text)
+    full = maps.on_grid(lambda s, z: 0.5 + sum(_gauss(a, b)(s, z) for a, b in c), grid, grid)
+    aware = surrogate.validate(k, full, text, sec, base=plate)
+    blind = surrogate.validate(dot, full, text, sec)
+    assert aware["max_abs_over_peak"] < 2e-3 and aware["within_tolerance"]
+    # six dots count the plate (0.5) six times: error 5 x 0.5 over the peak ~1.5
+    assert blind["max_abs_over_peak"] > 1.0
+    assert surrogate.fit_scale(k, {text: full}, sec, base=plate) == pytest.approx(1.0, abs=2e-3)
+
+
+def test_taxel_average_keeps_a_linear_map_and_matches_the_box_average_of_a_gaussian():
+    from scipy.special import erf
+
+    g = np.linspace(-4, 4, 321)
+    a, w = 0.4, 0.5
+    lin = maps.taxel_averaged(maps.on_grid(lambda s, z: 1 + 0.3 * s - 0.2 * z, g, g), a)
+    # a symmetric box average of a linear map is the map itself (away from the zero-padded edge)
+    assert maps.interpolator(lin)(np.array(1.0), np.array(-0.5)) == pytest.approx(1.4, abs=1e-9)
+    gauss = maps.taxel_averaged(maps.on_grid(_gauss(w=w), g, g), a)
+    exact = (np.sqrt(2 * np.pi) * w / a * erf(a / (2 * np.sqrt(2) * w))) ** 2  # box mean of the Gaussian at 0
+    # trapezoid with h = a / 8 and bilinear sampling on h = 0.025: error ~ h^2 max|f''| / 12 ~ 2e-3
+    assert maps.interpolator(gauss)(np.array(0.0), np.array(0.0)) == pytest.approx(exact, abs=3e-3)
+    # ripple finer than the taxel is averaged out: +-5 % at wavelength a / 2 leaves < 0.5 %
+    rip = maps.on_grid(lambda s, z: 1 + 0.05 * np.cos(4 * np.pi * s / a), g, g)
+    r = maps.taxel_averaged(rip, a)
+    inner = r.pressure[np.ix_(np.abs(r.z) < 3, np.abs(r.s) < 3)]
+    assert inner.size > 100 and np.ptp(inner) < 0.01
+    with pytest.raises(ParameterError):
+        maps.taxel_averaged(lin, 0.0)
+
+
+def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
+    """validate_surrogate at t = 3 (depth 0.6 mm > dot height): it asks the blank plate and
+    its plate-aware model reproduces a full map built as plate + dots, the plate-blind sum not."""
+    from types import SimpleNamespace
+
+    grid = np.linspace(-8, 8, 641)  # h = 0.025 (see test_plate_aware_superposition_counts_the_plate_once)
+    plate = maps.on_grid(lambda s, z: np.full(np.shape(s), 0.5), grid, grid)
+    lone = maps.on_grid(lambda s, z: 0.5 + _gauss()(s, z), grid, grid)
+    c = braille.dot_centres("l")
+    full = maps.on_grid(lambda s, z: 0.5 + sum(_gauss(a, b)(s, z) for a, b in c), grid, grid)
+    asked = []
+
+    def fake_solve(scenes, cache, on_event=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(scene=sc, path=tmp_path) for sc in scenes}
+
+    def bone(rec):
+        sc = rec.scene
+        return plate if sc.indenter == "flat" else lone if sc.braille_text == "" else full
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", bone)
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: full)
+    with pytest.raises(ParameterError):
+        chart.blank_scene(chart.dot_scene(1.0, "silicone", chart.ChartConfig()))  # 0.2 mm: no plate
+    rows = chart.validate_surrogate([3.0], "silicone", ["l"], chart.ChartConfig(), cache=None)
+    (blank,) = [sc for sc in asked if sc.indenter == "flat"]
+    assert blank.skin == "pad" and blank.dim == 3 and blank.indentation == pytest.approx(0.6 - 0.48)
+    by = {r["model"].split(" x ")[0]: r for r in rows}
+    assert set(by) == {"sum", "plate + sum"} and all(r["depth_mm"] == pytest.approx(0.6) for r in rows)
+    assert by["plate + sum"]["max_abs_over_peak"] < 2e-3 and by["plate + sum"]["within_tolerance_taxel"]
+    assert by["sum"]["max_abs_over_peak"] > 0.5  # three dots count the plate three times

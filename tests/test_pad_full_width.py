@@ -40,8 +40,10 @@ def test_full_width_enters_the_cache_key_of_asymmetric_scenes_only():
     sym = _pad("⠿", dim=3)
     from tactileskin.skins.pad import PadSkin
 
-    assert PadSkin.cache_content(sym) == {}            # symmetric scenes keep their keys
-    assert PadSkin.cache_content(_pad("r", dim=3)) == {"model": "full_width"}
+    assert PadSkin.cache_content(_pad("⠿", dim=2)) == {}  # symmetric scenes keep their keys
+    # (3D Braille adds the local mesh plan's tag, tests/test_pad_local_mesh.py)
+    assert PadSkin.cache_content(sym) == {"mesh_plan": "local"}
+    assert PadSkin.cache_content(_pad("r", dim=3)) == {"model": "full_width", "mesh_plan": "local"}
     assert cache_key(_pad("r", dim=3)) != cache_key(_pad("r", dim=3, braille_text="⠿"))
 
 

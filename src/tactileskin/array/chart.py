@@ -40,6 +40,7 @@ GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
 SETS = ("paper", "letters")
 SKINS = ("pad", "fingertip")
+DEPTH_FRACTION = 0.2        # the scenes' default depth, 20 % of t (Scene.depth_fraction)
 
 
 @dataclass(frozen=True)
@@ -57,10 +58,13 @@ class ChartConfig:
     n_test: int = 16
     template_grid: int = 4
     seed: int = 0
-    mesh_size: float = 1.2                 # 3D single-dot solves
-    refinement: float = 2.0
+    mesh_size: float = 1.2                 # 3D single-dot solves (local plan: fine = size / refinement
+    refinement: float = 8.0                # at the dot, the 3D Braille default preset)
     standard: str = "standard_american"
     skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
+    # depth cap (mm): a thickness whose 20 % depth exceeds it is indented by max_depth instead (all
+    # its stimuli, 2D and 3D); None: the paper's 20 % everywhere (t >= 2.4 mm: the plate touches)
+    max_depth: float | None = None
 
     def __post_init__(self):
         for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
@@ -79,9 +83,23 @@ class ChartConfig:
             raise ParameterError("set", bad[0], " or ".join(SETS))
         if self.skin not in SKINS:
             raise ParameterError("skin", self.skin, " or ".join(SKINS))
+        if self.max_depth is not None and not (np.isfinite(self.max_depth) and self.max_depth > 0):
+            raise ParameterError("max_depth", self.max_depth, "> 0 mm (or None: 20 % of t)")
         bad = [c for c in self.letters if c not in LETTERS]
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct letters a-z")
+
+    def depth_for(self, thickness: float) -> float | None:
+        """The depth (mm) a chart scene of this thickness is given: None (the scene's 20 % of t)
+        unless that exceeds max_depth."""
+        if self.max_depth is None or DEPTH_FRACTION * thickness <= self.max_depth:
+            return None
+        return float(self.max_depth)
+
+    @property
+    def min_taxel(self) -> float:
+        """The smallest taxel side of the chart (mm)."""
+        return self.taxel_fraction * min(self.pitches)
 
     def spec(self, pitch: float) -> ArraySpec:
         n = int(np.floor(self.window / pitch + 1e-9)) + 1
@@ -95,13 +113,43 @@ def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str |
 
     return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
                  braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
-                 refinement=cfg.refinement)
+                 refinement=cfg.refinement, depth=cfg.depth_for(thickness))
 
 
-def section_scene(thickness, material, indenter, skin="fingertip"):
+def section_scene(thickness, material, indenter, skin="fingertip", depth=None):
     from tactileskin.scene import Scene
 
-    return Scene(dim=2, skin=skin, indenter=indenter, thickness=thickness, material=material)
+    return Scene(dim=2, skin=skin, indenter=indenter, thickness=thickness, material=material, depth=depth)
+
+
+def plate_touches(dot) -> bool:
+    """True if the Braille scene `dot` indents past the dot height (its base plate presses too)."""
+    return dot.indentation > get_standard(dot.braille_standard).height + 1e-12
+
+
+def blank_scene(dot):
+    """The blank Braille plate of the scene `dot` alone: a flat plate at the plate's own depth
+    (depth - dot height), at the same rate, on the same skin: the 3D pad (the flat plate is wider
+    than the pad, so it presses the whole top like the Braille plate), or the fingertip's 2D
+    section (extruded along z by `blank_map`). Coarse mesh: its bone map is smooth away from the
+    pad's edges."""
+    from tactileskin.scene import Scene
+
+    d = dot.indentation - get_standard(dot.braille_standard).height
+    if d <= 0:
+        raise ParameterError("depth", dot.indentation, "> the dot height for a blank-plate solve")
+    if dot.skin == "pad":
+        return Scene(dim=3, skin="pad", indenter="flat", thickness=dot.thickness, material=dot.material,
+                     depth=d, rate=dot.rate, mesh_size=dot.mesh_size, refinement=1.0)
+    return Scene(dim=2, skin=dot.skin, indenter="flat", thickness=dot.thickness, material=dot.material,
+                 depth=d, rate=dot.rate)
+
+
+def blank_map(scene, record, like: BoneMap) -> BoneMap:
+    """The blank plate's full bone map (3D) or its 2D profile extruded over like.z."""
+    if scene.dim == 3:
+        return bone_map_of(record)
+    return extruded(record.s, record.pressure, like.z)
 
 
 def solve_cached(scenes, cache, on_event=None) -> dict:
@@ -145,10 +193,11 @@ def extruded(s, p, z) -> BoneMap:
     return mirrored(BoneMap(s, np.asarray(z, float), np.tile(p[idx], (len(z), 1))))
 
 
-def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None) -> dict:
+def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None,
+                  base: BoneMap | None = None) -> dict:
     """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
-    single dot on cfg.skin, `section` its section), the paper set's dot `paper_kernel` (the
-    fingertip's; default `kernel`)."""
+    single dot on cfg.skin, `section` its section; plus `base`, the blank plate, for the
+    plate-aware kernel), the paper set's dot `paper_kernel` (the fingertip's; default `kernel`)."""
     out = {}
     if "paper" in cfg.sets:
         pk = kernel if paper_kernel is None else paper_kernel
@@ -157,8 +206,8 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
     if "letters" in cfg.sets:
         from tactileskin.geometry.braille import LETTERS as MASKS
 
-        out["letters"] = {c: surrogate.superpose(kernel, surrogate.cell_centres(MASKS[c], cfg.standard), section)
-                          for c in cfg.letters}
+        out["letters"] = {c: surrogate.superpose(kernel, surrogate.cell_centres(MASKS[c], cfg.standard), section,
+                                                 base=base) for c in cfg.letters}
     return out
 
 
@@ -203,27 +252,34 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             # its 2D sections are exact (a plate wider than the pad has no converged solve there)
             dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
             pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
-            sec2 = {k: section_scene(t, material, k) for k in ("flat", "curved")} if pdot else {}
+            sec2 = {k: section_scene(t, material, k, depth=cfg.depth_for(t)) for k in ("flat", "curved")} if pdot else {}
+            blank = blank_scene(dot) if dot is not None and plate_touches(dot) else None
             say(f"{material} t = {t:g} mm: solving (cached cases are read)")
-            recs = solve_cached([x for x in (dot, pdot) if x is not None] + list(sec2.values()), cache,
+            recs = solve_cached([x for x in (dot, pdot, blank) if x is not None] + list(sec2.values()), cache,
                                 on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
             kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
             height = get_standard(cfg.standard).height
-            if dot is not None and dot.indentation >= height:
-                note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm reaches the dot height {height:g} mm, so "
-                        "the Braille plate presses the skin too: the dot kernel holds the plate's load and the "
-                        "letters' superposition counts it once per dot (not valid)")
-                log.warning(note)
+            base = None
+            if blank is not None:
+                base = blank_map(blank, recs[blank], kernels[dot])
+                note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm passes the dot height {height:g} mm, so "
+                        "the Braille plate presses the skin too: the letters are the blank plate plus the "
+                        "plate-aware kernels (surrogate.plate_kernel)")
+                log.info(note)
                 chart.notes.append(note)
             profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
+            letter_kernel = kernels.get(dot) if base is None else surrogate.plate_kernel(kernels[dot], base)
             for sc, kernel in kernels.items():
+                if sc == dot:  # the filter of a dot is what it adds to the plate
+                    kernel = letter_kernel
                 row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
                 kc = _cutoff(kernel.s, row, halfspace)
                 chart.cutoffs.append({"material": material, "thickness_mm": t, "skin": sc.skin,
+                                      "depth_mm": float(sc.indentation),
                                       "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
                                       "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
                                       "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
-            sets = stimulus_maps(kernels.get(dot), dot and dot.section(), profiles, cfg, kernels.get(pdot))
+            sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())
@@ -296,7 +352,10 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
     text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
     lone dot's surface deflection, surrogate.interaction_weights), "sum x a" (one scale a per
-    thickness fitted by least squares on these same maps: an in-sample fit).
+    thickness fitted by least squares on these same maps: an in-sample fit). Where the plate
+    touches (depth past the dot height): "plate + sum" (the blank plate plus the plate-aware
+    kernels, surrogate.plate_kernel), "plate + sum x a", and "sum" (the lone dot's map with
+    its plate added per dot: what the plate-blind model would do).
     On the fingertip (a half model) an x-asymmetric text is refused: it would be solved
     mirrored."""
     from tactileskin.geometry.braille import dot_centres
@@ -312,20 +371,29 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     for t in thicknesses:
         dot = dot_scene(t, material, cfg)
         fulls = [dot_scene(t, material, cfg, x) for x in texts]
+        blank = blank_scene(dot) if plate_touches(dot) else None
         say(f"validation {material} t = {t:g} mm: {len(fulls)} full solves (cached cases are read)")
-        recs = solve_cached([dot, *fulls], cache,
+        recs = solve_cached([x for x in (dot, blank) if x is not None] + fulls, cache,
                             on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
         kernel = bone_map_of(recs[dot])
         sec = dot.section()
         refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
-        defl = surface_deflection(recs[dot], sec.top) if cfg.skin == "pad" else None
-        scale = surrogate.fit_scale(kernel, refs, sec, cfg.standard)
-        for x in texts:
-            ref = refs[x]
-            models = {"sum": {}, f"sum x {scale:.3f}": {"scale": scale}}
+        depth = float(dot.indentation)
+        if blank is not None:
+            base = blank_map(blank, recs[blank], kernel)
+            pk = surrogate.plate_kernel(kernel, base)
+            scale = surrogate.fit_scale(pk, refs, sec, cfg.standard, base=base)
+            models = {"sum": (kernel, {}), "plate + sum": (pk, {"base": base}),
+                      f"plate + sum x {scale:.3f}": (pk, {"base": base, "scale": scale})}
+        else:
+            defl = surface_deflection(recs[dot], sec.top) if cfg.skin == "pad" else None
+            scale = surrogate.fit_scale(kernel, refs, sec, cfg.standard)
+            models = {"sum": (kernel, {}), f"sum x {scale:.3f}": (kernel, {"scale": scale})}
             if defl is not None:
-                models["interaction"] = {"deflection": defl}
-            for name, kw in models.items():
-                err = surrogate.validate(kernel, ref, x, sec, cfg.standard, **kw)
-                rows.append({"material": material, "thickness_mm": t, "text": x, "model": name, **err})
+                models["interaction"] = (kernel, {"deflection": defl})
+        for x in texts:
+            for name, (k, kw) in models.items():
+                err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel, **kw)
+                rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
+                             **err})
     return rows

@@ -10,13 +10,19 @@ What remains is the contact nonlinearity and, under depth control, the dots' int
 (a neighbour's load lowers the skin under a dot, so each dot of a cell carries less than
 a lone dot): `validate` measures it against full solves, and `scaled` is the one-number
 correction fitted on them.
+
+Past the dot height the Braille plate presses the skin too, and a lone dot's map holds the
+plate's load: summed per dot it would count the plate once per dot. The plate-aware model
+splits it: kernel = (lone dot with its plate) - (blank plate alone, at the plate's own depth,
+depth - dot height), and a character = blank plate + sum of kernels (`plate_kernel`, the
+`base` of `superpose`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from tactileskin.array.maps import interpolator, mirrored, relative_error
+from tactileskin.array.maps import interpolator, mirrored, relative_error, taxel_averaged
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille
 from tactileskin.results import BoneMap
@@ -47,11 +53,12 @@ def cell_centres(mask: int, standard="standard_american") -> np.ndarray:
     return full[[k for k in range(6) if mask >> k & 1]]
 
 
-def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None) -> BoneMap:
+def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None, base: BoneMap | None = None) -> BoneMap:
     """Map of the dots at face coordinates `centres` (k, 2) = (x, z): sum of the single-dot
     response `kernel` (a full map centred on the dot, see maps.mirrored) translated to each
-    (s_k, z_k), times `weights` (k,) (default 1: each dot as a lone dot). Evaluated on the
-    grid s x z (default: the kernel's grid)."""
+    (s_k, z_k), times `weights` (k,) (default 1: each dot as a lone dot), plus `base` (a full
+    map not translated: the blank plate's, see plate_kernel). Evaluated on the grid s x z
+    (default: the kernel's grid)."""
     centres = np.atleast_2d(np.asarray(centres, float))
     if centres.shape[1] != 2 or centres.shape[0] < 1:
         raise ParameterError("dot centres", centres.shape, "(k, 2) face coordinates (x, z)")
@@ -62,7 +69,16 @@ def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None) -
     sk = bone_s_under(centres[:, 0], section)
     w = np.ones(len(centres)) if weights is None else np.asarray(weights, float)
     P = sum(wk * f(S - a, Z - b) for wk, a, b in zip(w, sk, centres[:, 1]))
+    if base is not None:
+        P = P + interpolator(base)(S, Z)
     return BoneMap(s, z, P, kernel.section_z)
+
+
+def plate_kernel(dot: BoneMap, blank: BoneMap) -> BoneMap:
+    """The plate-aware kernel: the lone dot's map with its plate (`dot`, full) minus the blank
+    plate's (`blank`, full; interpolated on the dot's grid), i.e. what one dot adds to the plate."""
+    S, Z = np.meshgrid(dot.s, dot.z)
+    return BoneMap(dot.s, dot.z, dot.pressure - interpolator(blank)(S, Z), dot.section_z)
 
 
 def interaction_weights(centres, deflection) -> np.ndarray:
@@ -87,29 +103,41 @@ def kernel_from(bone_map: BoneMap) -> BoneMap:
 
 
 def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american",
-             deflection=None, scale: float = 1.0) -> dict:
+             deflection=None, scale: float = 1.0, base: BoneMap | None = None, taxel: float | None = None) -> dict:
     """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
     quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres);
-    with `deflection` the dots' loads from `interaction_weights`; all times
-    `scale`."""
+    with `deflection` the dots' loads from `interaction_weights`; the dots' sum times
+    `scale`, plus `base` (the blank plate's map of the plate-aware model). With `taxel` (mm)
+    also the errors of both maps as read by taxels of that side (keys *_taxel): what the
+    finest array of a chart sees, blind to sub-taxel ripple."""
     ref = mirrored(full)
     c = braille.dot_centres(text, standard)
     w = None if deflection is None else interaction_weights(c, deflection)
     approx = superpose(kernel, c, section, ref.s, ref.z, weights=w)
-    approx = BoneMap(approx.s, approx.z, scale * approx.pressure, approx.section_z)
+    P = scale * approx.pressure
+    if base is not None:
+        P = P + interpolator(base)(*np.meshgrid(ref.s, ref.z))
+    approx = BoneMap(approx.s, approx.z, P, approx.section_z)
     err = relative_error(approx, ref)
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
+    if taxel:
+        et = relative_error(taxel_averaged(approx, taxel), taxel_averaged(ref, taxel))
+        err.update({f"{k}_taxel": v for k, v in et.items()})
+        err["within_tolerance_taxel"] = et["max_abs_over_peak"] <= TOLERANCE
     return err
 
 
-def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american") -> float:
-    """The one factor a minimising sum ||a S - P||^2 over the full solves `fulls`
-    ({text: map}) of the plain superpositions S: the cheapest correction of the sum."""
+def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american",
+              base: BoneMap | None = None) -> float:
+    """The one factor a minimising sum ||a S + B - P||^2 over the full solves `fulls`
+    ({text: map}) of the plain superpositions S (B: `base`, the blank plate's map, or 0): the
+    cheapest correction of the sum."""
     num = den = 0.0
     for text, full in fulls.items():
         ref = mirrored(full)
         approx = superpose(kernel, braille.dot_centres(text, standard), section, ref.s, ref.z)
-        num += float(np.sum(approx.pressure * ref.pressure))
+        b = 0.0 if base is None else interpolator(base)(*np.meshgrid(ref.s, ref.z))
+        num += float(np.sum(approx.pressure * (ref.pressure - b)))
         den += float(np.sum(approx.pressure ** 2))
     if not den > 0:
         raise ParameterError("surrogate", "zero superposition", "a kernel with a positive response")

@@ -15,7 +15,7 @@ OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
                for e in ("png", "svg")))
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
-        "validate", "skin"}
+        "validate", "skin", "max_depth"}
 
 
 def load_config(path) -> dict:
@@ -46,7 +46,10 @@ def load_config(path) -> dict:
 @click.option("--letters", default=None, help="Letters of the letters set. Default a-z.")
 @click.option("--offsets", type=int, default=None, help="Random offsets per stimulus (train and test each). Default 16.")
 @click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm). Default 1.2.")
-@click.option("--refinement", type=float, default=None, help="3D single-dot refinement ratio. Default 2.")
+@click.option("--refinement", type=float, default=None, help="3D single-dot refinement ratio. Default 8.")
+@click.option("--max-depth", type=float, default=None,
+              help="Depth cap (mm) for thick skins: a t whose 20 % depth exceeds it is indented by this "
+                   "instead (below the dot height 0.48 mm the Braille plate never touches). Default none.")
 @click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
 @click.option("--skin", type=click.Choice(["pad", "fingertip"]), default=None,
               help="Skin of the 3D dot solves: pad (flat, a dot's response translates exactly; default) or "
@@ -56,7 +59,7 @@ def load_config(path) -> dict:
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, seed, skin, validate, cache_dir):
+            refinement, max_depth, seed, skin, validate, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast."""
     from rich.console import Console
     from rich.markup import escape
@@ -75,7 +78,8 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  pitches=pitch and tuple(parse_values(pitch, "pitch")),
                  noise_fs=noise and tuple(parse_values(noise, "noise")),
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
-                 n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin)
+                 n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
+                 max_depth=max_depth)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:
         texts = names(validate, "validate")

@@ -3,7 +3,9 @@
 mid-plane) or [-L/2, L/2] (free ends). An indenter not mirror-symmetric about x = 0 (e.g. a
 Braille text with dots on one side only) gets the full width x in [-W/2, W/2] (no
 `symmetry` boundary, both sides `side`): a half model would solve its mirror image too. The same size plan and fields as the fingertip
-(mesh.sizing: fine under the contact, fine along the bonded surface for s <= ROI_S, graded).
+(mesh.sizing: fine under the contact, fine along the bonded surface for s <= ROI_S, graded;
+3D Braille: fine only in balls at each dot's contact point and on the bonded surface under it,
+sizing.local_plan).
 
 Boundaries: `bone_interface` (y = 0, bonded to the board), `outer_surface` (y = t), `symmetry`
 (x = 0), `side` (x = W/2, free), and in 3D `end_front` (z = L/2), `end_back`. All faces are
@@ -50,8 +52,10 @@ def _add_rectangle(gmsh, w2: float, t: float, roi_s: float, full: bool = False) 
 
 
 def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refinement: float | None = None,
-                   order: int | None = None, cell: str = "tri", use_z_symmetry: bool = True) -> SkinMesh:
-    """Mesh the pad of `scene` (2D or 3D by scene.dim)."""
+                   order: int | None = None, cell: str = "tri", use_z_symmetry: bool = True,
+                   local: bool = True) -> SkinMesh:
+    """Mesh the pad of `scene` (2D or 3D by scene.dim). 3D Braille: fine only at the dots
+    (sizing.local_plan); local=False refines the whole contact strip and bonded ROI instead."""
     from tactileskin.geometry.indenters import indenter_symmetry
 
     section = scene.section() if section is None else section
@@ -65,7 +69,7 @@ def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refin
     zsym = zsym and use_z_symmetry and dim == 3
     full = not xsym  # a half model with a symmetry plane would solve the mirrored indenter too
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=dim,
-                       length=length if dim == 3 else None, z_symmetric=zsym, order=order)
+                       length=length if dim == 3 else None, z_symmetric=zsym, order=order, local=local)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"skin": "pad", "width": section.width, "thickness": t, "order": order, "cell": cell,
               "full_width": full,

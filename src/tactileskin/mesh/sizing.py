@@ -172,8 +172,9 @@ def _smallest_size(fits, too_small: float, largest: float = 5.0) -> float | None
 def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: float | None,
             z_symmetric: bool, local: bool = True) -> SizePlan:
     """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
-    # the local plan places its balls on the fingertip's contour; other skins keep the strip plan
-    if dim == 3 and local and scene.indenter.value == "braille" and getattr(scene, "skin", "fingertip") == "fingertip":
+    # the local plan places its balls on the fingertip's contour or the pad's flat top; other
+    # skins keep the strip plan
+    if dim == 3 and local and scene.indenter.value == "braille" and getattr(scene, "skin", "fingertip") in LOCAL_SKINS:
         return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric)
     fine = coarse / ratio
     t = section.thickness
@@ -215,57 +216,84 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
 # the dot and the skin thickness.
 GROWTH_3D = 0.35
 PATCH_RADIUS = 1.25
+LOCAL_SKINS = ("fingertip", "pad")  # skins whose outer surface `_dot_frame` knows
+
+
+def _dot_frame(section, x: float) -> tuple[np.ndarray, np.ndarray]:
+    """(outer point, outward normal) in the (x, y) section plane of the skin point a dot at face
+    coordinate x meets first: on the fingertip the outer curve at |x|, on the flat pad
+    (no `fingertip`) the top y = t straight above x."""
+    ft = getattr(section, "fingertip", None)
+    if ft is None:
+        return np.array([float(x), float(section.top)]), np.array([0.0, 1.0])
+    u = math.asin(min(abs(x) / ft.half_width, 1.0)) * (1.0 if x >= 0 else -1.0)
+    return np.asarray(ft.outer(u), float), np.asarray(ft.outer_normal(u), float)
+
+
+def _plate_halfwidth(section, depth_past_dots: float) -> float:
+    """Half-width of the base plate's contact when it presses `depth_past_dots` (> 0) into the
+    skin: the fingertip's Hertz-like estimate on its top radius; the pad's whole flat top (the
+    plate is at least as wide as the pad, indenters.toml min_width)."""
+    ft = getattr(section, "fingertip", None)
+    if ft is None:
+        return float(section.half_width)
+    r_top = ft.half_width ** 2 / ft.height
+    return min(1.5 * math.sqrt(2.0 * r_top * depth_past_dots), ft.half_width)
 
 
 def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_symmetric: bool) -> SizePlan:
-    """Local size plan of a 3D Braille slab: fine = coarse / ratio at the dots' contact patches
-    and (scaled with t) on the bone under them; if the indentation exceeds the dot height the
-    base plate touches along the whole slab, and that strip and the bone ROI get the geometric
-    mean of the fine and coarse sizes (`strip`)."""
+    """Local size plan of a 3D Braille slab (fingertip) or block (pad): fine = coarse / ratio
+    at the dots' contact patches and (scaled with t) on the bone under them (the pad's bonded
+    bottom y = 0); if the indentation exceeds the dot height the base plate touches along the
+    whole slab, and that strip and the bone ROI get the geometric mean of the fine and coarse
+    sizes (`strip`)."""
     from tactileskin.geometry import braille
+    from tactileskin.geometry.indenters import indenter_symmetry
 
     std = braille.get_standard(scene.braille_standard)
     a0 = std.base_radius
     fine = coarse / ratio
     t = section.thickness
-    ft = section.fingertip
     g = GROWTH_3D
     bone_fine = min(coarse, fine * max(1.0, t / (2.0 * a0)))
     r_patch, r_bone = PATCH_RADIUS * a0, a0 + t
     z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
     lz = z1 - z0
+    # the meshed x range starts at the symmetry plane x = 0, or at -W/2 on a full-width pad
+    # (mesh.pad: an x-asymmetric text)
+    full = getattr(section, "fingertip", None) is None and not indenter_symmetry(scene)[0]
+    x0 = -section.half_width if full else 0.0
     patches, bones = [], []
     excess = 0.0
     for x, z in braille.dot_centres(scene.braille_text, std):
-        u = math.asin(min(abs(x) / ft.half_width, 1.0)) * (1.0 if x >= 0 else -1.0)
-        po, n = ft.outer(u), ft.outer_normal(u)
+        po, n = _dot_frame(section, x)
         pb = po - t * n
         for balls, c, r, h, layer in ((patches, po, r_patch, fine, OUTER_LAYER * fine),
                                       (bones, pb, r_bone, bone_fine, ROI_LAYER * bone_fine)):
-            if c[0] < -r or z < z0 - r or z > z1 + r:
-                continue  # the ball misses the meshed part (x >= 0, z0 <= z <= z1)
+            if c[0] < x0 - r or z < z0 - r or z > z1 + r:
+                continue  # the ball misses the meshed part (x >= x0, z0 <= z <= z1)
             balls.append((float(c[0]), float(c[1]), float(z), float(r), float(h)))
             ext = r + (coarse - h) / g
-            frac = (min(1.0, 0.5 + c[0] / (2.0 * ext)) * min(1.0, 0.5 + (z - z0) / (2.0 * ext))
+            frac = (min(1.0, 0.5 + (c[0] - x0) / (2.0 * ext)) * min(1.0, 0.5 + (z - z0) / (2.0 * ext))
                     * min(1.0, 0.5 + (z1 - z) / (2.0 * ext)))
             excess += max(frac, 0.0) * _ball_excess(min(coarse, t), min(h, t), r, layer, t, g)
     strip = 0.0
     w = 0.0
     if scene.indentation > std.height:
         strip = math.sqrt(fine * coarse)
-        r_top = ft.half_width ** 2 / ft.height
-        w = min(1.5 * math.sqrt(2.0 * r_top * (scene.indentation - std.height)), ft.half_width)
+        w = _plate_halfwidth(section, scene.indentation - std.height)
     s_fine = strip if strip else coarse
     roi = min(ROI_S, section.interface_length)
     p = SizePlan(coarse, fine, g, w, (z0, z1), OUTER_LAYER * s_fine, roi, ROI_LAYER * s_fine,
                  (coarse - s_fine) / g, 0, tuple(patches), tuple(bones), strip)
+    sides = 2.0 if full else 1.0
     if strip:
         pe = dataclasses.replace(p, coarse=min(coarse, t), fine=min(strip, t))
-        kappa = 1.0 / max(ft.min_radius_of_curvature - t, 0.1 * t)
-        excess += lz * (section.outer_length_to_x(w + p.transition) * _strip(pe, p.outer_layer, t, 3)
-                        + roi * _strip(pe, p.roi_layer, t, 3, kappa=kappa)
-                        + (_strip(pe, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
-    n = int(_CELLS_PER_UNIT[3] * (_area(section) * lz / min(coarse, t) ** 3 + excess))
+        kappa = 1.0 / max(section.min_radius_of_curvature - t, 0.1 * t)
+        excess += sides * lz * (section.outer_length_to_x(w + p.transition) * _strip(pe, p.outer_layer, t, 3)
+                                + roi * _strip(pe, p.roi_layer, t, 3, kappa=kappa)
+                                + (_strip(pe, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
+    n = int(_CELLS_PER_UNIT[3] * (sides * _area(section) * lz / min(coarse, t) ** 3 + excess))
     return dataclasses.replace(p, estimate=n)
 
 
@@ -299,7 +327,7 @@ def apply_fields(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
     f = gmsh.model.mesh.field
     key = "CurvesList" if dim == 2 else "SurfacesList"
     if p.patches or p.bone_patches:
-        return _apply_local(gmsh, p, outer, interface_roi)
+        return _apply_local(gmsh, p, outer, interface_roi, full_width)
 
     def threshold(tags, layer, sampling):
         dist = f.add("Distance")
@@ -354,7 +382,7 @@ def _options(gmsh, p: SizePlan, smallest: float) -> None:
     gmsh.option.setNumber("Mesh.MeshSizeMin", smallest)
 
 
-def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int]) -> None:
+def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], full_width: bool = False) -> None:
     """Fields of a local plan: per ball, Max(surface threshold, ball) (fine only near the
     surface and inside the ball, graded outside both); Min over the balls and, if the plate
     touches, the strip's box and the bone ROI at size `strip`."""
@@ -397,7 +425,7 @@ def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int]) 
     if p.strip:
         near_outer = threshold(outer, p.strip, p.outer_layer)
         box = f.add("Box")
-        for k, v in (("VIn", p.strip), ("VOut", p.coarse), ("XMin", -1.0), ("XMax", p.contact_x),
+        for k, v in (("VIn", p.strip), ("VOut", p.coarse), ("XMin", -p.contact_x if full_width else -1.0), ("XMax", p.contact_x),
                      ("YMin", -1e3), ("YMax", 1e3), ("ZMin", p.contact_z[0] - 1.0),
                      ("ZMax", p.contact_z[1] + 1.0), ("Thickness", p.transition)):
             f.setNumber(box, k, v)

@@ -64,13 +64,16 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"{cfg.template_grid}x{cfg.template_grid} offsets; `lda` in the CSV). "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
-             "| material | t (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
-             "|---|---|---|---|---|---|---|"]
+             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
+             "|---|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
-        lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('skin', 'fingertip')} | {c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
+        lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('depth_mm', float('nan')):.3g} | {c.get('skin', 'fingertip')} | "
+                     f"{c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
                      f"{c['nyquist_pitch_mm']:.2f} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's section row (or of the half-space "
-              "kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1.", ""]
+              "kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
+              "Depth: 20 % of t" + (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: below the dot "
+                                    "height, so the Braille plate never touches)" if cfg.max_depth else "") + ".", ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
             lines += [f"### {material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", "",
@@ -87,16 +90,33 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     lines += [f"| {v['material']} | {v['claim']} | {v['verdict']} | {v['evidence']} |" for v in verdicts(chart, method)]
     lines += ["", f"(a set counts as discriminated at accuracy >= {GOOD:g}, at the lowest noise level)", ""]
     if validation:
-        lines += ["### Surrogate validation (superposition of single-dot responses against full 3D solves)", "",
-                  "| material | t (mm) | text | model | rel. L2 | max error / peak | peak error | within 5 % |",
-                  "|---|---|---|---|---|---|---|---|"]
-        for r in validation:
-            lines.append(f"| {r['material']} | {r['thickness_mm']:g} | {r['text']} | {r.get('model', 'sum')} | {r['rel_l2']:.1%} | "
-                         f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%} | {'yes' if r['within_tolerance'] else 'no'} |")
-        lines += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
-                  "surface deflection under depth control (surrogate.interaction_weights); sum x a = one "
-                  "factor per thickness fitted on these same solves (in-sample).", ""]
+        lines += validation_table(validation, "### Surrogate validation (superposition of single-dot responses against full 3D solves)")
     return "\n".join(lines)
+
+
+def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
+    """Markdown lines of surrogate-validation rows (array.chart.validate_surrogate), with the
+    errors of the pointwise maps and, where present, of the maps as the chart's finest taxels
+    read them; `mesh`: a column for r['mesh']."""
+    taxel = any("max_abs_over_peak_taxel" in r for r in rows)
+    head = ("| " + ("mesh | " if mesh else "") + "material | t (mm) | depth (mm) | text | model | rel. L2 | max error / peak | peak error"
+            + (" | taxel: max error / peak | taxel: peak error" if taxel else "") + " | within 5 % |")
+    out = [title, "", head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        ok = r.get("within_tolerance_taxel", r["within_tolerance"]) if taxel else r["within_tolerance"]
+        out.append("| " + (f"{r['mesh']} | " if mesh else "") + f"{r['material']} | {r['thickness_mm']:g} | "
+                   f"{r.get('depth_mm', float('nan')):.3g} | {r['text']} | {r.get('model', 'sum')} | {r['rel_l2']:.1%} | "
+                   f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%}"
+                   + (f" | {r['max_abs_over_peak_taxel']:.1%} | {r['peak_rel_taxel']:+.1%}" if taxel else "")
+                   + f" | {'yes' if ok else 'no'} |")
+    out += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
+            "surface deflection under depth control (surrogate.interaction_weights); sum x a = one "
+            "factor per thickness fitted on these same solves (in-sample); plate + sum = the blank plate's "
+            "map plus the plate-aware kernels (lone dot with plate minus blank plate, surrogate.plate_kernel), "
+            "where the depth passes the dot height. Errors over the full solve's peak, pointwise on its "
+            "bone-map grid and (taxel) after both maps are box-averaged over the chart's smallest taxel "
+            "(maps.taxel_averaged); within 5 % judges the taxel errors where given.", ""]
+    return out
 
 
 def _cell(a: float) -> str:

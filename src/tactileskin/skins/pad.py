@@ -131,10 +131,15 @@ class PadSkin(Skin):
     @classmethod
     def cache_content(cls, scene) -> dict:
         """An x-asymmetric indenter is solved on the full width (mesh.pad): its key changes
-        from the half model's it once had; the symmetric scenes keep theirs."""
+        from the half model's it once had; a 3D Braille scene is meshed by the local plan
+        (mesh.sizing.local_plan: fine at the dots only), not the strip plan it once had; the
+        other scenes keep their keys."""
         from tactileskin.geometry.indenters import indenter_symmetry
 
-        return {} if indenter_symmetry(scene)[0] else {"model": "full_width"}
+        out = {} if indenter_symmetry(scene)[0] else {"model": "full_width"}
+        if scene.dim == 3 and scene.indenter.value == "braille":
+            out["mesh_plan"] = "local"
+        return out
 
     @classmethod
     def label(cls, scene) -> str:
