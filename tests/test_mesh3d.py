@@ -11,6 +11,7 @@ import pytest
 from tactileskin.mesh import BOUNDARIES_3D, build_mesh
 from tactileskin.mesh.skinmesh import facet_nodes
 from tactileskin.scene import Scene
+from mesh_probe import edges_near
 
 COARSE = {"mesh_size": 1.5, "refinement": 1.5}  # a few thousand P2 tetrahedra: ~1 s
 
@@ -145,16 +146,6 @@ def test_cell_estimate_is_upper_side_3d(slab_t3):
 LOCAL = {"mesh_size": 1.2, "refinement": 4.0}  # fine 0.3 mm at the dot: ~10k dofs, ~1-2 s
 
 
-def _edges_near(sm, name, centre, radius):
-    """Median edge length of the `name` facets whose centroid is within radius of centre."""
-    m = sm.mesh
-    f = m.facets[:, sm.boundaries[name]]
-    d = np.linalg.norm(m.p[:, f].mean(axis=1) - np.asarray(centre, float)[:, None], axis=0)
-    sel = f[:, d < radius]
-    e = np.concatenate([np.linalg.norm(m.p[:, sel[i]] - m.p[:, sel[(i + 1) % 3]], axis=0) for i in range(3)])
-    return float(np.median(e)), sel.shape[1]
-
-
 @pytest.fixture(scope="module")
 def dot_t1():
     return build_mesh(Scene(thickness=1.0, dim=3, indenter="braille", braille_text=""), **LOCAL)
@@ -175,10 +166,10 @@ def test_local_plan_is_fine_under_the_dot_and_coarse_far_away(dot_t1):
     # gmsh meets the field to ~20 % (edges of a Delaunay mesh scatter around the target size);
     # far from the dot (z = 5 mm, 3.5 mm beyond the ball) the size is the coarse one, capped
     # by gmsh at about the skin thickness
-    near_out, n_out = _edges_near(dot_t1, "outer_surface", (0, y, 0), 0.6)
-    near_bone, n_bone = _edges_near(dot_t1, "bone_interface", (0, yb, 0), 1.0)
-    far_out, _ = _edges_near(dot_t1, "outer_surface", (0, y, 5.0), 1.0)
-    far_bone, _ = _edges_near(dot_t1, "bone_interface", (0, yb, 5.0), 1.0)
+    near_out, n_out = edges_near(dot_t1, "outer_surface", (0, y, 0), 0.6)
+    near_bone, n_bone = edges_near(dot_t1, "bone_interface", (0, yb, 0), 1.0)
+    far_out, _ = edges_near(dot_t1, "outer_surface", (0, y, 5.0), 1.0)
+    far_bone, _ = edges_near(dot_t1, "bone_interface", (0, yb, 5.0), 1.0)
     assert near_out < 1.2 * fine and near_bone < 1.2 * hb and n_out > 5 and n_bone > 10
     assert far_out > 0.75 * min(coarse, 2 * t) and far_bone > 0.75 * min(coarse, 2 * t)
 

@@ -8,6 +8,7 @@ from tactileskin.cache import cache_key
 from tactileskin.geometry import braille
 from tactileskin.mesh import build_mesh, sizing
 from tactileskin.scene import Scene
+from mesh_probe import edges_near
 
 LOCAL = {"mesh_size": 1.2, "refinement": 4.0}  # fine 0.3 mm at the dot: ~1-5k cells, < 1 s
 
@@ -15,16 +16,6 @@ LOCAL = {"mesh_size": 1.2, "refinement": 4.0}  # fine 0.3 mm at the dot: ~1-5k c
 def _pad(text, t=1.0, **kw):
     return Scene(**{"skin": "pad", "dim": 3, "indenter": "braille", "thickness": t, "braille_text": text,
                     **LOCAL, **kw})
-
-
-def _edges_near(sm, name, centre, radius):
-    """Median edge length of the `name` facets whose centroid is within radius of centre."""
-    m = sm.mesh
-    f = m.facets[:, sm.boundaries[name]]
-    d = np.linalg.norm(m.p[:, f].mean(axis=1) - np.asarray(centre, float)[:, None], axis=0)
-    sel = f[:, d < radius]
-    e = np.concatenate([np.linalg.norm(m.p[:, sel[i]] - m.p[:, sel[(i + 1) % 3]], axis=0) for i in range(3)])
-    return float(np.median(e)), sel.shape[1]
 
 
 def test_single_dot_on_the_pad_is_fine_at_the_dot_and_coarse_far_away():
@@ -41,10 +32,10 @@ def test_single_dot_on_the_pad_is_fine_at_the_dot_and_coarse_far_away():
     # gmsh meets the field to ~20 % (Delaunay edges scatter around the target size); far from
     # the dot (z = 7 mm, ~4 mm beyond the ball's graded shell) the size is the coarse one,
     # capped by gmsh at about twice the skin thickness
-    near_out, n_out = _edges_near(sm, "outer_surface", (0, t, 0), 0.6)
-    near_bone, n_bone = _edges_near(sm, "bone_interface", (0, 0, 0), 1.0)
-    far_out, _ = _edges_near(sm, "outer_surface", (0, t, 7.0), 1.5)
-    far_bone, _ = _edges_near(sm, "bone_interface", (7.0, 0, 7.0), 1.5)
+    near_out, n_out = edges_near(sm, "outer_surface", (0, t, 0), 0.6)
+    near_bone, n_bone = edges_near(sm, "bone_interface", (0, 0, 0), 1.0)
+    far_out, _ = edges_near(sm, "outer_surface", (0, t, 7.0), 1.5)
+    far_bone, _ = edges_near(sm, "bone_interface", (7.0, 0, 7.0), 1.5)
     assert near_out < 1.2 * fine and near_bone < 1.2 * hb and n_out > 5 and n_bone > 10
     assert far_out > 0.75 * min(coarse, 2 * t) and far_bone > 0.75 * min(coarse, 2 * t)
     # the strip plan refines the whole contact strip and 6 mm of the bonded bottom
@@ -65,10 +56,10 @@ def test_asymmetric_text_on_the_full_width_pad_is_fine_at_every_dot():
     got = {(round(b[0], 6), round(b[2], 6)) for b in sm.sizes["patches"]}
     assert {(round(x, 6), round(z, 6)) for x, z in inside} == got  # dot 1 (z < 0) lies > a ball away
     for x, z in inside:
-        near, n = _edges_near(sm, "outer_surface", (x, t, z), 0.5)
+        near, n = edges_near(sm, "outer_surface", (x, t, z), 0.5)
         assert near < 1.2 * fine and n > 3, (x, z, near, n)
     # between the columns (x = 0) and beyond the cell the top is coarser than at the dots
-    mid, _ = _edges_near(sm, "outer_surface", (0.0, t, 6.0), 1.5)
+    mid, _ = edges_near(sm, "outer_surface", (0.0, t, 6.0), 1.5)
     assert mid > 2.0 * fine
 
 
