@@ -57,10 +57,15 @@ def on_grid(f: Callable, s, z, section_z: float = 0.0) -> BoneMap:
     return BoneMap(s, z, f(S, Z), section_z)
 
 
+def resampled(m: BoneMap, s, z) -> np.ndarray:
+    """m's pressure on the grid s x z (rows z, columns s; bilinear, zero outside m)."""
+    return interpolator(m)(*np.meshgrid(np.asarray(s, float), np.asarray(z, float)))
+
+
 def relative_error(approx: BoneMap, ref: BoneMap) -> dict:
     """Errors of `approx` against `ref` on ref's grid: rel_l2 = ||a - r|| / ||r|| and
     max_abs_over_peak = max |a - r| / max r, peak_rel = (max a - max r) / max r."""
-    a = interpolator(approx)(*np.meshgrid(ref.s, ref.z))
+    a = resampled(approx, ref.s, ref.z)
     r = ref.pressure
     top = float(r.max())
     if top <= 0:
@@ -83,7 +88,7 @@ def taxel_averaged(m: BoneMap, side: float, h: float | None = None) -> BoneMap:
     h = side / n
     s = np.arange(m.s[0], m.s[-1] + 0.5 * h, h) if m.s.size > 1 else m.s.copy()
     z = np.arange(m.z[0], m.z[-1] + 0.5 * h, h) if m.z.size > 1 else m.z.copy()
-    P = on_grid(interpolator(m), s, z).pressure
+    P = resampled(m, s, z)
     # trapezoid weights over n + 1 samples: the box [-side/2, side/2] of the sampled map
     w = np.ones(n + 1)
     w[[0, -1]] = 0.5

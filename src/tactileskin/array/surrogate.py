@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactileskin.array.maps import interpolator, mirrored, relative_error, taxel_averaged
+from tactileskin.array.maps import interpolator, mirrored, relative_error, resampled, taxel_averaged
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille
 from tactileskin.results import BoneMap
@@ -70,15 +70,14 @@ def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None, b
     w = np.ones(len(centres)) if weights is None else np.asarray(weights, float)
     P = sum(wk * f(S - a, Z - b) for wk, a, b in zip(w, sk, centres[:, 1]))
     if base is not None:
-        P = P + interpolator(base)(S, Z)
+        P = P + resampled(base, s, z)
     return BoneMap(s, z, P, kernel.section_z)
 
 
 def plate_kernel(dot: BoneMap, blank: BoneMap) -> BoneMap:
     """The plate-aware kernel: the lone dot's map with its plate (`dot`, full) minus the blank
     plate's (`blank`, full; interpolated on the dot's grid), i.e. what one dot adds to the plate."""
-    S, Z = np.meshgrid(dot.s, dot.z)
-    return BoneMap(dot.s, dot.z, dot.pressure - interpolator(blank)(S, Z), dot.section_z)
+    return BoneMap(dot.s, dot.z, dot.pressure - resampled(blank, dot.s, dot.z), dot.section_z)
 
 
 def interaction_weights(centres, deflection) -> np.ndarray:
@@ -116,7 +115,7 @@ def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="stand
     approx = superpose(kernel, c, section, ref.s, ref.z, weights=w)
     P = scale * approx.pressure
     if base is not None:
-        P = P + interpolator(base)(*np.meshgrid(ref.s, ref.z))
+        P = P + resampled(base, ref.s, ref.z)
     approx = BoneMap(approx.s, approx.z, P, approx.section_z)
     err = relative_error(approx, ref)
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
@@ -136,7 +135,7 @@ def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american
     for text, full in fulls.items():
         ref = mirrored(full)
         approx = superpose(kernel, braille.dot_centres(text, standard), section, ref.s, ref.z)
-        b = 0.0 if base is None else interpolator(base)(*np.meshgrid(ref.s, ref.z))
+        b = 0.0 if base is None else resampled(base, ref.s, ref.z)
         num += float(np.sum(approx.pressure * (ref.pressure - b)))
         den += float(np.sum(approx.pressure ** 2))
     if not den > 0:
