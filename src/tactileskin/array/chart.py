@@ -40,7 +40,6 @@ GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
 SETS = ("paper", "letters")
 SKINS = ("pad", "fingertip")
-DEPTH_FRACTION = 0.2        # the scenes' default depth, 20 % of t (Scene.depth_fraction)
 
 
 @dataclass(frozen=True)
@@ -92,7 +91,10 @@ class ChartConfig:
     def depth_for(self, thickness: float) -> float | None:
         """The depth (mm) a chart scene of this thickness is given: None (the scene's 20 % of t)
         unless that exceeds max_depth."""
-        if self.max_depth is None or DEPTH_FRACTION * thickness <= self.max_depth:
+        from tactileskin.scene import Scene
+
+        # the scenes' default depth (Scene.depth_fraction x t, the paper's 20 %)
+        if self.max_depth is None or Scene.depth_fraction * thickness <= self.max_depth:
             return None
         return float(self.max_depth)
 
