@@ -116,9 +116,12 @@ PULL_FRACTION = 1.0
 
 
 class _Failure(Exception):
-    def __init__(self, why: str, diag: dict):
+    """A failed increment solve. inline_uzawa: whether Newton updated the multipliers inline
+    before failing (only then can a retry with one Newton solve per update differ)."""
+
+    def __init__(self, why: str, diag: dict, inline_uzawa: bool = True):
         super().__init__(why)
-        self.why, self.diag = why, diag
+        self.why, self.diag, self.inline_uzawa = why, diag, inline_uzawa
 
 
 @dataclass
@@ -318,7 +321,7 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
                 lam = np.where(off, -np.inf, lam)  # lambda_N = max(0, -inf) = 0 there
     ev = model.evaluate(u, t, dt, lam, tangent=False, sticky=sticky)
     if not ev.ok:
-        raise _Failure(f"start state inadmissible ({ev.why})", {"history": []})
+        raise _Failure(f"start state inadmissible ({ev.why})", {"history": []}, inline_uzawa=False)
     hist = []
     releases = 0
     it = 0
@@ -340,7 +343,8 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             if reduced is not None:
                 releases += 1
                 if releases > opts.max_releases:
-                    raise _Failure("contact points keep pulling after release", {"history": hist})
+                    raise _Failure("contact points keep pulling after release", {"history": hist},
+                                   inline_uzawa=last_uzawa >= 0)
                 log.debug("  releasing %d pulling contact points", int(np.sum(sticky & ~reduced)))
                 released |= sticky & ~reduced
                 sticky = reduced
@@ -366,19 +370,22 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             forcing = min(1e-3, opts.linear_forcing * rn / scale) if scale > 0 else None
             du[free] = -_factor(model, model.pattern.free_matrix(K), opts).solve(Rf, rtol=forcing)
         except (RuntimeError, FloatingPointError) as e:  # singular factor
-            raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)}) from None
+            raise _Failure(f"singular tangent ({e})", {"history": hist, **_worst(model, ev.R)},
+                           inline_uzawa=last_uzawa >= 0) from None
         stats.factorizations += 1
         if not np.all(np.isfinite(du)):
-            raise _Failure("non-finite Newton step", {"history": hist, **_worst(model, ev.R)})
+            raise _Failure("non-finite Newton step", {"history": hist, **_worst(model, ev.R)},
+                           inline_uzawa=last_uzawa >= 0)
         eta, tn, trial = _line_search(model, u, du, ev, t, dt, lam, opts, sticky)
         if trial is None:
-            raise _Failure("line search found no admissible state", {"history": hist, **_worst(model, ev.R)})
+            raise _Failure("line search found no admissible state", {"history": hist, **_worst(model, ev.R)},
+                           inline_uzawa=last_uzawa >= 0)
         if tn > opts.max_residual_growth * rn:
             # measured (t = 1 silicone, curved): an ascent direction (indefinite tangent)
             # taken at eta = 1/32 raised |R| 2400x into the lock-up; Newton then spent its
             # budget unwinding it. A smaller increment converges in 4-6 iterations.
             raise _Failure(f"Newton step raised the residual {tn / max(rn, 1e-300):.3g}x",
-                           {"history": hist + [tn], **_worst(model, trial.R)})
+                           {"history": hist + [tn], **_worst(model, trial.R)}, inline_uzawa=last_uzawa >= 0)
         if eta < 1.0:
             log.debug("  line search eta = %.4g", eta)
         u = u + eta * du
@@ -390,7 +397,8 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             sticky = _stick(ev, sticky, released)
         stats.newton_iterations += 1
         it += 1
-    raise _Failure("Newton did not converge", {"history": hist, **_worst(model, ev.R)})
+    raise _Failure("Newton did not converge", {"history": hist, **_worst(model, ev.R)},
+                   inline_uzawa=last_uzawa >= 0)
 
 
 def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts: SolverOptions, stats: Stats):
@@ -408,11 +416,13 @@ def _newton_uzawa(model: Model, u_pred: np.ndarray, t: float, dt: float, opts: S
         lam = np.maximum(0.0, lam + (lam - model.surface.lam_prev) * (dt / model.dt_prev))
     try:
         u, ev, its, hist, lam = newton(model, u_pred, t, dt, lam, opts, stats)
-    except _Failure:
-        if not opts.uzawa_inline or model.surface is None:
+    except _Failure as f:
+        if not opts.uzawa_inline or model.surface is None or not f.inline_uzawa:
             raise
         # in the lock-up the inline updates can keep Newton from settling (1 mm silicone at
-        # 40 %): retry the increment with a fresh Newton solve per update
+        # 40 %): retry the increment with a fresh Newton solve per update. Not when no update
+        # was made: the retry would repeat the same iterates (the 3D dot's first increment at
+        # t = 3 spent 10 Newton iterations on that)
         opts = replace(opts, uzawa_inline=False)
         lam = model.surface.lam.copy()
         u, ev, its, hist, lam = newton(model, u_pred, t, dt, lam, opts, stats)
