@@ -215,3 +215,21 @@ def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
     assert set(by) == {"sum", "plate + sum"} and all(r["depth_mm"] == pytest.approx(0.6) for r in rows)
     assert by["plate + sum"]["max_abs_over_peak"] < 2e-3 and by["plate + sum"]["within_tolerance_taxel"]
     assert by["sum"]["max_abs_over_peak"] > 0.5  # three dots count the plate three times
+
+
+@pytest.mark.slow
+def test_solve_cached_on_two_workers_matches_one_and_solves_a_repeated_scene_once(tmp_path):
+    """The chart's batch solve: two worker processes give the records one process gives (same
+    cache keys, same peaks), and a scene asked twice (the same blank plate for two sets) is
+    solved once."""
+    from tactileskin.cache import ResultCache
+
+    scenes = [Scene(thickness=t, indenter="flat", mesh_size=1.0, refinement=5.0) for t in (1.0, 3.0)]
+    events = []
+    par = chart.solve_cached(scenes + scenes[:1], ResultCache(tmp_path / "a"), on_event=events.append, workers=2)
+    ser = chart.solve_cached(scenes, ResultCache(tmp_path / "b"), workers=1)
+    assert [e.status for e in events] == ["done", "done"]
+    assert set(par) == set(ser) == set(scenes)
+    for sc in scenes:
+        assert par[sc].summary["peak_mpa"] == pytest.approx(ser[sc].summary["peak_mpa"], rel=1e-12)
+        assert np.allclose(par[sc].pressure, ser[sc].pressure, rtol=1e-12, atol=0)

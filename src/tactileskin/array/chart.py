@@ -154,13 +154,17 @@ def blank_map(scene, record, like: BoneMap) -> BoneMap:
     return extruded(record.s, record.pressure, like.z)
 
 
-def solve_cached(scenes, cache, on_event=None) -> dict:
-    """{scene: cache record} through the sweep's cache (serial: one heavy solve at a time).
-    A failed case raises TactileSkinError naming it."""
+def solve_cached(scenes, cache, on_event=None, workers: int | None = None) -> dict:
+    """{scene: cache record} through the sweep's cache, the uncached cases on a local Dask
+    cluster of `workers` processes (None: one per core; 1: in this process). Every solve
+    is single-threaded, so two cores solve two cases at once: the chart's nine 3D solves of
+    one material took 553 s one at a time. A failed case raises TactileSkinError naming it."""
     from tactileskin.sweep import run_sweep
 
+    scenes = list(dict.fromkeys(scenes))
     out = {}
-    for oc in run_sweep(list(scenes), cache, serial=True, on_event=on_event):
+    serial = workers == 1 or len(scenes) == 1
+    for oc in run_sweep(scenes, cache, serial=serial, workers=workers, on_event=on_event):
         if oc.status == "failed":
             raise TactileSkinError(f"solve of {oc.case or oc.scene.label()} failed: {oc.error}")
         out[oc.scene] = oc.record
@@ -241,24 +245,35 @@ class Chart:
         return "\n".join(lines) + "\n"
 
 
-def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = None) -> Chart:
-    """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`."""
+def _chart_scenes(cfg: ChartConfig, material: str, t: float) -> tuple:
+    """(dot, paper dot, blank plate, {flat, curved} sections) of one material and thickness:
+    the letters on cfg.skin; the paper set (flat, curved, dot) on the paper's fingertip, where
+    its 2D sections are exact (a plate wider than the pad has no converged solve there)."""
+    dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
+    pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
+    sec2 = {k: section_scene(t, material, k, depth=cfg.depth_for(t)) for k in ("flat", "curved")} if pdot else {}
+    blank = blank_scene(dot) if dot is not None and plate_touches(dot) else None
+    return dot, pdot, blank, sec2
+
+
+def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = None,
+            workers: int | None = None) -> Chart:
+    """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`,
+    all of them first, in one batch on `workers` processes (solve_cached)."""
     from tactileskin.array import halfspace
 
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     chart = Chart(cfg)
+    cases = {(m, t): _chart_scenes(cfg, m, t) for m in cfg.materials for t in cfg.thicknesses}
+    wanted = [x for dot, pdot, blank, sec2 in cases.values()
+              for x in (dot, pdot, blank, *sec2.values()) if x is not None]
+    say(f"solving {len(set(wanted))} cases (cached cases are read)")
+    recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
+                        **({} if workers is None else {"workers": workers}))
     for material in cfg.materials:
         for t in cfg.thicknesses:
-            # letters on cfg.skin; the paper set (flat, curved, dot) on the paper's fingertip, where
-            # its 2D sections are exact (a plate wider than the pad has no converged solve there)
-            dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
-            pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
-            sec2 = {k: section_scene(t, material, k, depth=cfg.depth_for(t)) for k in ("flat", "curved")} if pdot else {}
-            blank = blank_scene(dot) if dot is not None and plate_touches(dot) else None
-            say(f"{material} t = {t:g} mm: solving (cached cases are read)")
-            recs = solve_cached([x for x in (dot, pdot, blank) if x is not None] + list(sec2.values()), cache,
-                                on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
+            dot, pdot, blank, sec2 = cases[(material, t)]
             kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
             height = get_standard(cfg.standard).height
             base = None
@@ -350,7 +365,8 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
     return out
 
 
-def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None) -> list[dict]:
+def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None,
+                       workers: int | None = None) -> list[dict]:
     """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
     text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
     lone dot's surface deflection, surrogate.interaction_weights), "sum x a" (one scale a per
@@ -370,13 +386,15 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 raise ParameterError("validate text", x, "a text mirror-symmetric about x = 0 on the fingertip "
                                      "(its half model would solve the mirrored text; use skin pad)")
     rows = []
+    cases = {}
     for t in thicknesses:
         dot = dot_scene(t, material, cfg)
-        fulls = [dot_scene(t, material, cfg, x) for x in texts]
-        blank = blank_scene(dot) if plate_touches(dot) else None
-        say(f"validation {material} t = {t:g} mm: {len(fulls)} full solves (cached cases are read)")
-        recs = solve_cached([x for x in (dot, blank) if x is not None] + fulls, cache,
-                            on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"))
+        cases[t] = dot, [dot_scene(t, material, cfg, x) for x in texts], blank_scene(dot) if plate_touches(dot) else None
+    say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
+    recs = solve_cached([x for dot, fulls, blank in cases.values() for x in (dot, blank, *fulls) if x is not None],
+                        cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
+                        **({} if workers is None else {"workers": workers}))
+    for t, (dot, fulls, blank) in cases.items():
         kernel = bone_map_of(recs[dot])
         sec = dot.section()
         refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}

@@ -56,10 +56,12 @@ def load_config(path) -> dict:
                    "fingertip (the paper's; validation refuses x-asymmetric texts, solved mirrored there).")
 @click.option("--validate", default=None,
               help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, seed, skin, validate, cache_dir):
+            refinement, max_depth, seed, skin, validate, workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast."""
     from rich.console import Console
     from rich.markup import escape
@@ -94,11 +96,12 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
     cache = ResultCache(cache_dir or out / "cache")
     say = lambda msg: console.print(escape(msg), highlight=False)  # noqa: E731
     with claimed_output(out, "array", OWN_NAMES):
-        chart = compute(cfg, cache, progress=say)
+        chart = compute(cfg, cache, progress=say, workers=workers)
         rows = None
         if texts:
             rows = [r for m in cfg.materials
-                    for r in validate_surrogate(cfg.thicknesses, m, list(texts), cfg, cache, progress=say)]
+                    for r in validate_surrogate(cfg.thicknesses, m, list(texts), cfg, cache, progress=say,
+                                                    workers=workers)]
         paths = write_outputs(chart, out, rows)
     console.print(f"report: {escape(str(paths['report']))} ({chart.seconds:.0f} s)", highlight=False)
     return 0
