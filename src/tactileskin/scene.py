@@ -28,8 +28,10 @@ from tactileskin.skins import registry as _skins
 # off the first Newton step of an increment, earlier multiplier updates: other increment
 # sequences, peaks within 0.06 %; 5: result.vtu carries the contact pressure on the outer
 # surface; 6: contact penalty raised per point, other increment sequences on 3D dots past
-# travel 0.3 mm, peaks within 0.01 %)
-SCHEMA_VERSION = 6
+# travel 0.3 mm, peaks within 0.01 %; 7: the first increment's travel capped at 0.1 x the
+# indenter's tip radius, other increment sequences for dots, spheres and cylinders, peaks
+# within 0.03 %)
+SCHEMA_VERSION = 7
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

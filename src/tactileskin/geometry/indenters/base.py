@@ -127,6 +127,12 @@ class Indenter:
         return self.y0
 
     @property
+    def tip_radius(self) -> float:
+        """Smallest radius of curvature (mm) of the working face where it first touches: the
+        strain a travel d makes there scales as sqrt(d / R) (inf: flat or unknown)."""
+        return float("inf")
+
+    @property
     def section_z(self) -> float:
         """z of the plane whose section a 2D model (and the 3D profile) uses."""
         return 0.0

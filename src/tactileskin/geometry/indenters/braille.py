@@ -99,6 +99,10 @@ class BrailleIndenter(Indenter):
         return float(self.rows[self.row])
 
     @property
+    def tip_radius(self) -> float:
+        return float(self.standard.sphere_radius)
+
+    @property
     def section_x(self) -> np.ndarray:
         """x of the dot centres cut by the 2D section plane z = section_z (sorted)."""
         on = np.abs(self.dots[:, 1] - self.section_z) <= _ROW_TOL

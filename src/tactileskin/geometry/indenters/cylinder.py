@@ -67,6 +67,10 @@ class CylinderIndenter(Indenter):
                    back_thickness=back, **stem)
 
     @property
+    def tip_radius(self) -> float:
+        return float(self.radius)
+
+    @property
     def chord(self) -> float:
         """Extent of the curved face across the axis."""
         return self.width if self.axis == "z" else self.length

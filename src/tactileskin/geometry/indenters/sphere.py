@@ -45,6 +45,10 @@ class SphereIndenter(Indenter):
         stem["stem_diameter"] = min(stem["stem_diameter"], 1.6 * R)  # the stem fits the ball
         return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem)
 
+    @property
+    def tip_radius(self) -> float:
+        return float(self.radius)
+
     def centre(self, d: float = 0.0) -> np.ndarray:
         return np.array([0.0, self.y0 + self.radius - d, 0.0])
 
