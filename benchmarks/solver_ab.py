@@ -9,7 +9,7 @@ Cases are Scene keyword sets, named; variants are SolverOptions keyword sets:
 
 Built-in case sets (--set): "braille2d" (the 2D ridge at t = 1, 3, 5, both paper materials,
 preview and default meshes), "braille3d" (the single 3D dot: t = 1 default, t = 3 preview,
-t = 5 preview, silicone), "chart" (the array chart's 3D dots at t = 5 on the pad, 0.4 mm).
+t = 5 preview, silicone), "braille3d_default" (t = 3 and 5 at the default preset), "chart" (the array chart's 3D dots at t = 5 on the pad, 0.4 mm).
 """
 
 from __future__ import annotations
@@ -33,6 +33,9 @@ SETS = {
         "t3-silicone-dot-3d-preview": dict(thickness=3.0, dim=3, indenter="braille", quality="preview"),
         "t5-silicone-dot-3d-preview": dict(thickness=5.0, dim=3, indenter="braille", quality="preview"),
     },
+    "braille3d_default": {
+        f"t{t:g}-silicone-dot-3d-default": dict(thickness=t, dim=3, indenter="braille", quality="default")
+        for t in (3.0, 5.0)},
     "chart": {f"pad-t5-{m}-dot-3d-0.4mm": dict(thickness=5.0, material=m, dim=3, indenter="braille", skin="pad",
                                                pad_width=20.0, pad_length=20.0, depth=0.4, mesh_size=1.2,
                                                refinement=8.0)

@@ -1,0 +1,56 @@
+"""How far the letters' surrogate is trusted at each thickness: its measured error against
+full 3D solves, from this run's validation rows (`chart.validate_surrogate`) or, failing
+those, from the project's measurements in tactileskin/data/surrogate_validation.json.
+
+The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
+validated characters (the plain sum, the model the chart uses); where nothing matches it is
+not validated. Either way the chart says so beside the letters' accuracies.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from importlib import resources
+
+DATA = ("data", "surrogate_validation.json")
+_TOL = 1e-9
+
+
+@lru_cache(maxsize=1)
+def load() -> dict:
+    """The parsed measurement file (cached; do not mutate)."""
+    return json.loads(resources.files("tactileskin").joinpath(*DATA).read_text(encoding="utf-8"))
+
+
+def tolerance() -> float:
+    return float(load()["tolerance"])
+
+
+def _match(a: float, b: float) -> bool:
+    return abs(float(a) - float(b)) <= _TOL * max(1.0, abs(float(a)))
+
+
+def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None) -> dict:
+    """{"error": worst taxel error over the peak or None, "texts": the validated characters,
+    "source": where the numbers come from, "status": "within" | "exceeds" | "not validated"}."""
+    rows, source = [], ""
+    for r in validation or ():
+        if r.get("model", "sum") == "sum" and r["material"] == material and _match(r["thickness_mm"], t) \
+                and _match(r.get("depth_mm", depth), depth) and "max_abs_over_peak_taxel" in r:
+            rows.append({"text": r["text"], "taxel_max_error": r["max_abs_over_peak_taxel"]})
+            source = "this run's validation"
+    if not rows:
+        for case in load()["cases"]:
+            if case["material"] != material or case["skin"] != skin or \
+                    not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
+                continue
+            for r in case["rows"]:
+                if _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth):
+                    rows.append(r)
+                    source = r["source"]
+    if not rows:
+        return {"error": None, "texts": [], "source": "", "status": "not validated"}
+    err = max(float(r["taxel_max_error"]) for r in rows)
+    return {"error": err, "texts": [r["text"] for r in rows], "source": source,
+            "status": "within" if err <= tolerance() else "exceeds"}
