@@ -1,5 +1,7 @@
 """`tactileskin array`: user mistakes give one line and leave no output folder."""
 
+import pytest
+
 from tactileskin.cli import main
 
 
@@ -24,3 +26,16 @@ def test_refuses_a_foreign_folder(tmp_path, capsys):
     (out / "mine.txt").write_text("x")
     assert main(["array", "-o", str(out), "-t", "1", "--set", "paper"]) != 0
     assert (out / "mine.txt").read_text() == "x" and sorted(p.name for p in out.iterdir()) == ["mine.txt"]
+
+
+@pytest.mark.slow
+def test_a_chart_on_an_unvalidated_surrogate_is_written_and_exits_suspect(tmp_path, capsys):
+    """A real (coarse) run: polyurethane letters at t = 0.5 rest on a surrogate nobody validated:
+    the chart is written, says so, and the command exits 3 like a suspect solve or sweep."""
+    out = tmp_path / "chart"
+    rc = main(["array", "-o", str(out), "-t", "0.5", "-m", "polyurethane", "--set", "letters", "--letters", "abc",
+               "--pitch", "0.5", "--noise", "0.01", "--offsets", "2", "--mesh-size", "1.6"])
+    assert rc == 3
+    md = (out / "array_chart.md").read_text(encoding="utf-8")
+    assert "| 0.5 † | 0.01 |" in md and "not validated: indicative only" in md
+    assert "suspect: polyurethane" in capsys.readouterr().err

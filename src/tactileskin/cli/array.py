@@ -10,6 +10,7 @@ import click
 from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
+EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve` and `sweep`)
 OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
              *(f"array_{m}_{s}.{e}" for m in ("silicone", "polyurethane") for s in ("paper", "letters")
                for e in ("png", "svg")))
@@ -62,13 +63,17 @@ def load_config(path) -> dict:
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
             refinement, max_depth, seed, skin, validate, workers, cache_dir):
-    """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast."""
+    """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
+
+    Exit status 0, or 3 when the chart was written but a part of it is suspect (the letters'
+    surrogate not shown within 5 % of full solves at some thickness, or the plate touching):
+    the report lists them."""
     from rich.console import Console
     from rich.markup import escape
 
     from tactileskin.array.chart import ChartConfig, compute, validate_surrogate
     from tactileskin.cache import ResultCache
-    from tactileskin.report.array_chart import write_outputs
+    from tactileskin.report.array_chart import suspect, write_outputs
     from tactileskin.sweep import parse_values
 
     console = Console(stderr=True)
@@ -104,4 +109,7 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                                                     workers=workers)]
         paths = write_outputs(chart, out, rows)
     console.print(f"report: {escape(str(paths['report']))} ({chart.seconds:.0f} s)", highlight=False)
-    return 0
+    notes = suspect(chart, rows)
+    for n in notes:
+        console.print(f"suspect: {escape(n)}", highlight=False)
+    return EXIT_SUSPECT if notes else 0

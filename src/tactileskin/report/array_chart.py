@@ -43,7 +43,8 @@ def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
                     i = ts.index(5.0)
                     ax.add_patch(plt.Rectangle((-0.5, i - 0.5), len(ps), 1, fill=False, hatch="//",
                                                edgecolor="tab:red", lw=0.0, label="paper: 5 mm cannot"))
-            axes[0][0].legend(loc="upper right", fontsize=7, framealpha=0.8)
+            if axes[0][0].get_legend_handles_labels()[0]:  # the paper's marks, where on the grid
+                axes[0][0].legend(loc="upper right", fontsize=7, framealpha=0.8)
             fig.colorbar(im, ax=axes[0].tolist(), label=f"accuracy ({method})", shrink=0.9)
             fig.suptitle(f"{material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", fontsize=10)
             paths += _save(fig, out, f"array_{material}_{set_}")
@@ -88,7 +89,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
             lines.append("")
     if "letters" in cfg.sets:
         lines += _trust_section(chart, trust)
-    notes = list(getattr(chart, "notes", None) or []) + _trust_notes(trust)
+    notes = suspect(chart, validation, trust)
     if notes:
         lines += ["**Suspect:** " + n for n in notes] + [""]
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
@@ -116,6 +117,14 @@ def letters_trust(chart, validation=None) -> dict:
             out[(material, t)] = measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
                                           float(dot.indentation), validation)
     return out
+
+
+def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
+    """What makes a part of the chart suspect: the chart's notes (plate contact) and every
+    material whose letters rest on a surrogate not shown within the tolerance."""
+    if trust is None:
+        trust = letters_trust(chart, validation) if "letters" in chart.config.sets else {}
+    return list(getattr(chart, "notes", None) or []) + _trust_notes(trust)
 
 
 def _trust_section(chart, trust: dict) -> list[str]:
