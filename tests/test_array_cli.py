@@ -30,8 +30,8 @@ def test_refuses_a_foreign_folder(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_a_chart_on_an_unvalidated_surrogate_is_written_and_exits_suspect(tmp_path, capsys):
-    """A real (coarse) run: polyurethane letters at t = 0.5 rest on a surrogate nobody validated:
-    the chart is written, says so, and the command exits 3 like a suspect solve or sweep."""
+    """A real (coarse) run: letters at t = 0.5 on a mesh nobody validated the surrogate on: the
+    chart is written, says so, and the command exits 3 like a suspect solve or sweep."""
     out = tmp_path / "chart"
     rc = main(["array", "-o", str(out), "-t", "0.5", "-m", "polyurethane", "--set", "letters", "--letters", "abc",
                "--pitch", "0.5", "--noise", "0.01", "--offsets", "2", "--mesh-size", "1.6"])
