@@ -278,3 +278,57 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     # on the fingertip nothing is validated: every letters row marked, the 0.75 mm verdict qualified
     md = markdown(chart.compute(chart.ChartConfig(**{**cfg.__dict__, "skin": "fingertip"}), cache=None))
     assert "| 1 † | 0.01 |" in md and "(indicative: the letters' surrogate is not validated at t = 1 mm)" in md
+
+
+def test_a_full_solve_is_placed_in_the_full_cell_frame():
+    """surrogate.placed: the map of a letter solved with its own dots centred (dot_centres) lands
+    with a peak on each of its dots in the chart's full-cell frame (cell_centres); on the pad
+    the translation is exact, so the superposition of Gaussians placed there matches it."""
+    from tactileskin.geometry.braille import LETTERS as MASKS
+
+    sec = chart.dot_scene(1.0, "silicone", chart.ChartConfig()).section()
+    grid = np.linspace(-9, 9, 361)
+    for letter in "abk":
+        own = braille.dot_centres(letter)
+        cell = surrogate.cell_centres(MASKS[letter])
+        assert not np.allclose(own.mean(axis=0), cell.mean(axis=0))  # the frames differ for these letters
+        full = maps.on_grid(lambda s, z: sum(_gauss(a, b, w=0.3)(s, z) for a, b in own), grid, grid)
+        got = surrogate.placed(full, letter, sec)
+        want = maps.on_grid(lambda s, z: sum(_gauss(a, b, w=0.3)(s, z) for a, b in cell), grid, grid)
+        # the grid moves by the frames' offset exactly (s = x on the pad) ...
+        assert np.allclose(got.s - grid, cell[:, 0].mean() - own[:, 0].mean(), atol=1e-12)
+        assert np.allclose(got.z - grid, cell[:, 1].mean() - own[:, 1].mean(), atol=1e-12)
+        # ... and the values compare within the bilinear resampling error of relative_error:
+        # h^2 / 8 |f''| per direction = 0.05^2 / 8 / 0.3^2 = 0.35 % of the peak, two directions
+        assert maps.relative_error(got, want)["max_abs_over_peak"] < 0.01
+    with pytest.raises(ParameterError):
+        surrogate.placed(full, "ab", sec)
+
+
+def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypatch, tmp_path):
+    """letters_model = "full": one 3D scene per letter and thickness is asked, the letters' maps
+    come from those solves, and the report marks no letters row (no surrogate)."""
+    from types import SimpleNamespace
+
+    from tactileskin.report.array_chart import markdown, suspect
+
+    grid = np.linspace(-8, 8, 161)
+    asked = []
+
+    def fake_solve(scenes, cache, on_event=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path) for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    read = []
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: read.append(path) or maps.on_grid(_gauss(w=0.5), grid, grid))
+    cfg = chart.ChartConfig(thicknesses=(2.0,), pitches=(0.5,), noise_fs=(0.01,), letters="abk", n_train=4,
+                            n_test=4, template_grid=2, letters_model="full", sets=("letters",))
+    ch = chart.compute(cfg, cache=None)
+    texts = sorted(sc.braille_text for sc in asked if sc.dim == 3)
+    assert texts == ["", "a", "b", "k"] and len(read) == 3
+    md = markdown(ch)
+    assert "| 2 | 0.01 |" in md and "full 3D solves of every letter" in md and not suspect(ch)
+    with pytest.raises(ParameterError, match="letters_model"):
+        chart.ChartConfig(letters_model="guess")

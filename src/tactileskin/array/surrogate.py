@@ -141,3 +141,21 @@ def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american
     if not den > 0:
         raise ParameterError("surrogate", "zero superposition", "a kernel with a positive response")
     return num / den
+
+
+def placed(full: BoneMap, text: str, section, standard="standard_american") -> BoneMap:
+    """The full solve's map of a one-cell `text` (braille.dot_centres: the pattern centred on
+    its own dots; a half or quarter map is mirrored) moved to the full-cell frame of
+    `cell_centres`, where the chart reads every character: a translation (s through
+    `bone_s_under`: exact on the flat pad, approximate across the curved fingertip)."""
+    from tactileskin.geometry.braille import check_text
+
+    cells = check_text(text)
+    if len(cells) != 1 or len(cells[0]) != 1:
+        raise ParameterError("text", text, "one Braille cell")
+    ref = mirrored(full)
+    solver = braille.dot_centres(text, standard)
+    cell = cell_centres(cells[0][0], standard)
+    a, b = cell.mean(axis=0), solver.mean(axis=0)  # the same pattern, translated
+    ds = float(np.diff(bone_s_under(np.array([b[0], a[0]]), section))[0])
+    return BoneMap(ref.s + ds, ref.z + float(a[1] - b[1]), ref.pressure, ref.section_z)

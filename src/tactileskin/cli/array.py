@@ -16,7 +16,7 @@ OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
                for e in ("png", "svg")))
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
-        "validate", "skin", "max_depth"}
+        "validate", "skin", "max_depth", "letters_model"}
 
 
 def load_config(path) -> dict:
@@ -57,12 +57,15 @@ def load_config(path) -> dict:
                    "fingertip (the paper's; validation refuses x-asymmetric texts, solved mirrored there).")
 @click.option("--validate", default=None,
               help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
+@click.option("--letters-model", type=click.Choice(["sum", "full"]), default=None,
+              help="Letters from superposed single-dot solves (sum, default; its measured error is in the "
+                   "report) or a full 3D solve of every letter (full: one solve per letter and thickness).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, seed, skin, validate, workers, cache_dir):
+            refinement, max_depth, seed, skin, validate, letters_model, workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
 
     Exit status 0, or 3 when the chart was written but a part of it is suspect (the letters'
@@ -86,7 +89,7 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  noise_fs=noise and tuple(parse_values(noise, "noise")),
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
-                 max_depth=max_depth)
+                 max_depth=max_depth, letters_model=letters_model)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:
         texts = names(validate, "validate")

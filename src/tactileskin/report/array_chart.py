@@ -113,6 +113,10 @@ def letters_trust(chart, validation=None) -> dict:
     cfg, out = chart.config, {}
     for material in cfg.materials:
         for t in cfg.thicknesses:
+            if cfg.letters_model == "full":
+                out[(material, t)] = {"error": None, "texts": list(cfg.letters), "status": "within",
+                                      "source": "full 3D solves of every letter (no surrogate)"}
+                continue
             dot = dot_scene(t, material, cfg)
             out[(material, t)] = measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
                                           float(dot.indentation), validation)
@@ -130,13 +134,17 @@ def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
 def _trust_section(chart, trust: dict) -> list[str]:
     from tactileskin.array.validity import tolerance
 
+    cfg_full = chart.config.letters_model == "full"
+
     out = ["### How far the letters can be trusted", "",
-           "The letters are superposed single-dot responses (a surrogate). Its error against full 3D "
-           "solves of the same characters, as the chart's smallest taxels read them (worst over the "
-           "validated characters; `tactileskin array --validate` measures it for a run):", "",
+           ("The letters are full 3D solves of every letter (`letters_model = full`)." if cfg_full else
+            "The letters are superposed single-dot responses (a surrogate). Its error against full 3D "
+            "solves of the same characters, as the chart's smallest taxels read them (worst over the "
+            "validated characters; `tactileskin array --validate` measures it for a run; "
+            "`--letters-model full` solves every letter instead):"), "",
            "| material | t (mm) | surrogate error / peak | validated on | status | source |", "|---|---|---|---|---|---|"]
     for (material, t), m in trust.items():
-        err = "-" if m["error"] is None else f"{m['error']:.1%}"
+        err = ("0 (full solves)" if cfg_full else "-") if m["error"] is None else f"{m['error']:.1%}"
         status = {"within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
         out.append(f"| {material} | {t:g} | {err} | {', '.join(m['texts']) or '-'} | {status} | {m['source'] or '-'} |")
