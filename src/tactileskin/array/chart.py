@@ -207,16 +207,19 @@ def extruded(s, p, z) -> BoneMap:
 
 
 def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None,
-                  base: BoneMap | None = None) -> dict:
+                  base: BoneMap | None = None, letters: dict | None = None) -> dict:
     """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
     single dot on cfg.skin, `section` its section; plus `base`, the blank plate, for the
-    plate-aware kernel), the paper set's dot `paper_kernel` (the fingertip's; default `kernel`)."""
+    plate-aware kernel) unless given as `letters` (full solves), the paper set's dot
+    `paper_kernel` (the fingertip's; default `kernel`)."""
     out = {}
     if "paper" in cfg.sets:
         pk = kernel if paper_kernel is None else paper_kernel
         out["paper"] = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")}
         out["paper"]["braille"] = pk
-    if "letters" in cfg.sets:
+    if "letters" in cfg.sets and letters is not None:
+        out["letters"] = letters
+    elif "letters" in cfg.sets:
         from tactileskin.geometry.braille import LETTERS as MASKS
 
         out["letters"] = {c: surrogate.superpose(kernel, surrogate.cell_centres(MASKS[c], cfg.standard), section,
@@ -312,11 +315,10 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                                       "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
                                       "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
                                       "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
-            sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base)
-            if full[(material, t)]:
-                sets["letters"] = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c,
-                                                       dot.section(), cfg.standard)
-                                   for c, sc in full[(material, t)].items()}
+            letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
+                                           cfg.standard) for c, sc in full[(material, t)].items()} or None
+            sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
+                                 letters=letters)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())

@@ -24,7 +24,10 @@ def load() -> dict:
 
 
 def tolerance() -> float:
-    return float(load()["tolerance"])
+    """The surrogate's bound (surrogate.TOLERANCE), a fraction of the full map's peak."""
+    from tactileskin.array.surrogate import TOLERANCE
+
+    return float(TOLERANCE)
 
 
 def _match(a: float, b: float) -> bool:
