@@ -430,8 +430,12 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                        f"{_model_cell(c['ours'], 3)} | {_model_cell(c['verdict'], 3)} | "
                        f"{'**changes**' if c['changed'] else '–'} |")
         changed = [c["claim"] for c in checks if c["changed"]]
+        one = [c["claim"] for c in checks if len(c["verdict"]) < len(BRAILLE_MODELS)]
         out += ["", ("Verdicts the 3D dots change: " + "; ".join(changed) + ".") if changed
-                else "No verdict changes from the 2D ridge to the 3D dots."]
+                else "No verdict changes from the 2D ridge to the 3D dots"
+                + (f" among the {len(checks) - len(one)} checks both models answer; {len(one)} checks have "
+                   "one model only (n/a), so they compare nothing (`--braille-dim both` solves both)." if one
+                   else ".")]
     else:
         out += ["| paper says | ours | verdict |", "|---|---|---|"]
         for c in checks:
@@ -452,9 +456,12 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
         groups = discrimination_by_model(records)
         out += discrimination_table_by_model(groups)
         changed = [m["group"] for m in groups if m["changed"]]
+        dims = {r.get("dim", 2) for r in rows if r.get("indenter") == "braille"}
         out += ["", ("Discrimination verdicts the 3D dots change: "
                      + "; ".join(f"{m} {t:g} mm" + (f" {v}" if v else "") for m, t, v in changed) + ".")
-                if changed else "No discrimination verdict changes from the 2D ridge to the 3D dots."]
+                if changed else "No discrimination verdict changes from the 2D ridge to the 3D dots"
+                + ("." if len(dims) > 1 else f" (but the sweep has Braille in {BRAILLE_MODELS[min(dims)]} only: "
+                   "the other model's verdicts leave Braille out; `--braille-dim both` compares them).")]
     else:
         out += discrimination_table(records)
     sus = _suspect_records(records)
