@@ -82,7 +82,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                       "| t (mm) | noise | " + " | ".join(f"{p:g} mm" for p in cfg.pitches) + " |",
                       "|---|---|" + "---|" * len(cfg.pitches)]
             for t in cfg.thicknesses:
-                mark = " †" if set_ == "letters" and trust[(material, t)]["status"] != "within" else ""
+                mark = " †" if set_ == "letters" and trust[(material, t)]["status"] not in TRUSTED else ""
                 for n in cfg.noise_fs:
                     lines.append(f"| {t:g}{mark} | {n:g} | " + " | ".join(
                         _cell(chart.accuracy(material, t, set_, p, n, method)) for p in cfg.pitches) + " |")
@@ -95,7 +95,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
     for v in verdicts(chart, method):
         m = trust.get((v["material"], 1.0))
-        if v["claim"].startswith("0.75") and v["verdict"] != "not evaluated" and m and m["status"] != "within":
+        if v["claim"].startswith("0.75") and v["verdict"] != "not evaluated" and m and m["status"] not in TRUSTED:
             v = {**v, "verdict": v["verdict"] + " (indicative: the letters' surrogate is "
                  + ("not validated" if m["error"] is None else f"off by {m['error']:.1%}") + " at t = 1 mm)"}
         lines.append(f"| {v['material']} | {v['claim']} | {v['verdict']} | {v['evidence']} |")
@@ -103,6 +103,9 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     if validation:
         lines += validation_table(validation, "### Surrogate validation (superposition of single-dot responses against full 3D solves)")
     return "\n".join(lines)
+
+
+TRUSTED = ("within", "full")  # letters statuses that need no mark: the surrogate within tolerance, or none
 
 
 def letters_trust(chart, validation=None) -> dict:
@@ -114,7 +117,7 @@ def letters_trust(chart, validation=None) -> dict:
     for material in cfg.materials:
         for t in cfg.thicknesses:
             if cfg.letters_model == "full":
-                out[(material, t)] = {"error": None, "texts": list(cfg.letters), "status": "within",
+                out[(material, t)] = {"error": None, "texts": list(cfg.letters), "status": "full",
                                       "source": "full 3D solves of every letter (no surrogate)"}
                 continue
             dot = dot_scene(t, material, cfg)
@@ -144,8 +147,8 @@ def _trust_section(chart, trust: dict) -> list[str]:
             "`--letters-model full` solves every letter instead):"), "",
            "| material | t (mm) | surrogate error / peak | validated on | status | source |", "|---|---|---|---|---|---|"]
     for (material, t), m in trust.items():
-        err = ("0 (full solves)" if cfg_full else "-") if m["error"] is None else f"{m['error']:.1%}"
-        status = {"within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
+        err = "-" if m["error"] is None else f"{m['error']:.1%}"
+        status = {"full": "no surrogate", "within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
         out.append(f"| {material} | {t:g} | {err} | {', '.join(m['texts']) or '-'} | {status} | {m['source'] or '-'} |")
     out += ["", "† in the letters tables: a thickness whose surrogate is not within the tolerance or not validated.", ""]
@@ -157,7 +160,7 @@ def _trust_notes(trust: dict) -> list[str]:
 
     bad = {}
     for (material, t), m in trust.items():
-        if m["status"] != "within":
+        if m["status"] not in TRUSTED:
             what = "not validated" if m["error"] is None else f"{m['error']:.1%}"
             bad.setdefault(material, []).append(f"t = {t:g} mm ({what})")
     return [f"{material}: the letters' surrogate is not shown within {tolerance():.0%} of full solves at "
