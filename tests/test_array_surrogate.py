@@ -114,7 +114,7 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     asked = []
     grid = np.linspace(-8, 8, 161)
 
-    def fake_solve(scenes, cache, on_event=None):
+    def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
         return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes}
 
@@ -195,7 +195,7 @@ def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
     full = maps.on_grid(lambda s, z: 0.5 + sum(_gauss(a, b)(s, z) for a, b in c), grid, grid)
     asked = []
 
-    def fake_solve(scenes, cache, on_event=None):
+    def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
         return {sc: SimpleNamespace(scene=sc, path=tmp_path) for sc in scenes}
 
@@ -265,7 +265,7 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     from tactileskin.report.array_chart import markdown
 
     grid = np.linspace(-8, 8, 161)
-    monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None: {
+    monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
         sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes})
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), materials=("silicone",), pitches=(0.5, 0.75),
@@ -315,7 +315,7 @@ def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypa
     grid = np.linspace(-8, 8, 161)
     asked = []
 
-    def fake_solve(scenes, cache, on_event=None):
+    def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
         return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path) for sc in scenes}
 

@@ -289,7 +289,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     wanted += [x for f in full.values() for x in f.values()]
     say(f"solving {len(set(wanted))} cases (cached cases are read)")
     recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
-                        **({} if workers is None else {"workers": workers}))
+                        workers=workers)
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot, pdot, blank, sec2 = cases[(material, t)]
@@ -415,7 +415,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
     recs = solve_cached([x for dot, fulls, blank in cases.values() for x in (dot, blank, *fulls) if x is not None],
                         cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
-                        **({} if workers is None else {"workers": workers}))
+                        workers=workers)
     for t, (dot, fulls, blank) in cases.items():
         kernel = bone_map_of(recs[dot])
         sec = dot.section()

@@ -148,9 +148,7 @@ def placed(full: BoneMap, text: str, section, standard="standard_american") -> B
     its own dots; a half or quarter map is mirrored) moved to the full-cell frame of
     `cell_centres`, where the chart reads every character: a translation (s through
     `bone_s_under`: exact on the flat pad, approximate across the curved fingertip)."""
-    from tactileskin.geometry.braille import check_text
-
-    cells = check_text(text)
+    cells = braille.check_text(text)
     if len(cells) != 1 or len(cells[0]) != 1:
         raise ParameterError("text", text, "one Braille cell")
     ref = mirrored(full)

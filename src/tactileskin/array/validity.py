@@ -10,11 +10,11 @@ not validated. Either way the chart says so beside the letters' accuracies.
 from __future__ import annotations
 
 import json
+import math
 from functools import lru_cache
 from importlib import resources
 
 DATA = ("data", "surrogate_validation.json")
-_TOL = 1e-9
 
 
 @lru_cache(maxsize=1)
@@ -31,7 +31,7 @@ def tolerance() -> float:
 
 
 def _match(a: float, b: float) -> bool:
-    return abs(float(a) - float(b)) <= _TOL * max(1.0, abs(float(a)))
+    return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-9)
 
 
 def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None) -> dict:
