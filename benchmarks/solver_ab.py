@@ -2,7 +2,8 @@
 peak and CPU time per (case, variant), each solve in its own process (one BLAS thread),
 `--jobs` processes at a time.
 
-Cases are Scene keyword sets, named; variants are SolverOptions keyword sets:
+Cases are Scene keyword sets, named; variants are SolverOptions keyword sets (plus
+"penalty_factor", fe.model.PENALTY_FACTOR):
 
     .venv/bin/python benchmarks/solver_ab.py --set first_travel \
         --variant 'before:first_travel_radius=0' --variant 'now:' [--jobs 2] [--out FILE]
@@ -49,7 +50,11 @@ def one(case: dict, variant: dict) -> dict:
     from tactileskin.planner import with_quality
     from tactileskin.scene import Scene
 
-    case = dict(case)
+    case, variant = dict(case), dict(variant)
+    if "penalty_factor" in variant:  # fe.model's module constant, not a SolverOptions field
+        from tactileskin.fe import model as fe_model
+
+        fe_model.PENALTY_FACTOR = float(variant.pop("penalty_factor"))
     q = case.pop("quality", None)
     sc = Scene(**case)
     if q:
@@ -75,13 +80,14 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], choices=sorted(SETS))
     ap.add_argument("--variant", action="append", default=[])
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--only", default="", help="only the cases whose name contains this")
     ap.add_argument("--out", default=None)
     ap.add_argument("--one", nargs=2, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.one:
         print(json.dumps(one(json.loads(a.one[0]), json.loads(a.one[1]))))
         return 0
-    cases = {k: v for s in a.set for k, v in SETS[s].items()}
+    cases = {k: v for s in a.set for k, v in SETS[s].items() if a.only in k}
     variants = dict(parse_variant(v) for v in a.variant) or {"now": {}}
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"), MKL_NUM_THREADS="1", OMP_NUM_THREADS="1",
                OPENBLAS_NUM_THREADS="1")

@@ -55,6 +55,10 @@ def test_chart_config_refuses_bad_values():
         chart.ChartConfig(pitches=(0.0,))
     with pytest.raises(ParameterError):
         chart.ChartConfig(sets=("nope",))
+    with pytest.raises(ParameterError, match="indenter_radius"):
+        chart.ChartConfig(sphere_radius=0.0)
+    with pytest.raises(ParameterError, match="sphere_quality"):
+        chart.ChartConfig(sphere_quality="rough")
     assert chart.ChartConfig().spec(0.5).n == 17
 
 
@@ -126,7 +130,7 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
     # t = 3 also asks the blank plate on the pad (flat, 3D) at the plate's own depth
     assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
-                     (2, "curved", "fingertip"), (3, "flat", "pad")}
+                     (2, "curved", "fingertip"), (3, "flat", "pad"), (3, "sphere", "fingertip")}
     (blank,) = [sc for sc in asked if sc.indenter == "flat" and sc.dim == 3]
     assert blank.thickness == 3.0 and blank.indentation == pytest.approx(0.6 - 0.48)
     assert ch.accuracy("silicone", 1.0, "letters", 0.5, 0.01) >= 0.95  # separable dots at 0.5 mm pitch
@@ -139,6 +143,45 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     depths = {(sc.thickness, round(sc.indentation, 9)) for sc in asked}
     assert depths == {(1.0, 0.2), (3.0, 0.4)}  # t = 1 keeps its 20 %
     assert [c["depth_mm"] for c in ch.cutoffs if c["thickness_mm"] == 3.0] == [0.4, 0.4]
+
+
+def test_shapes_set_adds_a_3d_sphere_on_the_fingertip_and_tells_four_distinct_maps_apart(monkeypatch):
+    """The shapes set: the paper's three and a sphere solved in 3D on the fingertip (radius and
+    mesh preset from the config, the chart's depth cap); distinct maps are told apart by a fine
+    array, and a sphere whose map equals the dot's is confused with it."""
+    from types import SimpleNamespace
+
+    from tactileskin.planner import quality_mesh
+
+    asked = []
+    grid = np.linspace(-8, 8, 161)
+    widths = {"flat": 3.0, "curved": 1.5}
+
+    def fake_solve(scenes, cache, on_event=None, workers=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-(grid / widths.get(sc.indenter, 1.0)) ** 2), scene=sc)
+                for sc in scenes}
+
+    sphere_w = {"w": 1.0}
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(
+        _gauss(w=sphere_w["w"] if rec.scene.indenter == "sphere" else 0.3), grid, grid))
+    cfg = chart.ChartConfig(thicknesses=(3.0,), pitches=(0.5,), noise_fs=(0.01,), sets=("shapes",), n_train=4,
+                            n_test=8, template_grid=2, max_depth=0.4, sphere_radius=4.0, sphere_quality="default")
+    ch = chart.compute(cfg, cache=None)
+    (sph,) = [sc for sc in asked if sc.indenter == "sphere"]
+    assert (sph.dim, sph.skin, sph.indenter_radius, round(sph.indentation, 9)) == (3, "fingertip", 4.0, 0.4)
+    assert (sph.mesh_size, sph.refinement) == quality_mesh("default", "sphere", 3)
+    assert ch.labels == {"shapes": ["flat", "curved", "braille", "sphere"]}
+    assert ch.accuracy("silicone", 3.0, "shapes", 0.5, 0.01) >= 0.95
+    from tactileskin.report.array_chart import markdown
+
+    md = markdown(ch)
+    assert "### silicone: flat / curved / Braille dot / sphere R4 (chance 0.25)" in md
+    assert "sphere (R 4 mm): 3D at the `default` preset. Array: square taxels of 0.8 x pitch" in md
+    sphere_w["w"] = 0.3  # the sphere reads exactly as the dot: those two cannot be told apart
+    ch = chart.compute(cfg, cache=None)
+    assert ch.accuracy("silicone", 3.0, "shapes", 0.5, 0.01) < 0.9
 
 
 def test_plate_aware_superposition_counts_the_plate_once():

@@ -6,6 +6,9 @@ surface, the paper's sensor film):
 - "paper": the paper's three indenters on the paper's fingertip: flat and curved (their 2D
   plane-strain bone profile extruded along z; exact for an indenter uniform along the finger,
   away from the slab ends) and one Braille dot (the 3D bone map of the single-dot solve).
+- "shapes": the paper's three and a sphere (radius ChartConfig.sphere_radius, 3D on the
+  fingertip at the `sphere_quality` 3D preset): the issue's stimulus list beyond the
+  paper's claim, which stays on the "paper" set.
 - "letters": the 26 letters a-z as cells (digits share the masks of a-j), each the
   superposition of the single-dot response at its dots in the frame of the full cell
   (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
@@ -38,7 +41,7 @@ log = logging.getLogger(__name__)
 PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm -> 0.75 mm pitch
 GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
-SETS = ("paper", "letters")
+SETS = ("paper", "letters", "shapes")  # the index seeds each set's offsets: append only
 SKINS = ("pad", "fingertip")
 LETTERS_MODELS = ("sum", "full")
 
@@ -69,6 +72,10 @@ class ChartConfig:
     # is in data/surrogate_validation.json), "full" solves every letter in 3D (one solve per
     # letter and t: where the sum is not within 5 %)
     letters_model: str = "sum"
+    # the shapes set's sphere (mm) and the 3D preset it is meshed at (the strip plan; preview:
+    # peak 2.9 % and span 3.1 % from default at t = 1 silicone, 10 s against 56 s CPU)
+    sphere_radius: float = 2.5
+    sphere_quality: str = "preview"
 
     def __post_init__(self):
         for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
@@ -87,6 +94,12 @@ class ChartConfig:
             raise ParameterError("set", bad[0], " or ".join(SETS))
         if self.letters_model not in LETTERS_MODELS:
             raise ParameterError("letters_model", self.letters_model, " or ".join(LETTERS_MODELS))
+        from tactileskin.geometry.indenters.base import check_radius
+        from tactileskin.presets import QUALITIES
+
+        check_radius(self.sphere_radius, "sphere")
+        if self.sphere_quality not in QUALITIES:
+            raise ParameterError("sphere_quality", self.sphere_quality, " or ".join(QUALITIES))
         if self.skin not in SKINS:
             raise ParameterError("skin", self.skin, " or ".join(SKINS))
         if self.max_depth is not None and not (np.isfinite(self.max_depth) and self.max_depth > 0):
@@ -129,6 +142,16 @@ def section_scene(thickness, material, indenter, skin="fingertip", depth=None):
     from tactileskin.scene import Scene
 
     return Scene(dim=2, skin=skin, indenter=indenter, thickness=thickness, material=material, depth=depth)
+
+
+def sphere_scene(thickness, material, cfg: ChartConfig):
+    """The shapes set's sphere: 3D on the paper's fingertip at the chart's depth."""
+    from tactileskin.planner import with_quality
+    from tactileskin.scene import Scene
+
+    sc = Scene(dim=3, skin="fingertip", indenter="sphere", indenter_radius=cfg.sphere_radius, thickness=thickness,
+               material=material, depth=cfg.depth_for(thickness))
+    return with_quality(sc, cfg.sphere_quality)
 
 
 def plate_touches(dot) -> bool:
@@ -207,16 +230,20 @@ def extruded(s, p, z) -> BoneMap:
 
 
 def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None,
-                  base: BoneMap | None = None, letters: dict | None = None) -> dict:
+                  base: BoneMap | None = None, letters: dict | None = None, sphere: BoneMap | None = None) -> dict:
     """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
     single dot on cfg.skin, `section` its section; plus `base`, the blank plate, for the
     plate-aware kernel) unless given as `letters` (full solves), the paper set's dot
-    `paper_kernel` (the fingertip's; default `kernel`)."""
+    `paper_kernel` (the fingertip's; default `kernel`), the shapes set's `sphere`."""
     out = {}
+    pk = kernel if paper_kernel is None else paper_kernel
+    paper = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")} if profiles else {}
     if "paper" in cfg.sets:
-        pk = kernel if paper_kernel is None else paper_kernel
-        out["paper"] = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")}
-        out["paper"]["braille"] = pk
+        out["paper"] = {**paper, "braille": pk}
+    if "shapes" in cfg.sets:
+        if sphere is None:
+            raise ParameterError("sphere map", None, "the sphere's bone map for the shapes set")
+        out["shapes"] = {**paper, "braille": pk, "sphere": sphere}
     if "letters" in cfg.sets and letters is not None:
         out["letters"] = letters
     elif "letters" in cfg.sets:
@@ -256,14 +283,17 @@ class Chart:
 
 
 def _chart_scenes(cfg: ChartConfig, material: str, t: float) -> tuple:
-    """(dot, paper dot, blank plate, {flat, curved} sections) of one material and thickness:
-    the letters on cfg.skin; the paper set (flat, curved, dot) on the paper's fingertip, where
-    its 2D sections are exact (a plate wider than the pad has no converged solve there)."""
+    """(dot, paper dot, blank plate, {flat, curved} sections, sphere) of one material and
+    thickness: the letters on cfg.skin; the paper and shapes sets (flat, curved, dot; sphere)
+    on the paper's fingertip, where the 2D sections are exact (a plate wider than the pad has
+    no converged solve there)."""
+    shapes = "shapes" in cfg.sets
     dot = dot_scene(t, material, cfg) if "letters" in cfg.sets else None
-    pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets else None
+    pdot = dot_scene(t, material, cfg, skin="fingertip") if "paper" in cfg.sets or shapes else None
     sec2 = {k: section_scene(t, material, k, depth=cfg.depth_for(t)) for k in ("flat", "curved")} if pdot else {}
     blank = blank_scene(dot) if dot is not None and plate_touches(dot) else None
-    return dot, pdot, blank, sec2
+    sphere = sphere_scene(t, material, cfg) if shapes else None
+    return dot, pdot, blank, sec2, sphere
 
 
 def letter_scenes(cfg: ChartConfig, material: str, t: float) -> dict:
@@ -284,15 +314,15 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     chart = Chart(cfg)
     cases = {(m, t): _chart_scenes(cfg, m, t) for m in cfg.materials for t in cfg.thicknesses}
     full = {(m, t): letter_scenes(cfg, m, t) for m, t in cases}
-    wanted = [x for dot, pdot, blank, sec2 in cases.values()
-              for x in (dot, pdot, blank, *sec2.values()) if x is not None]
+    wanted = [x for dot, pdot, blank, sec2, sphere in cases.values()
+              for x in (dot, pdot, blank, *sec2.values(), sphere) if x is not None]
     wanted += [x for f in full.values() for x in f.values()]
     say(f"solving {len(set(wanted))} cases (cached cases are read)")
     recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
     for material in cfg.materials:
         for t in cfg.thicknesses:
-            dot, pdot, blank, sec2 = cases[(material, t)]
+            dot, pdot, blank, sec2, sphere = cases[(material, t)]
             kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
             height = get_standard(cfg.standard).height
             base = None
@@ -318,7 +348,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None
             sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
-                                 letters=letters)
+                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]))
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())

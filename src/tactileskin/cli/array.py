@@ -12,11 +12,11 @@ from tactileskin.errors import ParameterError
 
 EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve` and `sweep`)
 OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
-             *(f"array_{m}_{s}.{e}" for m in ("silicone", "polyurethane") for s in ("paper", "letters")
+             *(f"array_{m}_{s}.{e}" for m in ("silicone", "polyurethane") for s in ("paper", "letters", "shapes")
                for e in ("png", "svg")))
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
-        "validate", "skin", "max_depth", "letters_model"}
+        "validate", "skin", "max_depth", "letters_model", "sphere_radius", "sphere_quality"}
 
 
 def load_config(path) -> dict:
@@ -43,7 +43,8 @@ def load_config(path) -> dict:
 @click.option("--noise", default=None, help="Noise std as fractions of full scale. Default 0.01,0.05,0.1.")
 @click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
 @click.option("--bits", type=int, default=None, help="ADC bits over full scale. Default 12.")
-@click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters. Default both.")
+@click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters (a-z), shapes (the paper's three and a "
+                   "sphere). Default all three.")
 @click.option("--letters", default=None, help="Letters of the letters set. Default a-z.")
 @click.option("--offsets", type=int, default=None, help="Random offsets per stimulus (train and test each). Default 16.")
 @click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm). Default 1.2.")
@@ -51,6 +52,9 @@ def load_config(path) -> dict:
 @click.option("--max-depth", type=float, default=None,
               help="Depth cap (mm) for thick skins: a t whose 20 % depth exceeds it is indented by this "
                    "instead (below the dot height 0.48 mm the Braille plate never touches). Default none.")
+@click.option("--sphere-radius", type=float, default=None, help="Radius (mm) of the shapes set's sphere. Default 2.5.")
+@click.option("--sphere-quality", type=click.Choice(["preview", "default", "fine"]), default=None,
+              help="3D mesh preset of the sphere solves. Default preview.")
 @click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
 @click.option("--skin", type=click.Choice(["pad", "fingertip"]), default=None,
               help="Skin of the 3D dot solves: pad (flat, a dot's response translates exactly; default) or "
@@ -65,7 +69,8 @@ def load_config(path) -> dict:
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, seed, skin, validate, letters_model, workers, cache_dir):
+            refinement, max_depth, sphere_radius, sphere_quality, seed, skin, validate, letters_model, workers,
+            cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
 
     Exit status 0, or 3 when the chart was written but a part of it is suspect (the letters'
@@ -89,7 +94,8 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  noise_fs=noise and tuple(parse_values(noise, "noise")),
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
-                 max_depth=max_depth, letters_model=letters_model)
+                 max_depth=max_depth, letters_model=letters_model, sphere_radius=sphere_radius,
+                 sphere_quality=sphere_quality)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:
         texts = names(validate, "validate")

@@ -10,7 +10,12 @@ from tactileskin.array.chart import GOOD, PAPER_PITCH, verdicts
 from tactileskin.fileio import atomic_write_text
 from tactileskin.report.figures import _plt, _save
 
-SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille letters a-z"}
+SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille letters a-z",
+              "shapes": "flat / curved / Braille dot / sphere R{r:g}"}
+
+
+def set_title(set_: str, cfg) -> str:
+    return SET_TITLES[set_].format(r=cfg.sphere_radius)
 
 
 def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
@@ -46,7 +51,7 @@ def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
             if axes[0][0].get_legend_handles_labels()[0]:  # the paper's marks, where on the grid
                 axes[0][0].legend(loc="upper right", fontsize=7, framealpha=0.8)
             fig.colorbar(im, ax=axes[0].tolist(), label=f"accuracy ({method})", shrink=0.9)
-            fig.suptitle(f"{material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", fontsize=10)
+            fig.suptitle(f"{material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})", fontsize=10)
             paths += _save(fig, out, f"array_{material}_{set_}")
     return paths
 
@@ -57,9 +62,10 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     cfg = chart.config
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
     lines = ["## Sensor-array design chart", "",
-             f"Skin: letters on the {cfg.skin}, the paper set on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
+             f"Skin: letters on the {cfg.skin}, the paper and shapes sets on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
              f"(mesh {cfg.mesh_size:g} / {cfg.refinement:g}); flat and curved: 2D bone profiles extruded "
-             f"along z. Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
+             f"along z" + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
+             + f". Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
              f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
              f"a fraction of full scale; stimuli at random sub-pitch offsets ({cfg.n_test} test and "
              f"{cfg.n_train} training reads per stimulus); rule: {method} (nearest template over "
@@ -78,7 +84,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                                     "height, so the Braille plate never touches)" if cfg.max_depth else "") + ".", ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
-            lines += [f"### {material}: {SET_TITLES[set_]} (chance {1 / len(chart.labels[set_]):.2f})", "",
+            lines += [f"### {material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})", "",
                       "| t (mm) | noise | " + " | ".join(f"{p:g} mm" for p in cfg.pitches) + " |",
                       "|---|---|" + "---|" * len(cfg.pitches)]
             for t in cfg.thicknesses:
