@@ -3,7 +3,8 @@ peak and CPU time per (case, variant), each solve in its own process (one BLAS t
 `--jobs` processes at a time.
 
 Cases are Scene keyword sets, named; variants are SolverOptions keyword sets (plus
-"penalty_factor", fe.model.PENALTY_FACTOR):
+"penalty_factor", fe.model.PENALTY_FACTOR, and "direct_after_failures",
+fe.linsolve.DIRECT_AFTER_FAILURES_MAX):
 
     .venv/bin/python benchmarks/solver_ab.py --set first_travel \
         --variant 'before:first_travel_radius=0' --variant 'now:' [--jobs 2] [--out FILE]
@@ -55,6 +56,10 @@ def one(case: dict, variant: dict) -> dict:
         from tactileskin.fe import model as fe_model
 
         fe_model.PENALTY_FACTOR = float(variant.pop("penalty_factor"))
+    if "direct_after_failures" in variant:  # fe.linsolve's back-off cap (0: off)
+        from tactileskin.fe import linsolve
+
+        linsolve.DIRECT_AFTER_FAILURES_MAX = int(variant.pop("direct_after_failures"))
     q = case.pop("quality", None)
     sc = Scene(**case)
     if q:

@@ -43,6 +43,24 @@ def test_cell_centres_in_the_full_cell_frame():
         surrogate.cell_centres(0)
 
 
+def test_a_digit_is_the_number_sign_and_its_a_to_j_cell_in_a_two_cell_frame():
+    std = braille.get_standard("standard_american")
+    one = surrogate.char_centres("1")      # number sign (dots 3, 4, 5, 6) + a (dot 1)
+    two_full = braille.dot_centres(chr(0x283F) * 2)
+    assert len(one) == 5 and np.isclose(two_full[:, 0].min(), -0.5 * (std.cell_pitch + std.dot_pitch))
+    assert np.allclose(one[:4], two_full[[2, 3, 4, 5]]) and np.allclose(one[4], two_full[6])
+    # the digit's own cell is a's, one cell pitch right of the number sign
+    assert np.allclose(one[4] - surrogate.char_centres("a")[0], [0.5 * std.cell_pitch, 0.0])
+    assert np.allclose(surrogate.char_centres("0")[4:], two_full[[7, 9, 10]])  # 0 = j: dots 2, 4, 5
+    assert np.allclose(surrogate.char_centres("k"), surrogate.cell_centres(braille.LETTERS["k"]))
+    for bad in ("A", "ab", "?"):
+        with pytest.raises(ParameterError):
+            surrogate.char_centres(bad)
+    with pytest.raises(ParameterError, match="letters"):
+        chart.ChartConfig(letters="ab#")
+    assert chart.ChartConfig().letters == chart.LETTERS + chart.DIGITS
+
+
 def test_extruded_profile_is_uniform_along_z_and_mirrored():
     s = np.linspace(0, 5, 51)
     m = chart.extruded(s, np.exp(-s), np.linspace(-2, 2, 9))
@@ -124,9 +142,10 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
 
     monkeypatch.setattr(chart, "solve_cached", fake_solve)
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
-    cfg = chart.ChartConfig(thicknesses=(1.0, 3.0), pitches=(0.5,), noise_fs=(0.01,), letters="abcr",
+    cfg = chart.ChartConfig(thicknesses=(1.0, 3.0), pitches=(0.5,), noise_fs=(0.01,), letters="abcr1",
                             n_train=4, n_test=4, template_grid=2)
     ch = chart.compute(cfg, cache=None)
+    assert ch.labels["letters"] == list("abcr1")  # '1' = number sign + a's cell: told apart from 'a' below
     skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
     # t = 3 also asks the blank plate on the pad (flat, 3D) at the plate's own depth
     assert skins == {(3, "braille", "pad"), (3, "braille", "fingertip"), (2, "flat", "fingertip"),
@@ -331,9 +350,11 @@ def test_a_full_solve_is_placed_in_the_full_cell_frame():
 
     sec = chart.dot_scene(1.0, "silicone", chart.ChartConfig()).section()
     grid = np.linspace(-9, 9, 361)
-    for letter in "abk":
+    for letter in "abk1":
         own = braille.dot_centres(letter)
-        cell = surrogate.cell_centres(MASKS[letter])
+        cell = surrogate.char_centres(letter)
+        if letter in MASKS:
+            assert np.allclose(cell, surrogate.cell_centres(MASKS[letter]))
         assert not np.allclose(own.mean(axis=0), cell.mean(axis=0))  # the frames differ for these letters
         full = maps.on_grid(lambda s, z: sum(_gauss(a, b, w=0.3)(s, z) for a, b in own), grid, grid)
         got = surrogate.placed(full, letter, sec)
@@ -345,7 +366,7 @@ def test_a_full_solve_is_placed_in_the_full_cell_frame():
         # h^2 / 8 |f''| per direction = 0.05^2 / 8 / 0.3^2 = 0.35 % of the peak, two directions
         assert maps.relative_error(got, want)["max_abs_over_peak"] < 0.01
     with pytest.raises(ParameterError):
-        surrogate.placed(full, "ab", sec)
+        surrogate.placed(full, "a\nb", sec)
 
 
 def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypatch, tmp_path):

@@ -127,6 +127,39 @@ def test_useless_preconditioner_refactorises_at_once(backend):
     assert np.linalg.norm(B @ x - b) <= 1e-9 * np.linalg.norm(b)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_gmres_failures_in_a_row_back_off_to_direct_factorisations(backend):
+    """After n failed GMRES solves in a row the next 2^n - 1 matrices are factorised without a
+    GMRES try (a failure costs its budget and a factorisation); a converged GMRES solve ends
+    the streak."""
+    rng = np.random.default_rng(9)
+    A = _spd(900, rng)
+    s = linsolve.SymmetricSolver(A, backend, "reuse", factor_cost=15)
+    s.factor(A).solve(rng.standard_normal(900))
+    shift = [-3.0]
+
+    def far():  # each matrix far from the last factorised one: GMRES cannot converge in 15
+        shift[0] -= 3.0
+        return _shifted(A, shift[0])
+
+    B = far()
+    s.factor(B).solve(rng.standard_normal(900))          # failure 1: 15 iterations wasted
+    assert (s.factorizations, s.krylov_iterations) == (2, 15)
+    B = far()
+    x = s.factor(B).solve(b := rng.standard_normal(900))  # the next one directly
+    assert (s.factorizations, s.krylov_iterations) == (3, 15)
+    assert np.linalg.norm(B @ x - b) <= 1e-9 * np.linalg.norm(b)
+    s.factor(far()).solve(rng.standard_normal(900))      # failure 2: then 3 direct
+    assert (s.factorizations, s.krylov_iterations) == (4, 30)
+    for k in range(3):
+        s.factor(far()).solve(rng.standard_normal(900))
+    assert (s.factorizations, s.krylov_iterations) == (7, 30)
+    B = _shifted(A, shift[0] + 1e-6)                      # close to the last one: GMRES converges
+    x = s.factor(B).solve(b)
+    assert s.factorizations == 7 and 30 < s.krylov_iterations <= 33 and s._failures == 0
+    assert np.linalg.norm(B @ x - b) <= 10 * linsolve.KRYLOV_RTOL * np.linalg.norm(b)
+
+
 def test_unknown_method_is_a_parameter_error():
     with pytest.raises(ParameterError, match="linear solver method"):
         linsolve.SymmetricSolver(sp.eye(3, format="csr"), "superlu", "amg")

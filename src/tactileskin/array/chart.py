@@ -9,8 +9,8 @@ surface, the paper's sensor film):
 - "shapes": the paper's three and a sphere (radius ChartConfig.sphere_radius, 3D on the
   fingertip at the `sphere_quality` 3D preset): the issue's stimulus list beyond the
   paper's claim, which stays on the "paper" set.
-- "letters": the 26 letters a-z as cells (digits share the masks of a-j), each the
-  superposition of the single-dot response at its dots in the frame of the full cell
+- "letters": the 26 letters a-z as cells and the digits 0-9 as the number sign and a-j's
+  cell (surrogate.char_centres), each the superposition of the single-dot response at its dots in the frame of the full cell
   (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
   `skin` (default the flat pad, where a dot's response translates exactly; on the
   fingertip the translation across the curved finger is approximate).
@@ -41,6 +41,8 @@ log = logging.getLogger(__name__)
 PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm -> 0.75 mm pitch
 GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "abcdefghijklmnopqrstuvwxyz"
+DIGITS = "1234567890"       # each the number sign and a-j's cell (surrogate.char_centres)
+CHARACTERS = LETTERS + DIGITS
 SETS = ("paper", "letters", "shapes")  # the index seeds each set's offsets: append only
 SKINS = ("pad", "fingertip")
 LETTERS_MODELS = ("sum", "full")
@@ -56,7 +58,7 @@ class ChartConfig:
     bits: int | None = 12
     window: float = 8.0                    # array side (mm): n = floor(window / pitch) + 1 taxels a side
     sets: tuple = SETS
-    letters: str = LETTERS
+    letters: str = CHARACTERS              # the letters set: a-z and the digits 0-9
     n_train: int = 16
     n_test: int = 16
     template_grid: int = 4
@@ -104,9 +106,9 @@ class ChartConfig:
             raise ParameterError("skin", self.skin, " or ".join(SKINS))
         if self.max_depth is not None and not (np.isfinite(self.max_depth) and self.max_depth > 0):
             raise ParameterError("max_depth", self.max_depth, "> 0 mm (or None: 20 % of t)")
-        bad = [c for c in self.letters if c not in LETTERS]
+        bad = [c for c in self.letters if c not in CHARACTERS]
         if bad or len(set(self.letters)) < 2:
-            raise ParameterError("letters", self.letters, "at least two distinct letters a-z")
+            raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")
 
     def depth_for(self, thickness: float) -> float | None:
         """The depth (mm) a chart scene of this thickness is given: None (the scene's 20 % of t)
@@ -247,9 +249,7 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
     if "letters" in cfg.sets and letters is not None:
         out["letters"] = letters
     elif "letters" in cfg.sets:
-        from tactileskin.geometry.braille import LETTERS as MASKS
-
-        out["letters"] = {c: surrogate.superpose(kernel, surrogate.cell_centres(MASKS[c], cfg.standard), section,
+        out["letters"] = {c: surrogate.superpose(kernel, surrogate.char_centres(c, cfg.standard), section,
                                                  base=base) for c in cfg.letters}
     return out
 

@@ -47,10 +47,29 @@ def cell_centres(mask: int, standard="standard_american") -> np.ndarray:
     """(k, 2) face coordinates (x, z) of the raised dots of cell `mask`, in the frame of the
     full cell centred on the origin (as a reader's finger sits on a cell, whatever its dots;
     braille.dot_centres instead centres each pattern on its own dots)."""
-    if not (isinstance(mask, (int, np.integer)) and 0 < mask <= FULL_CELL):
-        raise ParameterError("cell mask", mask, "an integer in [1, 63] (at least one raised dot)")
-    full = braille.dot_centres(chr(0x2800 + FULL_CELL), standard)  # dots 1..6 in order
-    return full[[k for k in range(6) if mask >> k & 1]]
+    return cells_centres([mask], standard)
+
+
+def cells_centres(masks, standard="standard_american") -> np.ndarray:
+    """(k, 2) face coordinates of the raised dots of a row of cells, in the frame of as many
+    full cells centred on the origin."""
+    masks = list(masks)
+    for mask in masks:
+        if not (isinstance(mask, (int, np.integer)) and 0 <= mask <= FULL_CELL):
+            raise ParameterError("cell mask", mask, "an integer in [0, 63]")
+    if not masks or not any(masks):
+        raise ParameterError("cell masks", masks, "at least one raised dot")
+    full = braille.dot_centres(chr(0x2800 + FULL_CELL) * len(masks), standard)  # cell by cell, dots 1..6
+    return full[[6 * i + k for i, mask in enumerate(masks) for k in range(6) if mask >> k & 1]]
+
+
+def char_centres(ch: str, standard="standard_american") -> np.ndarray:
+    """The raised dots of a chart character in the frame of its full cells: a letter a-z one
+    cell; a digit 0-9 two, the number sign and the digit's cell (a-j's), as the standard
+    writes a digit standing alone."""
+    if not (isinstance(ch, str) and len(ch) == 1 and (ch in braille.LETTERS or ch in braille.DIGITS)):
+        raise ParameterError("character", ch, "one letter a-z or digit 0-9")
+    return cells_centres(braille.check_text(ch)[0], standard)
 
 
 def superpose(kernel: BoneMap, centres, section, s=None, z=None, weights=None, base: BoneMap | None = None) -> BoneMap:
@@ -144,16 +163,16 @@ def fit_scale(kernel: BoneMap, fulls: dict, section, standard="standard_american
 
 
 def placed(full: BoneMap, text: str, section, standard="standard_american") -> BoneMap:
-    """The full solve's map of a one-cell `text` (braille.dot_centres: the pattern centred on
+    """The full solve's map of a one-line `text` (braille.dot_centres: the pattern centred on
     its own dots; a half or quarter map is mirrored) moved to the full-cell frame of
-    `cell_centres`, where the chart reads every character: a translation (s through
+    `cells_centres`, where the chart reads every character: a translation (s through
     `bone_s_under`: exact on the flat pad, approximate across the curved fingertip)."""
     cells = braille.check_text(text)
-    if len(cells) != 1 or len(cells[0]) != 1:
-        raise ParameterError("text", text, "one Braille cell")
+    if len(cells) != 1 or not cells[0]:
+        raise ParameterError("text", text, "one line of Braille cells")
     ref = mirrored(full)
     solver = braille.dot_centres(text, standard)
-    cell = cell_centres(cells[0][0], standard)
+    cell = cells_centres(cells[0], standard)
     a, b = cell.mean(axis=0), solver.mean(axis=0)  # the same pattern, translated
     ds = float(np.diff(bone_s_under(np.array([b[0], a[0]]), section))[0])
     return BoneMap(ref.s + ds, ref.z + float(a[1] - b[1]), ref.pressure, ref.section_z)

@@ -43,9 +43,10 @@ def load_config(path) -> dict:
 @click.option("--noise", default=None, help="Noise std as fractions of full scale. Default 0.01,0.05,0.1.")
 @click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
 @click.option("--bits", type=int, default=None, help="ADC bits over full scale. Default 12.")
-@click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters (a-z), shapes (the paper's three and a "
+@click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters (a-z, 0-9), shapes (the paper's three and a "
                    "sphere). Default all three.")
-@click.option("--letters", default=None, help="Letters of the letters set. Default a-z.")
+@click.option("--letters", default=None, help="Characters of the letters set: a-z and 0-9 (a digit reads as the number sign and "
+                   "its a-j cell). Default all 36.")
 @click.option("--offsets", type=int, default=None, help="Random offsets per stimulus (train and test each). Default 16.")
 @click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm). Default 1.2.")
 @click.option("--refinement", type=float, default=None, help="3D single-dot refinement ratio. Default 8.")

@@ -51,6 +51,8 @@ METHODS = ("direct", "reuse")
 KRYLOV_RTOL = 1e-8
 # at most this many Krylov vectors (memory: 2 * n each); beyond, refactorise
 KRYLOV_MAX = 40
+# after n GMRES failures in a row the next min(2^n - 1, this) systems are factorised directly
+DIRECT_AFTER_FAILURES_MAX = 15
 # a factorisation runs near peak flop rate (BLAS3), a triangular solve is memory bound: time
 # ratio = flop ratio / this (measured on 3D Braille tangents: 5.3 at 17.5k free dofs, 5.7 at 57.5k)
 FACTOR_EFFICIENCY = 5.5
@@ -235,8 +237,6 @@ def gmres(matvec, psolve, b: np.ndarray, rtol: float, maxiter: int):
 
 # -- the solver a Model uses --------------------------------------------------------------------
 
-# -- the solver a Model uses --------------------------------------------------------------------
-
 class SymmetricSolver:
     """Factorise and solve symmetric matrices of one fixed CSR sparsity (sorted indices).
 
@@ -276,6 +276,8 @@ class SymmetricSolver:
         self._fresh = False           # the factorisation is of _A
         self._stale = True            # refactorise at the next factor()
         self._cycle = [0.0, 0]        # cost (in preconditioned iterations) and solves since the factorisation
+        self._failures = 0            # consecutive GMRES solves that did not converge
+        self._direct_left = 0         # factor() calls that refactorise without trying GMRES first
         self._ratio = factor_cost     # factorisation cost / iteration cost
         if backend == "pardiso":
             A = structure.tocsr()
@@ -289,7 +291,8 @@ class SymmetricSolver:
         """Take A as the matrix to solve with; factorise it unless the old factorisation is
         to be reused (method "reuse" and it has not gone stale)."""
         self._A = A
-        if self.method == "direct" or self._stale:
+        if self.method == "direct" or self._stale or self._direct_left > 0:
+            self._direct_left = max(0, self._direct_left - 1)
             return self._factor(A)
         self._fresh = False
         return self
@@ -352,12 +355,19 @@ class SymmetricSolver:
                 # the Givens estimate can drift from the true residual: check it (one product)
                 ok = np.linalg.norm(A @ x - b) <= 10.0 * rtol * np.linalg.norm(b)
             if not ok:
-                log.debug("GMRES: no convergence in %d iterations with the old factorisation; refactorising", k)
+                # a failed solve costs its iterations and a factorisation; while the tangent
+                # keeps changing that much (the Braille plate's first contact: 10 failures in
+                # a row) refactorise directly for the next 1, 3, 7 ... systems
+                self._failures += 1
+                self._direct_left = min(2 ** self._failures - 1, DIRECT_AFTER_FAILURES_MAX)
+                log.debug("GMRES: no convergence in %d iterations with the old factorisation; refactorising"
+                          " (directly for the next %d)", k, self._direct_left)
                 t1, c1 = time.perf_counter(), time.process_time()
                 self._factor(A)
                 t0 += time.perf_counter() - t1  # counted as factor time
                 c0 += time.process_time() - c1
                 return self._direct(b)
+            self._failures = 0
             cost, solves = self._cycle
             cost, solves = cost + k, solves + 1
             self._cycle = [cost, solves]

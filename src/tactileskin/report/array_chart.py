@@ -10,12 +10,17 @@ from tactileskin.array.chart import GOOD, PAPER_PITCH, verdicts
 from tactileskin.fileio import atomic_write_text
 from tactileskin.report.figures import _plt, _save
 
-SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille letters a-z",
+SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille characters {chars}",
               "shapes": "flat / curved / Braille dot / sphere R{r:g}"}
 
 
 def set_title(set_: str, cfg) -> str:
-    return SET_TITLES[set_].format(r=cfg.sphere_radius)
+    from tactileskin.array.chart import DIGITS, LETTERS
+
+    have = set(cfg.letters)
+    chars = {frozenset(LETTERS + DIGITS): "a-z, 0-9", frozenset(LETTERS): "a-z", frozenset(DIGITS): "0-9"}.get(
+        frozenset(have), cfg.letters)
+    return SET_TITLES[set_].format(r=cfg.sphere_radius, chars=chars)
 
 
 def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
