@@ -10,7 +10,7 @@ from tactileskin.errors import ParameterError
 from tactileskin.fe import Dirichlet, make_result, model_for_scene, run
 from tactileskin.fe.model import Model
 from tactileskin.fe.output import map_planes, plane_profile, surface_grid
-from tactileskin.results import OWN_NAMES, read_bone_map
+from tactileskin.results import OWN_NAMES, BoneMap, Result, read_bone_map
 from tactileskin.scene import Scene
 
 # t = 3 silicone under the flat plate, elastic, 0.1 mm travel, on a 1.5 mm slab (quarter
@@ -101,10 +101,35 @@ def test_max_over_z_and_peak_bound_the_section_profile(plane_strain):
     assert np.all(pmax >= res.pressure)
     assert np.all((zmax >= 0) & (zmax <= 0.5 * LENGTH + 1e-12))
     summ = res.summary()
-    assert summ["peak_map_mpa"] == pytest.approx(pmax.max(), rel=0, abs=0)
+    p, s_, z_ = res.bone_map.interior_peak(SCENE.thickness)
+    assert (summ["peak_map_mpa"], summ["peak_map_s_mm"], summ["peak_map_z_mm"]) == (p, s_, z_)
     assert summ["peak_map_mpa"] >= summ["peak_mpa"]
-    j, i = np.unravel_index(np.argmax(res.bone_map.pressure), res.bone_map.pressure.shape)
-    assert (summ["peak_map_s_mm"], summ["peak_map_z_mm"]) == (res.bone_map.s[i], res.bone_map.z[j])
+    # the whole map's peak is the interior one or, larger, reported apart as the edge's (this
+    # slab is shorter than two thicknesses: no interior, the whole map's peak)
+    full = res.bone_map.peak()
+    assert full[0] == pytest.approx(pmax.max(), rel=0, abs=0)
+    assert summ.get("peak_map_edge_mpa", p) == full[0]
+
+
+def test_interior_peak_leaves_out_the_edge_band_but_not_a_symmetry_plane():
+    """A bump under the dot (s = z = 0, a symmetry plane of the quarter map) and a larger
+    spike at the slab's free end: the interior peak is the bump's; margin 0 or a margin
+    wider than the map gives the whole map's."""
+    s, z = np.linspace(0.0, 6.0, 61), np.linspace(0.0, 10.0, 101)
+    S, Z = np.meshgrid(s, z)
+    P = np.exp(-(S ** 2 + Z ** 2)) + 2.0 * np.exp(-((Z - 10.0) / 0.2) ** 2) * np.exp(-S ** 2)
+    bm = BoneMap(s, z, P)
+    assert bm.peak()[0] == pytest.approx(2.0, rel=1e-3) and bm.peak()[2] == 10.0
+    assert bm.interior_peak(1.0) == (pytest.approx(1.0), 0.0, 0.0)  # the bump on both symmetry planes
+    assert bm.interior_peak(0.0) == bm.peak() and bm.interior_peak(20.0) == bm.peak()
+    # a full (mirrored) map has edges on both sides
+    full = BoneMap(np.concatenate([-s[:0:-1], s]), z, np.concatenate([P[:, :0:-1], P], axis=1))
+    assert full.interior_peak(1.0)[0] == pytest.approx(1.0)
+    res = Result(s=s, pressure=P[0], contact_x=np.zeros(1), contact_pressure=np.ones(1), reaction=1.0,
+                 stats={}, scene={"thickness": 1.0}, bone_map=bm)
+    summ = res.summary()
+    assert summ["peak_map_mpa"] == pytest.approx(1.0) and summ["peak_map_edge_mpa"] == pytest.approx(2.0, rel=1e-3)
+    assert summ["peak_map_edge_z_mm"] == 10.0
 
 
 def test_progress_once_per_increment(plane_strain):

@@ -30,8 +30,10 @@ from tactileskin.skins import registry as _skins
 # surface; 6: contact penalty raised per point, other increment sequences on 3D dots past
 # travel 0.3 mm, peaks within 0.01 %; 7: the first increment's travel capped at 0.1 x the
 # indenter's tip radius, other increment sequences for dots, spheres and cylinders, peaks
-# within 0.03 %)
-SCHEMA_VERSION = 7
+# within 0.03 %; 8: the bone map's summary peak (peak_map_mpa) at least one thickness from
+# the bonded skin's edges, the edge's corner value apart as peak_map_edge_mpa; and the GMRES
+# back-off of fe.linsolve, other Newton paths on 3D models)
+SCHEMA_VERSION = 8
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

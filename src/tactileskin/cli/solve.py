@@ -72,7 +72,10 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         t.add_row("bone profile on plane", f"z = {res.stats.get('profile_plane_z', 0.0):g} mm")
         if "peak_map_mpa" in s:
             t.add_row("peak of the bone map P(s, z)", f"{s['peak_map_mpa']:.4g} MPa at s = "
-                      f"{s['peak_map_s_mm']:.3g} mm, z = {s['peak_map_z_mm']:.3g} mm")
+                      f"{s['peak_map_s_mm']:.3g} mm, z = {s['peak_map_z_mm']:.3g} mm (>= t from the skin's edges)")
+        if "peak_map_edge_mpa" in s:
+            t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {s['peak_map_edge_s_mm']:.3g} mm, "
+                      f"z = {s['peak_map_edge_z_mm']:.3g} mm (a corner singularity: grows with mesh refinement)")
         t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
     else:
         t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
