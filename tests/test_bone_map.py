@@ -77,11 +77,13 @@ def test_map_planes_cover_the_slab_and_hold_the_section(plane_strain):
 
 def test_plane_strain_map_is_independent_of_z(plane_strain):
     # Plane strain: every row of the map is the section profile up to the discretisation of
-    # this unstructured h 1 / r 2 tet mesh: its P1-recovered pressure differs between rows by
-    # up to 7.3 % (relative L2) and 4.0 % in the peak, and the L2 spread shrinks with the mesh
-    # (measured at h 0.7 / 0.5: 5.5 % / 3.9 %, peaks 6.2 % / 2.0 %), so it is discretisation,
-    # not sampling (a wrong facet or z would be O(1)); benchmarks/results/braille_2d_vs_3d.md
-    # shows 1-3 % peak spreads between planes on the same nominal mesh.
+    # this unstructured h 1 / r 2 tet mesh. The bone values come from the local fit
+    # (recovery.PointFit, as in 2D): rows differ by up to 3.7 % (relative L2) and 1.1 % in the
+    # peak, and the section's peak is 0.46 % from the 2D section on the same mesh size. The
+    # nodal L2 projection used before read 7.3 % / 3.9 % and -3.4 %: the bounds below
+    # (5 %, 2 %, 1.5 %) tell the two apart. A wrong facet or z would be O(1).
+    from tactileskin.fe import solve
+
     _, res, _, _ = plane_strain
     bm, p0 = res.bone_map, res.pressure
     assert bm.z.size >= 3 and bm.z[0] == 0.0 and bm.z[-1] == pytest.approx(0.5 * LENGTH)
@@ -89,8 +91,9 @@ def test_plane_strain_map_is_independent_of_z(plane_strain):
     np.testing.assert_array_equal(bm.row(bm.section_z), p0)  # the profile is the section row
     norm = np.sqrt(np.trapezoid(p0 ** 2, bm.s))
     for row in bm.pressure:
-        assert np.sqrt(np.trapezoid((row - p0) ** 2, bm.s)) / norm < 0.10
-        assert abs(row.max() / p0.max() - 1) < 0.06
+        assert np.sqrt(np.trapezoid((row - p0) ** 2, bm.s)) / norm < 0.05
+        assert abs(row.max() / p0.max() - 1) < 0.02
+    assert abs(res.peak / solve(SCENE.replace(dim=2)).peak - 1) < 0.015
     # the load is carried near s = 0 (under the plate) on every row, as on the section
     assert np.all(bm.s[np.argmax(bm.pressure, axis=1)] < 1.0)
 

@@ -32,7 +32,9 @@ from tactileskin.skins import registry as _skins
 # indenter's tip radius, other increment sequences for dots, spheres and cylinders, peaks
 # within 0.03 %; 8: the bone map's summary peak (peak_map_mpa) at least one thickness from
 # the bonded skin's edges, the edge's corner value apart as peak_map_edge_mpa; and the GMRES
-# back-off of fe.linsolve, other Newton paths on 3D models)
+# back-off of fe.linsolve, other Newton paths on 3D models; and the 3D bone pressure from
+# the local fit at the bone nodes, as in 2D, instead of the nodal projection: 3D peaks move
+# by 1-3 %)
 SCHEMA_VERSION = 8
 
 
