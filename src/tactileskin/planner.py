@@ -55,24 +55,25 @@ TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin
 # "\u283f": the full cell); a key without pattern means the single dot. The planner's cost
 # is |peak|. Filled from benchmarks/results/braille_2d_vs_3d.md (see there for meshes and
 # caveats).
-# Source (2026-11-23): the 3D reference is the finest level of the local-plan convergence
-# study (benchmarks/results/convergence3d.md: 0.8 / 8 at t = 1, 1.2 / 8 at t = 3; peaks
-# 0.038148, 0.052799, 0.023361 MPa for the dot, 0.019166 for the cell), the 2D ridge the
-# `default` preset (0.10264, 0.14841, 0.07188, 0.04801 MPa): the ridge reads 2.5-3.1 times
-# the bone pressure of a real dot. The t = 3 full cell is the earlier coarse measurement
-# (benchmarks/braille_2d_vs_3d.py --contact-rule 2, 3D mesh 1.0 / 2, 2D on the same mesh).
-# Not measured: t = 5, polyurethane at t = 3.
+# Source (2026-11-25): the 3D reference is the finest level of the local-plan convergence
+# study with the bone pressure from the local fit (benchmarks/results/convergence3d.md: 0.6 / 8
+# at t = 1 silicone, 0.8 / 8 at t = 1 polyurethane, 1.2 / 8 at t = 3; peaks 0.039481,
+# 0.054248, 0.023810 MPa), the 2D ridge the `default` preset (0.10264, 0.14841, 0.07188 MPa):
+# the ridge reads 2.6-3.0 times the bone pressure of a real dot. The full cells are the
+# earlier measurements with the nodal projection (2-3 % low in 3D, tests/test_bone_map.py):
+# t = 1 the finest local level (0.019166 MPa), t = 3 a coarse one (braille_2d_vs_3d.py
+# --contact-rule 2, 3D mesh 1.0 / 2, 2D on the same mesh). Not measured: polyurethane at t = 3.
 MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
-    (1.0, "silicone", "\u2801"): {"peak": 1.690, "span": -0.015,
-                                  "note": "3D converged (local plan, finest level) vs 2D default"},
-    (1.0, "polyurethane", "\u2801"): {"peak": 1.811, "span": 0.028,
-                                      "note": "3D converged (local plan, finest level) vs 2D default"},
+    (1.0, "silicone", "\u2801"): {"peak": 1.600, "span": -0.016,
+                                  "note": "3D converged (local plan, finest two levels within 0.3 %) vs 2D default"},
+    (1.0, "polyurethane", "\u2801"): {"peak": 1.736, "span": 0.021,
+                                      "note": "3D finest level (local plan, 0.8 / 8) vs 2D default"},
     (1.0, "silicone", "\u283f"): {"peak": 1.505, "span": -0.000,
-                                  "note": "3D finest level (peak not shown converged to 2 %) vs 2D default"},
-    (3.0, "silicone", "\u2801"): {"peak": 2.077, "span": -0.081,
-                                  "note": "3D converged (local plan, finest level) vs 2D default"},
+                                  "note": "3D finest level (nodal projection; peak not shown converged to 2 %) vs 2D default"},
+    (3.0, "silicone", "\u2801"): {"peak": 2.019, "span": -0.082,
+                                  "note": "3D finest level (local plan, 1.2 / 8) vs 2D default"},
     (3.0, "silicone", "\u283f"): {"peak": 1.178, "span": 0.013,
-                                  "note": "coarse 3D; vs 2D default quality: peak +132%, span -0.6%"},
+                                  "note": "coarse 3D (nodal projection); vs 2D default quality: peak +132%, span -0.6%"},
 }
 
 SINGLE_DOT = "\u2801"
