@@ -73,7 +73,7 @@ def test_chart_config_refuses_bad_values():
         chart.ChartConfig(pitches=(0.0,))
     with pytest.raises(ParameterError):
         chart.ChartConfig(sets=("nope",))
-    with pytest.raises(ParameterError, match="indenter_radius"):
+    with pytest.raises(ParameterError, match="sphere_radius"):
         chart.ChartConfig(sphere_radius=0.0)
     with pytest.raises(ParameterError, match="sphere_quality"):
         chart.ChartConfig(sphere_quality="rough")

@@ -32,7 +32,7 @@ import numpy as np
 from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
 from tactileskin.array.sampler import ArraySpec, Readout
-from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.errors import ParameterError, TactileSkinError, check_range
 from tactileskin.geometry.braille import get_standard
 from tactileskin.results import BoneMap, read_bone_map
 
@@ -96,10 +96,9 @@ class ChartConfig:
             raise ParameterError("set", bad[0], " or ".join(SETS))
         if self.letters_model not in LETTERS_MODELS:
             raise ParameterError("letters_model", self.letters_model, " or ".join(LETTERS_MODELS))
-        from tactileskin.geometry.indenters.base import check_radius
         from tactileskin.presets import QUALITIES
 
-        check_radius(self.sphere_radius, "sphere")
+        check_range("sphere_radius", self.sphere_radius, 0.1, 1000.0, lo_open=True, unit="mm")  # the sphere kind's range
         if self.sphere_quality not in QUALITIES:
             raise ParameterError("sphere_quality", self.sphere_quality, " or ".join(QUALITIES))
         if self.skin not in SKINS:
