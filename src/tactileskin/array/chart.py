@@ -10,8 +10,8 @@ surface, the paper's sensor film):
   fingertip at the `sphere_quality` 3D preset): the issue's stimulus list beyond the
   paper's claim, which stays on the "paper" set.
 - "letters": the 26 letters a-z as cells and the digits 0-9 as the number sign and a-j's
-  cell (surrogate.char_centres), each the superposition of the single-dot response at its dots in the frame of the full cell
-  (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
+  cell (surrogate.char_centres), each the superposition of the single-dot response at its
+  dots in the frame of its full cells (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
   `skin` (default the flat pad, where a dot's response translates exactly; on the
   fingertip the translation across the curved finger is approximate).
 
