@@ -57,8 +57,8 @@ TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin
 # caveats).
 # Source (2026-11-25): the 3D reference is the finest level of the local-plan convergence
 # study with the bone pressure from the local fit (benchmarks/results/convergence3d.md: 0.6 / 8
-# at t = 1 silicone, 0.8 / 8 at t = 1 polyurethane, 1.2 / 8 at t = 3; peaks 0.039481,
-# 0.054248, 0.023810 MPa), the 2D ridge the `default` preset (0.10264, 0.14841, 0.07188 MPa):
+# at t = 1 silicone, 0.8 / 8 at t = 1 polyurethane and at t = 3; peaks 0.039481,
+# 0.054248, 0.023831 MPa), the 2D ridge the `default` preset (0.10264, 0.14841, 0.07188 MPa):
 # the ridge reads 2.6-3.0 times the bone pressure of a real dot. The full cells are the
 # earlier measurements with the nodal projection (2-3 % low in 3D, tests/test_bone_map.py):
 # t = 1 the finest local level (0.019166 MPa), t = 3 a coarse one (braille_2d_vs_3d.py
@@ -70,8 +70,8 @@ MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
                                       "note": "3D finest level (local plan, 0.8 / 8) vs 2D default"},
     (1.0, "silicone", "\u283f"): {"peak": 1.505, "span": -0.000,
                                   "note": "3D finest level (nodal projection; peak not shown converged to 2 %) vs 2D default"},
-    (3.0, "silicone", "\u2801"): {"peak": 2.019, "span": -0.082,
-                                  "note": "3D finest level (local plan, 1.2 / 8) vs 2D default"},
+    (3.0, "silicone", "\u2801"): {"peak": 2.016, "span": -0.069,
+                                  "note": "3D converged (local plan, finest two levels within 0.1 %) vs 2D default"},
     (3.0, "silicone", "\u283f"): {"peak": 1.178, "span": 0.013,
                                   "note": "coarse 3D (nodal projection); vs 2D default quality: peak +132%, span -0.6%"},
 }
