@@ -107,8 +107,8 @@ class BoneMap:
         whole map if none is. A grid starting at 0 starts at a symmetry plane of the reduced
         model, not at an edge. Why: where the bonded skin ends (a slab's free end, a pad's
         side) the bone pressure has a corner singularity (t = 5 mm dot, plate on the whole
-        slab: 0.060, 0.070, 0.082 MPa at the end on meshes 1.6, 1.2, 0.8 / 8, against
-        0.0364, 0.0363, 0.0362 under the dot; benchmarks/results/convergence3d.md)."""
+        slab: 0.044, 0.056, 0.065 MPa at the end on meshes 1.6, 1.2, 0.8 / 8, against
+        0.0348, 0.0352, 0.0353 under the dot; benchmarks/results/convergence3d.md)."""
         keep = []
         for v in (self.z, self.s):
             ok = v <= v[-1] - margin
