@@ -140,7 +140,7 @@ def test_side_by_side_pairs_equal_cases_only():
     lines = markdown.braille_comparison(recs + [extra])
     assert lines[0] == "## Braille: 2D ridge against 3D dots"
     text = "\n".join(lines)
-    assert "braille_2d_vs_3d.md" in text and "section plane" in text
+    assert "convergence3d.md" in text and "section plane" in text
     rows = [ln for ln in lines if ln.startswith("| t")]
     assert len(rows) == 2 and "d0.1" not in text
     cells = [c.strip() for c in rows[0].strip("|").split("|")]
