@@ -53,7 +53,7 @@ TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin
 # ("peak") and span ("span", results.span), signed, keyed by (thickness, material, dot
 # pattern) with the pattern as Unicode braille ("\u2801": one dot, the paper's section;
 # "\u283f": the full cell); a key without pattern means the single dot. The planner's cost
-# is |peak|. Filled from benchmarks/results/braille_2d_vs_3d.md (see there for meshes and
+# is |peak|. Filled from benchmarks/results/convergence3d.md (see there for meshes and
 # caveats).
 # Source (2026-11-25): the 3D reference is the finest level of the local-plan convergence
 # study with the bone pressure from the local fit (benchmarks/results/convergence3d.md: 0.6 / 8
@@ -63,7 +63,8 @@ TRUNCATION_MARGIN = 2.0  # mm of interface kept beyond the window (plus one skin
 # times the bone pressure of a real dot (1.9 at t = 5, where the plate presses too). The full cells are the
 # earlier measurements with the nodal projection (2-3 % low in 3D, tests/test_bone_map.py):
 # t = 1 the finest local level (0.019166 MPa), t = 3 a coarse one (braille_2d_vs_3d.py
-# --contact-rule 2, 3D mesh 1.0 / 2, 2D on the same mesh). Not measured: polyurethane at t = 3, 5.
+# --contact-rule 2, 3D mesh 1.0 / 2, 2D on the same mesh); t = 3 polyurethane: 0.032392 (0.8 / 8)
+# against 0.09913. Not measured: polyurethane at t = 5.
 MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
     (1.0, "silicone", "\u2801"): {"peak": 1.600, "span": -0.016,
                                   "note": "3D converged (local plan, finest two levels within 0.3 %) vs 2D default"},
@@ -73,6 +74,8 @@ MEASURED_RIDGE_VS_DOTS: dict[tuple, dict] = {
                                   "note": "3D finest level (nodal projection; peak not shown converged to 2 %) vs 2D default"},
     (3.0, "silicone", "\u2801"): {"peak": 2.016, "span": -0.069,
                                   "note": "3D converged (local plan, finest two levels within 0.1 %) vs 2D default"},
+    (3.0, "polyurethane", "\u2801"): {"peak": 2.060, "span": -0.040,
+                                      "note": "3D converged (local plan, finest two levels within 0.01 %) vs 2D default"},
     (5.0, "silicone", "\u2801"): {"peak": 0.877, "span": -0.044,
                                   "note": "3D Richardson limit (local plan, 1.6 / 1.2 / 0.8 / 8, order 4.8) vs 2D default"},
     (3.0, "silicone", "\u283f"): {"peak": 1.178, "span": 0.013,
