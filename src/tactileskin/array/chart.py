@@ -33,6 +33,8 @@ from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
 from tactileskin.array.sampler import ArraySpec, Readout
 from tactileskin.errors import ParameterError, TactileSkinError, check_range
+from tactileskin.geometry.braille import DIGITS as BRAILLE_DIGITS
+from tactileskin.geometry.braille import LETTERS as BRAILLE_LETTERS
 from tactileskin.geometry.braille import get_standard
 from tactileskin.results import BoneMap, read_bone_map
 
@@ -40,8 +42,10 @@ log = logging.getLogger(__name__)
 
 PAPER_PITCH = 0.75          # the paper's rule: Braille span 1.5 mm at t = 1 mm -> 0.75 mm pitch
 GOOD = 0.95                 # accuracy at which a set counts as discriminated
-LETTERS = "abcdefghijklmnopqrstuvwxyz"
-DIGITS = "1234567890"       # each the number sign and a-j's cell (surrogate.char_centres)
+# the characters of the letters set, from the Braille tables (geometry.braille): a-z, and the
+# digits 1-9, 0, each the number sign and a-j's cell (surrogate.char_centres)
+LETTERS = "".join(sorted(BRAILLE_LETTERS))
+DIGITS = "".join(BRAILLE_DIGITS)
 CHARACTERS = LETTERS + DIGITS
 SETS = ("paper", "letters", "shapes")  # the index seeds each set's offsets: append only
 SKINS = ("pad", "fingertip")
