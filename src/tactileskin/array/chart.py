@@ -11,7 +11,9 @@ surface, the paper's sensor film):
   paper's claim, which stays on the "paper" set.
 - "letters": the 26 letters a-z as cells and the digits 0-9 as the number sign and a-j's
   cell (surrogate.char_centres), each the superposition of the single-dot response at its
-  dots in the frame of its full cells (surrogate.py; its error against full solves is stated by `validate_surrogate`), on
+  dots in the frame of its full cells, each dot weighted by its load beside its neighbours
+  (ChartConfig.letters_model; surrogate.py; its error against full solves is stated by
+  `validate_surrogate`), on
   `skin` (default the flat pad, where a dot's response translates exactly; on the
   fingertip the translation across the curved finger is approximate).
 
@@ -49,7 +51,7 @@ DIGITS = "".join(BRAILLE_DIGITS)
 CHARACTERS = LETTERS + DIGITS
 SETS = ("paper", "letters", "shapes")  # the index seeds each set's offsets: append only
 SKINS = ("pad", "fingertip")
-LETTERS_MODELS = ("sum", "full")
+LETTERS_MODELS = ("interaction", "sum", "full")
 
 
 @dataclass(frozen=True)
@@ -74,10 +76,13 @@ class ChartConfig:
     # depth cap (mm): a thickness whose 20 % depth exceeds it is indented by max_depth instead (all
     # its stimuli, 2D and 3D); None: the paper's 20 % everywhere (t >= 2.4 mm: the plate touches)
     max_depth: float | None = None
-    # the letters' maps: "sum" superposes the single dot (one 3D solve per t; its measured error
-    # is in data/surrogate_validation.json), "full" solves every letter in 3D (one solve per
-    # letter and t: where the sum is not within 5 %)
-    letters_model: str = "sum"
+    # the letters' maps: "interaction" superposes the single dot with each dot's load from the
+    # lone dot's surface deflection (surrogate.interaction_weights; on the pad below the dot
+    # height, else the plain sum), "sum" adds lone dots (one 3D solve per t; measured errors of
+    # both in data/surrogate_validation.json: interaction 4.9, 8.5, 8.8, 3.9, 8.0 % against the
+    # sum's 5.3, 10.3, 14.7, 5.6, 15.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter
+    # in 3D (one solve per letter and t: where the surrogates are not within 5 %)
+    letters_model: str = "interaction"
     # the shapes set's sphere (mm) and the 3D preset it is meshed at (the strip plan; preview:
     # peak 2.9 % and span 3.1 % from default at t = 1 silicone, 10 s against 56 s CPU)
     sphere_radius: float = 2.5
@@ -235,11 +240,14 @@ def extruded(s, p, z) -> BoneMap:
 
 
 def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None,
-                  base: BoneMap | None = None, letters: dict | None = None, sphere: BoneMap | None = None) -> dict:
+                  base: BoneMap | None = None, letters: dict | None = None, sphere: BoneMap | None = None,
+                  deflection=None) -> dict:
     """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
     single dot on cfg.skin, `section` its section; plus `base`, the blank plate, for the
-    plate-aware kernel) unless given as `letters` (full solves), the paper set's dot
-    `paper_kernel` (the fingertip's; default `kernel`), the shapes set's `sphere`."""
+    plate-aware kernel; with `deflection`, the lone dot's surface deflection w(dx, dz), each
+    dot weighted by surrogate.interaction_weights) unless given as `letters` (full solves),
+    the paper set's dot `paper_kernel` (the fingertip's; default `kernel`), the shapes set's
+    `sphere`."""
     out = {}
     pk = kernel if paper_kernel is None else paper_kernel
     paper = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")} if profiles else {}
@@ -252,8 +260,11 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
     if "letters" in cfg.sets and letters is not None:
         out["letters"] = letters
     elif "letters" in cfg.sets:
-        out["letters"] = {c: surrogate.superpose(kernel, surrogate.char_centres(c, cfg.standard), section,
-                                                 base=base) for c in cfg.letters}
+        out["letters"] = {}
+        for c in cfg.letters:
+            centres = surrogate.char_centres(c, cfg.standard)
+            w = None if deflection is None else surrogate.interaction_weights(centres, deflection)
+            out["letters"][c] = surrogate.superpose(kernel, centres, section, weights=w, base=base)
     return out
 
 
@@ -267,6 +278,7 @@ class Chart:
     labels: dict = field(default_factory=dict)      # set -> class names
     cutoffs: list = field(default_factory=list)     # per (material, t): the single dot's measured cut-off
     notes: list = field(default_factory=list)       # what makes a part of the chart suspect
+    letters_models: dict = field(default_factory=dict)  # (material, t) -> the letters' model used
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
@@ -297,6 +309,15 @@ def _chart_scenes(cfg: ChartConfig, material: str, t: float) -> tuple:
     blank = blank_scene(dot) if dot is not None and plate_touches(dot) else None
     sphere = sphere_scene(t, material, cfg) if shapes else None
     return dot, pdot, blank, sec2, sphere
+
+
+def letters_model(cfg: ChartConfig, dot, base) -> str:
+    """The letters' model used for the dot scene `dot`: cfg.letters_model, except that the
+    interaction weights need the flat pad's free surface and no plate contact (`base` None):
+    elsewhere the plain sum."""
+    if cfg.letters_model == "interaction" and (dot is None or dot.skin != "pad" or base is not None):
+        return "sum"
+    return cfg.letters_model
 
 
 def letter_scenes(cfg: ChartConfig, material: str, t: float) -> dict:
@@ -350,8 +371,13 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                                       "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
             letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None
+            model = letters_model(cfg, dot, base)
+            deflection = surface_deflection(recs[dot], dot.section().top) if model == "interaction" else None
+            if dot is not None:
+                chart.letters_models[(material, t)] = model
             sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
-                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]))
+                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]),
+                                 deflection=deflection)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())

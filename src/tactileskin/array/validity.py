@@ -3,8 +3,8 @@ full 3D solves, from this run's validation rows (`chart.validate_surrogate`) or,
 those, from the project's measurements in tactileskin/data/surrogate_validation.json.
 
 The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
-validated characters (the plain sum, the model the chart uses); where nothing matches it is
-not validated. Either way the chart says so beside the letters' accuracies.
+validated characters, for the model the chart used ("interaction" or the plain "sum"; a row
+without a model is the sum); where nothing matches it is not validated. Either way the chart says so beside the letters' accuracies.
 """
 
 from __future__ import annotations
@@ -34,12 +34,13 @@ def _match(a: float, b: float) -> bool:
     return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-9)
 
 
-def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None) -> dict:
+def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None,
+             model: str = "sum") -> dict:
     """{"error": worst taxel error over the peak or None, "texts": the validated characters,
     "source": where the numbers come from, "status": "within" | "exceeds" | "not validated"}."""
     rows, source = [], ""
     for r in validation or ():
-        if r.get("model", "sum") == "sum" and r["material"] == material and _match(r["thickness_mm"], t) \
+        if r.get("model", "sum") == model and r["material"] == material and _match(r["thickness_mm"], t) \
                 and _match(r.get("depth_mm", depth), depth) and "max_abs_over_peak_taxel" in r:
             rows.append({"text": r["text"], "taxel_max_error": r["max_abs_over_peak_taxel"]})
             source = "this run's validation"
@@ -49,7 +50,7 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
                     not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
                 continue
             for r in case["rows"]:
-                if _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth):
+                if r.get("model", "sum") == model and _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth):
                     rows.append(r)
                     source = r["source"]
     if not rows:

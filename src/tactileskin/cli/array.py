@@ -62,9 +62,11 @@ def load_config(path) -> dict:
                    "fingertip (the paper's; validation refuses x-asymmetric texts, solved mirrored there).")
 @click.option("--validate", default=None,
               help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
-@click.option("--letters-model", type=click.Choice(["sum", "full"]), default=None,
-              help="Letters from superposed single-dot solves (sum, default; its measured error is in the "
-                   "report) or a full 3D solve of every letter (full: one solve per letter and thickness).")
+@click.option("--letters-model", type=click.Choice(["interaction", "sum", "full"]), default=None,
+              help="Letters from superposed single-dot solves, each dot's load from the lone dot's surface "
+                   "deflection (interaction, default; on the pad below the dot height, else sum) or as lone "
+                   "dots (sum): their measured errors are in the report; or a full 3D solve of every letter "
+                   "(full: one solve per letter and thickness).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,

@@ -132,8 +132,9 @@ def letters_trust(chart, validation=None) -> dict:
                                       "source": "full 3D solves of every letter (no surrogate)"}
                 continue
             dot = dot_scene(t, material, cfg)
-            out[(material, t)] = measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
-                                          float(dot.indentation), validation)
+            model = getattr(chart, "letters_models", {}).get((material, t), cfg.letters_model)
+            out[(material, t)] = {**measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
+                                             float(dot.indentation), validation, model=model), "model": model}
     return out
 
 
@@ -152,16 +153,20 @@ def _trust_section(chart, trust: dict) -> list[str]:
 
     out = ["### How far the letters can be trusted", "",
            ("The letters are full 3D solves of every letter (`letters_model = full`)." if cfg_full else
-            "The letters are superposed single-dot responses (a surrogate). Its error against full 3D "
+            "The letters are superposed single-dot responses (a surrogate: `interaction` weighs each dot "
+            "by the load the lone dot's surface deflection leaves it beside its neighbours; `sum` adds lone "
+            "dots). Its error against full 3D "
             "solves of the same characters, as the chart's smallest taxels read them (worst over the "
             "validated characters; `tactileskin array --validate` measures it for a run; "
             "`--letters-model full` solves every letter instead):"), "",
-           "| material | t (mm) | surrogate error / peak | validated on | status | source |", "|---|---|---|---|---|---|"]
+           "| material | t (mm) | model | surrogate error / peak | validated on | status | source |",
+           "|---|---|---|---|---|---|---|"]
     for (material, t), m in trust.items():
         err = "-" if m["error"] is None else f"{m['error']:.1%}"
         status = {"full": "no surrogate", "within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
-        out.append(f"| {material} | {t:g} | {err} | {', '.join(m['texts']) or '-'} | {status} | {m['source'] or '-'} |")
+        out.append(f"| {material} | {t:g} | {m.get('model', '-')} | {err} | {', '.join(m['texts']) or '-'} | {status} "
+                   f"| {m['source'] or '-'} |")
     out += ["", "† in the letters tables: a thickness whose surrogate is not within the tolerance or not validated.", ""]
     return out
 
