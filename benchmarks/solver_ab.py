@@ -3,8 +3,8 @@ peak and CPU time per (case, variant), each solve in its own process (one BLAS t
 `--jobs` processes at a time.
 
 Cases are Scene keyword sets, named; variants are SolverOptions keyword sets (plus
-"penalty_factor", fe.model.PENALTY_FACTOR, and "direct_after_failures",
-fe.linsolve.DIRECT_AFTER_FAILURES_MAX):
+"penalty_factor", fe.model.PENALTY_FACTOR, "direct_after_failures",
+fe.linsolve.DIRECT_AFTER_FAILURES_MAX, and "tol_relative", fe.model.Contact.tol_relative):
 
     .venv/bin/python benchmarks/solver_ab.py --set first_travel \
         --variant 'before:first_travel_radius=0' --variant 'now:' [--jobs 2] [--out FILE]
@@ -60,6 +60,13 @@ def one(case: dict, variant: dict) -> dict:
         from tactileskin.fe import linsolve
 
         linsolve.DIRECT_AFTER_FAILURES_MAX = int(variant.pop("direct_after_failures"))
+    if "tol_relative" in variant:  # fe.model.Contact's penetration tolerance over the facet size
+        import functools
+
+        import tactileskin.fe as fe
+        from tactileskin.fe.model import Contact
+
+        fe.Contact = functools.partial(Contact, tol_relative=float(variant.pop("tol_relative")))
     q = case.pop("quality", None)
     sc = Scene(**case)
     if q:
