@@ -34,8 +34,9 @@ from tactileskin.skins import registry as _skins
 # the bonded skin's edges, the edge's corner value apart as peak_map_edge_mpa; and the GMRES
 # back-off of fe.linsolve, other Newton paths on 3D models; and the 3D bone pressure from
 # the local fit at the bone nodes, as in 2D, instead of the nodal projection: 3D peaks move
-# by 1-3 %)
-SCHEMA_VERSION = 8
+# by 1-3 %; 9: the 3D contact penetration tolerance 1e-3 h (was 1e-4 h), 3D peaks within
+# 0.07 %)
+SCHEMA_VERSION = 9
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

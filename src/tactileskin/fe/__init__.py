@@ -19,8 +19,9 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
   by the parabola through the last three states (tangent factor g_inf + sum gain_i);
 - rigid frictionless contact on 2 Gauss points per P2 edge / 3 per P2 triangle (more
   over-constrain the multipliers), penalty 20 K0 / h with Uzawa updates (inside the Newton
-  solve) until the gap at the pressed points is below 1e-4 h (Contact.tol_relative; h the
-  contact facet size); points stay active within a Newton solve (no active-set cycling);
+  solve) until the gap at the pressed points is below 1e-4 h in 2D, 1e-3 h in 3D
+  (Contact.tol_relative, fe.model.TOL_RELATIVE; h the contact facet size); points stay
+  active within a Newton solve (no active-set cycling);
 - Newton with a Crisfield line search on s(eta) = du.R, inadmissible states halve the
   step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure;
 - nodal pressure by L2 projection onto P1 (exact mass matrix for the 3-point rule); the

@@ -27,6 +27,13 @@ from tactileskin.fe.contact import ContactSurface
 log = logging.getLogger(__name__)
 
 PENALTY_FACTOR = 20.0  # penalty = factor * modulus / facet size (MPa/mm)
+# penetration tolerance over the contact facet size, per model dimension (Contact.tol_relative
+# None). 2D 1e-4: 5e-4 left t1 silicone flat 0.16 % below its 1e-6 mm answer (lock-up), and
+# 1e-3 moved the 2D Braille ridges by up to 0.09 % for 8 % fewer Newton iterations. 3D 1e-3:
+# the Uzawa updates that settle the last 1e-4 h cost 14-45 % of the 3D dots' Newton iterations
+# for peak changes of at most 0.07 %, against 3D preset errors of 1-2 %
+# (benchmarks/results/contact_tolerance3d.md)
+TOL_RELATIVE = {2: 1e-4, 3: 1e-3}
 Law = Callable[..., tuple]  # law(C (...,3,3), tangent=True) -> (S, D or None, ok)
 
 
@@ -78,11 +85,10 @@ class Contact:
     penalty: float | None = None   # MPa/mm; None: from the material stiffness and mesh size
     # penetration tolerance (mm) of the augmented Lagrangian; None: tol_relative x the
     # contact facet size (Model.surface_size), so that it shrinks with the mesh and a
-    # convergence study sees no fixed floor. 1e-4 x h (2e-5 mm at the 2D preview facet of
-    # 0.2 mm): 5e-4 x h left t1 silicone flat 0.16 % below its 1e-6 mm answer (lock-up:
-    # the stress moves ~ alpha beta x gap / thickness); benchmarks/results/contact_newton.md
+    # convergence study sees no fixed floor (lock-up: the stress moves ~ alpha beta x gap /
+    # thickness; benchmarks/results/contact_newton.md)
     tol_penetration: float | None = None
-    tol_relative: float = 1e-4
+    tol_relative: float | None = None  # None: TOL_RELATIVE of the model's dimension
     # The indenter-curvature term -lambda dn/dx of the consistent tangent. The solver adds it
     # only after its first iterates (SolverOptions.curvature_after): it is negative
     # semi-definite, and early iterates with overshooting multipliers made the tangent
@@ -166,7 +172,10 @@ class Model:
                 contact.penalty = PENALTY_FACTOR * stiffness / h
                 log.debug("contact penalty %.3g MPa/mm (h = %.3g mm)", contact.penalty, h)
             if contact.tol_penetration is None:
-                contact.tol_penetration = contact.tol_relative * self.surface_size()
+                rel = TOL_RELATIVE[m] if contact.tol_relative is None else contact.tol_relative
+                if not (np.isfinite(rel) and 0 < rel < 1):
+                    raise ParameterError("contact tol_relative", rel, "(0, 1) of the contact facet size")
+                contact.tol_penetration = rel * self.surface_size()
 
         # committed state
         E, Q = self.w.shape
