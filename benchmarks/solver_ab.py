@@ -10,7 +10,7 @@ fe.linsolve.DIRECT_AFTER_FAILURES_MAX, and "tol_relative", fe.model.Contact.tol_
         --variant 'before:first_travel_radius=0' --variant 'now:' [--jobs 2] [--out FILE]
 
 Built-in case sets (--set): "braille2d" (the 2D ridge at t = 1, 3, 5, both paper materials,
-preview and default meshes), "braille3d" (the single 3D dot: t = 1 default, t = 3 preview,
+preview and default meshes), "paper2d" (the paper's 18 cases in 2D, preview and default), "braille3d" (the single 3D dot: t = 1 default, t = 3 preview,
 t = 5 preview, silicone), "braille3d_default" (t = 3 and 5 at the default preset), "chart" (the array chart's 3D dots at t = 5 on the pad, 0.4 mm).
 """
 
@@ -30,6 +30,9 @@ ROOT = Path(__file__).resolve().parents[1]
 SETS = {
     "braille2d": {f"t{t:g}-{m}-braille-2d-{q}": dict(thickness=t, material=m, indenter="braille", quality=q)
                   for q in ("preview", "default") for m in ("silicone", "polyurethane") for t in (1.0, 3.0, 5.0)},
+    "paper2d": {f"t{t:g}-{m}-{i}-2d-{q}": dict(thickness=t, material=m, indenter=i, quality=q)
+                for q in ("preview", "default") for m in ("silicone", "polyurethane") for t in (1.0, 3.0, 5.0)
+                for i in ("flat", "curved", "braille")},
     "braille3d": {
         "t1-silicone-dot-3d-default": dict(thickness=1.0, dim=3, indenter="braille", quality="default"),
         "t3-silicone-dot-3d-preview": dict(thickness=3.0, dim=3, indenter="braille", quality="preview"),

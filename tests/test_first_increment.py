@@ -1,6 +1,7 @@
 """The first increment's travel is capped at a fraction of the indenter's tip radius
 (SolverOptions.first_travel_radius): the contact strain of a small dot goes as sqrt(d / R)."""
 
+import numpy as np
 import pytest
 
 from tactileskin import fe
@@ -49,3 +50,39 @@ def test_capped_first_increment_keeps_the_answer(braille_t3):
     a, b = braille_t3["capped"][0], braille_t3["off"][0]
     assert a.peak == pytest.approx(b.peak, rel=1e-3)
     assert a.span == pytest.approx(b.span, rel=1e-3)
+
+
+def test_a_failed_increment_length_is_not_tried_again():
+    """SolverOptions.failed_dt_fraction: after an increment of length dt_f fails, the run's
+    later increments stay at or below that fraction of dt_f, where growth x1.5 alone would
+    climb back past dt_f and fail again (0 turns it off: the sawtooth returns)."""
+    from types import SimpleNamespace
+
+    from tactileskin.fe.solver import SolverOptions, _Failure, run
+
+    def fake_model():
+        m = SimpleNamespace(t=0.0, u=np.zeros(1), contact=None)
+        m.travel = lambda t: t
+        m.commit = lambda ev, u, t, dt: setattr(m, "t", t)
+        return m
+
+    def tried_lengths(fraction):
+        tried = []
+
+        def increment(model, u, t, dt, opts, stats):
+            tried.append(dt)
+            if dt > 0.1:  # everything longer than 0.1 fails
+                raise _Failure("too long", {})
+            return u, SimpleNamespace(), 3  # easy: the increment grows x1.5 next
+        opts = SolverOptions(dt0_fraction=0.25, dt_max_fraction=0.25, failed_dt_fraction=fraction)
+        run(fake_model(), 1.0, opts, increment=increment)
+        return tried
+
+    capped = tried_lengths(0.7)
+    failed = [k for k, dt in enumerate(capped) if dt > 0.1]
+    # 0.25 fails (cap 0.175), the grown 0.131 fails (cap 0.092), then nothing longer is tried
+    assert len(failed) == 2
+    for k in failed:
+        assert max(capped[k + 1:]) <= 0.7 * capped[k] + 1e-12
+    sawtooth = tried_lengths(0.0)
+    assert sum(dt > 0.1 for dt in sawtooth) > 4          # without it the growth fails again and again

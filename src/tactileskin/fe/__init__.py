@@ -23,7 +23,8 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
   (Contact.tol_relative, fe.model.TOL_RELATIVE; h the contact facet size); points stay
   active within a Newton solve (no active-set cycling);
 - Newton with a Crisfield line search on s(eta) = du.R, inadmissible states halve the
-  step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure;
+  step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure, and stay
+  below 0.7 x a failed increment's length for the rest of the run;
 - nodal pressure by L2 projection onto P1 (exact mass matrix for the 3-point rule); the
   2D bone profile by a local linear fit to element averages (fe.recovery.PointFit).
 """
