@@ -148,6 +148,10 @@ def test_interaction_letters_weigh_each_dot_by_its_neighbours():
     weighed = chart.stimulus_maps(kernel, sec, {}, cfg, deflection=_heave)["letters"]
     assert np.allclose(weighed["a"].pressure, plain["a"].pressure)
     assert np.allclose(weighed["b"].pressure, plain["b"].pressure / 0.9)
+    # a deflection that leaves a dot no load (neighbours lifting the surface by more than the
+    # dot presses it) is refused by name; compute() then falls back to the sum with a note
+    with pytest.raises(ParameterError, match="interaction weights of 'b'"):
+        chart.stimulus_maps(kernel, sec, {}, cfg, deflection=lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))
 
 
 def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch):
@@ -438,3 +442,24 @@ def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypa
     assert "| 2 | 0.01 |" in md and "full 3D solves of every letter" in md and not suspect(ch)
     with pytest.raises(ParameterError, match="letters_model"):
         chart.ChartConfig(letters_model="guess")
+
+
+def test_chart_falls_back_to_the_sum_where_the_interaction_weights_fail(monkeypatch):
+    """A deflection that gives a dot no load: the chart is still drawn, from the plain sum,
+    with a note (suspect), and the trust table judges the sum's rows."""
+    from types import SimpleNamespace
+
+    from tactileskin.report.array_chart import suspect
+
+    grid = np.linspace(-8, 8, 161)
+    monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
+        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes})
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    monkeypatch.setattr(chart, "surface_deflection",
+                        lambda rec, top: lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))
+    cfg = chart.ChartConfig(thicknesses=(1.0,), pitches=(0.5,), noise_fs=(0.01,), letters="abc", n_train=4,
+                            n_test=4, template_grid=2, sets=("letters",))
+    ch = chart.compute(cfg, cache=None)
+    assert ch.letters_models == {("silicone", 1.0): "sum"}
+    assert any("fall back to the plain sum" in n for n in ch.notes)
+    assert any("fall back to the plain sum" in n for n in suspect(ch))

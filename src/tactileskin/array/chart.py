@@ -264,6 +264,9 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
         for c in cfg.letters:
             centres = surrogate.char_centres(c, cfg.standard)
             w = None if deflection is None else surrogate.interaction_weights(centres, deflection)
+            if w is not None and not np.all(np.isfinite(w) & (w > 0)):
+                raise ParameterError(f"interaction weights of {c!r}", np.round(w, 3).tolist(),
+                                     "finite and > 0 (a surface deflection that gives a dot no load)")
             out["letters"][c] = surrogate.superpose(kernel, centres, section, weights=w, base=base)
     return out
 
@@ -375,9 +378,19 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             deflection = surface_deflection(recs[dot], dot.section().top) if model == "interaction" else None
             if dot is not None:
                 chart.letters_models[(material, t)] = model
-            sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
-                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]),
-                                 deflection=deflection)
+            sphere_map = None if sphere is None else bone_map_of(recs[sphere])
+            try:
+                sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot),
+                                     base=base, letters=letters, sphere=sphere_map, deflection=deflection)
+            except ParameterError as e:
+                if deflection is None:
+                    raise
+                note = f"t = {t:g} mm ({material}): the letters fall back to the plain sum: {e}"
+                log.warning(note)
+                chart.notes.append(note)
+                chart.letters_models[(material, t)] = "sum"
+                sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot),
+                                     base=base, letters=letters, sphere=sphere_map)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())

@@ -4,7 +4,8 @@ those, from the project's measurements in tactileskin/data/surrogate_validation.
 
 The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
 validated characters, for the model the chart used ("interaction" or the plain "sum"; a row
-without a model is the sum); where nothing matches it is not validated. Either way the chart says so beside the letters' accuracies.
+without a model is the sum); where nothing matches it is not validated. Either way the chart
+says so beside the letters' accuracies.
 """
 
 from __future__ import annotations
