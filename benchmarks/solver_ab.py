@@ -86,7 +86,7 @@ def parse_variant(text: str) -> tuple[str, dict]:
     for item in filter(None, (x.strip() for x in body.split(","))):
         k, _, v = item.partition("=")
         kw[k] = json.loads(v) if v[:1] in "[{\"" or v.replace(".", "", 1).replace("-", "", 1).replace("e", "", 1).isdigit() \
-            else {"true": True, "false": False}.get(v, v)
+            else {"true": True, "false": False}.get(v.lower(), v)
     return name, kw
 
 
