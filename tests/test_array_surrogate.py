@@ -136,7 +136,7 @@ def _heave(dx, dz):
 
 
 def test_interaction_letters_weigh_each_dot_by_its_neighbours():
-    """stimulus_maps with a deflection: each dot of a letter carries interaction_weights' load;
+    """stimulus_maps with letter_weights: each dot of a letter carries interaction_weights' load;
     a lone-dot letter ('a') is the kernel itself, and where the surface heaves beside a dot
     (w < 0) its neighbours carry more than a lone dot: 'b' (two dots 2.3-2.5 mm apart) by
     1 / (1 + w(d) / w0) = 1 / 0.9 each, the closed form of the 2 x 2 system."""
@@ -145,13 +145,13 @@ def test_interaction_letters_weigh_each_dot_by_its_neighbours():
     sec = chart.dot_scene(1.0, "silicone", chart.ChartConfig()).section()
     cfg = chart.ChartConfig(letters="ab", sets=("letters",))
     plain = chart.stimulus_maps(kernel, sec, {}, cfg)["letters"]
-    weighed = chart.stimulus_maps(kernel, sec, {}, cfg, deflection=_heave)["letters"]
+    weighed = chart.stimulus_maps(kernel, sec, {}, cfg, weights=chart.letter_weights(cfg, _heave))["letters"]
     assert np.allclose(weighed["a"].pressure, plain["a"].pressure)
     assert np.allclose(weighed["b"].pressure, plain["b"].pressure / 0.9)
     # a deflection that leaves a dot no load (neighbours lifting the surface by more than the
     # dot presses it) is refused by name; compute() then falls back to the sum with a note
     with pytest.raises(ParameterError, match="interaction weights of 'b'"):
-        chart.stimulus_maps(kernel, sec, {}, cfg, deflection=lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))
+        chart.letter_weights(cfg, lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))
 
 
 def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch):

@@ -241,13 +241,12 @@ def extruded(s, p, z) -> BoneMap:
 
 def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, paper_kernel: BoneMap = None,
                   base: BoneMap | None = None, letters: dict | None = None, sphere: BoneMap | None = None,
-                  deflection=None) -> dict:
+                  weights: dict | None = None) -> dict:
     """{set: {name: BoneMap}} for one material and thickness: the letters from `kernel` (the
     single dot on cfg.skin, `section` its section; plus `base`, the blank plate, for the
-    plate-aware kernel; with `deflection`, the lone dot's surface deflection w(dx, dz), each
-    dot weighted by surrogate.interaction_weights) unless given as `letters` (full solves),
-    the paper set's dot `paper_kernel` (the fingertip's; default `kernel`), the shapes set's
-    `sphere`."""
+    plate-aware kernel; `weights` {character: its dots' loads}, see `letter_weights`; default
+    1 each) unless given as `letters` (full solves), the paper set's dot `paper_kernel` (the
+    fingertip's; default `kernel`), the shapes set's `sphere`."""
     out = {}
     pk = kernel if paper_kernel is None else paper_kernel
     paper = {name: extruded(*profiles[name], pk.z) for name in ("flat", "curved")} if profiles else {}
@@ -260,14 +259,23 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
     if "letters" in cfg.sets and letters is not None:
         out["letters"] = letters
     elif "letters" in cfg.sets:
-        out["letters"] = {}
-        for c in cfg.letters:
-            centres = surrogate.char_centres(c, cfg.standard)
-            w = None if deflection is None else surrogate.interaction_weights(centres, deflection)
-            if w is not None and not np.all(np.isfinite(w) & (w > 0)):
-                raise ParameterError(f"interaction weights of {c!r}", np.round(w, 3).tolist(),
-                                     "finite and > 0 (a surface deflection that gives a dot no load)")
-            out["letters"][c] = surrogate.superpose(kernel, centres, section, weights=w, base=base)
+        out["letters"] = {c: surrogate.superpose(kernel, surrogate.char_centres(c, cfg.standard), section,
+                                                 weights=None if weights is None else weights[c], base=base)
+                          for c in cfg.letters}
+    return out
+
+
+def letter_weights(cfg: ChartConfig, deflection) -> dict:
+    """{character: the loads of its dots} from the lone dot's surface deflection w(dx, dz)
+    (surrogate.interaction_weights). Raises ParameterError naming the character where a dot
+    would carry no load (the neighbours lifting the surface more than the dot presses it)."""
+    out = {}
+    for c in cfg.letters:
+        w = surrogate.interaction_weights(surrogate.char_centres(c, cfg.standard), deflection)
+        if not np.all(np.isfinite(w) & (w > 0)):
+            raise ParameterError(f"interaction weights of {c!r}", np.round(w, 3).tolist(),
+                                 "finite and > 0 (a surface deflection that gives a dot no load)")
+        out[c] = w
     return out
 
 
@@ -375,22 +383,20 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None
             model = letters_model(cfg, dot, base)
-            deflection = surface_deflection(recs[dot], dot.section().top) if model == "interaction" else None
+            weights = None
+            if model == "interaction":
+                try:
+                    weights = letter_weights(cfg, surface_deflection(recs[dot], dot.section().top))
+                except ParameterError as e:
+                    note = f"t = {t:g} mm ({material}): the letters fall back to the plain sum: {e}"
+                    log.warning(note)
+                    chart.notes.append(note)
+                    model = "sum"
             if dot is not None:
                 chart.letters_models[(material, t)] = model
-            sphere_map = None if sphere is None else bone_map_of(recs[sphere])
-            try:
-                sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot),
-                                     base=base, letters=letters, sphere=sphere_map, deflection=deflection)
-            except ParameterError as e:
-                if deflection is None:
-                    raise
-                note = f"t = {t:g} mm ({material}): the letters fall back to the plain sum: {e}"
-                log.warning(note)
-                chart.notes.append(note)
-                chart.letters_models[(material, t)] = "sum"
-                sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot),
-                                     base=base, letters=letters, sphere=sphere_map)
+            sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
+                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]),
+                                 weights=weights)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())
