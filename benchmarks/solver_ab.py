@@ -1,5 +1,6 @@
 """A/B of SolverOptions variants on named scenes: increments, Newton iterations, cut-backs,
-peak and CPU time per (case, variant), each solve in its own process (one BLAS thread),
+peak, CPU and wall time per (case, variant), each solve in its own process (one BLAS thread;
+PARDISO's threads as the variant's `threads`, default 1 here),
 `--jobs` processes at a time.
 
 Cases are Scene keyword sets, named; variants are SolverOptions keyword sets (plus
@@ -74,10 +75,11 @@ def one(case: dict, variant: dict) -> dict:
     sc = Scene(**case)
     if q:
         sc = with_quality(sc, q)
-    c0 = time.process_time()
+    c0, w0 = time.process_time(), time.perf_counter()
     r = solve(sc, options=SolverOptions(**variant))
     return dict(dofs=r.stats["dofs"], increments=r.stats["increments"], newton=r.stats["newton_iterations"],
-                cutbacks=r.stats["cutbacks"], peak=r.peak, span=r.span, cpu=time.process_time() - c0)
+                cutbacks=r.stats["cutbacks"], peak=r.peak, span=r.span, cpu=time.process_time() - c0,
+                wall=time.perf_counter() - w0)
 
 
 def parse_variant(text: str) -> tuple[str, dict]:
@@ -116,16 +118,16 @@ def main(argv=None) -> int:
         return cname, vname, json.loads(p.stdout.strip().splitlines()[-1])
 
     items = [(c, v) for c in cases.items() for v in variants.items()]
-    lines = ["| case | variant | dofs | increments | Newton | cut-backs | peak MPa | span mm | CPU s |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| case | variant | dofs | increments | Newton | cut-backs | peak MPa | span mm | CPU s | wall s |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     print("\n".join(lines), flush=True)
     with ThreadPoolExecutor(a.jobs) as pool:
         for cname, vname, r in pool.map(run, items):
             if "error" in r:
-                line = f"| {cname} | {vname} | failed: {r['error'][:80]} | | | | | | |"
+                line = f"| {cname} | {vname} | failed: {r['error'][:80]} | | | | | | | |"
             else:
                 line = (f"| {cname} | {vname} | {r['dofs']:,} | {r['increments']} | {r['newton']} | {r['cutbacks']} | "
-                        f"{r['peak']:.6f} | {r['span']:.3f} | {r['cpu']:.1f} |")
+                        f"{r['peak']:.6f} | {r['span']:.3f} | {r['cpu']:.1f} | {r['wall']:.1f} |")
             print(line, flush=True)
             lines.append(line)
     if a.out:

@@ -1,6 +1,8 @@
 """fe.linsolve: both backends solve symmetric (indefinite) systems of a fixed structure,
 refactorise with new values, and fail with a typed error on singular input."""
 
+import os
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -81,3 +83,28 @@ def test_fingertip_solve_is_backend_independent():
     sc = Scene(thickness=1, material="silicone", indenter="curved", mesh_size=1.0, refinement=2)
     peaks = [fe.solve(sc, options=SolverOptions(linear_solver=b)).peak for b in ("superlu", "pardiso")]
     assert peaks[1] == pytest.approx(peaks[0], rel=1e-7)
+
+
+def test_thread_count_from_the_environment_or_the_cpus(monkeypatch):
+    monkeypatch.setenv("MKL_NUM_THREADS", "3")
+    assert linsolve.default_threads(large=False) == 3 and linsolve.default_threads(large=True) == 3
+    monkeypatch.setenv("MKL_NUM_THREADS", "many")
+    assert linsolve.default_threads(large=True) == 1
+    monkeypatch.delenv("MKL_NUM_THREADS")
+    assert linsolve.default_threads(large=False) == 1
+    n = linsolve.default_threads(large=True)
+    assert 1 <= n <= linsolve.MAX_THREADS and n <= (os.cpu_count() or 1)
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="MKL is installed on x86-64 only")
+def test_pardiso_with_two_threads_solves_the_same_system():
+    """The threaded factorisation sums in another order: same solution to rounding (cond < 1e5)."""
+    rng = np.random.default_rng(3)
+    A = _laplacian_like(2500, 0.3, rng)
+    b = rng.standard_normal(2500)
+    x1 = linsolve.SymmetricSolver(A, "pardiso", threads=1).factor(A).solve(b)
+    s2 = linsolve.SymmetricSolver(A, "pardiso", threads=2)
+    x2 = s2.factor(A).solve(b)
+    assert s2.describe()["threads"] == 2
+    assert np.linalg.norm(A @ x2 - b) <= 1e-9 * np.linalg.norm(b)
+    assert np.allclose(x1, x2, rtol=1e-8, atol=1e-10 * np.abs(x1).max())

@@ -18,8 +18,9 @@ import threading
 # One BLAS/OpenMP thread per process unless the user says otherwise (before numpy loads):
 # the solver's vectors are small, and threaded BLAS spinning on a busy 2-core machine made
 # each 11k-entry dot product take ~14 ms (measured under a running sweep). Dask workers get
-# the same from distributed's defaults.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+# the same from distributed's defaults. MKL (PARDISO only) is left to fe.linsolve, which
+# threads the large 3D systems of a lone solve.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import click

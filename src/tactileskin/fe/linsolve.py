@@ -24,7 +24,13 @@ Methods:
   17.5k free dofs, 1.9x at 57.5k, same Newton iterations. Smoothed-aggregation AMG (pyamg)
   was 6-10x slower than a PARDISO factorisation there and is not used.
 
-Threads: one, unless MKL_NUM_THREADS is set (Dask workers set it to 1 anyway).
+Threads: MKL_NUM_THREADS when set (Dask workers and the tests set 1). Else one, except for
+the systems a caller marks large (`threads=`, fe.solver: 3D models solved with method
+"reuse"), which get the cores this process may use, at most MAX_THREADS: PARDISO's
+factorisation and triangular solves of a 3D tangent scale (t = 3 mm dot, preview, 34k dofs,
+2 cores: factor 6.4 -> 3.6 s, solves 10.7 -> 7.0 s; benchmarks/results/threads3d.md), the
+2D ones are too small to. Intel OpenMP's threads sleep at once after a parallel region
+(KMP_BLOCKTIME=0 unless set): spinning threads took the core the Python thread needed.
 """
 
 from __future__ import annotations
@@ -58,6 +64,29 @@ DIRECT_AFTER_FAILURES_MAX = 15
 FACTOR_EFFICIENCY = 5.5
 
 
+# PARDISO threads of a large system when MKL_NUM_THREADS is not set
+MAX_THREADS = 4
+
+
+def default_threads(large: bool) -> int:
+    """PARDISO threads for a system: MKL_NUM_THREADS if set (a positive integer), else 1,
+    or for a large system the CPUs this process may run on (at most MAX_THREADS)."""
+    env = os.environ.get("MKL_NUM_THREADS", "").strip()
+    if env:
+        try:
+            return max(1, int(env))
+        except ValueError:
+            log.warning("MKL_NUM_THREADS=%r is not an integer; using 1 thread", env)
+            return 1
+    if not large:
+        return 1
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_THREADS))
+
+
 class SingularMatrix(RuntimeError):
     """The numerical factorisation failed (zero pivot or a solver error)."""
 
@@ -75,6 +104,7 @@ def _load_mkl():
     cands = [os.environ.get("TACTILESKIN_MKL_RT"), find_library("mkl_rt")]
     cands += sorted(glob.glob(os.path.join(sys.prefix, "lib", "libmkl_rt.so*")), key=len)
     cands += sorted(glob.glob(os.path.join(sys.prefix, "Library", "bin", "mkl_rt*.dll")), key=len)
+    os.environ.setdefault("KMP_BLOCKTIME", "0")  # read when Intel OpenMP starts
     for path in cands:
         if not path:
             continue
@@ -117,9 +147,10 @@ _PARDISO_ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reord
 class _Pardiso:
     """One PARDISO handle for a fixed upper-triangular CSR structure."""
 
-    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray):
+    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1):
         self.lib = _load_mkl()
         self.n = n
+        self.threads = threads
         self.indptr = np.ascontiguousarray(indptr, np.int32)
         self.indices = np.ascontiguousarray(indices, np.int32)
         self.pt = np.zeros(64, np.int64)
@@ -147,16 +178,25 @@ class _Pardiso:
         err = i32(0)
         p = lambda v: ctypes.byref(i32(v))  # noqa: E731
         i32p = ctypes.POINTER(i32)
+        setter = getattr(self.lib, "MKL_Set_Num_Threads_Local", None)
+        prev = setter(i32(self.threads)) if setter is not None else None
+        try:
+            self._pardiso(phase, a, b, x, err, p, i32p)
+        finally:
+            if setter is not None:
+                setter(i32(prev))
+        if err.value != 0:
+            raise SingularMatrix(f"PARDISO phase {phase}: error {err.value} "
+                                 f"({_PARDISO_ERRORS.get(err.value, 'unknown')})")
+        return err.value
+
+    def _pardiso(self, phase, a, b, x, err, p, i32p) -> None:
         self.lib.pardiso(self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), p(1), p(1), p(-2),
                          p(phase), p(self.n), a.ctypes.data if a.size else None,
                          self.indptr.ctypes.data_as(i32p), self.indices.ctypes.data_as(i32p),
                          None, p(1), self.iparm.ctypes.data_as(i32p), p(0),
                          b.ctypes.data if b.size else None,
                          x.ctypes.data if x is not None and x.size else None, ctypes.byref(err))
-        if err.value != 0:
-            raise SingularMatrix(f"PARDISO phase {phase}: error {err.value} "
-                                 f"({_PARDISO_ERRORS.get(err.value, 'unknown')})")
-        return err.value
 
     def factor(self, data: np.ndarray) -> None:
         self.data = np.ascontiguousarray(data, float)
@@ -246,9 +286,10 @@ class SymmetricSolver:
     """
 
     def __init__(self, structure: sp.csr_matrix, backend: str = "auto", method: str = "direct",
-                 factor_cost: float | None = None):
+                 factor_cost: float | None = None, threads: int = 1):
         """factor_cost: the cost of one factorisation in preconditioned GMRES iterations (the
-        refactorisation rule's unit); None: estimated from PARDISO's flop counts."""
+        refactorisation rule's unit); None: estimated from PARDISO's flop counts. threads:
+        PARDISO's (default_threads gives the usual choice)."""
         if method not in METHODS:
             from tactileskin.errors import ParameterError
 
@@ -285,7 +326,8 @@ class SymmetricSolver:
             upper = A.indices >= rows
             self._upper = np.flatnonzero(upper)
             indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[upper], minlength=self.n))])
-            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper])
+            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper], threads)
+        self.threads = threads if backend == "pardiso" else 1
 
     def factor(self, A: sp.csr_matrix) -> "SymmetricSolver":
         """Take A as the matrix to solve with; factorise it unless the old factorisation is
@@ -382,7 +424,8 @@ class SymmetricSolver:
 
     def describe(self) -> dict:
         """The method used and its work counts (for result stats)."""
-        return {"method": self.method, "backend": self.backend, "factorizations": self.factorizations,
+        return {"method": self.method, "backend": self.backend, "threads": self.threads,
+                "factorizations": self.factorizations,
                 "krylov_iterations": self.krylov_iterations,
                 "cpu_s": {k: round(v, 4) for k, v in self.cpu.items()}}
 
