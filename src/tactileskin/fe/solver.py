@@ -134,7 +134,16 @@ class SolverOptions:
     # the 36 paper cases in 2D: 1581 -> 1346 Newton iterations, 17 -> 7 cut-backs, peaks
     # within 0.09 % (fewer increments; benchmarks/results/ascent_remedy.md)
     ascent_remedy: bool = True
+    # with ascent_remedy, a line-search step shorter than this (a descent direction that goes
+    # nowhere) gets the held-points direction too, kept if its |R| is lower. None: SHORT_STEP
+    # of the model's dimension (benchmarks/results/ascent_remedy.md)
+    short_step: float | None = None
 
+
+# SolverOptions.short_step by dimension. 2D, 36 paper cases: default 755 -> 651 Newton
+# iterations, 5 -> 2 cut-backs, preview 591 -> 582; in 3D the held points then pulled at the
+# dots' plate contact (t = 3 / 5 preview: 66 -> 89, 121 -> 137), so it is off there
+SHORT_STEP = {2: 0.2, 3: 0.0}
 
 # of penalty * tol_penetration: the largest pull a sticky point may keep. 0.1 released so
 # many points that t3 silicone flat needed 548 Newton iterations (1.0: 67)
@@ -351,6 +360,7 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
     if not ev.ok:
         raise _Failure(f"start state inadmissible ({ev.why})", {"history": []}, inline_uzawa=False)
     hist = []
+    short_step = SHORT_STEP.get(model.m, 0.0) if opts.short_step is None else opts.short_step
     # points pressed at some iterate of this solve (ascent_remedy holds them active again)
     seen = None if sticky is None or ev.contact is None else ev.contact[1] > 0.0
     releases = 0
@@ -411,6 +421,16 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
             raise _Failure("non-finite Newton step", {"history": hist, **_worst(model, ev.R)},
                            inline_uzawa=last_uzawa >= 0)
         eta, tn, trial = _line_search(model, u, du, ev, t, dt, lam, opts, sticky)
+        if opts.ascent_remedy and eta < short_step and sticky is not None:
+            # a descent direction that goes nowhere: the same remedy, kept if it does better
+            d2, ev2, st2 = _descent(model, u, ev, du, sticky, seen, released, t, dt, lam, it, rn, scale,
+                                    opts, stats, held_only=True)
+            if d2 is not du:
+                eta2, tn2, trial2 = _line_search(model, u, d2, ev2, t, dt, lam, opts, st2)
+                log.debug("  short step (eta %.3g, |R| %.3e): held points give eta %.3g, |R| %.3e",
+                          eta, tn, eta2, tn2)
+                if trial2 is not None and (trial is None or tn2 < tn):
+                    du, ev, sticky, eta, tn, trial = d2, ev2, st2, eta2, tn2, trial2
         if trial is None:
             raise _Failure("line search found no admissible state", {"history": hist, **_worst(model, ev.R)},
                            inline_uzawa=last_uzawa >= 0)
@@ -445,7 +465,8 @@ def _solve_increment(model: Model, u_pred: np.ndarray, t: float, dt: float, opts
     return _newton_uzawa(model, u_pred, t, dt, opts, stats)
 
 
-def _descent(model: Model, u, ev, du, sticky, seen, released, t, dt, lam, it, rn, scale, opts, stats):
+def _descent(model: Model, u, ev, du, sticky, seen, released, t, dt, lam, it, rn, scale, opts, stats,
+             held_only: bool = False):
     """A descent direction in place of the ascent direction du (du . R > 0): with the points
     pressed at an earlier iterate held active again, else without the curvature term.
     Returns (du, evaluation, sticky); du unchanged when neither gives descent."""
@@ -459,7 +480,7 @@ def _descent(model: Model, u, ev, du, sticky, seen, released, t, dt, lam, it, rn
         if np.any(add):
             held = sticky | add
             tries.append(("held", held, curv))
-    if curv:
+    if curv and not held_only:
         tries.append(("no curvature", held, False))
     for why, st, c in tries:
         ev2 = ev if st is sticky else model.evaluate(u, t, dt, lam, tangent=False, sticky=st)
