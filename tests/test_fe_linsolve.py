@@ -86,8 +86,12 @@ def test_fingertip_solve_is_backend_independent():
 
 
 def test_thread_count_from_the_environment_or_the_cpus(monkeypatch):
+    monkeypatch.delenv("TACTILESKIN_THREADS", raising=False)
     monkeypatch.setenv("MKL_NUM_THREADS", "3")
     assert linsolve.default_threads(large=False) == 3 and linsolve.default_threads(large=True) == 3
+    monkeypatch.setenv("TACTILESKIN_THREADS", "2")  # a sweep worker's share: large systems only
+    assert linsolve.default_threads(large=True) == 2 and linsolve.default_threads(large=False) == 3
+    monkeypatch.delenv("TACTILESKIN_THREADS")
     monkeypatch.setenv("MKL_NUM_THREADS", "many")
     assert linsolve.default_threads(large=True) == 1
     monkeypatch.delenv("MKL_NUM_THREADS")
@@ -108,3 +112,15 @@ def test_pardiso_with_two_threads_solves_the_same_system():
     assert s2.describe()["threads"] == 2
     assert np.linalg.norm(A @ x2 - b) <= 1e-9 * np.linalg.norm(b)
     assert np.allclose(x1, x2, rtol=1e-8, atol=1e-10 * np.abs(x1).max())
+
+
+def test_sweep_workers_share_the_cpus(monkeypatch):
+    from tactileskin.sweep import worker_threads
+
+    for v in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
+        monkeypatch.delenv(v, raising=False)
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    assert worker_threads(cpus) == "1"
+    assert worker_threads(1) == str(cpus)
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    assert worker_threads(1) == "1"

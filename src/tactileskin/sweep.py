@@ -363,6 +363,7 @@ class _Runner:
         # silicone curved: 2.0 s in a worker, 1.0 s in a plain process; 1.4 s without it).
         # The statistical profiler samples every 10 ms; nobody reads it here.
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                              "distributed.nanny.pre-spawn-environ.TACTILESKIN_THREADS": worker_threads(n),
                               "distributed.worker.profile.enabled": False}):
             # quiet: CRITICAL. On a loaded machine a worker's heartbeat can race the
             # scheduler's shutdown after the last result and log a CommClosedError traceback
@@ -392,6 +393,23 @@ def _raise_fd_limit(n: int) -> None:
             resource.setrlimit(resource.RLIMIT_NOFILE, (want if hard == resource.RLIM_INFINITY else min(want, hard), hard))
     except (ImportError, ValueError, OSError):
         pass
+
+
+def worker_threads(n: int) -> str:
+    """PARDISO threads of each of n local workers for its large (3D) systems
+    (TACTILESKIN_THREADS, fe.linsolve.default_threads; the workers' BLAS and MKL default stay
+    at one): the user's TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the CPUs shared
+    out, so that fewer cases than cores (a lone 3D case, `--workers 1`) still use every core
+    and n = cores gives each worker one thread."""
+    for var in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
+        user = os.environ.get(var, "").strip()
+        if user:
+            return user
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:
+        cpus = os.cpu_count() or 1
+    return str(max(1, cpus // max(1, n)))
 
 
 def run_sweep(

@@ -24,7 +24,8 @@ Methods:
   17.5k free dofs, 1.9x at 57.5k, same Newton iterations. Smoothed-aggregation AMG (pyamg)
   was 6-10x slower than a PARDISO factorisation there and is not used.
 
-Threads: MKL_NUM_THREADS when set (Dask workers and the tests set 1). Else one, except for
+Threads: MKL_NUM_THREADS when set (Dask workers and the tests set 1); for the large systems
+TACTILESKIN_THREADS before it (sweep workers: their share of the CPUs). Else one, except for
 the systems a caller marks large (`threads=`, fe.solver: 3D models solved with method
 "reuse"), which get the cores this process may use, at most MAX_THREADS: PARDISO's
 factorisation and triangular solves of a 3D tangent scale (t = 3 mm dot, preview, 34k dofs,
@@ -69,15 +70,18 @@ MAX_THREADS = 4
 
 
 def default_threads(large: bool) -> int:
-    """PARDISO threads for a system: MKL_NUM_THREADS if set (a positive integer), else 1,
-    or for a large system the CPUs this process may run on (at most MAX_THREADS)."""
-    env = os.environ.get("MKL_NUM_THREADS", "").strip()
-    if env:
-        try:
-            return max(1, int(env))
-        except ValueError:
-            log.warning("MKL_NUM_THREADS=%r is not an integer; using 1 thread", env)
-            return 1
+    """PARDISO threads for a system: for a large one TACTILESKIN_THREADS if set (sweep
+    workers get their share of the CPUs there), else MKL_NUM_THREADS if set (a positive
+    integer), else 1, or for a large system the CPUs this process may run on (at most
+    MAX_THREADS)."""
+    for var in (("TACTILESKIN_THREADS",) if large else ()) + ("MKL_NUM_THREADS",):
+        env = os.environ.get(var, "").strip()
+        if env:
+            try:
+                return max(1, int(env))
+            except ValueError:
+                log.warning("%s=%r is not an integer; using 1 thread", var, env)
+                return 1
     if not large:
         return 1
     try:

@@ -61,8 +61,9 @@ class SolverOptions:
     linear_method: str = "auto"
     # auto takes "reuse" for 3D models with at least this many free dofs and PARDISO
     reuse_min_dofs: int = REUSE_MIN_DOFS
-    # PARDISO threads; 0: fe.linsolve.default_threads (MKL_NUM_THREADS if set, else the
-    # available CPUs up to 4 for the models solved with "reuse", 1 for the others)
+    # PARDISO threads; 0: fe.linsolve.default_threads (for the models solved with "reuse"
+    # TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the available CPUs up to 4; for the
+    # others MKL_NUM_THREADS if set, else 1)
     threads: int = 0
     # a reused-factorisation (GMRES) Newton step may stop at a relative linear residual of
     # linear_forcing * |R| / scale (capped at 1e-3, at least linsolve.KRYLOV_RTOL): it
