@@ -13,7 +13,8 @@
   not pressed when an increment starts take the base penalty again.
 - A Newton direction that is not a descent direction (indefinite tangent after the first
   step's overshoot released contact points) is recomputed with those points held active,
-  else without the indenter-curvature term (SolverOptions.ascent_remedy).
+  else without the indenter-curvature term (SolverOptions.ascent_remedy); in 2D a step the
+  line search cuts below 0.2 is retried the same way (SolverOptions.short_step).
 - Increments grow after easy convergence and are cut back after a failure; below the
   minimum increment a ConvergenceError carries a diagnosis (time, increment, residual
   history, where the worst residual sits).
@@ -132,8 +133,9 @@ class SolverOptions:
     # of this solve held active again (the first step's overshoot releases points at the
     # dot's edge, and the squeezed layer under them is not stable on its own), then without
     # the indenter-curvature term. Every cut-back of the 2D t = 5 mm Braille ridge started so;
-    # the 36 paper cases in 2D: 1581 -> 1346 Newton iterations, 17 -> 7 cut-backs, peaks
-    # within 0.09 % (fewer increments; benchmarks/results/ascent_remedy.md)
+    # the 36 paper cases in 2D: 1581 -> 1346 Newton iterations, 17 -> 7 cut-backs (with
+    # short_step: 1233, 4), peaks within 0.10 % (fewer increments;
+    # benchmarks/results/ascent_remedy.md)
     ascent_remedy: bool = True
     # with ascent_remedy, a line-search step shorter than this (a descent direction that goes
     # nowhere) gets the held-points direction too, kept if its |R| is lower. None: SHORT_STEP
