@@ -401,15 +401,13 @@ def worker_threads(n: int) -> str:
     at one): the user's TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the CPUs shared
     out, so that fewer cases than cores (a lone 3D case, `--workers 1`) still use every core
     and n = cores gives each worker one thread."""
+    from tactileskin.threads import available_cpus
+
     for var in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
         user = os.environ.get(var, "").strip()
         if user:
             return user
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except AttributeError:
-        cpus = os.cpu_count() or 1
-    return str(max(1, cpus // max(1, n)))
+    return str(max(1, available_cpus() // max(1, n)))
 
 
 def run_sweep(

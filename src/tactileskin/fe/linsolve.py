@@ -48,6 +48,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from tactileskin.threads import available_cpus
+
 log = logging.getLogger(__name__)
 
 BACKENDS = ("auto", "pardiso", "superlu")
@@ -84,11 +86,7 @@ def default_threads(large: bool) -> int:
                 return 1
     if not large:
         return 1
-    try:
-        n = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        n = os.cpu_count() or 1
-    return max(1, min(n, MAX_THREADS))
+    return max(1, min(available_cpus(), MAX_THREADS))
 
 
 class SingularMatrix(RuntimeError):
