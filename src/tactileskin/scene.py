@@ -35,8 +35,10 @@ from tactileskin.skins import registry as _skins
 # back-off of fe.linsolve, other Newton paths on 3D models; and the 3D bone pressure from
 # the local fit at the bone nodes, as in 2D, instead of the nodal projection: 3D peaks move
 # by 1-3 %; 9: the 3D contact penetration tolerance 1e-3 h (was 1e-4 h), 3D peaks within
-# 0.07 %, and increments capped at 0.7 x a failed one, peaks within 0.03 %)
-SCHEMA_VERSION = 9
+# 0.07 %, and increments capped at 0.7 x a failed one, peaks within 0.03 %; 10: ascent
+# directions recomputed with the held contact points (and 2D short steps retried): other
+# increment sequences on the 2D Braille, curved and flat cases, peaks within 0.10 %)
+SCHEMA_VERSION = 10
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
