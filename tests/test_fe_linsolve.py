@@ -108,8 +108,19 @@ def test_pardiso_with_two_threads_solves_the_same_system():
     b = rng.standard_normal(2500)
     x1 = linsolve.SymmetricSolver(A, "pardiso", threads=1).factor(A).solve(b)
     s2 = linsolve.SymmetricSolver(A, "pardiso", threads=2)
+    lib = s2._pardiso.lib
+    before = lib.MKL_Get_Max_Threads()
+    during = []
+    inner = s2._pardiso._pardiso
+
+    def spy(*args):  # MKL's thread count in effect inside each PARDISO call
+        during.append(lib.MKL_Get_Max_Threads())
+        return inner(*args)
+
+    s2._pardiso._pardiso = spy
     x2 = s2.factor(A).solve(b)
-    assert s2.describe()["threads"] == 2
+    assert during and set(during) == {2}
+    assert lib.MKL_Get_Max_Threads() == before  # the thread-local setting is undone after
     assert np.linalg.norm(A @ x2 - b) <= 1e-9 * np.linalg.norm(b)
     assert np.allclose(x1, x2, rtol=1e-8, atol=1e-10 * np.abs(x1).max())
 
@@ -127,3 +138,27 @@ def test_sweep_workers_share_the_cpus(monkeypatch):
     assert worker_threads(1) == str(cpus)
     monkeypatch.setenv("MKL_NUM_THREADS", "1")
     assert worker_threads(1) == "1"
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="MKL is installed on x86-64 only")
+def test_a_failed_factorisation_is_not_kept_as_the_preconditioner():
+    """Method "reuse": after a factorisation fails, the next factor() refactorises instead of
+    preconditioning GMRES with what the failed call left."""
+    rng = np.random.default_rng(4)
+    A = _laplacian_like(400, 0.0, rng)
+    s = linsolve.SymmetricSolver(A, "pardiso", method="reuse")
+    s.factor(A)
+    real = s._pardiso.factor
+
+    def fail(data):
+        raise linsolve.SingularMatrix("made to fail")
+
+    s._pardiso.factor, s._stale = fail, True
+    with pytest.raises(linsolve.SingularMatrix):
+        s.factor(A)
+    s._pardiso.factor = real
+    n = s.factorizations
+    b = rng.standard_normal(400)
+    x = s.factor(A).solve(b)
+    assert s.factorizations == n + 1
+    assert np.linalg.norm(A @ x - b) <= 1e-9 * np.linalg.norm(b)

@@ -81,3 +81,24 @@ def test_discriminate_verdict():
     assert v.distinguishable and v.min_distance > THRESHOLD
     v2 = discriminate({"a": (s, wide), "b": (s, 1.05 * wide)})
     assert not v2.distinguishable and v2.min_distance == pytest.approx(0.05 / 1.05, rel=1e-3)
+
+
+def test_workers_get_their_pardiso_share_and_this_process_keeps_its_environment(monkeypatch):
+    """A local cluster's workers read TACTILESKIN_THREADS = CPUs // workers; the nanny's
+    pre-spawn variables must not land in this process (a later lone solve or sweep here
+    would take a leftover MKL_NUM_THREADS=1 or thread share for the user's setting)."""
+    import os
+
+    from tactileskin.sweep import _Runner
+    from tactileskin.threads import available_cpus
+
+    for v in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
+        monkeypatch.delenv(v, raising=False)
+    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+    try:
+        client = runner._start(1)
+        seen = client.run(lambda: (os.environ.get("TACTILESKIN_THREADS"), os.environ.get("MKL_NUM_THREADS")))
+    finally:
+        runner.close()
+    assert list(seen.values()) == [(str(available_cpus()), None)]
+    assert "TACTILESKIN_THREADS" not in os.environ and "MKL_NUM_THREADS" not in os.environ

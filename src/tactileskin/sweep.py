@@ -362,8 +362,12 @@ class _Runner:
         # mmapped and unmapped, and a solve spent ~30 % of its time in the kernel (t1
         # silicone curved: 2.0 s in a worker, 1.0 s in a plain process; 1.4 s without it).
         # The statistical profiler samples every 10 ms; nobody reads it here.
+        # The nanny writes its pre-spawn variables into this process's environment too: the
+        # PARDISO threads (read at solve time) go to the workers alone, by `env`, and
+        # MKL_NUM_THREADS=1 is not set here, or a later lone solve or sweep in this process
+        # would take it for the user's choice
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-                              "distributed.nanny.pre-spawn-environ.TACTILESKIN_THREADS": worker_threads(n),
+                              "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": None,
                               "distributed.worker.profile.enabled": False}):
             # quiet: CRITICAL. On a loaded machine a worker's heartbeat can race the
             # scheduler's shutdown after the last result and log a CommClosedError traceback
@@ -371,7 +375,8 @@ class _Runner:
             # the sweep as its future's exception, recorded as a failed case
             quiet = logging.ERROR if log.isEnabledFor(logging.INFO) else logging.CRITICAL
             self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=quiet)
+                                        dashboard_address=None, silence_logs=quiet,
+                                        env={"TACTILESKIN_THREADS": worker_threads(n)})
         self.client = Client(self.cluster)
         return self.client
 
@@ -397,8 +402,8 @@ def _raise_fd_limit(n: int) -> None:
 
 def worker_threads(n: int) -> str:
     """PARDISO threads of each of n local workers for its large (3D) systems
-    (TACTILESKIN_THREADS, fe.linsolve.default_threads; the workers' BLAS and MKL default stay
-    at one): the user's TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the CPUs shared
+    (TACTILESKIN_THREADS, fe.linsolve.default_threads; the other systems and the workers'
+    BLAS stay at one): the user's TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the CPUs shared
     out, so that fewer cases than cores (a lone 3D case, `--workers 1`) still use every core
     and n = cores gives each worker one thread."""
     from tactileskin.threads import available_cpus

@@ -348,7 +348,12 @@ class SymmetricSolver:
         t0, c0 = time.perf_counter(), time.process_time()
         try:
             if self.backend == "pardiso":
-                self._pardiso.factor(A.data[self._upper])
+                try:
+                    self._pardiso.factor(A.data[self._upper])
+                except SingularMatrix:
+                    # no usable factorisation: not a preconditioner for the next solves either
+                    self._fresh, self._stale = False, True
+                    raise
                 if self._pardiso.perturbed:
                     log.debug("PARDISO: %d perturbed pivots", self._pardiso.perturbed)
                 return self
