@@ -485,8 +485,11 @@ def _descent(model: Model, u, ev, du, sticky, seen, released, t, dt, lam, it, rn
             tries.append(("held", held, curv))
     if curv and not held_only:
         tries.append(("no curvature", held, False))
+    evals = {id(sticky): ev}  # both tries may hold the same set: evaluate it once
     for why, st, c in tries:
-        ev2 = ev if st is sticky else model.evaluate(u, t, dt, lam, tangent=False, sticky=st)
+        ev2 = evals.get(id(st))
+        if ev2 is None:
+            ev2 = evals[id(st)] = model.evaluate(u, t, dt, lam, tangent=False, sticky=st)
         if not ev2.ok:
             continue
         K = model.tangent(ev2, curvature=c)
