@@ -82,7 +82,7 @@ def default_threads(large: bool) -> int:
             try:
                 return max(1, int(env))
             except ValueError:
-                log.warning("%s=%r is not an integer; using 1 thread", var, env)
+                log.warning("%s=%r is not a whole number of threads (1 or more); using 1 thread", var, env)
                 return 1
     if not large:
         return 1
