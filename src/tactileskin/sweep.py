@@ -403,15 +403,14 @@ def _raise_fd_limit(n: int) -> None:
 def worker_threads(n: int) -> str:
     """PARDISO threads of each of n local workers for its large (3D) systems
     (TACTILESKIN_THREADS, fe.linsolve.default_threads; the other systems and the workers'
-    BLAS stay at one): the user's TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the CPUs shared
-    out, so that fewer cases than cores (a lone 3D case, `--workers 1`) still use every core
-    and n = cores gives each worker one thread."""
-    from tactileskin.threads import available_cpus
+    BLAS stay at one): the user's setting if any (threads.user_setting), else the CPUs
+    shared out, so that fewer cases than cores (a lone 3D case, `--workers 1`) still use
+    every core and n = cores gives each worker one thread."""
+    from tactileskin.threads import available_cpus, user_setting
 
-    for var in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
-        user = os.environ.get(var, "").strip()
-        if user:
-            return user
+    user = user_setting(large=True)
+    if user is not None:
+        return user[1]
     return str(max(1, available_cpus() // max(1, n)))
 
 

@@ -48,7 +48,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from tactileskin.threads import available_cpus
+from tactileskin.threads import available_cpus, user_setting
 
 log = logging.getLogger(__name__)
 
@@ -76,14 +76,13 @@ def default_threads(large: bool) -> int:
     workers get their share of the CPUs there), else MKL_NUM_THREADS if set (a positive
     integer), else 1, or for a large system the CPUs this process may run on (at most
     MAX_THREADS)."""
-    for var in (("TACTILESKIN_THREADS",) if large else ()) + ("MKL_NUM_THREADS",):
-        env = os.environ.get(var, "").strip()
-        if env:
-            try:
-                return max(1, int(env))
-            except ValueError:
-                log.warning("%s=%r is not a whole number of threads (1 or more); using 1 thread", var, env)
-                return 1
+    user = user_setting(large)
+    if user is not None:
+        try:
+            return max(1, int(user[1]))
+        except ValueError:
+            log.warning("%s=%r is not a whole number of threads (1 or more); using 1 thread", *user)
+            return 1
     if not large:
         return 1
     return max(1, min(available_cpus(), MAX_THREADS))
