@@ -1,4 +1,4 @@
-"""Plane-strain hyperfoam law: general 3x3 path vs compiled (run: python benchmarks/hyperfoam_law.py).
+"""Hyperfoam law: numpy 3x3 path vs the compiled loops (run: python benchmarks/hyperfoam_law.py).
 
 Prints median CPU times (ms; process time, calls of the two implementations alternating so
 that both see the same load on a shared machine) of
@@ -12,7 +12,11 @@ C = F^T F with F = I + 0.05 N(0, 1) per point (in-plane block, C33 = 1), both pr
 Also the maximum difference compiled vs 3x3 (relative to max |S|, max |D|), and the JIT
 cost: a fresh compile and a cached load, each in a new process with its own NUMBA_CACHE_DIR.
 
-Options: --repeat N (default 25); --points N (default 11469).
+Second table, 3D: the compiled 3x3 loop hyperfoam.pk2_tangent_solid (Jacobi rotations; the
+3D solver's law) against the numpy path on the point count of the default 3D dot at t = 3 mm
+(11,900 P2 tets x 4 points = 47,600 states, F = I + 0.05 N(0, 1), 3x3).
+
+Options: --repeat N (default 25); --points N (default 11469); --points3d N (default 47600).
 """
 
 from __future__ import annotations
@@ -81,10 +85,11 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=25)
     ap.add_argument("--points", type=int, default=3823 * 3)
+    ap.add_argument("--points3d", type=int, default=11900 * 4)
     args = ap.parse_args(argv)
 
     from tactileskin.materials import get_material
-    from tactileskin.materials.hyperfoam import pk2, pk2_tangent, pk2_tangent_plane
+    from tactileskin.materials.hyperfoam import pk2, pk2_tangent, pk2_tangent_plane, pk2_tangent_solid
 
     C = states(args.points)
     C2 = C[..., :2, :2]               # strided view, as fe.material_law passes it
@@ -103,6 +108,27 @@ def main(argv=None):
             lambda: pk2_tangent_plane(hf, C2, out_of_plane=True),
             lambda: pk2(hf, C),
             lambda: pk2_tangent_plane(hf, C2, out_of_plane=True, tangent=False),
+        ], args.repeat)
+        print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
+        print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")
+    rng = np.random.default_rng(1)
+    F3 = np.eye(3) + 0.05 * rng.standard_normal((args.points3d, 3, 3))
+    C3 = np.swapaxes(F3, -1, -2) @ F3
+    print(f"\n{args.points3d} 3D points, median CPU ms of {args.repeat} alternating calls\n")
+    print(f"{'material':<13}{'output':<8}{'3x3':>9}{'compiled':>10}{'speed-up':>10}"
+          f"{'max dS/max|S|':>15}{'max dD/max|D|':>15}")
+    for name in ("polyurethane", "silicone"):
+        hf = get_material(name).hyperfoam
+        S, D, ok = pk2_tangent_solid(hf, C3)
+        S0, D0, ok0 = pk2_tangent(hf, C3)
+        assert np.array_equal(ok, ok0) and ok.all()
+        dS = np.abs(S - S0).max() / np.abs(S0).max()
+        dD = np.abs(D - D0).max() / np.abs(D0).max()
+        t_3, t_c, t_3_s, t_c_s = paired_ms([
+            lambda: pk2_tangent(hf, C3),
+            lambda: pk2_tangent_solid(hf, C3),
+            lambda: pk2(hf, C3),
+            lambda: pk2_tangent_solid(hf, C3, tangent=False),
         ], args.repeat)
         print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
         print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")

@@ -1,8 +1,9 @@
-"""Compiled plane-strain hyperfoam law (materials._hyperfoam_nb) against its oracle, the
-general 3x3 path `pk2_tangent` on the embedded C (C33 = 1, C13 = C23 = 0).
+"""Compiled hyperfoam laws (materials._hyperfoam_nb: the plane-strain loop and the 3x3 loop)
+against their oracle, the numpy 3x3 path `pk2_tangent` (for the plane loop on the embedded C,
+C33 = 1, C13 = C23 = 0).
 
-Both evaluate the same formulas; the compiled loop solves the 2x2 eigenproblem in closed
-form (LAPACK eigh in the 3x3 path) and forms some powers as products of shared
+All evaluate the same formulas; the compiled loops solve the eigenproblem in closed form
+(2x2) or by Jacobi rotations (3x3), LAPACK eigh in the oracle, and form some powers as products of shared
 exponentials (c^(alpha/2 - 1) = c^(alpha/2) / c, ...), a few ulp from the 3x3 path's
 single exp. Differences therefore stay at rounding level: observed <= 8e-14 of the point's
 largest entry (at the overflow guard, exponents ~300), ~1e-15 elsewhere; 1e-12 leaves a
@@ -17,7 +18,7 @@ import pytest
 
 from tactileskin.fe import material_law
 from tactileskin.materials import EXP_CAP, LOG_C_CAP, Hyperfoam, get_material
-from tactileskin.materials.hyperfoam import pk2_tangent, pk2_tangent_plane
+from tactileskin.materials.hyperfoam import pk2_tangent, pk2_tangent_plane, pk2_tangent_solid
 
 MATERIALS = {name: get_material(name).hyperfoam for name in ("silicone", "polyurethane")}
 # ln J range keeping J^(-alpha beta) within ~e^10 (as in test_materials_hyperfoam.py)
@@ -177,6 +178,97 @@ def test_material_law_passes_tangent_through():
     S1, D1, ok1 = law(C, tangent=False)
     assert D.shape == (6, 3, 3, 3, 3) and D1 is None
     assert np.array_equal(S, S1) and np.array_equal(ok, ok1)
-    C[0, 2, 2] = 1.01                                    # not plane: the 3x3 path keeps its D
-    S3, D3, _ = law(C, tangent=False)
-    assert D3 is not None and D3.shape == (6, 3, 3, 3, 3)
+    C[0, 2, 2] = 1.01                                    # not plane: the compiled 3x3 loop
+    S3, D3, ok3 = law(C)
+    S4, D4, ok4 = law(C, tangent=False)
+    assert D3.shape == (6, 3, 3, 3, 3) and D4 is None
+    assert np.array_equal(S3, S4) and np.array_equal(ok3, ok4) and ok3.all()
+    assert _max_rel(S3, pk2_tangent(mat, C)[0]) < TOL
+
+
+# --- the compiled 3x3 loop (pk2_tangent_solid), same oracle -------------------------------------
+
+def _rot3(angles, stretches2):
+    """R diag(c) R^T for the rotation of the (z, y, x) Euler angles."""
+    from scipy.spatial.transform import Rotation
+
+    R = Rotation.from_euler("zyx", angles).as_matrix()
+    return R @ np.diag(stretches2) @ R.T
+
+
+def solid_states(name, n=300, seed=5):
+    """Random rotated 3D states of moderate J, plus the hard admissible cases of the 3x3
+    eigenproblem: C = I, strains of 1e-8 (off-diagonal only among them), two and three equal
+    or nearly equal stretches (relative gaps down to 1e-16), a plane-strain C (already
+    diagonal in e_z: no rotation needed), and a compression just inside the overflow guard."""
+    mat = MATERIALS[name]
+    rng = np.random.default_rng(seed)
+    l = np.exp(rng.uniform(-0.35, 0.35, (n, 3)))
+    l[:, 2] = np.exp(rng.uniform(-1, 1, n) * LNJ_RANGE[name]) / (l[:, 0] * l[:, 1])
+    ang = rng.uniform(0, 2 * np.pi, (n, 3))
+    Cs = [_rot3(a, s * s) for a, s in zip(ang, l)]
+    Cs += [np.eye(3), np.diag([1 + 2e-8, 1, 1 - 1e-8]), _rot3((0.3, 0.2, 0.1), (1 + 1e-8, 1 - 3e-8, 1)),
+           np.array([[1.0, 1e-8, 0.0], [1e-8, 1.0, 2e-8], [0.0, 2e-8, 1.0]])]
+    for g in (0.0, 1e-16, 1e-14, 1e-12, 1e-10, 1e-8):
+        Cs += [_rot3((0.9, 0.4, 1.3), (0.97 * (1 + g), 0.97, 1.05)),
+               _rot3((2.1, 0.7, 0.2), (1.03, 1.03 * (1 - g), 1.03 * (1 + g))),
+               np.diag([1.0 + g, 1.0, 1.0])]
+    C2 = ordinary_states(name, n=10)
+    P = np.zeros((len(C2), 3, 3))
+    P[:, :2, :2], P[:, 2, 2] = C2, 1.0
+    cap = _lnj_cap(mat)
+    for lnj in (cap + 1e-3, cap + 0.05):
+        Cs += [_rot3((0.5, 0.1, 0.8), (np.exp(2 * lnj / 3),) * 3), np.diag([np.exp(2 * lnj), 1.0, 1.0])]
+    return np.concatenate([np.array(Cs), P])
+
+
+@pytest.mark.parametrize("name", MATERIALS)
+def test_solid_loop_equals_oracle_on_admissible_states(name):
+    mat = MATERIALS[name]
+    C = solid_states(name)
+    S, D, ok = pk2_tangent_solid(mat, C)
+    S0, D0, ok0 = pk2_tangent(mat, C)
+    assert ok0.all() and np.array_equal(ok, ok0)
+    assert _max_rel(S, S0) < TOL and _max_rel(D, D0) < TOL
+    assert not np.any(S[300])                            # C = I: S = 0 exactly
+    # D's minor and major symmetries hold to rounding, as the solver's tangent needs
+    assert _max_rel(D, np.swapaxes(D, -1, -2)) < TOL and _max_rel(D, np.transpose(D, (0, 3, 4, 1, 2))) < TOL
+    S1, D1, ok1 = pk2_tangent_solid(mat, C, tangent=False)
+    assert D1 is None and np.array_equal(S1, S) and np.array_equal(ok1, ok)
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # the oracle, C = 1e300
+@pytest.mark.parametrize("name", MATERIALS)
+def test_solid_loop_guard_flags_equal_oracle_and_values_are_finite(name):
+    mat = MATERIALS[name]
+    bad2 = inadmissible_states(mat)
+    bad = np.zeros((len(bad2), 3, 3))
+    bad[:, :2, :2], bad[:, 2, 2] = bad2, 1.0
+    bad[-1, 2, 2] = np.nan                                # non-finite out of the plane too
+    C = np.concatenate([bad, solid_states(name, n=5)])
+    detF = np.ones(len(C))
+    detF[-1] = -1.0
+    S, D, ok = pk2_tangent_solid(mat, C, detF=detF)
+    S0, D0, ok0 = pk2_tangent(mat, C, detF=detF)
+    assert np.array_equal(ok, ok0)
+    assert not ok[:len(bad)].any() and not ok[-1] and ok[len(bad):-1].all()
+    assert np.isfinite(S).all() and np.isfinite(D).all()
+    adm = ok | (np.arange(len(C)) == len(C) - 1)
+    assert _max_rel(S[adm], S0[adm]) < TOL and _max_rel(D[adm], D0[adm]) < TOL
+
+
+@pytest.mark.parametrize("mu,alpha,nu", [((0.2,), (3.0,), 0.3),
+                                         ((0.05, 0.1, -0.01), (0.01, 4.0, -2.0), 0.45)])
+def test_solid_loop_any_number_of_terms_and_shapes(mu, alpha, nu):
+    mat = Hyperfoam(mu, alpha, nu)
+    rng = np.random.default_rng(11)
+    C = np.array([_rot3(a, s) for a, s in zip(rng.uniform(0, 6, (40, 3)), rng.uniform(0.6, 1.5, (40, 3)))])
+    S, D, ok = pk2_tangent_solid(mat, C)
+    S0, D0, ok0 = pk2_tangent(mat, C)
+    assert ok.all() and np.array_equal(ok, ok0)
+    assert _max_rel(S, S0) < TOL and _max_rel(D, D0) < TOL
+    Cb = np.broadcast_to(C[3], (2, 5, 3, 3))             # read-only view, any leading shape
+    S2, D2, ok2 = pk2_tangent_solid(mat, Cb, detF=1.0)
+    assert S2.shape == (2, 5, 3, 3) and D2.shape == (2, 5, 3, 3, 3, 3) and ok2.shape == (2, 5)
+    assert np.array_equal(S2[1, 4], S[3]) and np.array_equal(D2[0, 2], D[3])
+    assert pk2_tangent_solid(mat, np.empty((0, 3, 3)))[0].shape == (0, 3, 3)

@@ -55,8 +55,8 @@ def material_law(law):
     the law's plane-strain path (hyperfoam: the compiled closed-form 2x2 loop, same values
     to rounding, ~3x cheaper than the 3x3 eigh; other laws: their 3D law on the embedded C);
     D is still the full (..., 3, 3, 3, 3), so a 3D state that happens to be plane is
-    served correctly too. law(C, tangent=False) skips D on the plane path and returns
-    (S, None, ok) (residual-only evaluations); the hyperfoam 3D path returns its D regardless.
+    served correctly too. law(C, tangent=False) returns (S, None, ok) where the law can
+    skip D (hyperfoam on both paths; residual-only evaluations).
     """
 
     def evaluate(C, tangent=True):

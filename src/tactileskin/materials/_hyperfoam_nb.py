@@ -230,6 +230,170 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
         Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
 
 
+_SIG3 = ("void(float64[:, :, :], float64[:], boolean, float64[:], float64[:], float64, "
+         "float64[:, :, ::1], float64[:, ::1], boolean[::1], boolean)")
+
+# D_ijkl (index 27 i + 9 j + 3 k + l) = T[6 (ik) + (jl)] + T[6 (il) + (jk)] + qv Ci[(ij)] Ci[(kl)],
+# (ab) the symmetric pair number of _PAIR_I / _PAIR_J (as hyperfoam._I6, _J6)
+_PAIR_I = np.array([0, 1, 2, 1, 0, 0], dtype=np.int64)
+_PAIR_J = np.array([0, 1, 2, 2, 2, 1], dtype=np.int64)
+
+
+def _tables():
+    V = np.empty((3, 3), np.int64)
+    V[_PAIR_I, _PAIR_J] = V[_PAIR_J, _PAIR_I] = np.arange(6)
+    i, j, k, l = np.indices((3, 3, 3, 3)).reshape(4, -1)
+    return 6 * V[i, k] + V[j, l], 6 * V[i, l] + V[j, k], V[i, j], V[k, l]
+
+
+_T1, _T2, _CI1, _CI2 = _tables()
+
+
+@numba.njit(inline="always")
+def _rotate(A, V, p, q):
+    """One Jacobi rotation zeroing A[p, q] of the symmetric 3x3 A (both triangles kept),
+    accumulated into the eigenvector columns V (Numerical Recipes' stable form)."""
+    apq = A[p, q]
+    h = A[q, q] - A[p, p]
+    g = 100.0 * abs(apq)
+    if abs(h) + g == abs(h):
+        t = apq / h
+    else:
+        th = 0.5 * h / apq
+        t = 1.0 / (abs(th) + math.sqrt(1.0 + th * th))
+        if th < 0.0:
+            t = -t
+    c = 1.0 / math.sqrt(1.0 + t * t)
+    s = t * c
+    tau = s / (1.0 + c)
+    A[p, p] -= t * apq
+    A[q, q] += t * apq
+    A[p, q] = A[q, p] = 0.0
+    r = 3 - p - q                                            # the third index
+    arp, arq = A[r, p], A[r, q]
+    A[r, p] = A[p, r] = arp - s * (arq + tau * arp)
+    A[r, q] = A[q, r] = arq + s * (arp - tau * arq)
+    for k in range(3):
+        vp, vq = V[k, p], V[k, q]
+        V[k, p] = vp - s * (vq + tau * vp)
+        V[k, q] = vq + s * (vp - tau * vq)
+
+
+@numba.njit(inline="always")
+def _eigh3(A, V):
+    """Eigenvalues (the diagonal of A on return) and orthonormal eigenvectors (columns of V)
+    of the symmetric 3x3 A by cyclic Jacobi: backward stable like LAPACK's eigh, and exact
+    (no rotation) for an already diagonal A, such as C - I at rest or in plane strain.
+    Off-diagonal entries negligible beside both diagonal ones are dropped after three sweeps."""
+    for i in range(3):
+        for j in range(3):
+            V[i, j] = 1.0 if i == j else 0.0
+    for sweep in range(60):
+        if A[0, 1] == 0.0 and A[0, 2] == 0.0 and A[1, 2] == 0.0:
+            return
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = A[p, q]
+            if apq == 0.0:
+                continue
+            g = 100.0 * abs(apq)
+            if sweep > 2 and abs(A[p, p]) + g == abs(A[p, p]) and abs(A[q, q]) + g == abs(A[q, q]):
+                A[p, q] = A[q, p] = 0.0
+            else:
+                _rotate(A, V, p, q)
+
+
+@numba.njit(_SIG3, cache=True, nogil=True, error_model="numpy")
+def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
+    """S (n, 3, 3), D (n, 81) (untouched unless `tangent`) and ok (n,) of the points C
+    (n, 3, 3), written into S, D, ok: `hyperfoam.pk2_tangent` point by point, with the
+    eigenproblem of C - I solved by `_eigh3`."""
+    n = C.shape[0]
+    m = mu.shape[0]
+    A = np.empty((3, 3))
+    V = np.empty((3, 3))
+    e = np.empty(3)
+    lc = np.empty(3)
+    ic = np.empty(3)
+    cq = np.empty(3)
+    pw = np.empty(3)
+    f = np.empty(3)
+    gd = np.empty(3)
+    P = np.empty((3, 6))
+    T = np.empty(36)
+    Ci = np.empty(6)
+    for p in range(n):
+        finite = True
+        for i in range(3):
+            for j in range(3):
+                if not math.isfinite(C[p, i, j]):
+                    finite = False
+        for i in range(3):
+            for j in range(3):
+                A[i, j] = 0.5 * (C[p, i, j] + C[p, j, i]) - (1.0 if i == j else 0.0) if finite else 0.0
+        _eigh3(A, V)
+        okp = finite
+        for a in range(3):
+            lca, ea, oka = _log_c(A[a, a])
+            lc[a], e[a] = lca, ea
+            okp = okp and oka
+            ic[a] = math.exp(-lca)
+        if has_detF:
+            okp = okp and detF[p] > 0.0
+        lJ = 0.5 * (lc[0] + lc[1] + lc[2])
+        bl = beta * lJ
+        f[0] = f[1] = f[2] = 0.0
+        gd[0] = gd[1] = gd[2] = 0.0
+        g01 = g02 = g12 = 0.0
+        qv = 0.0
+        if tangent:
+            ell01 = math.log1p((e[0] - e[1]) / (1.0 + e[1]))     # ln(c_a / c_b)
+            ell02 = math.log1p((e[0] - e[2]) / (1.0 + e[2]))
+            ell12 = math.log1p((e[1] - e[2]) / (1.0 + e[2]))
+        for i in range(m):
+            al = alpha[i]
+            k = 2.0 * mu[i] / al
+            xv = -al * bl
+            if xv > EXP_CAP:
+                okp = False
+            ev = _pos(xv)                                    # J^(-alpha beta)
+            q = 0.5 * al - 1.0
+            for a in range(3):
+                h = 0.5 * al * lc[a]
+                if h > EXP_CAP:
+                    okp = False
+                pw[a] = _pos(h)                              # c_a^(alpha/2)
+                cq[a] = pw[a] * ic[a]                        # c_a^q
+                # k (c^(alpha/2) - J^(-alpha beta)) / c = k (exp(x1) - exp(x2)), x1 - x2 = alpha (ln c/2 + beta ln J)
+                f[a] += k * _diff(cq[a], ev * ic[a], al * (0.5 * lc[a] + bl))
+            if tangent:
+                for a in range(3):
+                    gd[a] += k * (q * cq[a] * ic[a] + ev * ic[a] * ic[a])
+                g01 += _pair(k, q, cq[0], cq[1], e[0], e[1], lc[0], lc[1], ell01, ev * ic[0] * ic[1])
+                g02 += _pair(k, q, cq[0], cq[2], e[0], e[2], lc[0], lc[2], ell02, ev * ic[0] * ic[2])
+                g12 += _pair(k, q, cq[1], cq[2], e[1], e[2], lc[1], lc[2], ell12, ev * ic[1] * ic[2])
+                qv += 2.0 * mu[i] * beta * ev                # J dp/dJ
+        ok[p] = okp
+        for a in range(3):                                   # P[a] = n_a n_a in pairs (ab)
+            for r in range(6):
+                P[a, r] = V[_PAIR_I[r], a] * V[_PAIR_J[r], a]
+        for i in range(3):
+            for j in range(i, 3):
+                sij = f[0] * V[i, 0] * V[j, 0] + f[1] * V[i, 1] * V[j, 1] + f[2] * V[i, 2] * V[j, 2]
+                S[p, i, j] = S[p, j, i] = sij
+        if not tangent:
+            continue
+        for r in range(6):
+            Ci[r] = ic[0] * P[0, r] + ic[1] * P[1, r] + ic[2] * P[2, r]
+            x0 = gd[0] * P[0, r] + g01 * P[1, r] + g02 * P[2, r]   # (gamma P)[a, r]
+            x1 = g01 * P[0, r] + gd[1] * P[1, r] + g12 * P[2, r]
+            x2 = g02 * P[0, r] + g12 * P[1, r] + gd[2] * P[2, r]
+            for c in range(6):
+                T[6 * c + r] = P[0, c] * x0 + P[1, c] * x1 + P[2, c] * x2
+        Dp = D[p]
+        for j in range(81):
+            Dp[j] = T[_T1[j]] + T[_T2[j]] + qv * Ci[_CI1[j]] * Ci[_CI2[j]]
+
+
 def as_kernel_input(x, shape):
     """x as a float64 array of `shape` the compiled kernel accepts (writable: numba rejects
     read-only arrays such as np.broadcast_to views); a view where possible."""

@@ -31,11 +31,12 @@ Numerical care (see docs/architecture.md, "hard cases"):
   a stress of ~1e130 MPa (silicone term 2, alpha beta = 379.75: J < exp(-300/379.75) = 0.454;
   the confined-compression stress is already 4e5 MPa at J = 0.95).
 
-Two implementations, each needed: `pk2_tangent` (3x3 eigh, numpy; 3D and any non-plane
-state) and `pk2_tangent_plane` (plane strain: e_z is a principal direction with c_3 = 1, so
-the 2x2 eigenproblem has a closed form), the compiled point loop of `_hyperfoam_nb`, several
-times faster than the 3x3 path (benchmarks/hyperfoam_law.py); tangent=False skips D. The
-3x3 path is the plane loop's test oracle. In numpy, per-term arrays put the term axis
+Three implementations: `pk2_tangent` (3x3 eigh, numpy: the readable one, the oracle of the
+other two, and the energy's), and two compiled point loops of `_hyperfoam_nb`, several times
+faster (benchmarks/hyperfoam_law.py): `pk2_tangent_solid` (any 3x3 C: the eigenproblem by
+Jacobi rotations; the `Hyperfoam.pk2_tangent` of the 3D solver) and `pk2_tangent_plane`
+(plane strain: e_z is a principal direction with c_3 = 1, so the 2x2 eigenproblem has a
+closed form); tangent=False skips D in both. In numpy, per-term arrays put the term axis
 first; large inputs are evaluated in blocks of _BLOCK points written straight into the
 outputs.
 """
@@ -157,8 +158,8 @@ class Hyperfoam:
         return pk2(self, C, detF=detF)
 
     def pk2_tangent(self, C, *, detF=None, tangent=True):
-        """The 3x3 path; tangent=False still returns D (the eigh path computes it anyway)."""
-        return pk2_tangent(self, C, detF=detF)
+        """The compiled 3x3 point loop (`pk2_tangent_solid`); tangent=False skips D."""
+        return pk2_tangent_solid(self, C, detF=detF, tangent=tangent)
 
     def pk2_tangent_plane(self, C2, *, detF=None, out_of_plane=False, tangent=True):
         return pk2_tangent_plane(self, C2, detF=detF, out_of_plane=out_of_plane, tangent=tangent)
@@ -406,6 +407,38 @@ _I6, _J6 = np.array([0, 1, 2, 1, 0, 0]), np.array([0, 1, 2, 2, 2, 1])
 _T1_3, _T2_3, _C1_3, _C2_3, _V9 = _tables3()
 
 
+def _kernel_inputs(mat, X, k, detF):
+    """(lead shape, n, X as (n, k, k), detF as (n,) or empty, has_detF) for the compiled loops."""
+    from tactileskin.materials import _hyperfoam_nb as nb
+
+    lead = X.shape[:-2]
+    n = math.prod(lead)
+    Xk = nb.as_kernel_input(X, (n, k, k))
+    if detF is None:
+        return lead, n, Xk, np.empty(0), False
+    return lead, n, Xk, nb.as_kernel_input(np.broadcast_to(np.asarray(detF, dtype=float), lead), (n,)), True
+
+
+def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
+    """`pk2_tangent` by the compiled point loop of `_hyperfoam_nb` (`solid_kernel`: the
+    eigenproblem of C - I by Jacobi rotations, the same formulas and guards; ~5x cheaper than
+    the eigh path, which is its oracle: same values to rounding, identical ok flags,
+    tests/test_hyperfoam_nb.py). tangent=False skips D and returns (S, None, ok)."""
+    C = np.asarray(C, dtype=float)
+    _check_shape("C", C, 3)
+    from tactileskin.materials import _hyperfoam_nb as nb
+
+    lead, n, Ck, dk, has_detF = _kernel_inputs(mat, C, 3, detF)
+    S = np.empty((n, 3, 3))
+    D = np.empty((n, 81)) if tangent else np.empty((0, 0))
+    ok = np.empty(n, dtype=bool)
+    nb.solid_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
+                    float(mat.beta), S, D, ok, tangent)
+    ok = ok.reshape(lead)
+    _log_debug_inadmissible(ok)
+    return S.reshape(lead + (3, 3)), (D.reshape(lead + (3, 3, 3, 3)) if tangent else None), ok
+
+
 # --- plane strain ---------------------------------------------------------------------------
 
 def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False,
@@ -427,13 +460,7 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     # by programs that never evaluate the law
     from tactileskin.materials import _hyperfoam_nb as nb
 
-    lead = C2.shape[:-2]
-    n = math.prod(lead)
-    Ck = nb.as_kernel_input(C2, (n, 2, 2))
-    if detF is None:
-        dk, has_detF = np.empty(0), False
-    else:
-        dk, has_detF = nb.as_kernel_input(np.broadcast_to(np.asarray(detF, dtype=float), lead), (n,)), True
+    lead, n, Ck, dk, has_detF = _kernel_inputs(mat, C2, 2, detF)
     if not tangent:
         mode, D = nb.MODE_S, np.empty((0, 0))
     elif out_of_plane:
