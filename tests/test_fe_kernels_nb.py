@@ -68,6 +68,26 @@ def test_compiled_matches_reference(m, A, Q, mixed):
         assert _rel(kernels.tangent(kin_d, S, D), K) > 1e-3
 
 
+@pytest.mark.parametrize("mixed", [True, False], ids=["mixed", "displacement"])
+def test_threaded_tet_tangent_has_the_serial_bits(mixed, monkeypatch):
+    """Above PARALLEL_MIN_ELEMENTS the P2-tet tangent runs on numba's threads, element ranges
+    apart: the same arithmetic per element, so bit for bit the serial loop's (and uneven
+    ranges: 2001 elements in 8 chunks)."""
+    from tactileskin.threads import numba_threads
+
+    E = kernels.PARALLEL_MIN_ELEMENTS + 1
+    ue, G, w, S, D = _random_state(E, 4, 10, 3, seed=5)
+    kin = kernels.Kinematics(ue, G, w, mixed)
+    with numba_threads(1):
+        K1 = kernels.tangent(kin, S, D)
+    with numba_threads(2):
+        K2 = kernels.tangent(kin, S, D)
+    assert np.array_equal(K1, K2)
+    monkeypatch.setattr(kernels, "PARALLEL_MIN_ELEMENTS", 10 ** 9)   # the serial path, threads or not
+    with numba_threads(2):
+        assert np.array_equal(kernels.tangent(kin, S, D), K1)
+
+
 @pytest.mark.parametrize("bad", [-2.0, np.nan])
 def test_compiled_kinematics_flags_inadmissible_states(bad):
     """An inverted (J < 0) or non-finite point makes the whole state inadmissible (Model

@@ -37,3 +37,36 @@ def test_a_thread_count_set_by_the_user_is_respected(monkeypatch):
     if not seen or max(seen) < 2:
         pytest.skip("this BLAS cannot run 2 threads here")
     assert max(seen) == 2
+
+
+def _numba_threads_seen_by_tangent(monkeypatch, scene, options):
+    import numba
+
+    from tactileskin.fe import kernels
+
+    seen = []
+    real = kernels.tangent
+
+    def spy(*a, **k):
+        seen.append(numba.get_num_threads())
+        return real(*a, **k)
+
+    monkeypatch.setattr(kernels, "tangent", spy)
+    before = numba.get_num_threads()
+    fe.solve(scene, options=options)
+    assert numba.get_num_threads() == before     # the solve's setting is undone after
+    return seen
+
+
+def test_compiled_loops_take_the_solves_thread_count(monkeypatch):
+    """The element and material loops run on the solve's threads (SolverOptions.threads, else
+    linsolve.default_threads: 1 for a 2D model), not numba's default of every CPU."""
+    import numba
+
+    from tactileskin.fe.solver import SolverOptions
+
+    monkeypatch.delenv("MKL_NUM_THREADS", raising=False)
+    seen = _numba_threads_seen_by_tangent(monkeypatch, COARSE, SolverOptions())
+    assert seen and set(seen) == {1}
+    seen = _numba_threads_seen_by_tangent(monkeypatch, COARSE, SolverOptions(threads=2))
+    assert seen and set(seen) == {min(2, numba.config.NUMBA_NUM_THREADS)}

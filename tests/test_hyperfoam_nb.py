@@ -272,3 +272,23 @@ def test_solid_loop_any_number_of_terms_and_shapes(mu, alpha, nu):
     assert S2.shape == (2, 5, 3, 3) and D2.shape == (2, 5, 3, 3, 3, 3) and ok2.shape == (2, 5)
     assert np.array_equal(S2[1, 4], S[3]) and np.array_equal(D2[0, 2], D[3])
     assert pk2_tangent_solid(mat, np.empty((0, 3, 3)))[0].shape == (0, 3, 3)
+
+
+def test_threaded_solid_loop_has_the_serial_bits():
+    """From PARALLEL_MIN_POINTS points the 3x3 loop runs on numba's threads in point ranges:
+    each point's arithmetic is the serial loop's, so the outputs are bit for bit the same
+    (on a one-CPU machine numba's pool has one thread and both calls are serial)."""
+    from tactileskin.materials import hyperfoam
+    from tactileskin.threads import numba_threads
+
+    mat = MATERIALS["silicone"]
+    C = np.concatenate([solid_states("silicone")] * (hyperfoam.PARALLEL_MIN_POINTS // 300 + 1))
+    assert len(C) >= hyperfoam.PARALLEL_MIN_POINTS
+    with numba_threads(1):
+        one = pk2_tangent_solid(mat, C)
+    with numba_threads(2):
+        two = pk2_tangent_solid(mat, C)
+        s_only = pk2_tangent_solid(mat, C, tangent=False)
+    for a, b in zip(one, two):
+        assert np.array_equal(a, b)
+    assert np.array_equal(s_only[0], one[0]) and np.array_equal(s_only[2], one[2])

@@ -1,5 +1,5 @@
 """CPUs a process may use and the user's thread-count variables, for the thread counts of
-fe.linsolve (PARDISO) and sweep (workers).
+fe.linsolve (PARDISO), the compiled element and material loops (numba) and sweep (workers).
 
 Plain os calls: the sweep's main process asks before it starts its workers and must not
 import the solver for it.
@@ -7,6 +7,7 @@ import the solver for it.
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 
@@ -26,3 +27,17 @@ def user_setting(large: bool) -> tuple[str, str] | None:
         if value:
             return name, value
     return None
+
+
+@contextlib.contextmanager
+def numba_threads(n: int):
+    """Inside: numba's parallel loops of this thread run on n threads (at most numba's pool;
+    numba.set_num_threads is thread-local), restored on exit."""
+    import numba
+
+    old = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(old)

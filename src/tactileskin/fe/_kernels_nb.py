@@ -429,6 +429,19 @@ def tangent_any(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, out):
                     G.shape[3], G.shape[2])
 
 
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def tangent_3_10_parallel(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, out, chunks):
+    """tangent_3_10 on `chunks` contiguous element ranges run by numba's threads (each range
+    with its own scratch arrays; numba.set_num_threads sets how many run at once). The same
+    arithmetic per element as the serial loop, so the same bits."""
+    E = w.shape[0]
+    for c in nb.prange(chunks):
+        a, b = c * E // chunks, (c + 1) * E // chunks
+        _tangent(G[a:b], w[a:b], F[a:b], Fbar[a:b], Finv[a:b], alpha[a:b], J[a:b],
+                 theta[a:b] if mixed else theta, S[a:b], D[a:b], mixed, out[a:b], 3, 10)
+    return out
+
+
 _ENTRY = {"kinematics": {(2, 6): kinematics_2_6, (3, 10): kinematics_3_10},
           "residual": {(2, 6): residual_2_6, (3, 10): residual_3_10},
           "tangent": {(2, 6): tangent_2_6, (3, 10): tangent_3_10}}

@@ -35,6 +35,11 @@ import numpy as np
 
 from tactileskin.fe import _kernels_nb
 
+# P2 tets from which the tangent runs on numba's threads (tactileskin.threads.numba_threads;
+# fe.model sets them per solve): the default 3D dot at t = 3 mm, 11,900 elements, 67 -> 37 ms
+# on 2 threads, the same bits
+PARALLEL_MIN_ELEMENTS = 2000
+
 
 def _c(x: np.ndarray) -> np.ndarray:
     """C-contiguous float64 (the compiled loops take no strided views)."""
@@ -92,12 +97,16 @@ def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
 
     D must have minor symmetry (the material part is evaluated in Voigt pairs) and, in the
     mixed formulation, major symmetry (the rank-one terms use AA F for both sides); any
-    D = 2 dS/dC of a hyperelastic S has both. The algebra: fe._kernels_nb."""
+    D = 2 dS/dC of a hyperelastic S has both. The algebra: fe._kernels_nb. P2 tets run on
+    numba's threads (numba.get_num_threads()) from PARALLEL_MIN_ELEMENTS elements."""
     E, Q, A, m = kin.G.shape
     theta = kin.theta if kin.mixed else np.empty(0)
-    loop = _kernels_nb.entry("tangent", kin.G)
-    return loop(kin.G, kin.w, kin.F, kin.Fbar, kin.Finv, kin.alpha, kin.J,
-                _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)))
+    args = (kin.G, kin.w, kin.F, kin.Fbar, kin.Finv, kin.alpha, kin.J,
+            _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)))
+    threads = _kernels_nb.nb.get_num_threads()
+    if (m, A) == (3, 10) and threads > 1 and E >= PARALLEL_MIN_ELEMENTS:
+        return _kernels_nb.tangent_3_10_parallel(*args, 4 * threads)
+    return _kernels_nb.entry("tangent", kin.G)(*args)
 
 
 def cauchy(kin: Kinematics, S3: np.ndarray) -> np.ndarray:

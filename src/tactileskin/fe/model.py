@@ -23,6 +23,7 @@ from tactileskin.errors import ParameterError
 from tactileskin.fe import kernels
 from tactileskin.fe.assembly import Pattern, assemble_vector, vector_dofs
 from tactileskin.fe.contact import ContactSurface
+from tactileskin.threads import numba_threads
 
 log = logging.getLogger(__name__)
 
@@ -188,6 +189,9 @@ class Model:
 
         self.history = (Prony.elastic() if prony is None else prony).history((E, Q, 3, 3), qlv_order)
         self.t = 0.0
+        # threads of the compiled element and material loops (fe.solver.run sets them with
+        # PARDISO's: more than one for the large 3D models only)
+        self.threads = 1
         # loading (fe.loading): the travel as a function of time (None: contact.rate * t), or
         # under force control the fixed trial travel of the increment being solved
         self.travel_path: Callable | None = None
@@ -245,7 +249,8 @@ class Model:
         """Residual at a trial state; with tangent=True also the tangent (else `tangent(ev)` later)."""
         t0 = time.perf_counter()
         try:
-            return self._evaluate(u, t, dt, lam_k, tangent, sticky)
+            with numba_threads(self.threads):
+                return self._evaluate(u, t, dt, lam_k, tangent, sticky)
         finally:
             self.timing["residual"] += time.perf_counter() - t0
 
@@ -292,10 +297,12 @@ class Model:
             return ev.K
         t0 = time.perf_counter()
         m = self.m
-        if ev._D is None:
-            ev._D = self._law(ev.kin.C, True)[1]
-        Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
-        Kd = self.pattern.data(kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm))
+        with numba_threads(self.threads):
+            if ev._D is None:
+                ev._D = self._law(ev.kin.C, True)[1]
+            Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
+            Ke = kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm)
+        Kd = self.pattern.data(Ke)
         if self.surface is not None:
             c = self.contact
             tc = time.perf_counter()

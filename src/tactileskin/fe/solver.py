@@ -62,9 +62,10 @@ class SolverOptions:
     linear_method: str = "auto"
     # auto takes "reuse" for 3D models with at least this many free dofs and PARDISO
     reuse_min_dofs: int = REUSE_MIN_DOFS
-    # PARDISO threads; 0: fe.linsolve.default_threads (for the models solved with "reuse"
-    # TACTILESKIN_THREADS or MKL_NUM_THREADS if set, else the available CPUs up to 4; for the
-    # others MKL_NUM_THREADS if set, else 1)
+    # threads of PARDISO and of the compiled loops (fe.model.threads); 0: fe.linsolve.
+    # default_threads (for the models solved with "reuse" TACTILESKIN_THREADS or
+    # MKL_NUM_THREADS if set, else the available CPUs up to 4; for the others
+    # MKL_NUM_THREADS if set, else 1)
     threads: int = 0
     # a reused-factorisation (GMRES) Newton step may stop at a relative linear residual of
     # linear_forcing * |R| / scale (capped at 1e-3, at least linsolve.KRYLOV_RTOL): it
@@ -199,6 +200,14 @@ def linear_method(model: Model, nfree: int, opts: SolverOptions) -> str:
     return "reuse" if model.m == 3 and nfree >= opts.reuse_min_dofs and pardiso else "direct"
 
 
+def _threads(model: Model, nfree: int, opts: SolverOptions) -> int:
+    """Threads of PARDISO and of the compiled loops: opts.threads, else linsolve's default
+    (more than one for the large systems, those solved with "reuse")."""
+    if opts.threads > 0:
+        return opts.threads
+    return default_threads(large=linear_method(model, nfree, opts) == "reuse")
+
+
 def _factor(model: Model, K, opts: SolverOptions):
     """Give the free block K to the model's linear solver (which keeps the symbolic analysis
     and, with method "reuse", the factorisation it may precondition with)."""
@@ -206,8 +215,8 @@ def _factor(model: Model, K, opts: SolverOptions):
     if ls is None or opts.linear_solver not in ("auto", ls.backend) or \
             (opts.linear_method != "auto" and opts.linear_method != ls.method):
         method = linear_method(model, K.shape[0], opts)
-        threads = opts.threads if opts.threads > 0 else default_threads(large=method == "reuse")
-        ls = model._linsolve = SymmetricSolver(K, opts.linear_solver, method, threads=threads)
+        ls = model._linsolve = SymmetricSolver(K, opts.linear_solver, method,
+                                               threads=_threads(model, K.shape[0], opts))
         log.debug("linear solver: %s, %s, %d free dofs, %d threads", ls.backend, ls.method, K.shape[0],
                   ls.threads)
     return ls.factor(K)
@@ -603,6 +612,8 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
     (a loading history runs one segment after the other)."""
     opts = opts or SolverOptions()
     stats = stats if stats is not None else Stats()
+    if hasattr(model, "free"):  # a Model (the tests' stand-ins have no dofs)
+        model.threads = _threads(model, len(model.free), opts)
     newton_seen = stats.newton_iterations
     t0 = time.perf_counter() - stats.wall_s
     t = model.t

@@ -302,12 +302,9 @@ def _eigh3(A, V):
                 _rotate(A, V, p, q)
 
 
-@numba.njit(_SIG3, cache=True, nogil=True, error_model="numpy")
-def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
-    """S (n, 3, 3), D (n, 81) (untouched unless `tangent`) and ok (n,) of the points C
-    (n, 3, 3), written into S, D, ok: `hyperfoam.pk2_tangent` point by point, with the
-    eigenproblem of C - I solved by `_eigh3`."""
-    n = C.shape[0]
+@numba.njit(inline="always")
+def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, first, last):
+    """The point loop of solid_kernel over the points first .. last - 1."""
     m = mu.shape[0]
     A = np.empty((3, 3))
     V = np.empty((3, 3))
@@ -321,7 +318,7 @@ def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
     P = np.empty((3, 6))
     T = np.empty(36)
     Ci = np.empty(6)
-    for p in range(n):
+    for p in range(first, last):
         finite = True
         for i in range(3):
             for j in range(3):
@@ -392,6 +389,23 @@ def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
         Dp = D[p]
         for j in range(81):
             Dp[j] = T[_T1[j]] + T[_T2[j]] + qv * Ci[_CI1[j]] * Ci[_CI2[j]]
+
+
+@numba.njit(_SIG3, cache=True, nogil=True, error_model="numpy")
+def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
+    """S (n, 3, 3), D (n, 81) (untouched unless `tangent`) and ok (n,) of the points C
+    (n, 3, 3), written into S, D, ok: `hyperfoam.pk2_tangent` point by point, with the
+    eigenproblem of C - I solved by `_eigh3`."""
+    _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, 0, C.shape[0])
+
+
+@numba.njit(_SIG3[:-1] + ", int64)", cache=True, nogil=True, error_model="numpy", parallel=True)
+def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, chunks):
+    """solid_kernel on `chunks` contiguous point ranges run by numba's threads (as many at
+    once as numba.set_num_threads allows); the same arithmetic per point, so the same bits."""
+    n = C.shape[0]
+    for c in numba.prange(chunks):
+        _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, c * n // chunks, (c + 1) * n // chunks)
 
 
 def as_kernel_input(x, shape):
