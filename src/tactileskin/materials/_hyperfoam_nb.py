@@ -230,9 +230,6 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
         Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
 
 
-_SIG3 = ("void(float64[:, :, :], float64[:], boolean, float64[:], float64[:], float64, "
-         "float64[:, :, ::1], float64[:, ::1], boolean[::1], boolean)")
-
 # D_ijkl (index 27 i + 9 j + 3 k + l) = T[6 (ik) + (jl)] + T[6 (il) + (jk)] + qv Ci[(ij)] Ci[(kl)],
 # (ab) the symmetric pair number of _PAIR_I / _PAIR_J (as hyperfoam._I6, _J6)
 _PAIR_I = np.array([0, 1, 2, 1, 0, 0], dtype=np.int64)
@@ -391,7 +388,9 @@ def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, first, last):
             Dp[j] = T[_T1[j]] + T[_T2[j]] + qv * Ci[_CI1[j]] * Ci[_CI2[j]]
 
 
-@numba.njit(_SIG3, cache=True, nogil=True, error_model="numpy")
+# compiled on first call (no signature): programs that never solve in 3D do not pay its ~6 s
+# compile on a fresh install; hyperfoam.pk2_tangent_solid passes one layout (C-contiguous)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
     """S (n, 3, 3), D (n, 81) (untouched unless `tangent`) and ok (n,) of the points C
     (n, 3, 3), written into S, D, ok: `hyperfoam.pk2_tangent` point by point, with the
@@ -399,7 +398,7 @@ def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
     _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, 0, C.shape[0])
 
 
-@numba.njit(_SIG3[:-1] + ", int64)", cache=True, nogil=True, error_model="numpy", parallel=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, chunks):
     """solid_kernel on `chunks` contiguous point ranges run by numba's threads (as many at
     once as numba.set_num_threads allows); the same arithmetic per point, so the same bits."""

@@ -434,6 +434,7 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     from tactileskin.materials import _hyperfoam_nb as nb
 
     lead, n, Ck, dk, has_detF = _kernel_inputs(mat, C, 3, detF)
+    Ck, dk = np.ascontiguousarray(Ck), np.ascontiguousarray(dk)   # one compiled specialisation
     S = np.empty((n, 3, 3))
     D = np.empty((n, 81)) if tangent else np.empty((0, 0))
     ok = np.empty(n, dtype=bool)
