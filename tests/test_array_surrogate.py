@@ -119,6 +119,31 @@ def test_fit_scale_recovers_a_known_factor_and_weights_scale_the_sum():
     assert not surrogate.validate(kernel, fulls["r"], "r", PAD)["within_tolerance"]  # 1 / 1.3: 23 % off
 
 
+def test_validation_counts_only_the_square_the_arrays_read():
+    """A difference beyond the chart's read square (the skin's far edge) is not an error of
+    what the chart reads; one inside it is, in the chart's frame (the letter 'a' sits off the
+    cell's centre: the square is shifted by chart_shift in the solver's frame; a shift of the
+    wrong sign would take in one of the outside bumps, 1.5 mm < 2 x 1.17 mm beyond)."""
+    grid = np.linspace(-11, 11, 441)
+    kernel = maps.on_grid(_gauss(), grid, grid)
+    cfg = chart.ChartConfig()
+    ext = cfg.read_extent
+    assert ext == pytest.approx(4.0 + 0.5 * 4.0 * 1.8)          # window 8, pitch 4, taxels 0.8 x pitch
+    ds, dz = surrogate.chart_shift("a", PAD)
+    assert ds == pytest.approx(-1.17) and dz == pytest.approx(-2.34)
+    exact = surrogate.superpose(kernel, braille.dot_centres("a"), PAD, grid, grid)
+    for where, inside in ((ext + 1.5, False), (-ext - 1.5, False), (ext - 1.0, True), (-ext + 1.0, True)):
+        bump = 0.2 * _gauss(where - ds, -dz, 0.2)(*np.meshgrid(grid, grid))   # at (where, 0) in the chart frame
+        full = maps.BoneMap(grid, grid, exact.pressure + bump, 0.0)
+        whole = surrogate.validate(kernel, full, "a", PAD, taxel=0.4)
+        read = surrogate.validate(kernel, full, "a", PAD, taxel=0.4, extent=ext)
+        assert whole["max_abs_over_peak"] > 0.1 and read["extent_mm"] == ext
+        if inside:
+            assert read["max_abs_over_peak"] == pytest.approx(whole["max_abs_over_peak"], rel=1e-9)
+        else:
+            assert read["max_abs_over_peak"] < 1e-6 and read["within_tolerance_taxel"]
+
+
 def test_fingertip_validation_refuses_an_x_asymmetric_text_and_the_skin_is_checked():
     cfg = chart.ChartConfig(skin="fingertip")
     with pytest.raises(ParameterError, match="mirror-symmetric"):

@@ -133,6 +133,13 @@ class ChartConfig:
         """The smallest taxel side of the chart (mm)."""
         return self.taxel_fraction * min(self.pitches)
 
+    @property
+    def read_extent(self) -> float:
+        """Half side (mm) of the square around the cell's centre that any array of the chart
+        reads: the farthest taxel centre (window / 2), plus the largest sub-pitch offset
+        (pitch / 2) and half a taxel, at the coarsest pitch."""
+        return 0.5 * self.window + max(0.5 * p * (1.0 + self.taxel_fraction) for p in self.pitches)
+
     def spec(self, pitch: float) -> ArraySpec:
         n = int(np.floor(self.window / pitch + 1e-9)) + 1
         return ArraySpec(pitch=pitch, taxel=self.taxel_fraction * pitch, n=min(n, 200))
@@ -513,7 +520,8 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 models["interaction"] = (kernel, {"deflection": defl})
         for x in texts:
             for name, (k, kw) in models.items():
-                err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel, **kw)
+                err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,
+                                         extent=cfg.read_extent, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
                              **err})
     return rows

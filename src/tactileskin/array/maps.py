@@ -57,6 +57,15 @@ def on_grid(f: Callable, s, z, section_z: float = 0.0) -> BoneMap:
     return BoneMap(s, z, f(S, Z), section_z)
 
 
+def cropped(m: BoneMap, s_range, z_range) -> BoneMap:
+    """The part of m on its grid points with s in s_range and z in z_range (closed intervals)."""
+    ks = (m.s >= s_range[0] - 1e-9) & (m.s <= s_range[1] + 1e-9)
+    kz = (m.z >= z_range[0] - 1e-9) & (m.z <= z_range[1] + 1e-9)
+    if not ks.any() or not kz.any():
+        raise ParameterError("map region", (tuple(s_range), tuple(z_range)), "a region holding grid points of the map")
+    return BoneMap(m.s[ks], m.z[kz], m.pressure[np.ix_(kz, ks)], m.section_z)
+
+
 def resampled(m: BoneMap, s, z) -> np.ndarray:
     """m's pressure on the grid s x z (rows z, columns s; bilinear, zero outside m)."""
     return interpolator(m)(*np.meshgrid(np.asarray(s, float), np.asarray(z, float)))

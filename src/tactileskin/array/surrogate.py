@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactileskin.array.maps import interpolator, mirrored, relative_error, resampled, taxel_averaged
+from tactileskin.array.maps import cropped, interpolator, mirrored, relative_error, resampled, taxel_averaged
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille
 from tactileskin.results import BoneMap
@@ -121,13 +121,16 @@ def kernel_from(bone_map: BoneMap) -> BoneMap:
 
 
 def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american",
-             deflection=None, scale: float = 1.0, base: BoneMap | None = None, taxel: float | None = None) -> dict:
+             deflection=None, scale: float = 1.0, base: BoneMap | None = None, taxel: float | None = None,
+             extent: float | None = None) -> dict:
     """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
     quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres);
     with `deflection` the dots' loads from `interaction_weights`; the dots' sum times
     `scale`, plus `base` (the blank plate's map of the plate-aware model). With `taxel` (mm)
     also the errors of both maps as read by taxels of that side (keys *_taxel): what the
-    finest array of a chart sees, blind to sub-taxel ripple."""
+    finest array of a chart sees, blind to sub-taxel ripple. With `extent` (mm) the errors
+    count only the square |s|, |z| <= extent of the chart's frame (`cells_centres`: where
+    a chart's arrays read the character, ChartConfig.read_extent), not the skin's far edges."""
     ref = mirrored(full)
     c = braille.dot_centres(text, standard)
     w = None if deflection is None else interaction_weights(c, deflection)
@@ -136,12 +139,22 @@ def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="stand
     if base is not None:
         P = P + resampled(base, ref.s, ref.z)
     approx = BoneMap(approx.s, approx.z, P, approx.section_z)
-    err = relative_error(approx, ref)
+
+    def read(m):  # the part of a map (on ref's grid) the chart reads
+        if extent is None:
+            return m
+        ds, dz = chart_shift(text, section, standard)
+        return cropped(m, (-extent - ds, extent - ds), (-extent - dz, extent - dz))
+
+    approx = BoneMap(ref.s, ref.z, resampled(approx, ref.s, ref.z), ref.section_z)
+    err = relative_error(read(approx), read(ref))
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
     if taxel:
-        et = relative_error(taxel_averaged(approx, taxel), taxel_averaged(ref, taxel))
+        et = relative_error(read(taxel_averaged(approx, taxel)), read(taxel_averaged(ref, taxel)))
         err.update({f"{k}_taxel": v for k, v in et.items()})
         err["within_tolerance_taxel"] = et["max_abs_over_peak"] <= TOLERANCE
+    if extent is not None:
+        err["extent_mm"] = float(extent)
     return err
 
 
@@ -167,12 +180,20 @@ def placed(full: BoneMap, text: str, section, standard="standard_american") -> B
     its own dots; a half or quarter map is mirrored) moved to the full-cell frame of
     `cells_centres`, where the chart reads every character: a translation (s through
     `bone_s_under`: exact on the flat pad, approximate across the curved fingertip)."""
+    ds, dz = chart_shift(text, section, standard)
+    ref = mirrored(full)
+    return BoneMap(ref.s + ds, ref.z + dz, ref.pressure, ref.section_z)
+
+
+def chart_shift(text: str, section, standard="standard_american") -> tuple[float, float]:
+    """(ds, dz) (mm) that move a one-cell `text` from the solver's frame (braille.dot_centres:
+    the pattern centred on its own dots) to the chart's (`cells_centres`): s through
+    `bone_s_under`."""
     cells = braille.check_text(text)
     if len(cells) != 1 or not cells[0]:
         raise ParameterError("text", text, "one line of Braille cells")
-    ref = mirrored(full)
     solver = braille.dot_centres(text, standard)
     cell = cells_centres(cells[0], standard)
     a, b = cell.mean(axis=0), solver.mean(axis=0)  # the same pattern, translated
     ds = float(np.diff(bone_s_under(np.array([b[0], a[0]]), section))[0])
-    return BoneMap(ref.s + ds, ref.z + float(a[1] - b[1]), ref.pressure, ref.section_z)
+    return ds, float(a[1] - b[1])

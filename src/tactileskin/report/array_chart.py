@@ -204,7 +204,9 @@ def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
             "map plus the plate-aware kernels (lone dot with plate minus blank plate, surrogate.plate_kernel), "
             "where the depth passes the dot height. Errors over the full solve's peak, pointwise on its "
             "bone-map grid and (taxel) after both maps are box-averaged over the chart's smallest taxel "
-            "(maps.taxel_averaged); within 5 % judges the taxel errors where given.", ""]
+            "(maps.taxel_averaged), inside the square the chart's arrays read (|s|, |z| <= the window's "
+            "half side + the coarsest pitch's offset and half taxel, around the cell's centre; "
+            "ChartConfig.read_extent) where the row gives it; within 5 % judges the taxel errors where given.", ""]
     return out
 
 
