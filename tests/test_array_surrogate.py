@@ -374,6 +374,10 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
              "max_abs_over_peak_taxel": 0.5}]
     got = validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows)
     assert got["status"] == "within" and got["error"] == 0.03 and got["source"] == "this run's validation"
+    # a row measured inside a smaller square than the chart reads does not answer for it
+    rows[0]["extent_mm"] = 4.5
+    assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows, extent=4.5)["status"] == "within"
+    assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows, extent=7.6)["status"] == "not validated"
 
 
 def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monkeypatch):

@@ -3,7 +3,7 @@ full 3D solves, from this run's validation rows (`chart.validate_surrogate`) or,
 those, from the project's measurements in tactileskin/data/surrogate_validation.json.
 
 The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
-validated characters, for the model the chart used ("interaction" or the plain "sum"; a row
+validated characters, inside a square around the cell at least as large as the chart reads, for the model the chart used ("interaction" or the plain "sum"; a row
 without a model is the sum); where nothing matches it is not validated. Either way the chart
 says so beside the letters' accuracies.
 """
@@ -35,14 +35,23 @@ def _match(a: float, b: float) -> bool:
     return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-9)
 
 
+def _covers(row: dict, extent: float | None) -> bool:
+    """A row measured over the square |s|, |z| <= row["extent_mm"] answers for a chart that
+    reads within `extent`; a row without one was measured over the whole map (any chart)."""
+    return extent is None or "extent_mm" not in row or float(row["extent_mm"]) >= float(extent) - 1e-9
+
+
 def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None,
-             model: str = "sum") -> dict:
+             model: str = "sum", extent: float | None = None) -> dict:
     """{"error": worst taxel error over the peak or None, "texts": the validated characters,
-    "source": where the numbers come from, "status": "within" | "exceeds" | "not validated"}."""
+    "source": where the numbers come from, "status": "within" | "exceeds" | "not validated"};
+    `extent`: the half side (mm) of the square the chart reads (ChartConfig.read_extent), which
+    a row's own extent must cover."""
     rows, source = [], ""
     for r in validation or ():
         if r.get("model", "sum") == model and r["material"] == material and _match(r["thickness_mm"], t) \
-                and _match(r.get("depth_mm", depth), depth) and "max_abs_over_peak_taxel" in r:
+                and _match(r.get("depth_mm", depth), depth) and "max_abs_over_peak_taxel" in r \
+                and _covers(r, extent):
             rows.append({"text": r["text"], "taxel_max_error": r["max_abs_over_peak_taxel"]})
             source = "this run's validation"
     if not rows:
@@ -51,7 +60,8 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
                     not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
                 continue
             for r in case["rows"]:
-                if r.get("model", "sum") == model and _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth):
+                if r.get("model", "sum") == model and _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth) \
+                        and _covers(r, extent):
                     rows.append(r)
                     source = r["source"]
     if not rows:

@@ -134,7 +134,8 @@ def letters_trust(chart, validation=None) -> dict:
             dot = dot_scene(t, material, cfg)
             model = getattr(chart, "letters_models", {}).get((material, t), cfg.letters_model)
             out[(material, t)] = {**measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
-                                             float(dot.indentation), validation, model=model), "model": model}
+                                             float(dot.indentation), validation, model=model,
+                                             extent=cfg.read_extent), "model": model}
     return out
 
 
