@@ -247,6 +247,8 @@ def test_3d_solve_with_reuse_matches_direct(slab3d):
         out[method] = (model.u.copy(), st.newton_iterations, model._linsolve)
     (ud, nd, ld), (ur, nr, lr) = out["direct"], out["reuse"]
     assert lr.method == "reuse" and lr.krylov_iterations > 0 and lr.factorizations < ld.factorizations
+    # the reused factorisation is single precision (PARDISO): it only preconditions
+    assert lr.precision == ("single" if lr.backend == "pardiso" else "double") and ld.precision == "double"
     assert nr <= 1.1 * nd
     assert np.linalg.norm(ur - ud) <= 1e-6 * np.linalg.norm(ud)
 
@@ -269,3 +271,64 @@ def test_looser_krylov_tolerance_takes_fewer_iterations_and_is_met():
     d = linsolve.SymmetricSolver(B, "superlu", "direct")
     x = d.factor(B).solve(b, rtol=1e-2)
     assert np.linalg.norm(B @ x - b) <= 1e-12 * np.linalg.norm(b)
+
+
+@pytest.mark.skipif(not linsolve.pardiso_available(), reason="MKL is installed on x86-64 only")
+def test_single_precision_factorisation_only_preconditions():
+    """precision "single": PARDISO factorises in float32, which alone solves to ~1e-7; every
+    solve, the fresh factorisation's own matrix included, is GMRES in double precision to the
+    same tolerance as the double-precision solver, so the answers agree to it."""
+    rng = np.random.default_rng(21)
+    A = _spd(2500, rng)
+    b = rng.standard_normal(2500)
+    # (the cost rule would refactorise at once on so small a matrix: test the Krylov path)
+    s = linsolve.SymmetricSolver(A, "pardiso", "reuse", precision="single", factor_cost=linsolve.KRYLOV_MAX)
+    d = linsolve.SymmetricSolver(A, "pardiso", "direct")
+    xd = d.factor(A).solve(b)
+    x = s.factor(A).solve(b)
+    assert s._pardiso.data.dtype == np.float32 and s.describe()["precision"] == "single"
+    alone = s._direct(b)
+    assert np.linalg.norm(A @ alone - b) > 1e-10 * np.linalg.norm(b)      # float32 alone is not enough
+    assert s.krylov_iterations >= 1
+    assert np.linalg.norm(A @ x - b) <= 10 * linsolve.KRYLOV_RTOL * np.linalg.norm(b)
+    assert np.linalg.norm(x - xd) <= 1e-6 * np.linalg.norm(xd)
+    # reused for the next matrix, like the double-precision factorisation
+    A2 = _scaled(A, 1e-3, rng)
+    x2 = s.factor(A2).solve(b)
+    assert s.factorizations == 1 and np.linalg.norm(A2 @ x2 - b) <= 10 * linsolve.KRYLOV_RTOL * np.linalg.norm(b)
+
+
+@pytest.mark.skipif(not linsolve.pardiso_available(), reason="MKL is installed on x86-64 only")
+def test_single_precision_that_does_not_precondition_falls_back_to_double():
+    """If GMRES fails with the single-precision factorisation of the very matrix it solves,
+    the solver switches to double precision for good and answers directly."""
+    rng = np.random.default_rng(22)
+    A = _spd(900, rng)
+    b = rng.standard_normal(900)
+    s = linsolve.SymmetricSolver(A, "pardiso", "reuse", precision="single")
+    real = s._gmres
+    s._gmres = lambda A_, b_, rtol, limit: ((np.zeros_like(b_), limit, False) if s.precision == "single"
+                                             else real(A_, b_, rtol, limit))
+    x = s.factor(A).solve(b)
+    assert s.precision == "double" and s._pardiso.data.dtype == np.float64
+    assert np.linalg.norm(A @ x - b) <= 1e-10 * np.linalg.norm(b)
+
+
+def test_single_precision_is_for_reuse_only():
+    A = sp.eye(3, format="csr")
+    with pytest.raises(ParameterError, match="precision"):
+        linsolve.SymmetricSolver(A, "superlu", "direct", precision="single")
+    with pytest.raises(ParameterError, match="precision"):
+        linsolve.SymmetricSolver(A, "superlu", "reuse", precision="half")
+    assert linsolve.SymmetricSolver(A, "superlu", "reuse", precision="single").precision == "double"  # SuperLU
+
+
+def test_factor_precision_option_is_checked(slab3d):
+    from tactileskin.fe import model_for_scene, run
+    from tactileskin.fe.solver import SolverOptions
+    from tactileskin.mesh.slab3d import build_slab_mesh
+
+    sc, _ = slab3d
+    model = model_for_scene(sc, build_slab_mesh(sc, length=2.0))[0]
+    with pytest.raises(ParameterError, match="factor_precision"):
+        run(model, sc.duration, SolverOptions(linear_method="reuse", factor_precision="half"))

@@ -54,6 +54,7 @@ log = logging.getLogger(__name__)
 
 BACKENDS = ("auto", "pardiso", "superlu")
 METHODS = ("direct", "reuse")
+PRECISIONS = ("double", "single")
 
 # GMRES with a stale factorisation: stop at this relative residual (what a direct solve of
 # the Newton system gives in practice; the Newton iteration counts do not change with it)
@@ -148,10 +149,13 @@ _PARDISO_ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reord
 class _Pardiso:
     """One PARDISO handle for a fixed upper-triangular CSR structure."""
 
-    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1):
+    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1, single: bool = False):
+        """single: factorise and solve in single precision (values, right-hand sides and
+        solutions float32 inside; `solve` returns float64)."""
         self.lib = _load_mkl()
         self.n = n
         self.threads = threads
+        self.dtype = np.float32 if single else np.float64
         self.indptr = np.ascontiguousarray(indptr, np.int32)
         self.indices = np.ascontiguousarray(indices, np.int32)
         self.pt = np.zeros(64, np.int64)
@@ -167,9 +171,10 @@ class _Pardiso:
         ip[17] = -1  # report the number of nonzeros in the factors
         ip[18] = -1  # report the factorisation MFlops
         ip[34] = 1   # zero-based indexing
+        ip[27] = 1 if single else 0
         self.perturbed = 0
         self._alive = False
-        self._call(11, np.zeros(0), np.zeros(0))
+        self._call(11, np.zeros(0, self.dtype), np.zeros(0, self.dtype))
         self._alive = True
         self.factor_nnz = int(self.iparm[17])
         self.factor_mflops = float(self.iparm[18])
@@ -200,15 +205,15 @@ class _Pardiso:
                          x.ctypes.data if x is not None and x.size else None, ctypes.byref(err))
 
     def factor(self, data: np.ndarray) -> None:
-        self.data = np.ascontiguousarray(data, float)
-        self._call(22, self.data, np.zeros(0))
+        self.data = np.ascontiguousarray(data, self.dtype)
+        self._call(22, self.data, np.zeros(0, self.dtype))
         self.perturbed = int(self.iparm[13])
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        b = np.ascontiguousarray(b, float)
+        b = np.ascontiguousarray(b, self.dtype)
         x = np.zeros_like(b)
         self._call(33, self.data, b, x)
-        return x
+        return x.astype(np.float64, copy=False)
 
     def close(self) -> None:
         if self._alive:
@@ -287,20 +292,29 @@ class SymmetricSolver:
     """
 
     def __init__(self, structure: sp.csr_matrix, backend: str = "auto", method: str = "direct",
-                 factor_cost: float | None = None, threads: int = 1):
+                 factor_cost: float | None = None, threads: int = 1, precision: str = "double"):
         """factor_cost: the cost of one factorisation in preconditioned GMRES iterations (the
         refactorisation rule's unit); None: estimated from PARDISO's flop counts. threads:
-        PARDISO's (default_threads gives the usual choice)."""
-        if method not in METHODS:
-            from tactileskin.errors import ParameterError
+        PARDISO's (default_threads gives the usual choice). precision "single" (PARDISO,
+        method "reuse" only): the factorisation is single precision and only preconditions:
+        every solve is GMRES in double precision, to the same tolerance."""
+        from tactileskin.errors import ParameterError
 
+        if method not in METHODS:
             raise ParameterError("linear solver method", method, ", ".join(METHODS))
+        if precision not in PRECISIONS:
+            raise ParameterError("linear solver precision", precision, ", ".join(PRECISIONS))
+        if precision == "single" and method != "reuse":
+            raise ParameterError("linear solver precision", precision,
+                                 "'double' for method 'direct' (single precision only preconditions GMRES)")
         if backend not in BACKENDS:
             from tactileskin.errors import ParameterError
 
             raise ParameterError("linear solver backend", backend, ", ".join(BACKENDS))
         if backend == "auto":
             backend = "pardiso" if pardiso_available() else "superlu"
+        if backend != "pardiso":
+            precision = "double"   # SuperLU here is double only
         if backend == "pardiso" and not pardiso_available():
             from tactileskin.errors import ParameterError
 
@@ -327,8 +341,10 @@ class SymmetricSolver:
             upper = A.indices >= rows
             self._upper = np.flatnonzero(upper)
             indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[upper], minlength=self.n))])
-            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper], threads)
+            self._pattern = (indptr, A.indices[upper])
+            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper], threads, single=precision == "single")
         self.threads = threads if backend == "pardiso" else 1
+        self.precision = precision
 
     def factor(self, A: sp.csr_matrix) -> "SymmetricSolver":
         """Take A as the matrix to solve with; factorise it unless the old factorisation is
@@ -393,16 +409,13 @@ class SymmetricSolver:
         rtol = KRYLOV_RTOL if rtol is None else min(max(rtol, KRYLOV_RTOL), 1e-2)
         t0, c0 = time.perf_counter(), time.process_time()
         try:
-            if self._fresh or self._A is None:
+            if self._A is None or (self._fresh and self.precision == "double"):
                 return self._direct(b)
             A = self._A
             limit = int(min(KRYLOV_MAX, max(2, np.ceil(self._cost_ratio(A)))))
-            x, k, ok = gmres(A.dot, self._direct, b, rtol, limit)
-            self.krylov_iterations += k
-            if ok and np.all(np.isfinite(x)):
-                # the Givens estimate can drift from the true residual: check it (one product)
-                ok = np.linalg.norm(A @ x - b) <= 10.0 * rtol * np.linalg.norm(b)
-            if not ok:
+            x, k, ok = self._gmres(A, b, rtol, limit)
+            failed = not ok and not self._fresh
+            if failed:
                 # a failed solve costs its iterations and a factorisation; while the tangent
                 # keeps changing that much (the Braille plate's first contact: 10 failures in
                 # a row) refactorise directly for the next 1, 3, 7 ... systems
@@ -410,12 +423,23 @@ class SymmetricSolver:
                 self._direct_left = min(2 ** self._failures - 1, DIRECT_AFTER_FAILURES_MAX)
                 log.debug("GMRES: no convergence in %d iterations with the old factorisation; refactorising"
                           " (directly for the next %d)", k, self._direct_left)
-                t1, c1 = time.perf_counter(), time.process_time()
-                self._factor(A)
-                t0 += time.perf_counter() - t1  # counted as factor time
-                c0 += time.process_time() - c1
+                t0, c0 = self._factor_within_solve(A, t0, c0)
+                if self.precision == "double":
+                    return self._direct(b)
+                x, k, ok = self._gmres(A, b, rtol, limit)   # with the fresh single-precision one
+            if not ok:
+                # the single-precision factorisation of this very matrix does not precondition
+                # it (pivots lost to rounding): double precision from now on
+                log.info("PARDISO single precision does not precondition this tangent; switching to double")
+                self._pardiso.close()
+                self._pardiso = _Pardiso(self.n, *self._pattern, self.threads)
+                self.precision = "double"
+                t0, c0 = self._factor_within_solve(A, t0, c0)
                 return self._direct(b)
-            self._failures = 0
+            if not failed:
+                self._failures = 0
+            if self._fresh:      # single precision: the fresh factorisation's own matrix
+                return x
             cost, solves = self._cycle
             cost, solves = cost + k, solves + 1
             self._cycle = [cost, solves]
@@ -428,9 +452,26 @@ class SymmetricSolver:
             self.timing["solve"] += time.perf_counter() - t0
             self.cpu["solve"] += time.process_time() - c0
 
+    def _factor_within_solve(self, A, t0: float, c0: float) -> tuple[float, float]:
+        """Refactorise inside `solve`; returns its start times moved on by the factorisation's
+        (which counts as factor time, not solve time)."""
+        t1, c1 = time.perf_counter(), time.process_time()
+        self._factor(A)
+        return t0 + time.perf_counter() - t1, c0 + time.process_time() - c1
+
+    def _gmres(self, A, b, rtol, limit):
+        """GMRES preconditioned by the factorisation; (x, iterations, converged) with the
+        true residual checked (the Givens estimate can drift: one product)."""
+        x, k, ok = gmres(A.dot, self._direct, b, rtol, limit)
+        self.krylov_iterations += k
+        if ok and np.all(np.isfinite(x)):
+            ok = np.linalg.norm(A @ x - b) <= 10.0 * rtol * np.linalg.norm(b)
+        return x, k, bool(ok and np.all(np.isfinite(x)))
+
     def describe(self) -> dict:
         """The method used and its work counts (for result stats)."""
         return {"method": self.method, "backend": self.backend, "threads": self.threads,
+                "precision": self.precision,
                 "factorizations": self.factorizations,
                 "krylov_iterations": self.krylov_iterations,
                 "cpu_s": {k: round(v, 4) for k, v in self.cpu.items()}}
