@@ -11,6 +11,11 @@ from tactileskin.scene import Scene
 SEC = Scene(thickness=1.0).section()
 
 
+def _reaction(sc):
+    """A fake solve's summary: load ~ depth^1.5 (Hertz), for surrogate.load_exponent."""
+    return {"reaction_n_per_mm": float(sc.indentation) ** 1.5}
+
+
 def _gauss(cs=0.0, cz=0.0, w=0.4):
     return lambda s, z: np.exp(-((s - cs) ** 2 + (z - cz) ** 2) / (2 * w * w))
 
@@ -105,6 +110,43 @@ def test_interaction_weights_closed_forms():
         surrogate.interaction_weights(c, lambda dx, dz: np.zeros_like(dx))
 
 
+def test_interaction_weights_follow_the_lone_dots_load_approach_law():
+    """With load ~ approach^p two dots a heave h apart carry f = ((w0 + h f) / w0)^p each
+    (a scalar fixed point, solved here by bisection); p = 1 is the linear model; a neighbour
+    that pushes the surface below a dot's reach leaves it no load."""
+    c = np.array([[-1.25, 0.0], [1.25, 0.0]])
+    w0, heave = 0.2, 0.01
+    defl = lambda dx, dz: np.where((dx == 0) & (dz == 0), w0, -heave)  # noqa: E731
+    lin = surrogate.interaction_weights(c, defl)
+    assert np.array_equal(surrogate.interaction_weights(c, defl, 1.0), lin)
+    for p in (1.5, 2.0, 0.7):
+        lo, hi = 0.5, 2.0
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if mid < ((w0 + heave * mid) / w0) ** p else (lo, mid)
+        got = surrogate.interaction_weights(c, defl, p)
+        assert np.allclose(got, 0.5 * (lo + hi), rtol=1e-12)
+        # a stiffening law (p > 1) amplifies the interaction beyond the linear model's
+        assert (got[0] - 1.0) / (lin[0] - 1.0) == pytest.approx(p, rel=0.1)
+    # three in a row, the middle one shielded: its neighbours press the surface down past it
+    c3 = np.array([[-1.0, 0.0], [0.0, 0.0], [1.0, 0.0]])
+    r = lambda dx, dz: np.hypot(dx, dz)  # noqa: E731
+    sink = lambda dx, dz: np.where(r(dx, dz) < 0.5, w0, np.where(r(dx, dz) < 1.5, 0.6 * w0, 0.0))  # noqa: E731
+    f3 = surrogate.interaction_weights(c3, sink, 2.0)   # outer: (1 - 0.6 f1)^2 = 1; middle: 1 - 1.2 < 0
+    assert np.allclose(f3, [1.0, 0.0, 1.0], atol=1e-12)
+    with pytest.raises(ParameterError, match="load exponent"):
+        surrogate.interaction_weights(c, defl, 7.0)
+
+
+def test_load_exponent_of_a_power_law():
+    for p in (1.0, 1.5, 2.3):
+        d = 0.4
+        assert surrogate.load_exponent(3.0 * d ** p, 3.0 * (surrogate.SHALLOW * d) ** p) == pytest.approx(p, rel=1e-12)
+    for bad in ((1.0, 1.0), (1.0, 1.2), (1.0, 0.0), (float("nan"), 0.5), (1.0, 1e-6)):
+        with pytest.raises(ParameterError, match="lone-dot loads"):
+            surrogate.load_exponent(*bad)
+
+
 def test_fit_scale_recovers_a_known_factor_and_weights_scale_the_sum():
     grid = np.linspace(-6, 6, 241)
     kernel = maps.on_grid(_gauss(), grid, grid)
@@ -189,7 +231,8 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
 
     def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
-        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes}
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
+                                        summary=_reaction(sc)) for sc in scenes}
 
     monkeypatch.setattr(chart, "solve_cached", fake_solve)
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
@@ -217,7 +260,8 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     assert not ch.notes and not any(sc.indenter == "flat" and sc.dim == 3 for sc in asked)
     assert set(ch.letters_models.values()) == {"interaction"}
     depths = {(sc.thickness, round(sc.indentation, 9)) for sc in asked}
-    assert depths == {(1.0, 0.2), (3.0, 0.4)}  # t = 1 keeps its 20 %
+    # t = 1 keeps its 20 %; each lone dot on the pad also at 0.9 x its depth (its load exponent)
+    assert depths == {(1.0, 0.2), (1.0, 0.18), (3.0, 0.4), (3.0, 0.36)}
     assert [c["depth_mm"] for c in ch.cutoffs if c["thickness_mm"] == 3.0] == [0.4, 0.4]
 
 
@@ -316,7 +360,8 @@ def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
 
     def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
-        return {sc: SimpleNamespace(scene=sc, path=tmp_path) for sc in scenes}
+        return {sc: SimpleNamespace(scene=sc, path=tmp_path,
+                                        summary=_reaction(sc)) for sc in scenes}
 
     def bone(rec):
         sc = rec.scene
@@ -389,7 +434,8 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
 
     grid = np.linspace(-8, 8, 161)
     monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
-        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes})
+        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
+                                        summary=_reaction(sc)) for sc in scenes})
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), materials=("silicone",), pitches=(0.5, 0.75),
@@ -456,7 +502,8 @@ def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypa
 
     def fake_solve(scenes, cache, on_event=None, workers=None):
         asked.extend(scenes)
-        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path) for sc in scenes}
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path,
+                                        summary=_reaction(sc)) for sc in scenes}
 
     monkeypatch.setattr(chart, "solve_cached", fake_solve)
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
@@ -482,7 +529,8 @@ def test_chart_falls_back_to_the_sum_where_the_interaction_weights_fail(monkeypa
 
     grid = np.linspace(-8, 8, 161)
     monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
-        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc) for sc in scenes})
+        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
+                                        summary=_reaction(sc)) for sc in scenes})
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
     monkeypatch.setattr(chart, "surface_deflection",
                         lambda rec, top: lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))

@@ -12,7 +12,9 @@ surface, the paper's sensor film):
 - "letters": the 26 letters a-z as cells and the digits 0-9 as the number sign and a-j's
   cell (surrogate.char_centres), each the superposition of the single-dot response at its
   dots in the frame of its full cells, each dot weighted by its load beside its neighbours
-  (ChartConfig.letters_model; surrogate.py; its error against full solves is stated by
+  (ChartConfig.letters_model; surrogate.interaction_weights: the lone dot's surface
+  deflection and load-approach law, the latter from a second lone-dot solve at
+  surrogate.SHALLOW x the depth; its error against full solves is stated by
   `validate_surrogate`), on
   `skin` (default the flat pad, where a dot's response translates exactly; on the
   fingertip the translation across the curved finger is approximate).
@@ -272,13 +274,14 @@ def stimulus_maps(kernel: BoneMap, section, profiles: dict, cfg: ChartConfig, pa
     return out
 
 
-def letter_weights(cfg: ChartConfig, deflection) -> dict:
+def letter_weights(cfg: ChartConfig, deflection, exponent: float = 1.0) -> dict:
     """{character: the loads of its dots} from the lone dot's surface deflection w(dx, dz)
-    (surrogate.interaction_weights). Raises ParameterError naming the character where a dot
-    would carry no load (the neighbours lifting the surface more than the dot presses it)."""
+    and load-approach exponent (surrogate.interaction_weights). Raises ParameterError naming
+    the character where a dot would carry no load (its neighbours pushing the surface below
+    its reach)."""
     out = {}
     for c in cfg.letters:
-        w = surrogate.interaction_weights(surrogate.char_centres(c, cfg.standard), deflection)
+        w = surrogate.interaction_weights(surrogate.char_centres(c, cfg.standard), deflection, exponent)
         if not np.all(np.isfinite(w) & (w > 0)):
             raise ParameterError(f"interaction weights of {c!r}", np.round(w, 3).tolist(),
                                  "finite and > 0 (a surface deflection that gives a dot no load)")
@@ -338,6 +341,20 @@ def letters_model(cfg: ChartConfig, dot, base) -> str:
     return cfg.letters_model
 
 
+def shallow_scene(dot):
+    """The lone dot at surrogate.SHALLOW x its depth: with `dot`, its load-approach law
+    (surrogate.load_exponent)."""
+    import dataclasses
+
+    return dataclasses.replace(dot, depth=surrogate.SHALLOW * float(dot.indentation))
+
+
+def dot_exponent(rec, rec_shallow) -> float:
+    """surrogate.load_exponent of the lone dot's two solves (their reactions)."""
+    return surrogate.load_exponent(float(rec.summary["reaction_n_per_mm"]),
+                                   float(rec_shallow.summary["reaction_n_per_mm"]))
+
+
 def letter_scenes(cfg: ChartConfig, material: str, t: float) -> dict:
     """{letter: its full 3D scene} when cfg.letters_model is "full", else {}."""
     if "letters" not in cfg.sets or cfg.letters_model != "full":
@@ -356,9 +373,10 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     chart = Chart(cfg)
     cases = {(m, t): _chart_scenes(cfg, m, t) for m in cfg.materials for t in cfg.thicknesses}
     full = {(m, t): letter_scenes(cfg, m, t) for m, t in cases}
+    shallow = {k: shallow_scene(c[0]) for k, c in cases.items() if letters_model(cfg, c[0], c[2]) == "interaction"}
     wanted = [x for dot, pdot, blank, sec2, sphere in cases.values()
               for x in (dot, pdot, blank, *sec2.values(), sphere) if x is not None]
-    wanted += [x for f in full.values() for x in f.values()]
+    wanted += [x for f in full.values() for x in f.values()] + list(shallow.values())
     say(f"solving {len(set(wanted))} cases (cached cases are read)")
     recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
@@ -393,7 +411,8 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             weights = None
             if model == "interaction":
                 try:
-                    weights = letter_weights(cfg, surface_deflection(recs[dot], dot.section().top))
+                    weights = letter_weights(cfg, surface_deflection(recs[dot], dot.section().top),
+                                             dot_exponent(recs[dot], recs[shallow[(material, t)]]))
                 except ParameterError as e:
                     note = f"t = {t:g} mm ({material}): the letters fall back to the plain sum: {e}"
                     log.warning(note)
@@ -476,7 +495,8 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                        workers: int | None = None) -> list[dict]:
     """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
     text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
-    lone dot's surface deflection, surrogate.interaction_weights), "sum x a" (one scale a per
+    lone dot's surface deflection and load-approach law, surrogate.interaction_weights; the
+    chart's model), "interaction, linear" (the same with loads linear in the approach), "sum x a" (one scale a per
     thickness fitted by least squares on these same maps: an in-sample fit). Where the plate
     touches (depth past the dot height): "plate + sum" (the blank plate plus the plate-aware
     kernels, surrogate.plate_kernel), "plate + sum x a", and "sum" (the lone dot's map with
@@ -496,12 +516,14 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     cases = {}
     for t in thicknesses:
         dot = dot_scene(t, material, cfg)
-        cases[t] = dot, [dot_scene(t, material, cfg, x) for x in texts], blank_scene(dot) if plate_touches(dot) else None
+        blank = blank_scene(dot) if plate_touches(dot) else None
+        shallow = shallow_scene(dot) if blank is None and cfg.skin == "pad" else None
+        cases[t] = dot, [dot_scene(t, material, cfg, x) for x in texts], blank, shallow
     say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
-    recs = solve_cached([x for dot, fulls, blank in cases.values() for x in (dot, blank, *fulls) if x is not None],
+    recs = solve_cached([x for c in cases.values() for x in (c[0], c[2], c[3], *c[1]) if x is not None],
                         cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
-    for t, (dot, fulls, blank) in cases.items():
+    for t, (dot, fulls, blank, shallow) in cases.items():
         kernel = bone_map_of(recs[dot])
         sec = dot.section()
         refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
@@ -517,7 +539,9 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
             scale = surrogate.fit_scale(kernel, refs, sec, cfg.standard)
             models = {"sum": (kernel, {}), f"sum x {scale:.3f}": (kernel, {"scale": scale})}
             if defl is not None:
-                models["interaction"] = (kernel, {"deflection": defl})
+                models["interaction, linear"] = (kernel, {"deflection": defl})
+                models["interaction"] = (kernel, {"deflection": defl,
+                                                  "exponent": dot_exponent(recs[dot], recs[shallow])})
         for x in texts:
             for name, (k, kw) in models.items():
                 err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,

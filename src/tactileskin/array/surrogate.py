@@ -7,9 +7,11 @@ along z; across the finger the dot at face coordinate x_k is placed at the bone 
 s_k of the bone point on the skin's inward normal under x_k (the surface is curved, so the
 translation in s is approximate: an off-centre dot meets a skin that has dropped away).
 What remains is the contact nonlinearity and, under depth control, the dots' interaction
-(a neighbour's load lowers the skin under a dot, so each dot of a cell carries less than
-a lone dot): `validate` measures it against full solves, and `scaled` is the one-number
-correction fitted on them.
+(a neighbour's load lowers the skin under a dot, or on a thin layer heaves it up):
+`interaction_weights` gives each dot its load from the lone dot's surface deflection and
+its load-approach law (`load_exponent`, from a second lone-dot solve at SHALLOW x the
+depth); `validate` measures the models against full solves, and `fit_scale` is the
+one-number correction fitted on them.
 
 Past the dot height the Braille plate presses the skin too, and a lone dot's map holds the
 plate's load: summed per dot it would count the plate once per dot. The plate-aware model
@@ -99,20 +101,66 @@ def plate_kernel(dot: BoneMap, blank: BoneMap) -> BoneMap:
     return BoneMap(dot.s, dot.z, dot.pressure - resampled(blank, dot.s, dot.z), dot.section_z)
 
 
-def interaction_weights(centres, deflection) -> np.ndarray:
-    """Loads of the dots of one character, in units of a lone dot's, under depth control in
-    the linear limit: a dot carrying load f_j deflects the surface by f_j w(dx, dz) (w: the
-    lone dot's surface deflection, downward positive; on a thin bonded layer the surface
-    heaves up around a dot, w < 0), and every dot must reach the lone dot's own deflection
-    w0 = w(0, 0): sum_j W_kj f_j = w0 with W_kj = w(c_k - c_j). `deflection(dx, dz)` takes
-    arrays."""
+# the second lone-dot solve of the interaction model is indented to this fraction of the depth
+# (load_exponent: the lone dot's load over the +-10 % approach changes its neighbours make)
+SHALLOW = 0.9
+
+
+def interaction_weights(centres, deflection, exponent: float = 1.0) -> np.ndarray:
+    """Loads of the dots of one character, in units of a lone dot's, under depth control: a
+    dot carrying load f_j deflects the surface by f_j w(dx, dz) (w: the lone dot's surface
+    deflection, downward positive; on a thin bonded layer the surface heaves up around a dot,
+    w < 0), so dot k meets a surface already moved by sum_(j != k) f_j W_kj, W_kj = w(c_k - c_j),
+    and indents it by a_k = w0 - sum_(j != k) W_kj f_j, w0 = w(0, 0) the lone dot's own.
+    Its load follows the lone dot's load-approach law f = (a / w0)^exponent (`load_exponent`;
+    exponent 1, the linear limit: sum_j W_kj f_j = w0). A dot whose approach vanishes carries
+    nothing. `deflection(dx, dz)` takes arrays."""
     c = np.atleast_2d(np.asarray(centres, float))
     d = c[:, None, :] - c[None, :, :]
     W = np.asarray(deflection(d[..., 0], d[..., 1]), float)
     w0 = float(np.mean(np.diag(W)))
     if not (np.all(np.isfinite(W)) and w0 > 0):
         raise ParameterError("deflection", f"w(0, 0) = {w0:g}", "a finite surface deflection, > 0 under the dot")
-    return np.linalg.solve(W, np.full(len(c), w0))
+    if not (np.isfinite(exponent) and 0.5 <= exponent <= 5.0):
+        raise ParameterError("load exponent", exponent, "[0.5, 5] (a lone dot's load ~ approach^exponent)")
+    if exponent == 1.0:
+        return np.linalg.solve(W, np.full(len(c), w0))
+    off = W / w0
+    np.fill_diagonal(off, 0.0)
+
+    def residual(f):
+        a = np.maximum(1.0 - off @ f, 0.0)
+        return f - a ** exponent, a
+
+    # damped Newton on r(f) = f - max(1 - off f, 0)^p over f >= 0, from the lone dots' loads
+    f = np.ones(len(c))
+    r, a = residual(f)
+    for _ in range(100):
+        norm = float(np.max(np.abs(r)))
+        if norm <= 1e-13:
+            return f
+        slope = np.where(a > 0, exponent * np.where(a > 0, a, 1.0) ** (exponent - 1.0), 0.0)
+        step = np.linalg.solve(np.eye(len(c)) + slope[:, None] * off, r)
+        lam = 1.0
+        while True:
+            fn = np.maximum(f - lam * step, 0.0)
+            rn, an = residual(fn)
+            if np.max(np.abs(rn)) < norm or lam < 1e-6:
+                break
+            lam *= 0.5
+        f, r, a = fn, rn, an
+    raise ParameterError("interaction weights", np.round(f, 3).tolist(), "a converged load of every dot")
+
+
+def load_exponent(load: float, load_shallow: float, fraction: float = SHALLOW) -> float:
+    """p of the lone dot's load ~ approach^p from its loads at the full depth and at `fraction`
+    of it (a power law through the two: Hertz 1.5, a flat punch 1)."""
+    ok = np.isfinite(load) and np.isfinite(load_shallow) and 0 < load_shallow < load
+    p = float(np.log(load / load_shallow) / -np.log(fraction)) if ok else float("nan")
+    if not (np.isfinite(p) and 0.5 <= p <= 5.0):
+        raise ParameterError("lone-dot loads", (load, load_shallow),
+                             f"0 < load at {fraction:g} x depth < load at depth, a power law p in [0.5, 5]")
+    return p
 
 
 def kernel_from(bone_map: BoneMap) -> BoneMap:
@@ -122,10 +170,10 @@ def kernel_from(bone_map: BoneMap) -> BoneMap:
 
 def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="standard_american",
              deflection=None, scale: float = 1.0, base: BoneMap | None = None, taxel: float | None = None,
-             extent: float | None = None) -> dict:
+             extent: float | None = None, exponent: float = 1.0) -> dict:
     """Errors of the superposition against the full solve of `text` (its map `full`, possibly a
     quarter: mirrored here), dots placed as the solver placed them (braille.dot_centres);
-    with `deflection` the dots' loads from `interaction_weights`; the dots' sum times
+    with `deflection` the dots' loads from `interaction_weights` (with `exponent`); the dots' sum times
     `scale`, plus `base` (the blank plate's map of the plate-aware model). With `taxel` (mm)
     also the errors of both maps as read by taxels of that side (keys *_taxel): what the
     finest array of a chart sees, blind to sub-taxel ripple. With `extent` (mm) the errors
@@ -133,7 +181,7 @@ def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="stand
     a chart's arrays read the character, ChartConfig.read_extent), not the skin's far edges."""
     ref = mirrored(full)
     c = braille.dot_centres(text, standard)
-    w = None if deflection is None else interaction_weights(c, deflection)
+    w = None if deflection is None else interaction_weights(c, deflection, exponent)
     approx = superpose(kernel, c, section, ref.s, ref.z, weights=w)
     P = scale * approx.pressure
     if base is not None:

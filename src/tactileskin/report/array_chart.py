@@ -155,7 +155,8 @@ def _trust_section(chart, trust: dict) -> list[str]:
     out = ["### How far the letters can be trusted", "",
            ("The letters are full 3D solves of every letter (`letters_model = full`)." if cfg_full else
             "The letters are superposed single-dot responses (a surrogate: `interaction` weighs each dot "
-            "by the load the lone dot's surface deflection leaves it beside its neighbours; `sum` adds lone "
+            "by the load the lone dot's surface deflection and load-approach law leave it beside its "
+            "neighbours; `sum` adds lone "
             "dots). Its error against full 3D "
             "solves of the same characters, as the chart's smallest taxels read them (worst over the "
             "validated characters; `tactileskin array --validate` measures it for a run; "
@@ -200,7 +201,9 @@ def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
                    + (f" | {r['max_abs_over_peak_taxel']:.1%} | {r['peak_rel_taxel']:+.1%}" if taxel else "")
                    + f" | {'yes' if ok else 'no'} |")
     out += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
-            "surface deflection under depth control (surrogate.interaction_weights); sum x a = one "
+            "surface deflection under depth control and its load-approach law, load ~ approach^p with p from "
+            "a second lone-dot solve at 0.9 x the depth (surrogate.interaction_weights, load_exponent); "
+            "interaction, linear = the same with p = 1; sum x a = one "
             "factor per thickness fitted on these same solves (in-sample); plate + sum = the blank plate's "
             "map plus the plate-aware kernels (lone dot with plate minus blank plate, surrogate.plate_kernel), "
             "where the depth passes the dot height. Errors over the full solve's peak, pointwise on its "
