@@ -1,0 +1,76 @@
+"""The letters' surrogates against full 3D solves: the rows of data/surrogate_validation.json.
+
+For each material, `array.chart.validate_surrogate` on the default chart (pad 20 x 20 mm, mesh
+1.2 / 8, the default pitches and window, so its read square; depth cap --max-depth) solves
+the texts in full (through the result cache in --cache: a rerun only reads) and compares them
+with every model. Prints the table (markdown) and, with --write, replaces the JSON's rows of
+the "interaction" and "sum" models for (material, pad, mesh) with these measurements (source:
+this script, today's date). Wall time from the start; the solves run on --workers processes.
+
+    PYTHONPATH=src .venv/bin/python benchmarks/surrogate_validation.py --materials silicone,polyurethane \
+        --thickness 0.5,1,2,3,5 --texts '⠿,l' --max-depth 0.4 --cache /tmp/val_cache [--write]
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "src" / "tactileskin" / "data" / "surrogate_validation.json"
+MODELS = ("interaction", "sum")  # the models a chart uses (validity.measured)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--materials", default="silicone,polyurethane")
+    ap.add_argument("--thickness", default="0.5,1,2,3,5")
+    ap.add_argument("--texts", default="⠿,l")
+    ap.add_argument("--max-depth", type=float, default=0.4)
+    ap.add_argument("--cache", required=True)
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--write", action="store_true", help="replace the JSON rows of these measurements")
+    a = ap.parse_args(argv)
+
+    from tactileskin.array.chart import ChartConfig, validate_surrogate
+    from tactileskin.cache import ResultCache
+    from tactileskin.fileio import atomic_write_text
+    from tactileskin.report.array_chart import validation_table
+
+    t0 = time.perf_counter()
+    ts = [float(x) for x in a.thickness.split(",")]
+    cfg = ChartConfig(thicknesses=tuple(ts), max_depth=a.max_depth)
+    cache = ResultCache(Path(a.cache))
+    rows = {m: validate_surrogate(ts, m, a.texts.split(","), cfg, cache, progress=print, workers=a.workers)
+            for m in a.materials.split(",")}
+    wall = time.perf_counter() - t0
+    for m, rs in rows.items():
+        print("\n".join(validation_table(rs, f"### {m}: read square |s|, |z| <= {cfg.read_extent:g} mm")))
+    print(f"wall {wall:.0f} s")
+    if not a.write:
+        return 0
+    data = json.loads(DATA.read_text(encoding="utf-8"))
+    source = f"benchmarks/surrogate_validation.py ({_dt.date.today().isoformat()})"
+    for m, rs in rows.items():
+        case = next((c for c in data["cases"] if c["material"] == m and c["skin"] == cfg.skin
+                     and c["mesh"] == [cfg.mesh_size, cfg.refinement]), None)
+        if case is None:
+            case = {"material": m, "skin": cfg.skin, "mesh": [cfg.mesh_size, cfg.refinement], "rows": []}
+            data["cases"].append(case)
+        new = [{"thickness_mm": r["thickness_mm"], "depth_mm": round(r["depth_mm"], 9), "text": r["text"],
+                "model": r["model"], "taxel_max_error": round(r["max_abs_over_peak_taxel"], 4),
+                "extent_mm": r["extent_mm"], "source": source} for r in rs if r["model"] in MODELS]
+        measured = {(r["thickness_mm"], r["depth_mm"], r["model"]) for r in new}
+        case["rows"] = [r for r in case["rows"]
+                        if (r["thickness_mm"], r["depth_mm"], r.get("model", "sum")) not in measured] + new
+    atomic_write_text(DATA, json.dumps(data, indent=2) + "\n")
+    print(f"wrote {DATA}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
