@@ -79,11 +79,12 @@ class ChartConfig:
     # its stimuli, 2D and 3D); None: the paper's 20 % everywhere (t >= 2.4 mm: the plate touches)
     max_depth: float | None = None
     # the letters' maps: "interaction" superposes the single dot with each dot's load from the
-    # lone dot's surface deflection (surrogate.interaction_weights; on the pad below the dot
-    # height, else the plain sum), "sum" adds lone dots (one 3D solve per t; measured errors of
-    # both in data/surrogate_validation.json: interaction 4.9, 8.5, 8.8, 3.9, 8.0 % against the
-    # sum's 5.3, 10.3, 14.7, 5.6, 15.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter
-    # in 3D (one solve per letter and t: where the surrogates are not within 5 %)
+    # lone dot's surface deflection and load-approach law (surrogate.interaction_weights; on the
+    # pad below the dot height, else the plain sum; two lone-dot solves per t), "sum" adds lone
+    # dots (one 3D solve per t; measured errors of both in data/surrogate_validation.json,
+    # silicone: interaction 4.6, 6.8, 4.4, 2.8, 3.5 % against the sum's 5.3, 10.3, 14.7, 5.7,
+    # 15.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter in 3D (one solve per letter
+    # and t: where the surrogates are not within 5 %)
     letters_model: str = "interaction"
     # the shapes set's sphere (mm) and the 3D preset it is meshed at (the strip plan; preview:
     # peak 2.9 % and span 3.1 % from default at t = 1 silicone, 10 s against 56 s CPU)

@@ -64,7 +64,8 @@ def load_config(path) -> dict:
               help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
 @click.option("--letters-model", type=click.Choice(["interaction", "sum", "full"]), default=None,
               help="Letters from superposed single-dot solves, each dot's load from the lone dot's surface "
-                   "deflection (interaction, default; on the pad below the dot height, else sum) or as lone "
+                   "deflection and load-approach law (interaction, default; a second lone-dot solve at 0.9 x "
+                   "the depth; on the pad below the dot height, else sum) or as lone "
                    "dots (sum): their measured errors are in the report; or a full 3D solve of every letter "
                    "(full: one solve per letter and thickness).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,

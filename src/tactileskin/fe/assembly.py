@@ -45,17 +45,21 @@ class Pattern:
         self._ff_indices = newidx[c[keep]].astype(np.int32)
         self._ff_indptr = np.concatenate([[0], np.cumsum(np.bincount(rf, minlength=nf))]).astype(np.int32)
         self.nfree = nf
+        self._add_dofs, self._add_pos = None, None   # Pattern.add's positions of its last dofs
 
     def data(self, Ke: np.ndarray) -> np.ndarray:
         """CSR data from element matrices (E, nd, nd)."""
         return np.bincount(self._inv, weights=Ke.ravel(), minlength=len(self.keys))
 
     def add(self, data: np.ndarray, dofs: np.ndarray, Kb: np.ndarray) -> None:
-        """Add blocks Kb (B, k, k) with dofs (B, k) (must lie inside the pattern)."""
-        k = dofs.shape[1]
-        keys = (np.repeat(dofs, k, axis=1).astype(np.int64) * self.n + np.tile(dofs, (1, k))).ravel()
-        pos = np.searchsorted(self.keys, keys)
-        np.add.at(data, pos, Kb.ravel())
+        """Add blocks Kb (B, k, k) with dofs (B, k) (must lie inside the pattern). The data
+        positions of the last dofs given are kept: the contact blocks of a model always come
+        with the same dofs (the 3D dot's: 29 ms of searchsorted per tangent)."""
+        if self._add_dofs is None or not np.array_equal(self._add_dofs, dofs):
+            k = dofs.shape[1]
+            keys = (np.repeat(dofs, k, axis=1).astype(np.int64) * self.n + np.tile(dofs, (1, k))).ravel()
+            self._add_dofs, self._add_pos = np.array(dofs), np.searchsorted(self.keys, keys)
+        np.add.at(data, self._add_pos, Kb.ravel())
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))

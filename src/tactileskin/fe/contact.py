@@ -69,7 +69,13 @@ class ContactSurface:
             if curvature and np.any(active):
                 dn = self._dn_dx(x, indenter, d, active)
                 Kpt = Kpt - lamN[..., None, None] * dn
-            Kc = np.einsum("fq,fqa,fqb,fqik->faibk", self.w, self.N, self.N, Kpt).reshape(Fc, A * m, A * m)
+            # only facets with a pressed (or held) point have a block: the rest of the outer
+            # surface is zero (a 3D dot: a few % of its facets; 15 ms per tangent before)
+            Kc = np.zeros((Fc, A * m, A * m))
+            on = np.flatnonzero(np.any(Kpt != 0.0, axis=(1, 2, 3)))
+            if on.size:
+                Kc[on] = np.einsum("fq,fqa,fqb,fqik->faibk", self.w[on], self.N[on], self.N[on], Kpt[on],
+                                   optimize=True).reshape(len(on), A * m, A * m)
         return fc, Kc, (g, lamN, x, n)
 
     def _dn_dx(self, x, indenter, d, active):
