@@ -2,8 +2,8 @@
 
 Prints median CPU times (ms; process time, calls of the two implementations alternating so
 that both see the same load on a shared machine) of
-  3x3       hyperfoam.pk2_tangent on the embedded C (LAPACK eigh, numpy; the law of 3D and
-            non-plane states, and the compiled loop's test oracle); S only: hyperfoam.pk2,
+  3x3       hyperfoam.pk2_tangent on the embedded C (LAPACK eigh, numpy; the compiled
+            loops' test oracle); S only: hyperfoam.pk2,
   compiled  hyperfoam.pk2_tangent_plane (the numba point loop of materials._hyperfoam_nb),
 as fe.material_law calls them (out_of_plane=True: S (..., 3, 3), D (..., 3, 3, 3, 3)),
 with the tangent (S+D) and without (S only; the compiled tangent=False), on the point count
@@ -14,7 +14,8 @@ cost: a fresh compile and a cached load, each in a new process with its own NUMB
 
 Second table, 3D: the compiled 3x3 loop hyperfoam.pk2_tangent_solid (Jacobi rotations; the
 3D solver's law) against the numpy path on the point count of the default 3D dot at t = 3 mm
-(11,900 P2 tets x 4 points = 47,600 states, F = I + 0.05 N(0, 1), 3x3).
+(11,900 P2 tets x 4 points = 47,600 states, F = I + 0.05 N(0, 1), 3x3), on numba's default
+threads (all CPUs: CPU time counts every thread).
 
 Options: --repeat N (default 25); --points N (default 11469); --points3d N (default 47600).
 """
@@ -81,6 +82,31 @@ def paired_ms(fns, repeat):
     return [1e3 * float(np.median(ti)) for ti in t]
 
 
+def table(title, C, compiled, repeat):
+    """Print the S+D and S-only rows of the numpy 3x3 path on C against `compiled(hf, tangent)`."""
+    from tactileskin.materials import get_material
+    from tactileskin.materials.hyperfoam import pk2, pk2_tangent
+
+    print(f"{title}, median CPU ms of {repeat} alternating calls\n")
+    print(f"{'material':<13}{'output':<8}{'3x3':>9}{'compiled':>10}{'speed-up':>10}"
+          f"{'max dS/max|S|':>15}{'max dD/max|D|':>15}")
+    for name in ("polyurethane", "silicone"):
+        hf = get_material(name).hyperfoam
+        S, D, ok = compiled(hf)
+        S0, D0, ok0 = pk2_tangent(hf, C)
+        assert np.array_equal(ok, ok0) and ok.all()
+        dS = np.abs(S - S0).max() / np.abs(S0).max()
+        dD = np.abs(D - D0).max() / np.abs(D0).max()
+        t_3, t_c, t_3_s, t_c_s = paired_ms([
+            lambda: pk2_tangent(hf, C),
+            lambda: compiled(hf),
+            lambda: pk2(hf, C),
+            lambda: compiled(hf, False),
+        ], repeat)
+        print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
+        print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=25)
@@ -88,50 +114,17 @@ def main(argv=None):
     ap.add_argument("--points3d", type=int, default=11900 * 4)
     args = ap.parse_args(argv)
 
-    from tactileskin.materials import get_material
-    from tactileskin.materials.hyperfoam import pk2, pk2_tangent, pk2_tangent_plane, pk2_tangent_solid
+    from tactileskin.materials.hyperfoam import pk2_tangent_plane, pk2_tangent_solid
 
     C = states(args.points)
     C2 = C[..., :2, :2]               # strided view, as fe.material_law passes it
-    print(f"{args.points} plane-strain points, median CPU ms of {args.repeat} alternating calls\n")
-    print(f"{'material':<13}{'output':<8}{'3x3':>9}{'compiled':>10}{'speed-up':>10}"
-          f"{'max dS/max|S|':>15}{'max dD/max|D|':>15}")
-    for name in ("polyurethane", "silicone"):
-        hf = get_material(name).hyperfoam
-        S, D, ok = pk2_tangent_plane(hf, C2, out_of_plane=True)
-        S0, D0, ok0 = pk2_tangent(hf, C)
-        assert np.array_equal(ok, ok0) and ok.all()
-        dS = np.abs(S - S0).max() / np.abs(S0).max()
-        dD = np.abs(D - D0).max() / np.abs(D0).max()
-        t_3, t_c, t_3_s, t_c_s = paired_ms([
-            lambda: pk2_tangent(hf, C),
-            lambda: pk2_tangent_plane(hf, C2, out_of_plane=True),
-            lambda: pk2(hf, C),
-            lambda: pk2_tangent_plane(hf, C2, out_of_plane=True, tangent=False),
-        ], args.repeat)
-        print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
-        print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")
+    plane = lambda hf, tangent=True: pk2_tangent_plane(hf, C2, out_of_plane=True, tangent=tangent)  # noqa: E731
+    table(f"{args.points} plane-strain points", C, plane, args.repeat)
     rng = np.random.default_rng(1)
     F3 = np.eye(3) + 0.05 * rng.standard_normal((args.points3d, 3, 3))
     C3 = np.swapaxes(F3, -1, -2) @ F3
-    print(f"\n{args.points3d} 3D points, median CPU ms of {args.repeat} alternating calls\n")
-    print(f"{'material':<13}{'output':<8}{'3x3':>9}{'compiled':>10}{'speed-up':>10}"
-          f"{'max dS/max|S|':>15}{'max dD/max|D|':>15}")
-    for name in ("polyurethane", "silicone"):
-        hf = get_material(name).hyperfoam
-        S, D, ok = pk2_tangent_solid(hf, C3)
-        S0, D0, ok0 = pk2_tangent(hf, C3)
-        assert np.array_equal(ok, ok0) and ok.all()
-        dS = np.abs(S - S0).max() / np.abs(S0).max()
-        dD = np.abs(D - D0).max() / np.abs(D0).max()
-        t_3, t_c, t_3_s, t_c_s = paired_ms([
-            lambda: pk2_tangent(hf, C3),
-            lambda: pk2_tangent_solid(hf, C3),
-            lambda: pk2(hf, C3),
-            lambda: pk2_tangent_solid(hf, C3, tangent=False),
-        ], args.repeat)
-        print(f"{name:<13}{'S+D':<8}{t_3:>8.2f} {t_c:>9.2f} {t_3 / t_c:>9.1f}x{dS:>15.1e}{dD:>15.1e}")
-        print(f"{name:<13}{'S only':<8}{t_3_s:>8.2f} {t_c_s:>9.2f} {t_3_s / t_c_s:>9.1f}x")
+    solid = lambda hf, tangent=True: pk2_tangent_solid(hf, C3, tangent=tangent)  # noqa: E731
+    table(f"\n{args.points3d} 3D points", C3, solid, args.repeat)
     print("\nJIT (s; new process each): numba import, _hyperfoam_nb import (compile / cache load), first call")
     for label, (a, b, c) in jit_costs().items():
         print(f"  {label:<14} {a:6.3f} {b:6.3f} {c:6.3f}")
