@@ -424,6 +424,15 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
              "max_abs_over_peak_taxel": 0.5}]
     got = validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows)
     assert got["status"] == "within" and got["error"] == 0.03 and got["source"] == "this run's validation"
+    # rows against full solves on a finer mesh than the chart's take precedence (the coarse full
+    # solve carries its own discretisation error), whatever their error
+    fine = [dict(rows[0], text="⠿", max_abs_over_peak_taxel=0.031, reference_mesh=[0.8, 8.0]),
+            dict(rows[0], text="l", max_abs_over_peak_taxel=0.029, reference_mesh=[0.8, 8.0]),
+            dict(rows[0], text="⠿", max_abs_over_peak_taxel=0.068, reference_mesh=[1.2, 8.0])]
+    got = validity.measured("polyurethane", "pad", mesh, 1.0, 0.2, fine)
+    assert got["status"] == "within" and got["error"] == 0.031 and got["texts"] == ["⠿", "l"]
+    worse = [dict(fine[0], max_abs_over_peak_taxel=0.09), fine[2]]
+    assert validity.measured("polyurethane", "pad", mesh, 1.0, 0.2, worse)["error"] == 0.09
     # a row measured inside a smaller square than the chart reads does not answer for it
     rows[0]["extent_mm"] = 4.5
     assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows, extent=4.5)["status"] == "within"

@@ -493,7 +493,7 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
 
 
 def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, progress=None,
-                       workers: int | None = None) -> list[dict]:
+                       workers: int | None = None, reference_mesh: tuple | None = None) -> list[dict]:
     """Surrogate against full nonlinear 3D solves of `texts` at each thickness: one row per
     text and model: "sum" (lone-dot kernels added), "interaction" (the dots' loads from the
     lone dot's surface deflection and load-approach law, surrogate.interaction_weights; the
@@ -503,7 +503,9 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     kernels, surrogate.plate_kernel), "plate + sum x a", and "sum" (the lone dot's map with
     its plate added per dot: what the plate-blind model would do).
     On the fingertip (a half model) an x-asymmetric text is refused: it would be solved
-    mirrored."""
+    mirrored. reference_mesh (mesh_size, refinement): solve the texts in full on that mesh
+    (finer than the chart's, whose single dots the surrogates keep): the error of the chart's
+    letters against a better reference; each row says its "reference_mesh"."""
     from tactileskin.geometry.braille import dot_centres
 
     say = progress or (lambda msg: None)
@@ -519,7 +521,13 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         dot = dot_scene(t, material, cfg)
         blank = blank_scene(dot) if plate_touches(dot) else None
         shallow = shallow_scene(dot) if blank is None and cfg.skin == "pad" else None
-        cases[t] = dot, [dot_scene(t, material, cfg, x) for x in texts], blank, shallow
+        fulls = [dot_scene(t, material, cfg, x) for x in texts]
+        if reference_mesh is not None:
+            import dataclasses
+
+            fulls = [dataclasses.replace(f, mesh_size=float(reference_mesh[0]), refinement=float(reference_mesh[1]))
+                     for f in fulls]
+        cases[t] = dot, fulls, blank, shallow
     say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
     recs = solve_cached([x for c in cases.values() for x in (c[0], c[2], c[3], *c[1]) if x is not None],
                         cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
@@ -548,5 +556,6 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,
                                          extent=cfg.read_extent, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
+                             "reference_mesh": [float(v) for v in (reference_mesh or (cfg.mesh_size, cfg.refinement))],
                              **err})
     return rows

@@ -308,16 +308,12 @@ class SymmetricSolver:
             raise ParameterError("linear solver precision", precision,
                                  "'double' for method 'direct' (single precision only preconditions GMRES)")
         if backend not in BACKENDS:
-            from tactileskin.errors import ParameterError
-
             raise ParameterError("linear solver backend", backend, ", ".join(BACKENDS))
         if backend == "auto":
             backend = "pardiso" if pardiso_available() else "superlu"
         if backend != "pardiso":
             precision = "double"   # SuperLU here is double only
         if backend == "pardiso" and not pardiso_available():
-            from tactileskin.errors import ParameterError
-
             raise ParameterError("linear solver backend", backend,
                                  "'superlu' or 'auto' (MKL's mkl_rt is not installed here)")
         self.backend = backend
