@@ -95,6 +95,20 @@ def test_map_l2_on_the_coarsest_grid():
     assert e[0] == pytest.approx(0.1 / 1.1, rel=1e-9)
 
 
+def test_map_l2_leaves_out_the_free_end():
+    """A difference confined to z within z_margin of the far end (the slab's free end, where
+    the bone pressure is singular) does not count with the margin, and counts without it."""
+    s = np.linspace(0.0, 6.0, 13)
+    z = np.linspace(0.0, 10.0, 21)
+    P = np.outer(1.0 + 0.0 * z, np.exp(-s))
+    bump = np.where(z[:, None] > 8.0, 0.5, 0.0) * np.ones_like(P)
+    coarse = {"s": s, "z": z, "pressure": P + bump}
+    fine = {"s": s, "z": z, "pressure": P}
+    assert cv.map_l2([coarse, fine])[0] > 0.1
+    assert cv.map_l2([coarse, fine], z_margin=2.0)[0] == pytest.approx(0.0, abs=1e-12)
+    assert cv.map_l2([coarse, fine], z_margin=1.0)[0] > 0.1
+
+
 def test_cheapest_level_within_the_targets():
     lv = [{"dofs": 10, "peak_error": -0.05, "map_l2": 0.03}, {"dofs": 20, "peak_error": -0.015, "map_l2": 0.04},
           {"dofs": 40, "peak_error": -0.005, "map_l2": 0.01}, {"dofs": 80, "peak_error": 0.0, "map_l2": 0.0}]
