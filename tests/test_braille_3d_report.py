@@ -28,7 +28,7 @@ def test_both_dims_double_only_the_braille_cases():
             assert sc.dim == 2
     three = [sc for sc in scenes if sc.dim == 3]
     assert [sc.thickness for sc in three] == [1.0, 3.0]
-    assert all((sc.mesh_size, sc.refinement) == default_mesh(3, "braille") for sc in three)
+    assert all((sc.mesh_size, sc.refinement) == default_mesh(3, "braille", sc.thickness) for sc in three)
     two = [sc for sc in scenes if sc.dim == 2 and sc.indenter.value == "braille"]
     assert all((sc.mesh_size, sc.refinement) == default_mesh(2, "braille") for sc in two)
 

@@ -53,6 +53,13 @@ def test_with_quality_applies_the_dimensions_preset():
         s2 = with_quality(s3.replace(dim=2), q)
         assert (s2.mesh_size, s2.refinement) == presets.mesh(2, q, braille=True)
     assert (s3.mesh_size, s3.refinement) == default_mesh(3, "braille") == presets.mesh(3, "default", braille=True)
+    # from t = 3 mm the 3D default takes the coarser local plan the convergence study measured
+    # within 2 % (peak) and 5 % (map) there; with_quality follows the thickness
+    s5 = s3.replace(thickness=5.0)
+    assert (s5.mesh_size, s5.refinement) == presets.mesh(3, "default", braille=True, thickness=5.0) == (1.6, 8.0)
+    assert (with_quality(s5, "default").mesh_size, with_quality(s5, "fine").mesh_size) == (1.6, 0.8)
+    e = presets.preset_errors("default")
+    assert e["peak_error"] < 0.035 and e["map_l2"] < 0.05 and not e["reference_in"]
     assert DEFAULT_MESH[3] == presets.mesh(3, "default")
     assert presets.mesh(3, "preview") != presets.mesh(3, "fine")
     with pytest.raises(ParameterError, match="quality"):

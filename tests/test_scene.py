@@ -78,6 +78,15 @@ def test_braille_2d_default_mesh_is_finer():
     assert Scene(mesh_size=0.4).replace(indenter="braille").mesh_size == 0.4
     from tactileskin.scene import DEFAULT_MESH_BRAILLE_3D
 
-    b3 = Scene(indenter="braille", dim=3)
+    b3 = Scene(indenter="braille", dim=3, thickness=1.0)
     assert (b3.mesh_size, b3.refinement) == DEFAULT_MESH_BRAILLE_3D  # the local plan's sizes
-    assert b3.replace(indenter="flat") == Scene(dim=3)
+    assert b3.replace(indenter="flat") == Scene(dim=3, thickness=1.0)
+    # thick skins take the preset's thick-skin sizes (presets.json braille_mesh_by_thickness),
+    # re-derived when the thickness changes; sizes the user gave are kept
+    from tactileskin import presets
+
+    b5 = b3.replace(thickness=5.0)
+    assert (b5.mesh_size, b5.refinement) == presets.mesh(3, "default", braille=True, thickness=5.0) \
+        != DEFAULT_MESH_BRAILLE_3D
+    assert b5 == Scene(indenter="braille", dim=3, thickness=5.0) and b5.replace(thickness=1.0) == b3
+    assert b3.replace(mesh_size=1.0).replace(thickness=5.0).mesh_size == 1.0

@@ -164,7 +164,7 @@ class Plan:
 # -0.12..-3.18 %, default -0.10..-0.47 %, fine +0.03..-0.17 %, every preset reading low;
 # against 5-level series the t = 1 cases read lower still (preset_accuracy_fit_t1.md).
 # 3D: "mesh3d" for flat / curved (the strip plan), "braille_mesh3d" for Braille (the local
-# plan at the dots, mesh.sizing.local_plan); the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
+# plan at the dots, mesh.sizing.local_plan; thin skins: quality_mesh gives a thick skin's); the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
 # benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
 # "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
@@ -188,21 +188,25 @@ def _quality_table() -> dict[str, dict]:
 QUALITY: dict[str, dict] = _quality_table()
 
 
-def quality_mesh(quality: str, indenter, dim: int = 2) -> tuple[float, float]:
-    """(mesh_size, refinement) of a quality preset for an indenter kind and dimension."""
+def quality_mesh(quality: str, indenter, dim: int = 2, thickness: float | None = None) -> tuple[float, float]:
+    """(mesh_size, refinement) of a quality preset for an indenter kind, dimension and skin
+    thickness (3D Braille: the preset's thick-skin sizes from their thickness on)."""
     if quality not in QUALITY:
         raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
     q = QUALITY[quality]
+    from tactileskin import presets
     from tactileskin.geometry.indenters import get_kind
 
     if dim == 3:
-        return q["braille_mesh3d"] if get_kind(indenter).name == "braille" else q["mesh3d"]
+        if get_kind(indenter).name == "braille":
+            return presets.mesh(3, quality, braille=True, thickness=thickness)
+        return q["mesh3d"]
     return q["braille_mesh"] if get_kind(indenter).fine_2d_mesh else q["mesh"]
 
 
 def with_quality(scene: Scene, quality: str) -> Scene:
     """The scene meshed at a quality preset of its dimension."""
-    size, ref = quality_mesh(quality, scene.indenter, scene.dim)
+    size, ref = quality_mesh(quality, scene.indenter, scene.dim, scene.thickness)
     return scene.replace(mesh_size=size, refinement=ref)
 
 

@@ -4,7 +4,10 @@ their measured errors live (scene.default_mesh and planner.QUALITY read it).
 
 File layout: "2" and "3" map each preset to its mesh ([mesh_size, refinement]) and its
 "braille_mesh" (2D: finer at the dot; 3D: the local plan's sizes, mesh.sizing.local_plan:
-coarse size and coarse / fine ratio at the dots); 2D also has the "peak_error" measured by
+coarse size and coarse / fine ratio at the dots), optionally overridden for thick skins by
+"braille_mesh_by_thickness" ([[from thickness mm, [mesh_size, refinement]], ...]: the 3D
+`default` takes 1.6 / 8 from t = 3 mm, where the convergence study measured it within the
+accuracy target); 2D also has the "peak_error" measured by
 benchmarks/preset_accuracy.py. "cases3d"
 holds the 3D convergence study (benchmarks/convergence3d.py writes it): per case (thickness,
 material, dot pattern) each level's dofs, relative peak error against the reference, map L2
@@ -35,6 +38,11 @@ def load() -> dict:
             mesh = data.get(dim, {}).get(q, {}).get("mesh")
             if not (isinstance(mesh, list) and len(mesh) == 2 and all(float(v) > 0 for v in mesh)):
                 raise ParameterError(f"presets.json {dim}D {q} mesh", mesh, "[mesh_size, refinement] > 0")
+            for row in data.get(dim, {}).get(q, {}).get("braille_mesh_by_thickness", ()):
+                if not (isinstance(row, list) and len(row) == 2 and float(row[0]) > 0 and isinstance(row[1], list)
+                        and len(row[1]) == 2 and all(float(v) > 0 for v in row[1])):
+                    raise ParameterError(f"presets.json {dim}D {q} braille_mesh_by_thickness", row,
+                                         "[thickness > 0, [mesh_size, refinement] > 0]")
     return data
 
 
@@ -44,11 +52,16 @@ def check_quality(quality: str) -> str:
     return quality
 
 
-def mesh(dim: int, quality: str, braille: bool = False) -> tuple[float, float]:
+def mesh(dim: int, quality: str, braille: bool = False, thickness: float | None = None) -> tuple[float, float]:
     """(mesh_size, refinement) of a preset; Braille has its own (2D: finer at the dot; 3D: the
-    local plan's coarse size and ratio)."""
+    local plan's coarse size and ratio), and with the skin's `thickness` its thick-skin
+    override ("braille_mesh_by_thickness": the last row whose thickness it reaches)."""
     q = load()[str(int(dim))][check_quality(quality)]
     m = q["braille_mesh"] if braille and "braille_mesh" in q else q["mesh"]
+    if braille and thickness is not None:
+        for t_from, override in q.get("braille_mesh_by_thickness", ()):
+            if float(thickness) >= float(t_from) - 1e-9:
+                m = override
     return float(m[0]), float(m[1])
 
 
@@ -56,15 +69,24 @@ def _same(a: float, b: float) -> bool:
     return math.isclose(float(a), float(b), rel_tol=1e-9)
 
 
+def case_thickness(key: str) -> float | None:
+    """The skin thickness (mm) of a convergence-study case key ("t5-silicone-..."), or None."""
+    import re
+
+    found = re.match(r"t([0-9.]+)-", key)
+    return float(found.group(1)) if found else None
+
+
 def preset_errors(quality: str) -> dict:
-    """Measured errors of a 3D preset over the convergence study's cases: {"peak_error": worst
+    """Measured errors of a 3D preset over the convergence study's cases, each at the preset's
+    mesh for its thickness: {"peak_error": worst
     |relative peak error|, "map_l2": worst map L2, "cases": measured case keys, "not_measured":
     case keys whose levels do not include this preset's mesh, "reference_in": cases where this
     level is the finest, i.e. the reference (error 0 by construction, not a measurement)}.
     Errors are None when no case measured the level."""
-    h, r = mesh(3, quality, braille=True)  # the study's cases are Braille
     peak, l2, seen, missing, ref = [], [], [], [], []
     for key, case in load().get("cases3d", {}).items():
+        h, r = mesh(3, quality, braille=True, thickness=case_thickness(key))  # the study's cases are Braille
         lv = [v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)]
         if not lv:
             missing.append(key)

@@ -52,16 +52,18 @@ SCHEMA_VERSION = 10
 # 3D: chosen by the convergence study benchmarks/convergence3d.py).
 DEFAULT_MESH = {2: _presets.mesh(2, "default"), 3: _presets.mesh(3, "default")}
 DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
-# 3D Braille: (coarse size, coarse / fine ratio) of the local plan (mesh.sizing.local_plan)
+# 3D Braille: (coarse size, coarse / fine ratio) of the local plan (mesh.sizing.local_plan),
+# thin skins (thick ones: presets.mesh(..., thickness=))
 DEFAULT_MESH_BRAILLE_3D = _presets.mesh(3, "default", braille=True)
 
 
-def default_mesh(dim: int, indenter) -> tuple[float, float]:
-    """(mesh_size, refinement) a scene of this dimension and indenter gets by default (the
-    kind says whether its 2D section needs the finer preset; 3D Braille is refined at the dots)."""
+def default_mesh(dim: int, indenter, thickness: float | None = None) -> tuple[float, float]:
+    """(mesh_size, refinement) a scene of this dimension, indenter and skin thickness gets by
+    default (the kind says whether its 2D section needs the finer preset; 3D Braille is
+    refined at the dots, with the preset's thick-skin sizes from its thickness on)."""
     kind = _indenters.get(indenter)
     if dim == 3 and kind.name == "braille":
-        return DEFAULT_MESH_BRAILLE_3D
+        return _presets.mesh(3, "default", braille=True, thickness=thickness)
     if dim == 2 and kind.fine_2d_mesh:
         return DEFAULT_MESH_BRAILLE_2D
     return DEFAULT_MESH[dim]
@@ -181,7 +183,7 @@ class Scene:
             # of the mixed formulation equals J: it silently becomes the locking displacement one.
             raise ParameterError("order", 1, "2 with the mixed formulation",
                                  "order 1 locks; use formulation='displacement' to study it")
-        size0, ref0 = default_mesh(self.dim, self.indenter)
+        size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness)
         set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
                                       0.01, 5.0, unit="mm"))
         set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
@@ -310,8 +312,9 @@ class Scene:
             for name in ("indenter_radius", "indenter_axis", "indenter_file"):
                 if name not in changes and name not in reads:
                     changes[name] = None
-        if (new_dim != self.dim or new_ind != self.indenter) and new_dim in DEFAULT_MESH:
-            size0, ref0 = default_mesh(self.dim, self.indenter)
+        new_t = changes.get("thickness", self.thickness)
+        if (new_dim != self.dim or new_ind != self.indenter or new_t != self.thickness) and new_dim in DEFAULT_MESH:
+            size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness)
             if "mesh_size" not in changes and self.mesh_size == size0:
                 changes["mesh_size"] = None
             if "refinement" not in changes and self.refinement == ref0:

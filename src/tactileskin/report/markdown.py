@@ -342,8 +342,8 @@ def quality_name(scene) -> str:
     from tactileskin import presets
 
     braille = scene.indenter.value == "braille"
-    for q in presets.QUALITIES:
-        size, ref = presets.mesh(scene.dim, q, braille=braille and scene.dim == 2)
+    for q in ("default", "preview", "fine"):  # default first: thick 3D skins share preview's sizes
+        size, ref = presets.mesh(scene.dim, q, braille=braille, thickness=scene.thickness)
         if math.isclose(size, scene.mesh_size, rel_tol=1e-9) and math.isclose(ref, scene.refinement, rel_tol=1e-9):
             return q
     return "custom"
