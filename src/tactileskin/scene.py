@@ -297,8 +297,9 @@ class Scene:
         return _indenters.get(self.indenter)
 
     def replace(self, **changes) -> "Scene":
-        """A changed copy. Changing `dim` or `indenter` re-derives mesh defaults left at
-        default; changing `indenter` drops kind parameters the new kind does not read."""
+        """A changed copy. Changing `dim`, `indenter` or `thickness` re-derives mesh defaults
+        left at default (3D Braille's depend on the thickness); changing `indenter` drops kind
+        parameters the new kind does not read."""
         new_dim = changes.get("dim", self.dim)
         new_skin = changes.get("skin", self.skin)
         if new_skin != self.skin:

@@ -345,9 +345,7 @@ def letters_model(cfg: ChartConfig, dot, base) -> str:
 def shallow_scene(dot):
     """The lone dot at surrogate.SHALLOW x its depth: with `dot`, its load-approach law
     (surrogate.load_exponent)."""
-    import dataclasses
-
-    return dataclasses.replace(dot, depth=surrogate.SHALLOW * float(dot.indentation))
+    return dot.replace(depth=surrogate.SHALLOW * float(dot.indentation))
 
 
 def dot_exponent(rec, rec_shallow) -> float:
@@ -523,10 +521,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         shallow = shallow_scene(dot) if blank is None and cfg.skin == "pad" else None
         fulls = [dot_scene(t, material, cfg, x) for x in texts]
         if reference_mesh is not None:
-            import dataclasses
-
-            fulls = [dataclasses.replace(f, mesh_size=float(reference_mesh[0]), refinement=float(reference_mesh[1]))
-                     for f in fulls]
+            fulls = [f.replace(mesh_size=float(reference_mesh[0]), refinement=float(reference_mesh[1])) for f in fulls]
         cases[t] = dot, fulls, blank, shallow
     say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
     recs = solve_cached([x for c in cases.values() for x in (c[0], c[2], c[3], *c[1]) if x is not None],
