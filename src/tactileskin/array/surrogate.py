@@ -124,7 +124,10 @@ def interaction_weights(centres, deflection, exponent: float = 1.0) -> np.ndarra
     if not (np.isfinite(exponent) and 0.5 <= exponent <= 5.0):
         raise ParameterError("load exponent", exponent, "[0.5, 5] (a lone dot's load ~ approach^exponent)")
     if exponent == 1.0:
-        return np.linalg.solve(W, np.full(len(c), w0))
+        try:
+            return np.linalg.solve(W, np.full(len(c), w0))
+        except np.linalg.LinAlgError:
+            raise ParameterError("deflection", "singular dot-to-dot matrix", "distinct dot centres") from None
     off = W / w0
     np.fill_diagonal(off, 0.0)
 
@@ -140,7 +143,10 @@ def interaction_weights(centres, deflection, exponent: float = 1.0) -> np.ndarra
         if norm <= 1e-13:
             return f
         slope = np.where(a > 0, exponent * np.where(a > 0, a, 1.0) ** (exponent - 1.0), 0.0)
-        step = np.linalg.solve(np.eye(len(c)) + slope[:, None] * off, r)
+        try:
+            step = np.linalg.solve(np.eye(len(c)) + slope[:, None] * off, r)
+        except np.linalg.LinAlgError:
+            break
         lam = 1.0
         while True:
             fn = np.maximum(f - lam * step, 0.0)
