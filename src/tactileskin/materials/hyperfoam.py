@@ -411,7 +411,7 @@ _I6, _J6 = np.array([0, 1, 2, 1, 0, 0]), np.array([0, 1, 2, 2, 2, 1])
 _T1_3, _T2_3, _C1_3, _C2_3, _V9 = _tables3()
 
 
-def _kernel_inputs(mat, X, k, detF):
+def _kernel_inputs(X, k, detF):
     """(lead shape, n, X as (n, k, k), detF as (n,) or empty, has_detF) for the compiled loops."""
     from tactileskin.materials import _hyperfoam_nb as nb
 
@@ -425,7 +425,7 @@ def _kernel_inputs(mat, X, k, detF):
 
 def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     """`pk2_tangent` by the compiled point loop of `_hyperfoam_nb` (`solid_kernel`: the
-    eigenproblem of C - I by Jacobi rotations, the same formulas and guards; ~5x cheaper than
+    eigenproblem of C - I by Jacobi rotations, the same formulas and guards; ~3x cheaper than
     the eigh path, which is its oracle: same values to rounding, identical ok flags,
     tests/test_hyperfoam_nb.py). tangent=False skips D and returns (S, None, ok). From
     PARALLEL_MIN_POINTS points on numba's threads (numba.get_num_threads(); the same bits)."""
@@ -433,7 +433,7 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     _check_shape("C", C, 3)
     from tactileskin.materials import _hyperfoam_nb as nb
 
-    lead, n, Ck, dk, has_detF = _kernel_inputs(mat, C, 3, detF)
+    lead, n, Ck, dk, has_detF = _kernel_inputs(C, 3, detF)
     Ck, dk = np.ascontiguousarray(Ck), np.ascontiguousarray(dk)   # one compiled specialisation
     S = np.empty((n, 3, 3))
     D = np.empty((n, 81)) if tangent else np.empty((0, 0))
@@ -471,7 +471,7 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     # by programs that never evaluate the law
     from tactileskin.materials import _hyperfoam_nb as nb
 
-    lead, n, Ck, dk, has_detF = _kernel_inputs(mat, C2, 2, detF)
+    lead, n, Ck, dk, has_detF = _kernel_inputs(C2, 2, detF)
     if not tangent:
         mode, D = nb.MODE_S, np.empty((0, 0))
     elif out_of_plane:
