@@ -73,7 +73,8 @@ def main(argv=None) -> int:
                for r in rs if r["model"] in MODELS]
 
         def key(r):
-            return r["thickness_mm"], r["depth_mm"], r.get("model", "sum"), tuple(r.get("reference_mesh") or case["mesh"])
+            return (r["thickness_mm"], r["depth_mm"], r["text"], r.get("model", "sum"),
+                    tuple(r.get("reference_mesh") or case["mesh"]))
 
         measured = {key(r) for r in new}
         case["rows"] = [r for r in case["rows"] if key(r) not in measured] + new

@@ -406,7 +406,7 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
 
     mesh = (1.2, 8.0)
     t1 = validity.measured("silicone", "pad", mesh, 1.0, 0.2)  # the file's worst row there: the full cell
-    assert t1["status"] == "exceeds" and t1["error"] == pytest.approx(0.0827) and set(t1["texts"]) == {"⠿", "l"}
+    assert t1["status"] == "exceeds" and t1["error"] == pytest.approx(0.0827) and {"⠿", "l"} <= set(t1["texts"])
     # (against the full solves on 0.8 / 8, not the 10.3 % against 1.2 / 8 ones)
     t2 = validity.measured("silicone", "pad", mesh, 2.0, 0.4)
     assert t2["status"] == "exceeds" and t2["error"] > validity.tolerance()
@@ -456,9 +456,9 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), materials=("silicone",), pitches=(0.5, 0.75),
                             noise_fs=(0.01,), letters="abcr", n_train=4, n_test=4, template_grid=2)
     ch = chart.compute(cfg, cache=None)
-    md = markdown(ch)  # the file's interaction rows: t = 1 3.1 % (against 0.8 / 8 full solves), t = 2 4.4 %
+    md = markdown(ch)  # the file's interaction rows: t = 1 4.0 % (against 0.8 / 8 full solves), t = 2 4.4 %
     assert "| 1 | 0.01 |" in md and "| 2 | 0.01 |" in md and "**Suspect:**" not in md
-    assert "| silicone | 1 | interaction | 3.1% |" in md and "| silicone | 2 | interaction | 4.4% |" in md
+    assert "| silicone | 1 | interaction | 4.0% |" in md and "| silicone | 2 | interaction | 4.4% |" in md
     assert "| silicone | 0.75 mm pitch reads Braille at t = 1 mm | supported |" in md
     # the plain sum is judged by the sum's rows (t = 1 8.3 % against 0.8 / 8, t = 2 14.7 %): marked
     sum_cfg = chart.ChartConfig(**{**cfg.__dict__, "letters_model": "sum"})
