@@ -55,13 +55,14 @@ def check_quality(quality: str) -> str:
 def mesh(dim: int, quality: str, braille: bool = False, thickness: float | None = None) -> tuple[float, float]:
     """(mesh_size, refinement) of a preset; Braille has its own (2D: finer at the dot; 3D: the
     local plan's coarse size and ratio), and with the skin's `thickness` its thick-skin
-    override ("braille_mesh_by_thickness": the last row whose thickness it reaches)."""
+    override ("braille_mesh_by_thickness": the row of the largest thickness it reaches, in any
+    order)."""
     q = load()[str(int(dim))][check_quality(quality)]
     m = q["braille_mesh"] if braille and "braille_mesh" in q else q["mesh"]
     if braille and thickness is not None:
-        for t_from, override in q.get("braille_mesh_by_thickness", ()):
-            if float(thickness) >= float(t_from) - 1e-9:
-                m = override
+        reached = [row for row in q.get("braille_mesh_by_thickness", ()) if float(thickness) >= float(row[0]) - 1e-9]
+        if reached:
+            m = max(reached, key=lambda row: float(row[0]))[1]
     return float(m[0]), float(m[1])
 
 

@@ -192,15 +192,14 @@ def validate(kernel: BoneMap, full: BoneMap, text: str, section, standard="stand
     P = scale * approx.pressure
     if base is not None:
         P = P + resampled(base, ref.s, ref.z)
-    approx = BoneMap(approx.s, approx.z, P, approx.section_z)
+    approx = BoneMap(approx.s, approx.z, P, approx.section_z)   # on ref's grid
+    ds, dz = chart_shift(text, section, standard) if extent is not None else (0.0, 0.0)
 
     def read(m):  # the part of a map (on ref's grid) the chart reads
         if extent is None:
             return m
-        ds, dz = chart_shift(text, section, standard)
         return cropped(m, (-extent - ds, extent - ds), (-extent - dz, extent - dz))
 
-    approx = BoneMap(ref.s, ref.z, resampled(approx, ref.s, ref.z), ref.section_z)
     err = relative_error(read(approx), read(ref))
     err["within_tolerance"] = err["max_abs_over_peak"] <= TOLERANCE
     if taxel:

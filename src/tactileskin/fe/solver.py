@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tactileskin.errors import ConvergenceError
-from tactileskin.fe.linsolve import METHODS, SymmetricSolver, default_threads, pardiso_available
+from tactileskin.fe.linsolve import METHODS, PRECISIONS, SymmetricSolver, default_threads, pardiso_available
 from tactileskin.fe.model import Evaluation, Model
 
 log = logging.getLogger(__name__)
@@ -220,10 +220,10 @@ def _factor(model: Model, K, opts: SolverOptions):
     if ls is None or opts.linear_solver not in ("auto", ls.backend) or \
             (opts.linear_method != "auto" and opts.linear_method != ls.method):
         method = linear_method(model, K.shape[0], opts)
-        if opts.factor_precision not in ("auto", "double", "single"):
+        if opts.factor_precision not in ("auto",) + PRECISIONS:
             from tactileskin.errors import ParameterError
 
-            raise ParameterError("factor_precision", opts.factor_precision, "auto, double, single")
+            raise ParameterError("factor_precision", opts.factor_precision, ", ".join(("auto",) + PRECISIONS))
         # single precision only preconditions: a "direct" solve keeps double
         precision = "single" if method == "reuse" and opts.factor_precision != "double" else "double"
         ls = model._linsolve = SymmetricSolver(K, opts.linear_solver, method,
