@@ -24,7 +24,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "src" / "tactileskin" / "data" / "surrogate_validation.json"
-MODELS = ("interaction", "sum")  # the models a chart uses (validity.measured)
+MODELS = ("interaction", "sum", "plate + sum")  # the models a chart uses (validity.measured)
 
 
 def main(argv=None) -> int:
@@ -32,7 +32,8 @@ def main(argv=None) -> int:
     ap.add_argument("--materials", default="silicone,polyurethane")
     ap.add_argument("--thickness", default="0.5,1,2,3,5")
     ap.add_argument("--texts", default="⠿,l")
-    ap.add_argument("--max-depth", type=float, default=0.4)
+    ap.add_argument("--max-depth", type=lambda v: None if v.lower() == "none" else float(v), default=0.4,
+                    help="depth cap (mm); 'none': the paper's 20 %% of t (the plate touches from t = 2.4 mm)")
     ap.add_argument("--cache", required=True)
     ap.add_argument("--workers", type=int, default=None)
     ap.add_argument("--reference-mesh", default=None,

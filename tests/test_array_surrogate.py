@@ -243,7 +243,7 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     ch = chart.compute(cfg, cache=None)
     assert ch.labels["letters"] == list("abcr1")  # '1' = number sign + a's cell: told apart from 'a' below
     # the interaction weights on the pad below the dot height (t = 1); past it (t = 3) the plate-aware sum
-    assert ch.letters_models == {("silicone", 1.0): "interaction", ("silicone", 3.0): "sum"}
+    assert ch.letters_models == {("silicone", 1.0): "interaction", ("silicone", 3.0): "plate + sum"}
     assert [(sc.thickness, sc.skin, sc.braille_text) for sc in deflected] == [(1.0, "pad", "")]
     skins = {(sc.dim, sc.indenter, sc.skin) for sc in asked}
     # t = 3 also asks the blank plate on the pad (flat, 3D) at the plate's own depth
@@ -461,7 +461,8 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     assert "| silicone | 1 | interaction | 4.0% |" in md and "| silicone | 2 | interaction | 4.4% |" in md
     assert "| silicone | 0.75 mm pitch reads Braille at t = 1 mm | supported |" in md
     # the plain sum is judged by the sum's rows (t = 1 8.3 % against 0.8 / 8, t = 2 14.7 %): marked
-    sum_cfg = chart.ChartConfig(**{**cfg.__dict__, "letters_model": "sum"})
+    # where it is kept (no fallback to full solves)
+    sum_cfg = chart.ChartConfig(**{**cfg.__dict__, "letters_model": "sum", "fallback": False})
     ch = chart.compute(sum_cfg, cache=None)
     md = markdown(ch)
     assert "| 1 † | 0.01 |" in md and "| 2 † | 0.01 |" in md
@@ -542,6 +543,52 @@ def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypa
     assert "| 2 | 0.01 |" in md and "full 3D solves of every letter" in md and not suspect(ch)
     with pytest.raises(ParameterError, match="letters_model"):
         chart.ChartConfig(letters_model="guess")
+
+
+def test_chart_solves_the_letters_in_full_where_the_surrogate_is_measured_past_the_tolerance(monkeypatch, tmp_path):
+    """Validation rows that put the surrogate at 7 % (> 5 %) at t = 2 and 3 % at t = 1: the
+    letters of t = 2 alone are solved in full (one scene per letter), recorded as a fallback
+    with its error, and the report trusts both thicknesses; with fallback off the t = 2
+    letters stay on the surrogate and are marked indicative (suspect)."""
+    from types import SimpleNamespace
+
+    from tactileskin.report.array_chart import letters_trust, markdown, suspect
+
+    grid = np.linspace(-8, 8, 161)
+    asked = []
+
+    def fake_solve(scenes, cache, on_event=None, workers=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path,
+                                    summary=_reaction(sc)) for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: maps.on_grid(_gauss(w=0.5), grid, grid))
+    monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
+    cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), pitches=(0.5,), noise_fs=(0.01,), letters="abk", n_train=4,
+                            n_test=4, template_grid=2, sets=("letters",))
+    rows = [{"material": "silicone", "thickness_mm": t, "depth_mm": 0.2 * t, "text": "⠿", "model": "interaction",
+             "max_abs_over_peak_taxel": e, "extent_mm": cfg.read_extent, "rel_l2": e / 2, "max_abs_over_peak": e,
+             "peak_rel": -e / 2, "within_tolerance": e <= 0.05, "peak_rel_taxel": -e / 2,
+             "within_tolerance_taxel": e <= 0.05} for t, e in ((1.0, 0.03), (2.0, 0.07))]
+    ch = chart.compute(cfg, cache=None, validation=rows)
+    full = sorted((sc.thickness, sc.braille_text) for sc in asked if sc.dim == 3 and sc.braille_text)
+    assert full == [(2.0, "a"), (2.0, "b"), (2.0, "k")]
+    assert ch.letters_models == {("silicone", 1.0): "interaction", ("silicone", 2.0): "full"}
+    assert ch.fallbacks[("silicone", 2.0)]["error"] == pytest.approx(0.07)
+    # no second lone-dot solve where the letters are solved in full
+    assert sorted(round(sc.indentation, 9) for sc in asked if sc.dim == 3 and not sc.braille_text) == [0.18, 0.2, 0.4]
+    trust = letters_trust(ch, rows)
+    assert trust[("silicone", 1.0)]["status"] == "within" and trust[("silicone", 2.0)]["status"] == "full"
+    assert "measured 7.0% off" in trust[("silicone", 2.0)]["source"] and not suspect(ch, rows)
+    assert "| 2 | 0.01 |" in markdown(ch, rows)  # the t = 2 letters rows carry no † mark
+    asked.clear()
+    off = chart.compute(chart.ChartConfig(**{**cfg.__dict__, "fallback": False}), cache=None, validation=rows)
+    assert not any(sc.braille_text for sc in asked) and not off.fallbacks
+    assert any("t = 2 mm (7.0%)" in n for n in suspect(off, rows)) and "| 2 † | 0.01 |" in markdown(off, rows)
+    with pytest.raises(ParameterError, match="fallback"):
+        chart.ChartConfig(fallback="yes")
 
 
 def test_chart_falls_back_to_the_sum_where_the_interaction_weights_fail(monkeypatch):

@@ -86,6 +86,11 @@ class ChartConfig:
     # 15.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter in 3D (one solve per letter
     # and t: where the surrogates are not within 5 %)
     letters_model: str = "interaction"
+    # where the surrogate's measured error (this run's validation rows, else
+    # data/surrogate_validation.json; array.validity) exceeds its tolerance, solve that
+    # thickness's letters in full instead (one 3D solve per letter); False: keep the surrogate,
+    # marked indicative
+    fallback: bool = True
     # the shapes set's sphere (mm) and the 3D preset it is meshed at (the strip plan; preview:
     # peak 2.9 % and span 3.1 % from default at t = 1 silicone, 10 s against 56 s CPU)
     sphere_radius: float = 2.5
@@ -106,6 +111,8 @@ class ChartConfig:
         bad = [s for s in self.sets if s not in SETS]
         if bad:
             raise ParameterError("set", bad[0], " or ".join(SETS))
+        if not isinstance(self.fallback, bool):
+            raise ParameterError("fallback", self.fallback, "true or false")
         if self.letters_model not in LETTERS_MODELS:
             raise ParameterError("letters_model", self.letters_model, " or ".join(LETTERS_MODELS))
         from tactileskin.presets import QUALITIES
@@ -301,6 +308,8 @@ class Chart:
     cutoffs: list = field(default_factory=list)     # per (material, t): the single dot's measured cut-off
     notes: list = field(default_factory=list)       # what makes a part of the chart suspect
     letters_models: dict = field(default_factory=dict)  # (material, t) -> the letters' model used
+    fallbacks: dict = field(default_factory=dict)  # (material, t) -> the surrogate's measured error that
+    #                                                sent its letters to full solves (validity.measured)
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
@@ -334,12 +343,37 @@ def _chart_scenes(cfg: ChartConfig, material: str, t: float) -> tuple:
 
 
 def letters_model(cfg: ChartConfig, dot, base) -> str:
-    """The letters' model used for the dot scene `dot`: cfg.letters_model, except that the
-    interaction weights need the flat pad's free surface and no plate contact (`base` None):
-    elsewhere the plain sum."""
-    if cfg.letters_model == "interaction" and (dot is None or dot.skin != "pad" or base is not None):
+    """The letters' model used for the dot scene `dot` (`base`: its blank plate, or None): "full",
+    or where the plate touches "plate + sum" (the blank plate plus the plate-aware kernels);
+    else cfg.letters_model, except that the interaction weights need the flat pad's free
+    surface: elsewhere the plain sum."""
+    if cfg.letters_model == "full":
+        return "full"
+    if base is not None:
+        return "plate + sum"
+    if cfg.letters_model == "interaction" and (dot is None or dot.skin != "pad"):
         return "sum"
     return cfg.letters_model
+
+
+def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, validation=None) -> dict:
+    """array.validity.measured of the letters' `model` at (material, t) as this chart reads
+    them (its dot scene's depth and mesh, its read square), from `validation` rows, else the
+    project's measurements."""
+    from tactileskin.array.validity import measured
+
+    dot = dot_scene(t, material, cfg)
+    return measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t, float(dot.indentation), validation,
+                    model=model, extent=cfg.read_extent)
+
+
+def fallback_reason(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
+    """The measured error (surrogate_trust) that sends the letters of (material, t) to full
+    solves: its status is "exceeds" and cfg.fallback is on; else None."""
+    if not cfg.fallback or dot is None or "letters" not in cfg.sets or cfg.letters_model == "full":
+        return None
+    m = surrogate_trust(cfg, material, t, letters_model(cfg, dot, blank), validation)
+    return m if m["status"] == "exceeds" else None
 
 
 def shallow_scene(dot):
@@ -354,25 +388,37 @@ def dot_exponent(rec, rec_shallow) -> float:
                                    float(rec_shallow.summary["reaction_n_per_mm"]))
 
 
-def letter_scenes(cfg: ChartConfig, material: str, t: float) -> dict:
-    """{letter: its full 3D scene} when cfg.letters_model is "full", else {}."""
-    if "letters" not in cfg.sets or cfg.letters_model != "full":
+def letter_scenes(cfg: ChartConfig, material: str, t: float, full: bool = False) -> dict:
+    """{letter: its full 3D scene} when cfg.letters_model is "full" or `full`, else {}."""
+    if "letters" not in cfg.sets or not (full or cfg.letters_model == "full"):
         return {}
     return {c: dot_scene(t, material, cfg, c) for c in cfg.letters}
 
 
 def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = None,
-            workers: int | None = None) -> Chart:
+            workers: int | None = None, validation=None) -> Chart:
     """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`,
-    all of them first, in one batch on `workers` processes (solve_cached)."""
+    all of them first, in one batch on `workers` processes (solve_cached). `validation`: this
+    run's validate_surrogate rows, which judge the letters' surrogate before the project's
+    measurements do (fallback_reason)."""
     from tactileskin.array import halfspace
 
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     chart = Chart(cfg)
     cases = {(m, t): _chart_scenes(cfg, m, t) for m in cfg.materials for t in cfg.thicknesses}
-    full = {(m, t): letter_scenes(cfg, m, t) for m, t in cases}
-    shallow = {k: shallow_scene(c[0]) for k, c in cases.items() if letters_model(cfg, c[0], c[2]) == "interaction"}
+    for (m, t), c in cases.items():
+        why = fallback_reason(cfg, m, t, c[0], c[2], validation)
+        if why is not None:
+            chart.fallbacks[(m, t)] = why
+            msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {why['error']:.1%} off full solves "
+                   f"(over {', '.join(why['texts'])}; tolerance {surrogate.TOLERANCE:.0%}), so its "
+                   f"{len(cfg.letters)} letters are solved in full")
+            log.info(msg)
+            say(msg)
+    full = {(m, t): letter_scenes(cfg, m, t, full=(m, t) in chart.fallbacks) for m, t in cases}
+    shallow = {k: shallow_scene(c[0]) for k, c in cases.items()
+               if not full[k] and letters_model(cfg, c[0], c[2]) == "interaction"}
     wanted = [x for dot, pdot, blank, sec2, sphere in cases.values()
               for x in (dot, pdot, blank, *sec2.values(), sphere) if x is not None]
     wanted += [x for f in full.values() for x in f.values()] + list(shallow.values())
@@ -387,11 +433,12 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             base = None
             if blank is not None:
                 base = blank_map(blank, recs[blank], kernels[dot])
-                note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm passes the dot height {height:g} mm, so "
-                        "the Braille plate presses the skin too: the letters are the blank plate plus the "
-                        "plate-aware kernels (surrogate.plate_kernel)")
-                log.info(note)
-                chart.notes.append(note)
+                if not full[(material, t)]:
+                    note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm passes the dot height {height:g} mm, "
+                            "so the Braille plate presses the skin too: the letters are the blank plate plus the "
+                            "plate-aware kernels (surrogate.plate_kernel)")
+                    log.info(note)
+                    chart.notes.append(note)
             profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
             letter_kernel = kernels.get(dot) if base is None else surrogate.plate_kernel(kernels[dot], base)
             for sc, kernel in kernels.items():
@@ -406,7 +453,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                                       "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
             letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None
-            model = letters_model(cfg, dot, base)
+            model = "full" if letters else letters_model(cfg, dot, base)
             weights = None
             if model == "interaction":
                 try:

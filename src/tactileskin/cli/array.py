@@ -16,7 +16,7 @@ OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
                for e in ("png", "svg")))
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
-        "validate", "skin", "max_depth", "letters_model", "sphere_radius", "sphere_quality"}
+        "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality"}
 
 
 def load_config(path) -> dict:
@@ -68,13 +68,17 @@ def load_config(path) -> dict:
                    "the depth; on the pad below the dot height, else sum) or as lone "
                    "dots (sum): their measured errors are in the report; or a full 3D solve of every letter "
                    "(full: one solve per letter and thickness).")
+@click.option("--fallback/--no-fallback", default=None,
+              help="Where the letters' surrogate is measured past 5 % of full solves (this run's --validate, "
+                   "else the project's measurements), solve that thickness's letters in full (default), or "
+                   "keep the surrogate and mark those letters indicative.")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, sphere_radius, sphere_quality, seed, skin, validate, letters_model, workers,
-            cache_dir):
+            refinement, max_depth, sphere_radius, sphere_quality, seed, skin, validate, letters_model, fallback,
+            workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
 
     Exit status 0, or 3 when the chart was written but a part of it is suspect (the letters'
@@ -98,7 +102,7 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  noise_fs=noise and tuple(parse_values(noise, "noise")),
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
-                 max_depth=max_depth, letters_model=letters_model, sphere_radius=sphere_radius,
+                 max_depth=max_depth, letters_model=letters_model, fallback=fallback, sphere_radius=sphere_radius,
                  sphere_quality=sphere_quality)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:
@@ -114,12 +118,12 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
     cache = ResultCache(cache_dir or out / "cache")
     say = lambda msg: console.print(escape(msg), highlight=False)  # noqa: E731
     with claimed_output(out, "array", OWN_NAMES):
-        chart = compute(cfg, cache, progress=say, workers=workers)
         rows = None
-        if texts:
+        if texts:  # first: this run's measurements decide where the letters fall back to full solves
             rows = [r for m in cfg.materials
                     for r in validate_surrogate(cfg.thicknesses, m, list(texts), cfg, cache, progress=say,
                                                     workers=workers)]
+        chart = compute(cfg, cache, progress=say, workers=workers, validation=rows)
         paths = write_outputs(chart, out, rows)
     console.print(f"report: {escape(str(paths['report']))} ({chart.seconds:.0f} s)", highlight=False)
     notes = suspect(chart, rows)

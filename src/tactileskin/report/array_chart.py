@@ -121,21 +121,22 @@ TRUSTED = ("within", "full")  # letters statuses that need no mark: the surrogat
 
 def letters_trust(chart, validation=None) -> dict:
     """{(material, t): array.validity.measured(...)} for the letters set's dot scenes."""
-    from tactileskin.array.chart import dot_scene
-    from tactileskin.array.validity import measured
+    from tactileskin.array.chart import surrogate_trust
 
     cfg, out = chart.config, {}
+    fallbacks = getattr(chart, "fallbacks", {})
     for material in cfg.materials:
         for t in cfg.thicknesses:
-            if cfg.letters_model == "full":
-                out[(material, t)] = {"error": None, "texts": list(cfg.letters), "status": "full",
-                                      "source": "full 3D solves of every letter (no surrogate)"}
-                continue
-            dot = dot_scene(t, material, cfg)
             model = getattr(chart, "letters_models", {}).get((material, t), cfg.letters_model)
-            out[(material, t)] = {**measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t,
-                                             float(dot.indentation), validation, model=model,
-                                             extent=cfg.read_extent), "model": model}
+            if model == "full":
+                why = fallbacks.get((material, t))
+                src = "full 3D solves of every letter (no surrogate)" if why is None else (
+                    f"full 3D solves of every letter: the surrogate measured {why['error']:.1%} off "
+                    f"({why['source'] or 'this run'})")
+                out[(material, t)] = {"error": None, "texts": list(cfg.letters), "status": "full",
+                                      "source": src, "model": "full"}
+                continue
+            out[(material, t)] = {**surrogate_trust(cfg, material, t, model, validation), "model": model}
     return out
 
 
@@ -150,7 +151,7 @@ def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
 def _trust_section(chart, trust: dict) -> list[str]:
     from tactileskin.array.validity import tolerance
 
-    cfg_full = chart.config.letters_model == "full"
+    cfg_full = all(m.get("model") == "full" for m in trust.values())
 
     out = ["### How far the letters can be trusted", "",
            ("The letters are full 3D solves of every letter (`letters_model = full`)." if cfg_full else
@@ -160,7 +161,8 @@ def _trust_section(chart, trust: dict) -> list[str]:
             "dots). Its error against full 3D "
             "solves of the same characters, as the chart's smallest taxels read them (worst over the "
             "validated characters; `tactileskin array --validate` measures it for a run; "
-            "`--letters-model full` solves every letter instead):"), "",
+            "`--letters-model full` solves every letter instead; where the error is measured past the "
+            "tolerance the chart solves that thickness's letters in full, model `full`):"), "",
            "| material | t (mm) | model | surrogate error / peak | validated on | status | source |",
            "|---|---|---|---|---|---|---|"]
     for (material, t), m in trust.items():
