@@ -121,8 +121,14 @@ def test_quality_presets_order_cost_and_error():
     assert sizes == sorted(sizes, reverse=True)  # finer preset, smaller refined size
     errs = [QUALITY[q]["peak_error"] for q in ("preview", "default", "fine")]
     assert errs == sorted(errs, reverse=True)
-    s3 = with_quality(sc.replace(dim=3, indenter="braille"), "fine")  # 3D: the 3D preset
-    assert (s3.mesh_size, s3.refinement) == QUALITY["fine"]["braille_mesh3d"]
+    from tactileskin import presets
+
+    for q in ("preview", "default", "fine"):  # 3D Braille: the 3D preset at the skin's thickness
+        for t in (1.0, 3.0, 5.0):
+            s3 = with_quality(sc.replace(dim=3, indenter="braille", thickness=t), q)
+            assert (s3.mesh_size, s3.refinement) == presets.mesh(3, q, braille=True, thickness=t)
+    assert with_quality(sc.replace(dim=3, indenter="braille", thickness=1.0), "default").mesh_size < \
+        with_quality(sc.replace(dim=3, indenter="braille", thickness=3.0), "default").mesh_size
     f3 = with_quality(sc.replace(dim=3), "fine")  # flat / curved 3D: the strip plan's preset
     assert (f3.mesh_size, f3.refinement) == QUALITY["fine"]["mesh3d"]
     with pytest.raises(ParameterError, match="quality"):

@@ -163,8 +163,9 @@ class Plan:
 # (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md): preview
 # -0.12..-3.18 %, default -0.10..-0.47 %, fine +0.03..-0.17 %, every preset reading low;
 # against 5-level series the t = 1 cases read lower still (preset_accuracy_fit_t1.md).
-# 3D: "mesh3d" for flat / curved (the strip plan), "braille_mesh3d" for Braille (the local
-# plan at the dots, mesh.sizing.local_plan; thin skins: quality_mesh gives a thick skin's); the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
+# 3D: "mesh3d" for flat / curved (the strip plan); Braille meshes on the local plan at the dots
+# (mesh.sizing.local_plan) at sizes that follow the skin thickness, so only quality_mesh
+# (presets.mesh(..., thickness=)) gives them; the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
 # benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
 # "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
@@ -178,7 +179,7 @@ def _quality_table() -> dict[str, dict]:
         e3 = presets.preset_errors(q)
         out[q] = {"mesh": presets.mesh(2, q), "braille_mesh": presets.mesh(2, q, braille=True),
                   "peak_error": float(presets.load()["2"][q]["peak_error"]),
-                  "mesh3d": presets.mesh(3, q), "braille_mesh3d": presets.mesh(3, q, braille=True),
+                  "mesh3d": presets.mesh(3, q),
                   "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
                   "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"]),
                   "cases3d_reference": tuple(e3["reference_in"])}
