@@ -20,6 +20,15 @@ def test_unknown_config_key(tmp_path, capsys):
     assert "pitchez" in capsys.readouterr().err
 
 
+def test_bad_fallback_in_a_config_is_one_line(tmp_path, capsys):
+    cfg = tmp_path / "a.toml"
+    cfg.write_text('[array]\nfallback = "sometimes"\n')
+    assert main(["array", "-o", str(tmp_path / "o"), "--config", str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert "fallback" in err and "true or false" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_refuses_a_foreign_folder(tmp_path, capsys):
     out = tmp_path / "o"
     out.mkdir()
