@@ -413,7 +413,9 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             chart.fallbacks[(m, t)] = why
             msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {why['error']:.1%} off full solves "
                    f"(over {', '.join(why['texts'])}; tolerance {surrogate.TOLERANCE:.0%}), so its "
-                   f"{len(cfg.letters)} letters are solved in full")
+                   f"{len(cfg.letters)} letters are solved in full ({len(cfg.letters)} 3D solves"
+                   + ("; a depth cap below the dot height keeps the plate off" if c[2] is not None else "")
+                   + "; fallback off keeps the surrogate, marked indicative)")
             log.info(msg)
             say(msg)
     full = {(m, t): letter_scenes(cfg, m, t, full=(m, t) in chart.fallbacks) for m, t in cases}
