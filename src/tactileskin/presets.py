@@ -6,8 +6,9 @@ File layout: "2" and "3" map each preset to its mesh ([mesh_size, refinement]) a
 "braille_mesh" (2D: finer at the dot; 3D: the local plan's sizes, mesh.sizing.local_plan:
 coarse size and coarse / fine ratio at the dots), optionally overridden for thick skins by
 "braille_mesh_by_thickness" ([[from thickness mm, [mesh_size, refinement]], ...]: the 3D
-`default` takes 1.6 / 8 from t = 3 mm, where the convergence study measured it within the
-accuracy target); 2D also has the "peak_error" measured by
+`default` is 0.8 / 8 below t = 3 mm, where the t = 1 full cells need it (1.2 / 8 read them 5 %
+low), and 1.6 / 8 from t = 3 mm, where the convergence study measured it within the accuracy
+target; `fine` one level finer on both sides); 2D also has the "peak_error" measured by
 benchmarks/preset_accuracy.py. "cases3d"
 holds the 3D convergence study (benchmarks/convergence3d.py writes it): per case (thickness,
 material, dot pattern) each level's dofs, relative peak error against the reference, map L2
