@@ -238,8 +238,10 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
     deflected = []
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: deflected.append(rec.scene) or _heave)
+    # fallback off: the plate-aware surrogate at t = 3 (measured 50 % off, so by default its
+    # letters are solved in full: below)
     cfg = chart.ChartConfig(thicknesses=(1.0, 3.0), pitches=(0.5,), noise_fs=(0.01,), letters="abcr1",
-                            n_train=4, n_test=4, template_grid=2)
+                            n_train=4, n_test=4, template_grid=2, fallback=False)
     ch = chart.compute(cfg, cache=None)
     assert ch.labels["letters"] == list("abcr1")  # '1' = number sign + a's cell: told apart from 'a' below
     # the interaction weights on the pad below the dot height (t = 1); past it (t = 3) the plate-aware sum
@@ -263,6 +265,10 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     # t = 1 keeps its 20 %; each lone dot on the pad also at 0.9 x its depth (its load exponent)
     assert depths == {(1.0, 0.2), (1.0, 0.18), (3.0, 0.4), (3.0, 0.36)}
     assert [c["depth_mm"] for c in ch.cutoffs if c["thickness_mm"] == 3.0] == [0.4, 0.4]
+    # with the fallback (default) the project's measurements send t = 3 at 0.6 mm to full solves
+    dot, _, blank, _, _ = chart._chart_scenes(cfg, "silicone", 3.0)
+    why = chart.fallback_reason(chart.ChartConfig(**{**cfg.__dict__, "fallback": True}), "silicone", 3.0, dot, blank)
+    assert why["status"] == "exceeds" and why["error"] > 0.3
 
 
 def test_shapes_set_adds_a_3d_sphere_on_the_fingertip_and_tells_four_distinct_maps_apart(monkeypatch):
