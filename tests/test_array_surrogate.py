@@ -16,6 +16,20 @@ def _reaction(sc):
     return {"reaction_n_per_mm": float(sc.indentation) ** 1.5}
 
 
+def _fake_solver(monkeypatch, asked: list, path=None, grid=np.linspace(-8, 8, 161)):
+    """Replace chart.solve_cached and chart.bone_map_of by analytic stand-ins: every scene
+    asked is appended to `asked` and gets a record whose bone map is a Gaussian dot."""
+    from types import SimpleNamespace
+
+    def fake_solve(scenes, cache, on_event=None, workers=None):
+        asked.extend(scenes)
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=path,
+                                    summary=_reaction(sc)) for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+
+
 def _gauss(cs=0.0, cz=0.0, w=0.4):
     return lambda s, z: np.exp(-((s - cs) ** 2 + (z - cz) ** 2) / (2 * w * w))
 
@@ -224,18 +238,8 @@ def test_interaction_letters_weigh_each_dot_by_its_neighbours():
 def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch):
     """compute() on analytic maps (no solve): which skin each set's scenes use, the letters
     told apart by a fine array, and the plate note when the depth reaches the dot height."""
-    from types import SimpleNamespace
-
     asked = []
-    grid = np.linspace(-8, 8, 161)
-
-    def fake_solve(scenes, cache, on_event=None, workers=None):
-        asked.extend(scenes)
-        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
-                                        summary=_reaction(sc)) for sc in scenes}
-
-    monkeypatch.setattr(chart, "solve_cached", fake_solve)
-    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    _fake_solver(monkeypatch, asked)
     deflected = []
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: deflected.append(rec.scene) or _heave)
     # fallback off: the plate-aware surrogate at t = 3 (measured 50 % off, so by default its
@@ -449,15 +453,9 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
 def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monkeypatch):
     """The report flags (†, a trust table, a Suspect line, a qualified 0.75 mm verdict) every
     thickness whose letters rest on a surrogate not shown within 5 %."""
-    from types import SimpleNamespace
-
     from tactileskin.report.array_chart import markdown
 
-    grid = np.linspace(-8, 8, 161)
-    monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
-        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
-                                        summary=_reaction(sc)) for sc in scenes})
-    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    _fake_solver(monkeypatch, [])
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), materials=("silicone",), pitches=(0.5, 0.75),
                             noise_fs=(0.01,), letters="abcr", n_train=4, n_test=4, template_grid=2)
@@ -524,20 +522,11 @@ def test_a_full_solve_is_placed_in_the_full_cell_frame():
 def test_chart_full_letters_model_solves_every_letter_and_is_not_marked(monkeypatch, tmp_path):
     """letters_model = "full": one 3D scene per letter and thickness is asked, the letters' maps
     come from those solves, and the report marks no letters row (no surrogate)."""
-    from types import SimpleNamespace
-
     from tactileskin.report.array_chart import markdown, suspect
 
     grid = np.linspace(-8, 8, 161)
     asked = []
-
-    def fake_solve(scenes, cache, on_event=None, workers=None):
-        asked.extend(scenes)
-        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path,
-                                        summary=_reaction(sc)) for sc in scenes}
-
-    monkeypatch.setattr(chart, "solve_cached", fake_solve)
-    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    _fake_solver(monkeypatch, asked, tmp_path, grid)
     read = []
     monkeypatch.setattr(chart, "read_bone_map", lambda path: read.append(path) or maps.on_grid(_gauss(w=0.5), grid, grid))
     cfg = chart.ChartConfig(thicknesses=(2.0,), pitches=(0.5,), noise_fs=(0.01,), letters="abk", n_train=4,
@@ -556,20 +545,11 @@ def test_chart_solves_the_letters_in_full_where_the_surrogate_is_measured_past_t
     letters of t = 2 alone are solved in full (one scene per letter), recorded as a fallback
     with its error, and the report trusts both thicknesses; with fallback off the t = 2
     letters stay on the surrogate and are marked indicative (suspect)."""
-    from types import SimpleNamespace
-
     from tactileskin.report.array_chart import letters_trust, markdown, suspect
 
     grid = np.linspace(-8, 8, 161)
     asked = []
-
-    def fake_solve(scenes, cache, on_event=None, workers=None):
-        asked.extend(scenes)
-        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc, path=tmp_path,
-                                    summary=_reaction(sc)) for sc in scenes}
-
-    monkeypatch.setattr(chart, "solve_cached", fake_solve)
-    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    _fake_solver(monkeypatch, asked, tmp_path, grid)
     monkeypatch.setattr(chart, "read_bone_map", lambda path: maps.on_grid(_gauss(w=0.5), grid, grid))
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), pitches=(0.5,), noise_fs=(0.01,), letters="abk", n_train=4,
@@ -600,15 +580,9 @@ def test_chart_solves_the_letters_in_full_where_the_surrogate_is_measured_past_t
 def test_chart_falls_back_to_the_sum_where_the_interaction_weights_fail(monkeypatch):
     """A deflection that gives a dot no load: the chart is still drawn, from the plain sum,
     with a note (suspect), and the trust table judges the sum's rows."""
-    from types import SimpleNamespace
-
     from tactileskin.report.array_chart import suspect
 
-    grid = np.linspace(-8, 8, 161)
-    monkeypatch.setattr(chart, "solve_cached", lambda scenes, cache, on_event=None, workers=None: {
-        sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2), scene=sc,
-                                        summary=_reaction(sc)) for sc in scenes})
-    monkeypatch.setattr(chart, "bone_map_of", lambda rec: maps.on_grid(_gauss(w=0.5), grid, grid))
+    _fake_solver(monkeypatch, [])
     monkeypatch.setattr(chart, "surface_deflection",
                         lambda rec, top: lambda dx, dz: np.where(np.hypot(dx, dz) < 1, 0.1, -0.2))
     cfg = chart.ChartConfig(thicknesses=(1.0,), pitches=(0.5,), noise_fs=(0.01,), letters="abc", n_train=4,
