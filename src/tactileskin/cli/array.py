@@ -65,7 +65,8 @@ def load_config(path) -> dict:
 @click.option("--letters-model", type=click.Choice(["interaction", "sum", "full"]), default=None,
               help="Letters from superposed single-dot solves, each dot's load from the lone dot's surface "
                    "deflection and load-approach law (interaction, default; a second lone-dot solve at 0.9 x "
-                   "the depth; on the pad below the dot height, else sum) or as lone "
+                   "the depth; on the pad below the dot height; past it the blank plate plus plate-aware dots; "
+                   "on the fingertip sum) or as lone "
                    "dots (sum): their measured errors are in the report; or a full 3D solve of every letter "
                    "(full: one solve per letter and thickness).")
 @click.option("--fallback/--no-fallback", default=None,
