@@ -569,6 +569,8 @@ def test_chart_solves_the_letters_in_full_where_the_surrogate_is_measured_past_t
     assert trust[("silicone", 1.0)]["status"] == "within" and trust[("silicone", 2.0)]["status"] == "full"
     assert "measured 7.0% off" in trust[("silicone", 2.0)]["source"] and not suspect(ch, rows)
     assert "| 2 | 0.01 |" in markdown(ch, rows)  # the t = 2 letters rows carry no † mark
+    only2 = chart.compute(chart.ChartConfig(**{**cfg.__dict__, "thicknesses": (2.0,)}), cache=None, validation=rows)
+    assert "full 3D solves of every letter (the surrogate is measured past the tolerance" in markdown(only2, rows)
     asked.clear()
     off = chart.compute(chart.ChartConfig(**{**cfg.__dict__, "fallback": False}), cache=None, validation=rows)
     assert not any(sc.braille_text for sc in asked) and not off.fallbacks

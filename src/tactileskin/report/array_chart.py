@@ -154,7 +154,10 @@ def _trust_section(chart, trust: dict) -> list[str]:
     cfg_full = all(m.get("model") == "full" for m in trust.values())
 
     out = ["### How far the letters can be trusted", "",
-           ("The letters are full 3D solves of every letter (`letters_model = full`)." if cfg_full else
+           ("The letters are full 3D solves of every letter (" + (
+               "`letters_model = full`" if chart.config.letters_model == "full" else
+               "the surrogate is measured past the tolerance at every thickness of the chart: fallback") + ")."
+            if cfg_full else
             "The letters are superposed single-dot responses (a surrogate: `interaction` weighs each dot "
             "by the load the lone dot's surface deflection and load-approach law leave it beside its "
             "neighbours; `sum` adds lone "
