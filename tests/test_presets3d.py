@@ -44,13 +44,6 @@ def test_3d_cases_in_the_file_are_consistent():
         assert lv[-1]["map_l2"] == 0.0  # the map error is measured against the finest level
 
 
-def _default_level(item) -> dict:
-    """The `default` preset's level of a convergence-study case (key, case)."""
-    key, case = item
-    h, r = presets.mesh(3, "default", braille=True, thickness=presets.case_thickness(key))
-    return next(v for v in case["levels"] if v["mesh_size"] == h and v["refinement"] == r)
-
-
 def test_with_quality_applies_the_dimensions_preset():
     s3 = Scene(dim=3, thickness=1.0, indenter="braille")
     for q in presets.QUALITIES:
@@ -68,7 +61,7 @@ def test_with_quality_applies_the_dimensions_preset():
     e = presets.preset_errors("default")
     # every studied case (dots and full cells) measured the default, none by itself
     assert not e["reference_in"] and not e["not_measured"]
-    levels = [_default_level(c) for c in presets.load()["cases3d"].items()]
+    levels = [presets.preset_level(k, c, "default") for k, c in presets.load()["cases3d"].items()]
     assert e["peak_error"] == max(abs(v["peak_error"]) for v in levels)
     assert e["map_l2"] == max(v["map_l2"] for v in levels)
     # against the issue-13 targets (peak 2 %, map 5 %): the dots within (worst -1.9 % / 4.9 %);
@@ -76,7 +69,7 @@ def test_with_quality_applies_the_dimensions_preset():
     # limits of order 3.6 / 3.2; the t = 5 cells' maps 7.5 % (silicone) and 5.4 % (polyurethane)
     # from their finest levels (misses)
     for key, case in presets.load()["cases3d"].items():
-        lv = _default_level((key, case))
+        lv = presets.preset_level(key, case, "default")
         assert abs(lv["peak_error"]) <= (0.021 if "\u283f" in key else 0.02), key
         assert lv["map_l2"] <= {"t5-silicone-\u283f": 0.076, "t5-polyurethane-\u283f": 0.054}.get(key, 0.05), key
     assert DEFAULT_MESH[3] == presets.mesh(3, "default")

@@ -79,6 +79,13 @@ def case_thickness(key: str) -> float | None:
     return float(found.group(1)) if found else None
 
 
+def preset_level(key: str, case: dict, quality: str) -> dict | None:
+    """The level of convergence-study case `key` (presets.json "cases3d") meshed as the 3D
+    Braille preset `quality` at the case's thickness, or None if the study did not solve it."""
+    h, r = mesh(3, quality, braille=True, thickness=case_thickness(key))  # the study's cases are Braille
+    return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)), None)
+
+
 def preset_errors(quality: str) -> dict:
     """Measured errors of a 3D preset over the convergence study's cases, each at the preset's
     mesh for its thickness: {"peak_error": worst
@@ -88,15 +95,14 @@ def preset_errors(quality: str) -> dict:
     Errors are None when no case measured the level."""
     peak, l2, seen, missing, ref = [], [], [], [], []
     for key, case in load().get("cases3d", {}).items():
-        h, r = mesh(3, quality, braille=True, thickness=case_thickness(key))  # the study's cases are Braille
-        lv = [v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)]
-        if not lv:
+        lv = preset_level(key, case, quality)
+        if lv is None:
             missing.append(key)
             continue
         seen.append(key)
-        if _same(case["levels"][-1]["mesh_size"], h) and _same(case["levels"][-1]["refinement"], r):
+        if lv is case["levels"][-1]:
             ref.append(key)  # the case's finest level: its errors are 0 by construction
-        peak.append(abs(float(lv[0]["peak_error"])))
-        l2.append(float(lv[0]["map_l2"]))
+        peak.append(abs(float(lv["peak_error"])))
+        l2.append(float(lv["map_l2"]))
     return {"peak_error": max(peak) if peak else None, "map_l2": max(l2) if l2 else None,
             "cases": seen, "not_measured": missing, "reference_in": ref}
