@@ -4,7 +4,7 @@ those, from the project's measurements in tactileskin/data/surrogate_validation.
 
 The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
 validated characters, inside a square around the cell at least as large as the chart reads,
-against the full solves on the finest mesh measured (a row's reference_mesh, else the chart's), for the model the chart used ("interaction" or the plain "sum"; a row
+against the full solves on the finest mesh measured (a row's reference_mesh, else the chart's), for the model the chart used ("interaction", the plain "sum", or past the dot height "plate + sum"; a row
 without a model is the sum); where nothing matches it is not validated. Either way the chart
 says so beside the letters' accuracies.
 """
