@@ -203,6 +203,18 @@ def test_local_plan_covers_every_dot_of_a_cell_and_the_plate_strip_when_it_touch
     assert p.bone_patches[0][4] == pytest.approx(p.fine * 3.0 / 1.44)
 
 
+@pytest.mark.parametrize("t, scale", [(1.0, 1.0), (3.0, 3.0 / 1.44), (5.0, 2.3)])
+def test_the_bone_patch_size_grows_with_thickness_up_to_its_cap(t, scale):
+    from tactileskin.mesh import sizing
+
+    sc = Scene(thickness=t, dim=3, indenter="braille", braille_text="")
+    sec = sc.section()
+    p = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True, **LOCAL)
+    # dot base diameter 1.44 mm: 1 below it, t / 1.44 above, capped at t = 5 (3.47 -> 2.3)
+    assert p.bone_patches[0][4] == pytest.approx(min(p.coarse, p.fine * scale))
+    assert sizing.BONE_SCALE_MAX == 2.3
+
+
 @pytest.mark.parametrize("indenter", ["flat", "curved"])
 def test_flat_and_curved_keep_the_strip_plan(indenter):
     from tactileskin.mesh import sizing

@@ -37,8 +37,10 @@ from tactileskin.skins import registry as _skins
 # by 1-3 %; 9: the 3D contact penetration tolerance 1e-3 h (was 1e-4 h), 3D peaks within
 # 0.07 %, and increments capped at 0.7 x a failed one, peaks within 0.03 %; 10: ascent
 # directions recomputed with the held contact points (and 2D short steps retried): other
-# increment sequences on the 2D Braille, curved and flat cases, peaks within 0.10 %)
-SCHEMA_VERSION = 10
+# increment sequences on the 2D Braille, curved and flat cases, peaks within 0.10 %; 11: the
+# 3D Braille bone patches at most 2.3 x the dot patch size (mesh.sizing.BONE_SCALE_MAX):
+# other meshes from t = 3.3 mm)
+SCHEMA_VERSION = 11
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

@@ -212,11 +212,19 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
 # base radii: the contact radius is at most the base radius) and around the bone point under
 # it (radius base radius + thickness: the bone imprint spreads over ~t; the measured spans are
 # 0.9 mm at t = 1, 2.2 mm at t = 3), graded by GROWTH_3D to the coarse size. On the bone the
-# size is scaled by max(1, t / base diameter): the bone field's length scale is the larger of
-# the dot and the skin thickness.
+# size is scaled by max(1, t / base diameter), at most BONE_SCALE_MAX: the bone field's length
+# scale is the larger of the dot and the skin thickness, but at t = 5 mm the unbounded scale
+# (3.5) left the full cell's bone map 7.5 % off on 1.6 / 8 (BONE_SCALE_MAX 2.3: 3.8 %;
+# benchmarks/results/convergence3d.md). t <= 3.3 mm is not affected.
 GROWTH_3D = 0.35
 PATCH_RADIUS = 1.25
+BONE_SCALE_MAX = 2.3
 LOCAL_SKINS = ("fingertip", "pad")  # skins whose outer surface `_dot_frame` knows
+
+
+def bone_scale(thickness: float, base_radius: float) -> float:
+    """Bone patch size / dot patch size of the local plan at a skin thickness."""
+    return min(max(1.0, thickness / (2.0 * base_radius)), BONE_SCALE_MAX)
 
 
 def _dot_frame(section, x: float) -> tuple[np.ndarray, np.ndarray]:
@@ -255,7 +263,7 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     fine = coarse / ratio
     t = section.thickness
     g = GROWTH_3D
-    bone_fine = min(coarse, fine * max(1.0, t / (2.0 * a0)))
+    bone_fine = min(coarse, fine * bone_scale(t, a0))
     r_patch, r_bone = PATCH_RADIUS * a0, a0 + t
     z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
     lz = z1 - z0
