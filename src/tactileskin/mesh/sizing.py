@@ -272,19 +272,17 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     full = getattr(section, "fingertip", None) is None and not indenter_symmetry(scene)[0]
     x0 = -section.half_width if full else 0.0
     patches, bones = [], []
-    excess = 0.0
     for x, z in braille.dot_centres(scene.braille_text, std):
         po, n = _dot_frame(section, x)
         pb = po - t * n
-        for balls, c, r, h, layer in ((patches, po, r_patch, fine, OUTER_LAYER * fine),
-                                      (bones, pb, r_bone, bone_fine, ROI_LAYER * bone_fine)):
+        for balls, c, r, h in ((patches, po, r_patch, fine), (bones, pb, r_bone, bone_fine)):
             if c[0] < x0 - r or z < z0 - r or z > z1 + r:
                 continue  # the ball misses the meshed part (x >= x0, z0 <= z <= z1)
             balls.append((float(c[0]), float(c[1]), float(z), float(r), float(h)))
-            ext = r + (coarse - h) / g
-            frac = (min(1.0, 0.5 + (c[0] - x0) / (2.0 * ext)) * min(1.0, 0.5 + (z - z0) / (2.0 * ext))
-                    * min(1.0, 0.5 + (z1 - z) / (2.0 * ext)))
-            excess += max(frac, 0.0) * _ball_excess(min(coarse, t), min(h, t), r, layer, t, g)
+    box = (x0, float(section.half_width), z0, z1)
+    excess = sum(_balls_excess([(b[0], b[2]) for b in balls], min(coarse, t), min(h, t), r, layer, t, g, box)
+                 for balls, r, h, layer in ((patches, r_patch, fine, OUTER_LAYER * fine),
+                                            (bones, r_bone, bone_fine, ROI_LAYER * bone_fine)))
     strip = 0.0
     w = 0.0
     if scene.indentation > std.height:
@@ -305,17 +303,31 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     return dataclasses.replace(p, estimate=n)
 
 
-def _ball_excess(coarse: float, h: float, r: float, layer: float, depth: float, g: float) -> float:
-    """Integral of size^-3 - coarse^-3 over a ball's refined layer: size = the larger of the
-    surface threshold (h within `layer` of the surface, growing by g per mm of depth) and the
-    ball's (h within lateral distance r of the centre, growing by g beyond), to `depth`."""
-    rho = np.linspace(0.0, r + max(coarse - h, 0.0) / g, 301)
+def _balls_excess(centres, coarse: float, h: float, r: float, layer: float, depth: float, g: float,
+                  box: tuple[float, float, float, float]) -> float:
+    """Integral of size^-3 - coarse^-3 over the refined layer of equal balls at lateral centres
+    (x, z), inside box = (x_lo, x_hi, z_lo, z_hi): size = the larger of the surface threshold
+    (h within `layer` of the surface, growing by g per mm of depth) and the balls' (h within
+    lateral distance r of the nearest centre, growing by g beyond), to `depth`. Overlapping
+    balls count once (summing them read a t = 5 mm full cell's bone patches 3x over)."""
+    if not centres:
+        return 0.0
+    ext = r + max(coarse - h, 0.0) / g
     d = np.linspace(0.0, depth, 301)
     hd = np.minimum(coarse, h + g * np.maximum(d - layer, 0.0))
-    hr = np.minimum(coarse, h + g * np.maximum(rho - r, 0.0))
-    size = np.maximum(hr[:, None], hd[None, :])
-    ex = np.maximum(size ** -3.0 - coarse ** -3.0, 0.0)
-    return float(np.trapezoid(np.trapezoid(ex, d, axis=1) * 2.0 * np.pi * rho, rho))
+    h_tab = np.linspace(h, coarse, 201)
+    size = np.maximum(h_tab[:, None], hd[None, :])
+    per_area = np.trapezoid(np.maximum(size ** -3.0 - coarse ** -3.0, 0.0), d, axis=1)
+    c = np.asarray(centres, float)
+    xa, xb = max(box[0], c[:, 0].min() - ext), min(box[1], c[:, 0].max() + ext)
+    za, zb = max(box[2], c[:, 1].min() - ext), min(box[3], c[:, 1].max() + ext)
+    if xb <= xa or zb <= za:
+        return 0.0
+    xs, zs = np.linspace(xa, xb, 301), np.linspace(za, zb, 301)
+    X, Z = np.meshgrid(xs, zs, indexing="ij")
+    dist = np.min(np.hypot(X[..., None] - c[:, 0], Z[..., None] - c[:, 1]), axis=-1)
+    hr = np.minimum(coarse, h + g * np.maximum(dist - r, 0.0))
+    return float(np.trapezoid(np.trapezoid(np.interp(hr, h_tab, per_area), zs, axis=1), xs))
 
 
 def _area(section) -> float:
