@@ -214,7 +214,7 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
 # 0.9 mm at t = 1, 2.2 mm at t = 3), graded by GROWTH_3D to the coarse size. On the bone the
 # size is scaled by max(1, t / base diameter), at most BONE_SCALE_MAX: the bone field's length
 # scale is the larger of the dot and the skin thickness, but at t = 5 mm the unbounded scale
-# (3.5) left the full cell's bone map 7.5 % off on 1.6 / 8 (BONE_SCALE_MAX 2.3: 3.8 %;
+# (3.47) left the full cell's bone map 7.5 % off on 1.6 / 8 (BONE_SCALE_MAX 2.3: 3.1 %;
 # benchmarks/results/convergence3d.md). t <= 3.3 mm is not affected.
 GROWTH_3D = 0.35
 PATCH_RADIUS = 1.25
