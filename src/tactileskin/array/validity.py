@@ -52,9 +52,10 @@ def _reference(row: dict, mesh) -> float:
 def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None,
              model: str = "sum", extent: float | None = None) -> dict:
     """{"error": worst taxel error over the peak or None, "texts": the validated characters,
-    "source": where the numbers come from, "status": "within" | "exceeds" | "not validated"};
-    `extent`: the half side (mm) of the square the chart reads (ChartConfig.read_extent), which
-    a row's own extent must cover."""
+    "source": where the numbers come from, "status": "within" | "exceeds" | "not validated",
+    "reference_mesh": (mesh_size, refinement) of the full solves judged against, finer than
+    `mesh` or `mesh` itself}; `extent`: the half side (mm) of the square the chart reads
+    (ChartConfig.read_extent), which a row's own extent must cover."""
     rows, source = [], ""
     for r in validation or ():
         if r.get("model", "sum") == model and r["material"] == material and _match(r["thickness_mm"], t) \
@@ -81,5 +82,12 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
     rows = [r for r in rows if _reference(r, mesh) == finest]
     source = rows[0].get("source", source)
     err = max(float(r["taxel_max_error"]) for r in rows)
+    ref = tuple(float(v) for v in (rows[0].get("reference_mesh") or mesh))
     return {"error": err, "texts": [r["text"] for r in rows], "source": source,
-            "status": "within" if err <= tolerance() else "exceeds"}
+            "status": "within" if err <= tolerance() else "exceeds", "reference_mesh": ref}
+
+
+def finer_reference(m: dict, mesh) -> bool:
+    """Whether a `measured` answer judged the chart's `mesh` against full solves on a finer one."""
+    ref = m.get("reference_mesh")
+    return ref is not None and ref[0] / ref[1] < float(mesh[0]) / float(mesh[1]) * (1.0 - 1e-9)

@@ -149,7 +149,7 @@ def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
 
 
 def _trust_section(chart, trust: dict) -> list[str]:
-    from tactileskin.array.validity import tolerance
+    from tactileskin.array.validity import finer_reference, tolerance
 
     cfg_full = all(m.get("model") == "full" for m in trust.values())
 
@@ -168,10 +168,16 @@ def _trust_section(chart, trust: dict) -> list[str]:
             "tolerance the chart solves that thickness's letters in full, model `full`):"), "",
            "| material | t (mm) | model | surrogate error / peak | validated on | status | source |",
            "|---|---|---|---|---|---|---|"]
+    mesh = (chart.config.mesh_size, chart.config.refinement)
     for (material, t), m in trust.items():
         err = "-" if m["error"] is None else f"{m['error']:.1%}"
         status = {"full": "no surrogate", "within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
+        if m["status"] == "exceeds" and finer_reference(m, mesh):
+            ref = m["reference_mesh"]
+            status += (f" (against full solves on the finer {ref[0]:g} / {ref[1]:g} mesh: full solves on the "
+                       f"chart's {mesh[0]:g} / {mesh[1]:g} would carry its error too, so no fallback; a finer "
+                       "chart mesh, --mesh-size, and --validate answer it)")
         out.append(f"| {material} | {t:g} | {m.get('model', '-')} | {err} | {', '.join(m['texts']) or '-'} | {status} "
                    f"| {m['source'] or '-'} |")
     out += ["", "† in the letters tables: a thickness whose surrogate is not within the tolerance or not validated.", ""]
