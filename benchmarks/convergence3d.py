@@ -163,6 +163,8 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     mesher's local refinement at the dots (sizing.local_plan); "strip": the former plan."""
     from tactileskin.fe import solve
     from tactileskin.fileio import atomic_write_json
+    from tactileskin.geometry import braille
+    from tactileskin.mesh.sizing import bone_scale
     from tactileskin.mesh.slab3d import build_slab_mesh
     from tactileskin.scene import Scene
 
@@ -176,6 +178,8 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
         "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
+        **({"bone_scale": round(bone_scale(t, braille.get_standard("standard_american").base_radius), 4)}
+           if plan == "local" else {}),
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),
@@ -285,6 +289,15 @@ def write_presets(path: Path, key: str, study: dict) -> None:
     data = json.loads(path.read_text(encoding="utf-8")) if path.exists() else {}
     cases = data.setdefault("cases3d", {})
     ref = study["reference"]
+    # the bone patch scale a level was meshed with (presets.preset_level matches it): from the
+    # level's raw record, else kept from the file (levels solved before records carried it)
+    known = {(v["mesh_size"], v["refinement"]): v["bone_scale"]
+             for v in cases.get(key, {}).get("levels", []) if "bone_scale" in v}
+
+    def scale(d):
+        b = d.get("bone_scale", known.get((d["mesh_size"], d["refinement"])))
+        return {} if b is None else {"bone_scale": b}
+
     cases[key] = {
         "plan": study["levels"][-1].get("plan", "strip"),
         "reference_peak": ref["value"], "reference_method": ref["method"],
@@ -293,7 +306,7 @@ def write_presets(path: Path, key: str, study: dict) -> None:
                     "peak_error": round(d["peak_error"], 6), "map_l2": round(d["map_l2"], 6),
                     "span_error": round(d["span_error"], 6), "map_peak_error": round(d["map_peak_error"], 6),
                     "cpu_s": round(d["cpu_s"], 1),
-                    "maxrss_mb": round(d["maxrss_mb"])} for d in study["levels"]],
+                    "maxrss_mb": round(d["maxrss_mb"]), **scale(d)} for d in study["levels"]],
         "date": _dt.date.today().isoformat(),
     }
     atomic_write_json(path, data)

@@ -144,3 +144,17 @@ def test_preset_errors_name_where_a_level_is_the_reference():
         assert set(e["cases"]) | set(e["not_measured"]) == set(presets.load()["cases3d"])
         if e["cases"] and set(e["cases"]) - set(e["reference_in"]):
             assert e["map_l2"] > 0.0  # measured against a finer level somewhere
+
+
+def test_a_level_meshed_with_another_bone_layout_does_not_count_for_the_preset():
+    # the t = 5 cases' 0.8 / 8 levels were meshed before the bone patches were capped
+    # (mesh.sizing.BONE_SCALE_MAX): `fine` gives the same sizes with finer bone patches now
+    case = presets.load()["cases3d"]["t5-silicone-\u2801"]
+    assert presets.preset_level("t5-silicone-\u2801", case, "fine") is None
+    assert presets.preset_level("t5-silicone-\u2801", case, "default")["bone_scale"] == 2.3
+    e = presets.preset_errors("fine")
+    assert {k for k in e["not_measured"] if k.startswith("t5-")} == {k for k in presets.load()["cases3d"]
+                                                                     if k.startswith("t5-")}
+    # below t = 3.3 mm the rule is unchanged: levels without a recorded scale count
+    t1 = presets.load()["cases3d"]["t1-silicone-\u2801"]
+    assert "bone_scale" not in t1["levels"][0] and presets.preset_level("t1-silicone-\u2801", t1, "fine")

@@ -81,9 +81,18 @@ def case_thickness(key: str) -> float | None:
 
 def preset_level(key: str, case: dict, quality: str) -> dict | None:
     """The level of convergence-study case `key` (presets.json "cases3d") meshed as the 3D
-    Braille preset `quality` at the case's thickness, or None if the study did not solve it."""
-    h, r = mesh(3, quality, braille=True, thickness=case_thickness(key))  # the study's cases are Braille
-    return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)), None)
+    Braille preset `quality` at the case's thickness, or None if the study did not solve it.
+    A level that records the bone patch scale it was meshed with ("bone_scale") counts only if
+    the local plan gives that scale now (mesh.sizing.bone_scale): the same sizes with another
+    bone layout are another mesh."""
+    from tactileskin.geometry import braille
+    from tactileskin.mesh.sizing import bone_scale
+
+    t = case_thickness(key)
+    h, r = mesh(3, quality, braille=True, thickness=t)  # the study's cases are Braille
+    now = bone_scale(t, braille.get_standard("standard_american").base_radius)
+    return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)
+                 and ("bone_scale" not in v or _same(v["bone_scale"], now))), None)
 
 
 def preset_errors(quality: str) -> dict:
