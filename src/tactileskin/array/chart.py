@@ -367,19 +367,25 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
                     model=model, extent=cfg.read_extent)
 
 
-def fallback_reason(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
-    """The measured error (surrogate_trust) that sends the letters of (material, t) to full
-    solves: its status is "exceeds" against full solves on the chart's own mesh and
-    cfg.fallback is on; else None. Measured past the tolerance only against a finer mesh, the
-    letters stay on the surrogate (marked): full solves on the chart's mesh carry its
-    discretisation error too (t = 1 mm silicone: the full cell on 1.2 / 8 reads 6.8 % off
-    0.8 / 8, the surrogate's worst letter 5.5 %)."""
-    from tactileskin.array.validity import finer_reference
-
+def letters_judgment(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
+    """surrogate_trust of the letters' model at (material, t) where a fallback to full solves
+    could apply (cfg.fallback on, a dot scene, the letters set, a surrogate); else None."""
     if not cfg.fallback or dot is None or "letters" not in cfg.sets or cfg.letters_model == "full":
         return None
-    m = surrogate_trust(cfg, material, t, letters_model(cfg, dot, blank), validation)
-    if m["status"] != "exceeds" or finer_reference(m, (cfg.mesh_size, cfg.refinement)):
+    return surrogate_trust(cfg, material, t, letters_model(cfg, dot, blank), validation)
+
+
+def fallback_reason(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
+    """The measured error (letters_judgment) that sends the letters of (material, t) to full
+    solves: its status is "exceeds" against full solves on the chart's own mesh; else None.
+    Measured past the tolerance only against a finer mesh, the letters stay on the surrogate
+    (marked): full solves on the chart's mesh carry its discretisation error too (t = 1 mm
+    silicone: the full cell on 1.2 / 8 reads 6.8 % off 0.8 / 8, the surrogate's worst letter
+    5.5 %)."""
+    from tactileskin.array.validity import finer_reference
+
+    m = letters_judgment(cfg, material, t, dot, blank, validation)
+    if m is None or m["status"] != "exceeds" or finer_reference(m, (cfg.mesh_size, cfg.refinement)):
         return None
     return m
 
@@ -424,18 +430,17 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                    f"{len(cfg.letters)} letters are solved in full ({len(cfg.letters)} 3D solves"
                    + ("; a depth cap below the dot height keeps the plate off" if c[2] is not None else "")
                    + "; fallback off keeps the surrogate, marked indicative)")
-            log.info(msg)
-            say(msg)
-        elif cfg.fallback and c[0] is not None and "letters" in cfg.sets and cfg.letters_model != "full":
-            j = surrogate_trust(cfg, m, t, letters_model(cfg, c[0], c[2]), validation)
-            if j["status"] == "exceeds":  # against a finer mesh only (fallback_reason)
-                ref = j["reference_mesh"]
-                msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off full solves "
-                       f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {cfg.mesh_size:g} / "
-                       f"{cfg.refinement:g} would carry its error too, so the letters stay on the surrogate, "
-                       "marked indicative (a finer --mesh-size with --validate answers it)")
-                log.info(msg)
-                say(msg)
+        else:
+            j = letters_judgment(cfg, m, t, c[0], c[2], validation)
+            if j is None or j["status"] != "exceeds":
+                continue
+            ref = j["reference_mesh"]  # exceeds against a finer mesh only (fallback_reason)
+            msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off full solves "
+                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {cfg.mesh_size:g} / "
+                   f"{cfg.refinement:g} would carry its error too, so the letters stay on the surrogate, "
+                   "marked indicative (a finer --mesh-size with --validate answers it)")
+        log.info(msg)
+        say(msg)
     full = {(m, t): letter_scenes(cfg, m, t, full=(m, t) in chart.fallbacks) for m, t in cases}
     shallow = {k: shallow_scene(c[0]) for k, c in cases.items()
                if not full[k] and letters_model(cfg, c[0], c[2]) == "interaction"}
