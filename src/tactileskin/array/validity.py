@@ -89,5 +89,4 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
 
 def finer_reference(m: dict, mesh) -> bool:
     """Whether a `measured` answer judged the chart's `mesh` against full solves on a finer one."""
-    ref = m.get("reference_mesh")
-    return ref is not None and ref[0] / ref[1] < float(mesh[0]) / float(mesh[1]) * (1.0 - 1e-9)
+    return m.get("reference_mesh") is not None and _reference(m, mesh) < _reference({}, mesh) * (1.0 - 1e-9)
