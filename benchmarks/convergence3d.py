@@ -163,9 +163,8 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     mesher's local refinement at the dots (sizing.local_plan); "strip": the former plan."""
     from tactileskin.fe import solve
     from tactileskin.fileio import atomic_write_json
-    from tactileskin.geometry import braille
-    from tactileskin.mesh.sizing import bone_scale
     from tactileskin.mesh.slab3d import build_slab_mesh
+    from tactileskin.presets import study_bone_scale
     from tactileskin.scene import Scene
 
     scene = Scene(dim=3, indenter="braille", thickness=t, material=material, braille_text=text,
@@ -178,8 +177,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
         "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
-        **({"bone_scale": round(bone_scale(t, braille.get_standard("standard_american").base_radius), 4)}
-           if plan == "local" else {}),
+        **({"bone_scale": study_bone_scale(t)} if plan == "local" else {}),
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),

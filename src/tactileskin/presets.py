@@ -85,14 +85,20 @@ def preset_level(key: str, case: dict, quality: str) -> dict | None:
     A level that records the bone patch scale it was meshed with ("bone_scale") counts only if
     the local plan gives that scale now (mesh.sizing.bone_scale): the same sizes with another
     bone layout are another mesh."""
+    t = case_thickness(key)
+    h, r = mesh(3, quality, braille=True, thickness=t)  # the study's cases are Braille
+    now = study_bone_scale(t)
+    return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)
+                 and ("bone_scale" not in v or _same(v["bone_scale"], now))), None)
+
+
+def study_bone_scale(thickness: float) -> float:
+    """mesh.sizing.bone_scale of the convergence study's dots (the standard American cell) at a
+    skin thickness: what a level records and preset_level matches."""
     from tactileskin.geometry import braille
     from tactileskin.mesh.sizing import bone_scale
 
-    t = case_thickness(key)
-    h, r = mesh(3, quality, braille=True, thickness=t)  # the study's cases are Braille
-    now = bone_scale(t, braille.get_standard("standard_american").base_radius)
-    return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)
-                 and ("bone_scale" not in v or _same(v["bone_scale"], now))), None)
+    return round(bone_scale(thickness, braille.get_standard("standard_american").base_radius), 4)
 
 
 def preset_errors(quality: str) -> dict:
