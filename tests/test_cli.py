@@ -25,6 +25,22 @@ def test_user_error_is_one_line_without_traceback(capsys, tmp_path):
     assert not (tmp_path / "o").exists()  # nothing written for a rejected request
 
 
+def test_ctrl_c_exits_130_not_the_failed_case_code(monkeypatch, capsys, tmp_path):
+    """Ctrl-C is 130 (128 + SIGINT), so a script cannot take it for `sweep`'s 1 (some case
+    failed, the others reported)."""
+    import tactileskin.sweep as sweep
+
+    def interrupted(*a, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sweep, "run_sweep", interrupted)
+    rc = main(["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 130
+    assert "interrupted" in err and "Traceback" not in err
+    assert not (tmp_path / "o" / "results.csv").exists()
+
+
 def test_module_entry_point():
     r = subprocess.run([sys.executable, "-m", "tactileskin", "--version"], capture_output=True, text=True)
     assert r.returncode == 0 and "version" in r.stdout

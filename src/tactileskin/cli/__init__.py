@@ -108,8 +108,10 @@ def main(argv: list[str] | None = None) -> int:
         e.show()
         return e.exit_code
     except click.exceptions.Abort:
-        err.print("aborted")
-        return 1
+        # 128 + SIGINT, the shell's code for Ctrl-C (SIGTERM exits 143, _on_sigterm): not 1,
+        # which `sweep` uses for "some case failed, the others reported"
+        err.print("interrupted: no output was left half-written (a sweep keeps its finished cases in its cache)")
+        return 130
     except OSError as e:  # last resort: a file error that no writer turned into an OutputError
         from rich.markup import escape
 
