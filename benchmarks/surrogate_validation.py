@@ -4,7 +4,7 @@ For each material, `array.chart.validate_surrogate` on the default chart (pad 20
 1.2 / 8, the default pitches and window, so its read square; depth cap --max-depth) solves
 the texts in full (through the result cache in --cache: a rerun only reads) and compares them
 with every model. Prints the table (markdown) and, with --write, replaces the JSON's rows of
-the "interaction" and "sum" models for (material, pad, mesh) with these measurements (source:
+the "interaction" and "sum" models for (material, pad, mesh; --mesh another chart mesh) with these measurements (source:
 this script, today's date). --reference-mesh solves the texts in full on a finer mesh than the
 chart's (the rows say so; array.validity judges a chart by the finest reference measured).
 Wall time from the start; the solves run on --workers processes.
@@ -36,6 +36,8 @@ def main(argv=None) -> int:
                     help="depth cap (mm); 'none': the paper's 20 %% of t (the plate touches from t = 2.4 mm)")
     ap.add_argument("--cache", required=True)
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--mesh", default=None,
+                    help="mesh_size,refinement of the chart (its single dots and the rows' case); default the chart's")
     ap.add_argument("--reference-mesh", default=None,
                     help="mesh_size,refinement of the full solves (finer than the chart's); default the chart's")
     ap.add_argument("--write", action="store_true", help="replace the JSON rows of these measurements")
@@ -48,7 +50,8 @@ def main(argv=None) -> int:
 
     t0 = time.perf_counter()
     ts = [float(x) for x in a.thickness.split(",")]
-    cfg = ChartConfig(thicknesses=tuple(ts), max_depth=a.max_depth)
+    mesh = {} if a.mesh is None else dict(zip(("mesh_size", "refinement"), (float(x) for x in a.mesh.split(","))))
+    cfg = ChartConfig(thicknesses=tuple(ts), max_depth=a.max_depth, **mesh)
     cache = ResultCache(Path(a.cache))
     ref = None if a.reference_mesh is None else tuple(float(x) for x in a.reference_mesh.split(","))
     rows = {m: validate_surrogate(ts, m, a.texts.split(","), cfg, cache, progress=print, workers=a.workers,
