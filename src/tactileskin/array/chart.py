@@ -56,13 +56,6 @@ SKINS = ("pad", "fingertip")
 LETTERS_MODELS = ("interaction", "sum", "full")
 
 
-# The chart's default single-dot mesh. Below t = 3 mm the 3D `default` preset (0.8 / 8) is finer
-# and mesh_for takes it: on 1.2 / 8 the t = 1 mm full cell reads 5 % low (convergence3d.md) and
-# the letters' surrogate 5.5 % off full solves on 0.8 / 8; on 0.8 / 8 it reads 3.5 % (f, the
-# worst; data/surrogate_validation.json)
-CHART_MESH = (1.2, 8.0)
-
-
 @dataclass(frozen=True)
 class ChartConfig:
     thicknesses: tuple = (1.0, 3.0)
@@ -78,10 +71,8 @@ class ChartConfig:
     n_test: int = 16
     template_grid: int = 4
     seed: int = 0
-    # 3D single-dot solves on the local plan (fine = size / refinement at the dot); None, None:
-    # mesh_for's rule (CHART_MESH, or the 3D Braille `default` preset where that is finer)
-    mesh_size: float | None = None
-    refinement: float | None = None
+    mesh_size: float = 1.2                 # 3D single-dot solves (local plan: fine = size / refinement
+    refinement: float = 8.0                # at the dot, the 3D Braille default preset)
     standard: str = "standard_american"
     skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
     # depth cap (mm): a thickness whose 20 % depth exceeds it is indented by max_depth instead (all
@@ -137,18 +128,6 @@ class ChartConfig:
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")
 
-    def mesh_for(self, thickness: float) -> tuple[float, float]:
-        """(mesh_size, refinement) of the chart's 3D single dots at a thickness: the user's
-        where either is given (the other from CHART_MESH), else CHART_MESH, or the 3D Braille
-        `default` preset where its fine size is smaller (0.8 / 8 below t = 3 mm)."""
-        if self.mesh_size is not None or self.refinement is not None:
-            return (float(CHART_MESH[0] if self.mesh_size is None else self.mesh_size),
-                    float(CHART_MESH[1] if self.refinement is None else self.refinement))
-        from tactileskin.presets import mesh
-
-        size, ratio = mesh(3, "default", braille=True, thickness=thickness)
-        return (float(size), float(ratio)) if size / ratio < CHART_MESH[0] / CHART_MESH[1] else CHART_MESH
-
     def depth_for(self, thickness: float) -> float | None:
         """The depth (mm) a chart scene of this thickness is given: None (the scene's 20 % of t)
         unless that exceeds max_depth."""
@@ -181,10 +160,9 @@ class ChartConfig:
 def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str | None = None):
     from tactileskin.scene import Scene
 
-    size, ratio = cfg.mesh_for(thickness)
     return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
-                 braille_text=text, braille_standard=cfg.standard, mesh_size=size,
-                 refinement=ratio, depth=cfg.depth_for(thickness))
+                 braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
+                 refinement=cfg.refinement, depth=cfg.depth_for(thickness))
 
 
 def section_scene(thickness, material, indenter, skin="fingertip", depth=None):
@@ -385,7 +363,7 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
     from tactileskin.array.validity import measured
 
     dot = dot_scene(t, material, cfg)
-    return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
+    return measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t, float(dot.indentation), validation,
                     model=model, extent=cfg.read_extent)
 
 
@@ -401,13 +379,13 @@ def fallback_reason(cfg: ChartConfig, material: str, t: float, dot, blank, valid
     """The measured error (letters_judgment) that sends the letters of (material, t) to full
     solves: its status is "exceeds" against full solves on the chart's own mesh; else None.
     Measured past the tolerance only against a finer mesh, the letters stay on the surrogate
-    (marked): full solves on the chart's mesh carry its discretisation error too (a 1.2 / 8
-    chart at t = 1 mm silicone: the full cell on 1.2 / 8 reads 6.8 % off 0.8 / 8, the
-    surrogate's worst letter 5.5 %)."""
+    (marked): full solves on the chart's mesh carry its discretisation error too (t = 1 mm
+    silicone: the full cell on 1.2 / 8 reads 6.8 % off 0.8 / 8, the surrogate's worst letter
+    5.5 %)."""
     from tactileskin.array.validity import finer_reference
 
     m = letters_judgment(cfg, material, t, dot, blank, validation)
-    if m is None or m["status"] != "exceeds" or finer_reference(m, cfg.mesh_for(t)):
+    if m is None or m["status"] != "exceeds" or finer_reference(m, (cfg.mesh_size, cfg.refinement)):
         return None
     return m
 
@@ -457,10 +435,9 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             if j is None or j["status"] != "exceeds":
                 continue
             ref = j["reference_mesh"]  # exceeds against a finer mesh only (fallback_reason)
-            size, ratio = cfg.mesh_for(t)
             msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off full solves "
-                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {size:g} / "
-                   f"{ratio:g} would carry its error too, so the letters stay on the surrogate, "
+                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {cfg.mesh_size:g} / "
+                   f"{cfg.refinement:g} would carry its error too, so the letters stay on the surrogate, "
                    "marked indicative (a finer --mesh-size with --validate answers it)")
         log.info(msg)
         say(msg)
@@ -646,6 +623,6 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,
                                          extent=cfg.read_extent, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
-                             "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
+                             "reference_mesh": [float(v) for v in (reference_mesh or (cfg.mesh_size, cfg.refinement))],
                              **err})
     return rows
