@@ -82,9 +82,10 @@ class ChartConfig:
     # lone dot's surface deflection and load-approach law (surrogate.interaction_weights; on the
     # pad below the dot height, else the plain sum; two lone-dot solves per t), "sum" adds lone
     # dots (one 3D solve per t; measured errors of both in data/surrogate_validation.json,
-    # silicone: interaction 4.6, 5.5, 4.4, 2.8, 3.2 % against the sum's 5.3, 8.5, 14.7, 5.7,
-    # 13.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter in 3D (one solve per letter
-    # and t: where the surrogates are not within 5 %)
+    # silicone: interaction 7.3, 5.5, 4.2, 2.8, 3.2 % against the sum's 8.1, 8.5, 14.7, 5.7,
+    # 13.7 % at t = 0.5, 1, 2, 3, 5 mm, below 3 mm against full solves on 0.8 / 8), "full"
+    # solves every letter in 3D (one solve per letter and t: where the surrogates are not
+    # within 5 %)
     letters_model: str = "interaction"
     # where the surrogate's measured error (this run's validation rows, else
     # data/surrogate_validation.json; array.validity) exceeds its tolerance, solve that
