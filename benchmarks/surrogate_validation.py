@@ -1,7 +1,7 @@
 """The letters' surrogates against full 3D solves: the rows of data/surrogate_validation.json.
 
 For each material, `array.chart.validate_surrogate` on the default chart (pad 20 x 20 mm, mesh
-1.2 / 8, the default pitches and window, so its read square; depth cap --max-depth) solves
+ChartConfig.mesh_for: 0.8 / 8 below t = 3 mm, 1.2 / 8 from it; --mesh one for all; the default pitches and window, so its read square; depth cap --max-depth) solves
 the texts in full (through the result cache in --cache: a rerun only reads) and compares them
 with every model. Prints the table (markdown) and, with --write, replaces the JSON's rows of
 the "interaction" and "sum" models for (material, pad, mesh; --mesh another chart mesh) with these measurements (source:
@@ -65,11 +65,12 @@ def main(argv=None) -> int:
         return 0
     data = json.loads(DATA.read_text(encoding="utf-8"))
     source = f"benchmarks/surrogate_validation.py ({_dt.date.today().isoformat()})"
-    for m, rs in rows.items():
+    for (m, mesh), rs in _by_case(rows, cfg).items():
+        mesh = list(mesh)
         case = next((c for c in data["cases"] if c["material"] == m and c["skin"] == cfg.skin
-                     and c["mesh"] == [cfg.mesh_size, cfg.refinement]), None)
+                     and c["mesh"] == mesh), None)
         if case is None:
-            case = {"material": m, "skin": cfg.skin, "mesh": [cfg.mesh_size, cfg.refinement], "rows": []}
+            case = {"material": m, "skin": cfg.skin, "mesh": mesh, "rows": []}
             data["cases"].append(case)
         new = [{"thickness_mm": r["thickness_mm"], "depth_mm": round(r["depth_mm"], 9), "text": r["text"],
                 "model": r["model"], "taxel_max_error": round(r["max_abs_over_peak_taxel"], 4),
@@ -85,6 +86,16 @@ def main(argv=None) -> int:
     atomic_write_text(DATA, json.dumps(data, indent=2) + "\n")
     print(f"wrote {DATA}")
     return 0
+
+
+def _by_case(rows: dict, cfg) -> dict:
+    """{(material, (mesh_size, refinement) of the chart at the row's thickness): rows}: the
+    JSON's cases are keyed by the chart's mesh, which ChartConfig.mesh_for sets per thickness."""
+    out: dict = {}
+    for m, rs in rows.items():
+        for r in rs:
+            out.setdefault((m, tuple(float(v) for v in cfg.mesh_for(r["thickness_mm"]))), []).append(r)
+    return out
 
 
 if __name__ == "__main__":

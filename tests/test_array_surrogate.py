@@ -469,10 +469,11 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     _fake_solver(monkeypatch, [])
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
     cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), materials=("silicone",), pitches=(0.5, 0.75),
-                            noise_fs=(0.01,), letters="abcr", n_train=4, n_test=4, template_grid=2)
+                            noise_fs=(0.01,), letters="abcr", n_train=4, n_test=4, template_grid=2,
+                            mesh_size=1.2)
     ch = chart.compute(cfg, cache=None)
-    # the file's interaction rows: t = 1 5.5 % (f, against 0.8 / 8 full solves: finer than the
-    # chart's mesh, so no fallback, marked), t = 2 4.2 % (against 0.8 / 8 too)
+    # the file's interaction rows of a 1.2 / 8 chart: t = 1 5.5 % (f, against 0.8 / 8 full
+    # solves: finer than the chart's mesh, so no fallback, marked), t = 2 4.2 % (against 0.8 / 8 too)
     md = markdown(ch)
     assert not ch.fallbacks and "| 1 † | 0.01 |" in md and "| 2 | 0.01 |" in md
     assert "| silicone | 1 | interaction | 5.5% |" in md and "| silicone | 2 | interaction | 4.2% |" in md
@@ -609,7 +610,7 @@ def test_no_fallback_where_the_surrogate_exceeds_only_against_a_finer_mesh(monke
     monkeypatch.setattr(chart, "read_bone_map", lambda path: maps.on_grid(_gauss(w=0.5), grid, grid))
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
     cfg = chart.ChartConfig(thicknesses=(1.0,), pitches=(0.5,), noise_fs=(0.01,), letters="ab", n_train=4,
-                            n_test=4, template_grid=2, sets=("letters",))
+                            n_test=4, template_grid=2, sets=("letters",), mesh_size=1.2)
 
     def row(text, e, ref):
         return {"material": "silicone", "thickness_mm": 1.0, "depth_mm": 0.2, "text": text, "model": "interaction",
@@ -643,3 +644,33 @@ def test_chart_falls_back_to_the_sum_where_the_interaction_weights_fail(monkeypa
     assert ch.letters_models == {("silicone", 1.0): "sum"}
     assert any("fall back to the plain sum" in n for n in ch.notes)
     assert any("fall back to the plain sum" in n for n in suspect(ch))
+
+
+def test_chart_mesh_follows_the_3d_default_where_that_is_finer():
+    """The chart's single dots: the 3D Braille `default` preset below t = 3 mm (0.8 / 8, where
+    1.2 / 8 reads the full cell 5 % low), CHART_MESH (1.2 / 8) from it; a user's mesh size or
+    refinement applies at every thickness."""
+    from tactileskin import presets
+
+    cfg = chart.ChartConfig(thicknesses=(0.5, 1.0, 2.0, 3.0, 5.0))
+    got = {t: cfg.mesh_for(t) for t in cfg.thicknesses}
+    for t, m in got.items():
+        preset = presets.mesh(3, "default", braille=True, thickness=t)
+        finer = preset[0] / preset[1] < chart.CHART_MESH[0] / chart.CHART_MESH[1]
+        assert m == (tuple(float(v) for v in preset) if finer else chart.CHART_MESH), t
+        sc = chart.dot_scene(t, "silicone", cfg)
+        assert (sc.mesh_size, sc.refinement) == m
+    assert got[1.0] == (0.8, 8.0) and got[3.0] == (1.2, 8.0)
+    assert {chart.ChartConfig(mesh_size=1.0).mesh_for(t) for t in (1.0, 5.0)} == {(1.0, 8.0)}
+    assert {chart.ChartConfig(refinement=4.0).mesh_for(t) for t in (1.0, 5.0)} == {(1.2, 4.0)}
+
+
+def test_default_chart_reads_its_own_mesh_rows_below_3_mm():
+    """The default chart judges t < 3 mm by the rows measured on its 0.8 / 8 single dots against
+    full solves on that mesh (data/surrogate_validation.json), not by the 1.2 / 8 chart's."""
+    cfg = chart.ChartConfig(thicknesses=(1.0,), materials=("silicone",))
+    m = chart.surrogate_trust(cfg, "silicone", 1.0, "interaction")
+    assert m["reference_mesh"] == (0.8, 8.0) == cfg.mesh_for(1.0)
+    coarse = chart.surrogate_trust(chart.ChartConfig(thicknesses=(1.0,), mesh_size=1.2), "silicone", 1.0, "interaction")
+    assert coarse["reference_mesh"] == (0.8, 8.0) and coarse["error"] != m["error"]
+    assert "f" in m["texts"] and m["status"] in ("within", "exceeds")

@@ -56,6 +56,13 @@ SKINS = ("pad", "fingertip")
 LETTERS_MODELS = ("interaction", "sum", "full")
 
 
+# The chart's default single-dot mesh. Below t = 3 mm the 3D `default` preset (0.8 / 8) is finer
+# and mesh_for takes it: on 1.2 / 8 the t = 1 mm full cell reads 5 % low (convergence3d.md), and
+# the letters' surrogate is 5.5 % (t = 1, silicone, f) and 5.2 % (t = 0.5) off full solves on
+# finer meshes; on 0.8 / 8 it reads 3.5 and 3.6 % (data/surrogate_validation.json)
+CHART_MESH = (1.2, 8.0)
+
+
 @dataclass(frozen=True)
 class ChartConfig:
     thicknesses: tuple = (1.0, 3.0)
@@ -71,8 +78,10 @@ class ChartConfig:
     n_test: int = 16
     template_grid: int = 4
     seed: int = 0
-    mesh_size: float = 1.2                 # 3D single-dot solves (local plan: fine = size / refinement
-    refinement: float = 8.0                # at the dot, the 3D Braille default preset)
+    # 3D single-dot solves on the local plan (fine = size / refinement at the dot); None, None:
+    # mesh_for's rule (CHART_MESH, or the 3D Braille `default` preset where that is finer)
+    mesh_size: float | None = None
+    refinement: float | None = None
     standard: str = "standard_american"
     skin: str = "pad"                      # pad: translation exact (surrogate.py); fingertip: the paper's
     # depth cap (mm): a thickness whose 20 % depth exceeds it is indented by max_depth instead (all
@@ -82,10 +91,9 @@ class ChartConfig:
     # lone dot's surface deflection and load-approach law (surrogate.interaction_weights; on the
     # pad below the dot height, else the plain sum; two lone-dot solves per t), "sum" adds lone
     # dots (one 3D solve per t; measured errors of both in data/surrogate_validation.json,
-    # silicone: interaction 7.3, 5.5, 4.2, 2.8, 3.2 % against the sum's 8.1, 8.5, 14.7, 5.7,
-    # 13.7 % at t = 0.5, 1, 2, 3, 5 mm, below 3 mm against full solves on 0.8 / 8), "full"
-    # solves every letter in 3D (one solve per letter and t: where the surrogates are not
-    # within 5 %)
+    # silicone on the default meshes (mesh_for): interaction 3.6, 3.5, 4.3, 2.8, 3.2 % against
+    # the sum's 4.3, 6.4, 14.5, 5.7, 13.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter
+    # in 3D (one solve per letter and t: where the surrogates are not within 5 %)
     letters_model: str = "interaction"
     # where the surrogate's measured error (this run's validation rows, else
     # data/surrogate_validation.json; array.validity) exceeds its tolerance, solve that
@@ -129,6 +137,18 @@ class ChartConfig:
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")
 
+    def mesh_for(self, thickness: float) -> tuple[float, float]:
+        """(mesh_size, refinement) of the chart's 3D single dots at a thickness: the user's
+        where either is given (the other from CHART_MESH), else CHART_MESH, or the 3D Braille
+        `default` preset where its fine size is smaller (0.8 / 8 below t = 3 mm)."""
+        if self.mesh_size is not None or self.refinement is not None:
+            return (float(CHART_MESH[0] if self.mesh_size is None else self.mesh_size),
+                    float(CHART_MESH[1] if self.refinement is None else self.refinement))
+        from tactileskin.presets import mesh
+
+        size, ratio = mesh(3, "default", braille=True, thickness=thickness)
+        return (float(size), float(ratio)) if size / ratio < CHART_MESH[0] / CHART_MESH[1] else CHART_MESH
+
     def depth_for(self, thickness: float) -> float | None:
         """The depth (mm) a chart scene of this thickness is given: None (the scene's 20 % of t)
         unless that exceeds max_depth."""
@@ -161,9 +181,10 @@ class ChartConfig:
 def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str | None = None):
     from tactileskin.scene import Scene
 
+    size, ratio = cfg.mesh_for(thickness)
     return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
-                 braille_text=text, braille_standard=cfg.standard, mesh_size=cfg.mesh_size,
-                 refinement=cfg.refinement, depth=cfg.depth_for(thickness))
+                 braille_text=text, braille_standard=cfg.standard, mesh_size=size,
+                 refinement=ratio, depth=cfg.depth_for(thickness))
 
 
 def section_scene(thickness, material, indenter, skin="fingertip", depth=None):
@@ -364,7 +385,7 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
     from tactileskin.array.validity import measured
 
     dot = dot_scene(t, material, cfg)
-    return measured(material, cfg.skin, (cfg.mesh_size, cfg.refinement), t, float(dot.indentation), validation,
+    return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
                     model=model, extent=cfg.read_extent)
 
 
@@ -380,13 +401,13 @@ def fallback_reason(cfg: ChartConfig, material: str, t: float, dot, blank, valid
     """The measured error (letters_judgment) that sends the letters of (material, t) to full
     solves: its status is "exceeds" against full solves on the chart's own mesh; else None.
     Measured past the tolerance only against a finer mesh, the letters stay on the surrogate
-    (marked): full solves on the chart's mesh carry its discretisation error too (t = 1 mm
-    silicone: the full cell on 1.2 / 8 reads 6.8 % off 0.8 / 8, the surrogate's worst letter
-    5.5 %)."""
+    (marked): full solves on the chart's mesh carry its discretisation error too (a 1.2 / 8
+    chart at t = 1 mm silicone: the full cell on 1.2 / 8 reads 6.8 % off 0.8 / 8, the
+    surrogate's worst letter 5.5 %)."""
     from tactileskin.array.validity import finer_reference
 
     m = letters_judgment(cfg, material, t, dot, blank, validation)
-    if m is None or m["status"] != "exceeds" or finer_reference(m, (cfg.mesh_size, cfg.refinement)):
+    if m is None or m["status"] != "exceeds" or finer_reference(m, cfg.mesh_for(t)):
         return None
     return m
 
@@ -436,9 +457,10 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             if j is None or j["status"] != "exceeds":
                 continue
             ref = j["reference_mesh"]  # exceeds against a finer mesh only (fallback_reason)
+            size, ratio = cfg.mesh_for(t)
             msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off full solves "
-                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {cfg.mesh_size:g} / "
-                   f"{cfg.refinement:g} would carry its error too, so the letters stay on the surrogate, "
+                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {size:g} / "
+                   f"{ratio:g} would carry its error too, so the letters stay on the surrogate, "
                    "marked indicative (a finer --mesh-size with --validate answers it)")
         log.info(msg)
         say(msg)
@@ -624,6 +646,6 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,
                                          extent=cfg.read_extent, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
-                             "reference_mesh": [float(v) for v in (reference_mesh or (cfg.mesh_size, cfg.refinement))],
+                             "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
                              **err})
     return rows

@@ -48,7 +48,7 @@ def load_config(path) -> dict:
 @click.option("--letters", default=None, help="Characters of the letters set: a-z and 0-9 (a digit reads as the number sign and "
                    "its a-j cell). Default all 36.")
 @click.option("--offsets", type=int, default=None, help="Random offsets per stimulus (train and test each). Default 16.")
-@click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm). Default 1.2.")
+@click.option("--mesh-size", type=float, default=None, help="3D single-dot mesh size (mm), at every thickness. Default: the 3D Braille default preset below t = 3 mm (0.8), 1.2 from it.")
 @click.option("--refinement", type=float, default=None, help="3D single-dot refinement ratio. Default 8.")
 @click.option("--max-depth", type=float, default=None,
               help="Depth cap (mm) for thick skins: a t whose 20 % depth exceeds it is indented by this "

@@ -61,6 +61,16 @@ def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
     return paths
 
 
+def _meshes(cfg) -> str:
+    """The single dots' mesh sizes / refinement, per thickness where they differ."""
+    by = {}
+    for t in cfg.thicknesses:
+        by.setdefault(cfg.mesh_for(t), []).append(t)
+    if len(by) == 1:
+        return "{:g} / {:g}".format(*next(iter(by)))
+    return ", ".join(f"{m[0]:g} / {m[1]:g} at t = {', '.join(f'{t:g}' for t in ts)} mm" for m, ts in by.items())
+
+
 def markdown(chart, validation=None, method: str = "template") -> str:
     """The report section: conditions, the skin as a filter, accuracy tables, verdicts, and the
     surrogate's validation."""
@@ -68,7 +78,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
     lines = ["## Sensor-array design chart", "",
              f"Skin: letters on the {cfg.skin}, the paper and shapes sets on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
-             f"(mesh {cfg.mesh_size:g} / {cfg.refinement:g}); flat and curved: 2D bone profiles extruded "
+             f"(mesh {_meshes(cfg)}); flat and curved: 2D bone profiles extruded "
              f"along z" + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
              + f". Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
              f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
@@ -168,8 +178,8 @@ def _trust_section(chart, trust: dict) -> list[str]:
             "tolerance the chart solves that thickness's letters in full, model `full`):"), "",
            "| material | t (mm) | model | surrogate error / peak | validated on | status | source |",
            "|---|---|---|---|---|---|---|"]
-    mesh = (chart.config.mesh_size, chart.config.refinement)
     for (material, t), m in trust.items():
+        mesh = chart.config.mesh_for(t)
         err = "-" if m["error"] is None else f"{m['error']:.1%}"
         status = {"full": "no surrogate", "within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
