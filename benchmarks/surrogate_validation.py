@@ -66,11 +66,10 @@ def main(argv=None) -> int:
     data = json.loads(DATA.read_text(encoding="utf-8"))
     source = f"benchmarks/surrogate_validation.py ({_dt.date.today().isoformat()})"
     for (m, mesh), rs in _by_case(rows, cfg).items():
-        mesh = list(mesh)
         case = next((c for c in data["cases"] if c["material"] == m and c["skin"] == cfg.skin
-                     and c["mesh"] == mesh), None)
+                     and c["mesh"] == list(mesh)), None)
         if case is None:
-            case = {"material": m, "skin": cfg.skin, "mesh": mesh, "rows": []}
+            case = {"material": m, "skin": cfg.skin, "mesh": list(mesh), "rows": []}
             data["cases"].append(case)
         new = [{"thickness_mm": r["thickness_mm"], "depth_mm": round(r["depth_mm"], 9), "text": r["text"],
                 "model": r["model"], "taxel_max_error": round(r["max_abs_over_peak_taxel"], 4),
@@ -94,7 +93,7 @@ def _by_case(rows: dict, cfg) -> dict:
     out: dict = {}
     for m, rs in rows.items():
         for r in rs:
-            out.setdefault((m, tuple(float(v) for v in cfg.mesh_for(r["thickness_mm"]))), []).append(r)
+            out.setdefault((m, cfg.mesh_for(r["thickness_mm"])), []).append(r)
     return out
 
 
