@@ -438,6 +438,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     run's validate_surrogate rows, which judge the letters' surrogate before the project's
     measurements do (fallback_reason)."""
     from tactileskin.array import halfspace
+    from tactileskin.array.validity import finer_mesh_reason
 
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
@@ -456,12 +457,9 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             j = letters_judgment(cfg, m, t, c[0], c[2], validation)
             if j is None or j["status"] != "exceeds":
                 continue
-            ref = j["reference_mesh"]  # exceeds against a finer mesh only (fallback_reason)
-            size, ratio = cfg.mesh_for(t)
-            msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off full solves "
-                   f"on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's {size:g} / "
-                   f"{ratio:g} would carry its error too, so the letters stay on the surrogate, "
-                   "marked indicative (a finer --mesh-size with --validate answers it)")
+            # exceeds against a finer mesh only (fallback_reason)
+            msg = (f"t = {t:g} mm ({m}): the letters' surrogate is measured {j['error']:.1%} off "
+                   + finer_mesh_reason(j, cfg.mesh_for(t)))
         log.info(msg)
         say(msg)
     full = {(m, t): letter_scenes(cfg, m, t, full=(m, t) in chart.fallbacks) for m, t in cases}

@@ -90,3 +90,12 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
 def finer_reference(m: dict, mesh) -> bool:
     """Whether a `measured` answer judged the chart's `mesh` against full solves on a finer one."""
     return m.get("reference_mesh") is not None and _reference(m, mesh) < _reference({}, mesh) * (1.0 - 1e-9)
+
+
+def finer_mesh_reason(m: dict, mesh) -> str:
+    """Why letters measured past the tolerance only against full solves on a finer mesh stay
+    on the surrogate (finer_reference): one wording for the run's progress and the report."""
+    ref = m["reference_mesh"]
+    return (f"full solves on the finer {ref[0]:g} / {ref[1]:g} mesh; full solves on the chart's "
+            f"{mesh[0]:g} / {mesh[1]:g} would carry its error too, so no fallback: the letters stay on the "
+            "surrogate, marked indicative (a finer --mesh-size with --validate answers it)")

@@ -159,7 +159,7 @@ def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
 
 
 def _trust_section(chart, trust: dict) -> list[str]:
-    from tactileskin.array.validity import finer_reference, tolerance
+    from tactileskin.array.validity import finer_mesh_reason, finer_reference, tolerance
 
     cfg_full = all(m.get("model") == "full" for m in trust.values())
 
@@ -184,10 +184,7 @@ def _trust_section(chart, trust: dict) -> list[str]:
         status = {"full": "no surrogate", "within": f"within {tolerance():.0%}", "exceeds": f"exceeds {tolerance():.0%}: indicative only",
                   "not validated": "not validated: indicative only"}[m["status"]]
         if m["status"] == "exceeds" and finer_reference(m, mesh):
-            ref = m["reference_mesh"]
-            status += (f" (against full solves on the finer {ref[0]:g} / {ref[1]:g} mesh: full solves on the "
-                       f"chart's {mesh[0]:g} / {mesh[1]:g} would carry its error too, so no fallback; a finer "
-                       "chart mesh, --mesh-size, and --validate answer it)")
+            status += f" (against {finer_mesh_reason(m, mesh)})"
         out.append(f"| {material} | {t:g} | {m.get('model', '-')} | {err} | {', '.join(m['texts']) or '-'} | {status} "
                    f"| {m['source'] or '-'} |")
     out += ["", "† in the letters tables: a thickness whose surrogate is not within the tolerance or not validated.", ""]
