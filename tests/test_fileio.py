@@ -60,7 +60,7 @@ def test_claim_refuses_a_folder_of_user_files_and_keeps_them(tmp_path):
     assert not (d / fileio.MARKER).exists()
 
 
-def test_claim_accepts_new_empty_own_and_legacy_folders(tmp_path):
+def test_claim_accepts_new_empty_and_own_folders_only(tmp_path):
     fileio.claim_dir(tmp_path / "new", "solve")
     assert (tmp_path / "new" / fileio.MARKER).is_file()
     (tmp_path / "empty").mkdir()
@@ -69,10 +69,13 @@ def test_claim_accepts_new_empty_own_and_legacy_folders(tmp_path):
     fileio.claim_dir(tmp_path / "new", "solve")
     with pytest.raises(OutputError):  # but not for another command's kind
         fileio.claim_dir(tmp_path / "new", "sweep")
-    legacy = tmp_path / "legacy"
-    legacy.mkdir()
-    (legacy / "summary.json").write_text("{}")
-    fileio.claim_dir(legacy, "solve", own_names={"summary.json", "profile.csv"})
+    # no marker: a user's summary.json is not ours, however much it looks like a solve output
+    user = tmp_path / "user"
+    user.mkdir()
+    (user / "summary.json").write_text("MY DATA")
+    with pytest.raises(OutputError, match="summary.json"):
+        fileio.claim_dir(user, "solve")
+    assert (user / "summary.json").read_text() == "MY DATA" and not (user / fileio.MARKER).exists()
 
 
 def test_claim_refuses_a_file_and_a_path_under_a_file(tmp_path):

@@ -72,19 +72,22 @@ def test_solve_refuses_a_folder_holding_a_user_file_and_keeps_it(tmp_path, capsy
     assert [p.name for p in d.iterdir()] == ["notes.txt"] and (d / "notes.txt").read_text() == "mine"
 
 
-def test_solve_rewrites_its_own_folder_and_accepts_an_earlier_versions(tmp_path, capsys, fake_solve):
+def test_solve_rewrites_its_own_folder_and_refuses_unmarked_lookalikes(tmp_path, capsys, fake_solve):
     d = tmp_path / "d"
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # marked as ours: rewritten
     assert sorted(p.name for p in d.iterdir()) == [".tactileskin", "contact.csv", "profile.csv",
                                                   "result.vtu", "summary.json"]
-    old = tmp_path / "old"  # written before the marker existed: only solve's own names
-    old.mkdir()
-    (old / "summary.json").write_text("{}")
-    (old / "profile.csv").write_text("s_mm,pressure_mpa\n")
-    assert main(["solve", *CHEAP, "--out", str(old)]) == 0
-    assert (old / "result.vtu").is_file() and "peak_mpa" in (old / "summary.json").read_text()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "old"]  # no staging siblings
+    # without our marker, files with solve's names are the user's: refused, left as they are
+    user = tmp_path / "user"
+    user.mkdir()
+    (user / "summary.json").write_text("MY DATA")
+    (user / "profile.csv").write_text("x\n")
+    assert main(["solve", *CHEAP, "--out", str(user)]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert (user / "summary.json").read_text() == "MY DATA" and (user / "profile.csv").read_text() == "x\n"
+    assert sorted(p.name for p in user.iterdir()) == ["profile.csv", "summary.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "user"]  # no staging siblings
 
 
 def test_solve_out_dot_works_when_empty_and_refuses_cleanly_otherwise(tmp_path, capsys, monkeypatch, fake_solve):
@@ -224,16 +227,16 @@ def test_sweep_refuses_a_foreign_folder_before_solving(tmp_path, capsys, counted
     assert (out / "results.csv").read_text() == "mine"
 
 
-def test_sweep_accepts_the_folder_of_an_earlier_version(tmp_path, capsys, counted_cases):
+def test_sweep_refuses_an_unmarked_folder_of_lookalike_names(tmp_path, capsys, counted_cases):
     out = tmp_path / "out"
     (out / "cache").mkdir(parents=True)
     for name in ("results.csv", "profiles.csv", "report.md", "fig11_peak.svg", "fig9_t1-silicone-flat-2d.png"):
-        (out / name).write_text("old")
+        (out / name).write_text("mine")
     argv = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
-    assert main(argv) == 1  # accepted and run; the (faked) case failed
-    assert len(counted_cases) == 1 and "failed" in (out / "results.csv").read_text()
-    assert (out / fileio.MARKER).is_file()
-    assert main(argv) == 1  # now marked as ours
+    assert main(argv) == 2
+    assert "did not write" in capsys.readouterr().err and counted_cases == []  # refused before solving
+    assert all((out / n).read_text() == "mine" for n in ("results.csv", "report.md", "fig11_peak.svg"))
+    assert not (out / fileio.MARKER).exists()
 
 
 # --- build --------------------------------------------------------------------------------
@@ -255,6 +258,12 @@ def test_build_output_has_umask_permissions_and_refuses_the_current_folder(tmp_p
     assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", "."]) == 2
     assert "current folder" in _err(capsys)
     assert set(p.name for p in out.iterdir()) == set(modes)
+    monkeypatch.chdir(tmp_path)
+    # the build replaces its folder whole: a file added to a previous build refuses it
+    (out / "notes.txt").write_text("mine")
+    assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]) == 2
+    assert "notes.txt" in _err(capsys) and (out / "notes.txt").read_text() == "mine"
+    assert set(p.name for p in out.iterdir()) == set(modes) | {"notes.txt"}
 
 
 # --- install --------------------------------------------------------------------------------

@@ -135,7 +135,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     if out is not None:
         from tactileskin.fileio import claim_dir
 
-        claim_dir(Path(out), "sweep", own_names=_own_names(out), what="out")
+        claim_dir(Path(out), "sweep", what="out")
     with _script_not_rerun():
         outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
     failed = [oc for oc in outcomes if oc.status == "failed"]
@@ -158,12 +158,6 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         return metrics
     prof = pd.DataFrame(profile_rows(records), columns=["case", "s_mm", "pressure_mpa"])
     return metrics, prof
-
-
-def _own_names(out) -> set[str]:
-    from tactileskin.cli.sweep import _own_names as names
-
-    return names(Path(out))
 
 
 @contextlib.contextmanager

@@ -89,6 +89,11 @@ def _tmp_prefix(path: Path) -> str:
     return f".{path.name}.tsk{os.getpid()}-"
 
 
+def is_temporary(name: str) -> bool:
+    """Whether a file name is one of our temporaries (`.NAME.tskPID-XXXX.tmp`)."""
+    return bool(_TMP_RE.match(name))
+
+
 def _pid_alive(pid: int) -> bool:
     if pid == os.getpid():
         return True
@@ -176,27 +181,26 @@ def atomic_write_json(path, obj) -> Path:
 
 # --- output folders -------------------------------------------------------------------
 
-def _is_ours(folder: Path, kind: str | None, own_names: Iterable[str]) -> bool:
+def _is_ours(folder: Path, kind: str | None) -> bool:
+    """Whether `folder` carries our marker (of `kind`, if given). A folder without it is not
+    ours, whatever its file names: a user's summary.json or report.md looks like ours."""
     marker = folder / MARKER
-    if marker.is_file():
-        if kind is None:
-            return True
-        try:
-            return json.loads(marker.read_text()).get("kind") in (kind, None)
-        except (OSError, ValueError, AttributeError):
-            return False
-    # a folder written before the marker existed: only names this command writes
-    own = set(own_names)
-    names = [p.name for p in folder.iterdir() if not _TMP_RE.match(p.name)]
-    return bool(own) and bool(names) and all(n in own for n in names)
+    if not marker.is_file():
+        return False
+    if kind is None:
+        return True
+    try:
+        return json.loads(marker.read_text()).get("kind") in (kind, None)
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
-def claim_dir(folder, kind: str, *, own_names: Iterable[str] = (), what: str = "out") -> Path:
+def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     """Make `folder` the toolkit's output folder of `kind`, or refuse it.
 
-    Accepted: a missing or empty folder, a folder with our marker of the same kind, or one
-    holding only `own_names` (outputs of an earlier version). Anything else raises
-    OutputError and nothing is written. Stale temporaries of killed runs are removed.
+    Accepted: a missing or empty folder, or a folder with our marker of the same kind.
+    Anything else raises OutputError and nothing is written. Stale temporaries of killed runs
+    are removed.
     """
     folder = Path(folder)
     if folder.is_symlink() and not folder.is_dir():
@@ -206,7 +210,7 @@ def claim_dir(folder, kind: str, *, own_names: Iterable[str] = (), what: str = "
     if folder.is_dir():
         with os_errors(folder):
             entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)]
-        if entries and not _is_ours(folder, kind, own_names):
+        if entries and not _is_ours(folder, kind):
             shown = ", ".join(sorted(p.name for p in entries)[:3]) + (", ..." if len(entries) > 3 else "")
             raise OutputError(folder, f"the folder holds files tactileskin did not write ({shown}); "
                                       f"refusing to write into it: give {what} a new or empty folder")

@@ -130,7 +130,7 @@ def scene_from_options(scene_opts: dict, command: str = "solve"):
 
 
 @contextlib.contextmanager
-def claimed_output(out, kind: str, own_names=(), what: str = "--out"):
+def claimed_output(out, kind: str, what: str = "--out"):
     """Claim the output folder `out` (fileio.claim_dir) for the body; if the body fails and the
     folder was created here and holds nothing but our marker, remove it again (no empty
     leftovers from a refused or failed run)."""
@@ -138,7 +138,7 @@ def claimed_output(out, kind: str, own_names=(), what: str = "--out"):
 
     out = Path(out)
     existed = out.exists()
-    fileio.claim_dir(out, kind, own_names=own_names, what=what)
+    fileio.claim_dir(out, kind, what=what)
     try:
         yield out
     except BaseException:

@@ -11,9 +11,6 @@ from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
 EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve` and `sweep`)
-OWN_NAMES = ("accuracies.csv", "array_chart.md", "cache",
-             *(f"array_{m}_{s}.{e}" for m in ("silicone", "polyurethane") for s in ("paper", "letters", "shapes")
-               for e in ("png", "svg")))
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
         "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality"}
@@ -118,7 +115,7 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     say = lambda msg: console.print(escape(msg), highlight=False)  # noqa: E731
-    with claimed_output(out, "array", OWN_NAMES):
+    with claimed_output(out, "array"):
         rows = None
         if texts:  # first: this run's measurements decide where the letters fall back to full solves
             rows = [r for m in cfg.materials

@@ -9,7 +9,7 @@ import click
 from tactileskin import results
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
-# every name `solve` writes into its folder (also how a folder of an earlier version is recognised)
+# every name `solve` writes into its folder
 RESULT_FILES = (*results.OWN_NAMES, "bone_map.png", "sensors.png")
 OWN_NAMES = RESULT_FILES + ("section_2d", "compare_2d.json")
 
@@ -57,7 +57,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         scene = scene.replace(sensors=doc["sensors"])
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
-    with claimed_output(out, "solve", OWN_NAMES):  # a folder of other files is refused before solving
+    with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)
         path = res.write(out)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 import time
 from pathlib import Path
 
@@ -10,12 +9,6 @@ import click
 
 from tactileskin.cli._common import _field_changes, claimed_output, scene_options
 from tactileskin.errors import ParameterError
-
-# the names a sweep writes into OUT (a folder of an earlier version holding only these is ours)
-OWN_NAMES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md", "cache",
-             *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span", "fig13_auc")
-               for ext in ("png", "svg")), "metrics_vs_thickness.pdf")
-_RENDER_RE = re.compile(r"fig9_.+\.png")  # one render per material, named by its case
 
 
 EXIT_FAILED, EXIT_SUSPECT = 1, 3
@@ -60,7 +53,7 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
     scenes = scenes_from_options(scene_opts, braille_dim)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
-    with claimed_output(out, "sweep", _own_names(out)):  # before any solving
+    with claimed_output(out, "sweep"):  # before any solving
         console.print(f"sweep: {len(scenes)} cases → {escape(str(out))}")
 
         t0 = time.perf_counter()
@@ -145,13 +138,3 @@ def _names(text: str, name: str) -> tuple[str, ...]:
     if not items:
         raise ParameterError(name, text, "a comma-separated list of names")
     return items
-
-
-def _own_names(out: Path) -> set[str]:
-    names = set(OWN_NAMES)
-    if out.is_dir():
-        from tactileskin.fileio import os_errors
-
-        with os_errors(out):
-            names |= {p.name for p in out.iterdir() if _RENDER_RE.fullmatch(p.name)}
-    return names

@@ -130,9 +130,9 @@ class Comparison:
 
         out = Path(out)
         if _is_analyze_folder(out):
-            fileio.claim_dir(out, "film-analyze", own_names=ANALYZE_NAMES + COMPARE_NAMES)
+            fileio.claim_dir(out, "film-analyze")
         else:
-            fileio.claim_dir(out, "film-compare", own_names=COMPARE_NAMES)
+            fileio.claim_dir(out, "film-compare")
         doc = json.loads(json.dumps(self.to_dict(), default=str))
         fileio.atomic_write_json(out / "comparison.json", _finite_or_none(doc))
         plots.overlay(self, out / "overlay.png")

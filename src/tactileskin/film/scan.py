@@ -202,7 +202,7 @@ class FilmProfile:
         from tactileskin.film import plots
 
         plots._check_cmap(cmap)
-        out = fileio.claim_dir(out, "film-analyze", own_names=ANALYZE_NAMES + COMPARE_NAMES)
+        out = fileio.claim_dir(out, "film-analyze")
         names = {"profile": "profile.csv", "summary": "summary.json", "map": "pressure_map.png"}
         lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
         for k in range(self.s_mm.size):

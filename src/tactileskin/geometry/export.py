@@ -122,11 +122,16 @@ def _write_part(part: Part, folder: Path, tolerance: float, angular_tolerance: f
     }
 
 
-def _is_previous_build(out: Path) -> bool:
+def _previous_build_files(out: Path) -> set[str] | None:
+    """The names a previous parts build in `out` wrote (its manifest and the STL / STEP files
+    the manifest lists), or None if `out` holds no manifest of ours."""
     try:
-        return json.loads((out / MANIFEST).read_text()).get("kind") == MANIFEST_KIND
-    except (OSError, ValueError, AttributeError):
-        return False
+        manifest = json.loads((out / MANIFEST).read_text())
+        if manifest.get("kind") != MANIFEST_KIND:
+            return None
+        return {MANIFEST} | {str(e[k]) for e in manifest.get("parts", ()) for k in ("stl", "step") if k in e}
+    except (OSError, ValueError, AttributeError, TypeError):
+        return None
 
 
 def check_target(out: Path) -> None:
@@ -139,9 +144,15 @@ def check_target(out: Path) -> None:
     if out.is_dir():
         with fileio.os_errors(out):
             entries = list(out.iterdir())
-        if entries and not _is_previous_build(out):
+        ours = _previous_build_files(out)
+        # the build replaces the folder whole: a previous build with anything added to it
+        # (a user's notes, a slicer's files) is refused, not emptied
+        others = sorted(p.name for p in entries if not fileio.is_temporary(p.name)
+                        and (ours is None or p.name not in ours))
+        if others:
+            shown = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
             raise ParameterError("out", str(out), "a new or empty folder, or the folder of a previous `tactileskin build`",
-                                 hint="refusing to replace a folder holding other files")
+                                 hint=f"refusing to replace a folder holding files the build did not write ({shown})")
         cwd = Path.cwd().resolve()
         if cwd == out.resolve() or out.resolve() in cwd.parents:
             raise ParameterError("out", str(out), "a folder that does not hold the current folder",
