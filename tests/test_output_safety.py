@@ -266,6 +266,36 @@ def test_build_output_has_umask_permissions_and_refuses_the_current_folder(tmp_p
     assert set(p.name for p in out.iterdir()) == set(modes) | {"notes.txt"}
 
 
+# --- single output files -------------------------------------------------------------------
+
+def test_single_file_outputs_replace_only_their_own_unchanged_files(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    deck = ["export", *CHEAP, "--out", "deck.inp"]
+    Path("deck.inp").write_text("MY DECK")  # a user's file of that name: refused, kept
+    assert main(deck) == 2
+    assert "did not write" in _err(capsys) and Path("deck.inp").read_text() == "MY DECK"
+    Path("deck.inp").unlink()
+    assert main(deck) == 0 and main(deck) == 0  # ours, unchanged: replaced
+    assert Path("deck.inp").read_text().startswith("*")
+    with open("deck.inp", "a") as fh:  # the user edited it since: no longer replaced
+        fh.write("** my edit\n")
+    assert main(deck) == 2 and Path("deck.inp").read_text().endswith("** my edit\n")
+    capsys.readouterr()
+    Path("notes.vtu").write_text("MINE")
+    assert main(["mesh", *CHEAP[:4], "--out", "notes.vtu"]) == 2 and Path("notes.vtu").read_text() == "MINE"
+    assert "did not write" in _err(capsys)
+    # film calibrate: a plot over its own input CSV is refused before anything is written
+    cal = "force_n,area_mm2,gray\n30,100,40\n17,100,120\n2,100,220\n"
+    Path("cal.csv").write_text(cal)
+    assert main(["film", "calibrate", "cal.csv", "-o", "c.json", "--plot", "cal.csv"]) == 2
+    assert Path("cal.csv").read_text() == cal and not Path("c.json").exists()
+    assert "--plot" in _err(capsys)
+    assert main(["film", "calibrate", "cal.csv", "-o", "c.json", "--plot", "c.png"]) == 0
+    assert main(["film", "calibrate", "cal.csv", "-o", "c.json", "--plot", "c.png"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        ".tactileskin-files.json", "c.json", "c.png", "cal.csv", "deck.inp", "notes.vtu"]
+
+
 # --- install --------------------------------------------------------------------------------
 
 def test_geometry_files_are_package_data_and_read_from_the_package(monkeypatch):

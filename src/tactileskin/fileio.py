@@ -11,6 +11,8 @@ Rules (issue #12, "never destroy user data"):
 - An output folder is written into only if it is new, empty, or marked as the toolkit's
   (`claim_dir` writes the marker `.tactileskin`); a folder holding files we did not write
   is refused, never emptied.
+- A single output file of the CLI replaces an existing file only if the toolkit wrote it and
+  nobody changed it since (`claim_file`, `record_file`: the folder's `.tactileskin-files.json`).
 - An OSError becomes an `OutputError` that names the path and the cause in one line.
 """
 
@@ -75,14 +77,16 @@ def _cause(e: OSError) -> str:
 
 
 @contextlib.contextmanager
-def os_errors(path) -> Iterator[None]:
-    """Turn an OSError raised inside into an OutputError naming `path` (or the error's own file)."""
+def os_errors(path, *, own_name: bool = True) -> Iterator[None]:
+    """Turn an OSError raised inside into an OutputError naming `path`, or with own_name the
+    error's own file if it has one (not for our temporaries: the user gave `path`)."""
     try:
         yield
     except OutputError:
         raise
     except OSError as e:
-        raise OutputError(e.filename or path, _cause(e)) from e
+        named = e.filename if own_name and e.filename and not _TMP_RE.match(Path(str(e.filename)).name) else path
+        raise OutputError(named, _cause(e)) from e
 
 
 def _tmp_prefix(path: Path) -> str:
@@ -141,13 +145,13 @@ def atomic_path(path, *, suffix: str = ".tmp") -> Iterator[Path]:
     path = Path(path)
     make_dirs(path.parent)
     clean_stale(path.parent)
-    with os_errors(path):
+    with os_errors(path, own_name=False):
         fd, tmp = tempfile.mkstemp(prefix=_tmp_prefix(path), suffix=suffix, dir=path.parent)
         os.close(fd)
     tmp = Path(tmp)
     try:
         yield tmp
-        with os_errors(path):
+        with os_errors(path, own_name=False):
             os.chmod(tmp, file_mode())
             os.replace(tmp, path)
     finally:
@@ -157,7 +161,7 @@ def atomic_path(path, *, suffix: str = ".tmp") -> Iterator[Path]:
 
 def atomic_write_bytes(path, data: bytes) -> Path:
     path = Path(path)
-    with atomic_path(path) as tmp, os_errors(path):
+    with atomic_path(path) as tmp, os_errors(path, own_name=False):
         with open(tmp, "wb") as fh:
             fh.write(data)
             fh.flush()
@@ -177,6 +181,60 @@ def atomic_write_json(path, obj) -> Path:
     except ValueError as e:
         raise OutputError(path, f"non-finite number in the data ({e})") from None
     return atomic_write_text(path, text + "\n")
+
+
+# --- single output files ------------------------------------------------------------------
+
+# Beside single files the CLI writes (a deck, a mesh, a calibration, a plot), the folder's
+# record of them: name -> sha256 of the contents written. An existing file is replaced only
+# if the record lists it with its current contents, i.e. the toolkit wrote it and nobody has
+# changed it since; a user's file of the same name (or the command's own input) is refused.
+OWNED_FILES = ".tactileskin-files.json"
+
+
+def _digest(path: Path) -> str:
+    import hashlib
+
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _owned(folder: Path) -> dict:
+    try:
+        rec = json.loads((folder / OWNED_FILES).read_text())
+        return rec if isinstance(rec, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def claim_file(path, what: str = "--out") -> Path:
+    """Refuse `path` as an output file unless it is new or a file the toolkit wrote there and
+    nobody changed since (OWNED_FILES); call before the work, `record_file` after writing."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError(path, f"{what} must be a file name, and this is a folder")
+    if path.exists() or path.is_symlink():
+        try:
+            ours = (not path.is_symlink() and path.is_file()
+                    and _owned(path.parent).get(path.name) == _digest(path))
+        except OSError:
+            ours = False
+        if not ours:
+            raise OutputError(path, "the file exists and tactileskin did not write it (or it was changed since); "
+                                    f"refusing to overwrite it: give {what} a new file name")
+    return path
+
+
+def record_file(path) -> None:
+    """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
+    path = Path(path)
+    rec = {k: v for k, v in _owned(path.parent).items() if (path.parent / k).is_file()}
+    with os_errors(path):
+        rec[path.name] = _digest(path)
+    atomic_write_json(path.parent / OWNED_FILES, rec)
 
 
 # --- output folders -------------------------------------------------------------------

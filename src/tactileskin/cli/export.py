@@ -19,12 +19,15 @@ def command(out, dialect, scene_opts):
     from rich.console import Console
     from rich.markup import escape
 
+    from tactileskin import fileio
     from tactileskin.errors import ParameterError
     from tactileskin.mesh.deck import write_deck
 
     if not out.lower().endswith(".inp"):
         raise ParameterError("--out", out, "a file name ending in .inp")
     scene = scene_from_options(scene_opts, "export")  # --elastic: leave out the Prony series
+    fileio.claim_file(out)  # before meshing: a user's file of that name is refused
     deck = write_deck(scene, out, dialect=dialect)
+    fileio.record_file(out)
     Console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes, "
                     f"{'viscoelastic' if deck.info['viscoelastic'] else 'elastic'} {dialect} deck")

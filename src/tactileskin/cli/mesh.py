@@ -20,11 +20,14 @@ def command(out, cell, scene_opts):
     from rich.markup import escape
     from rich.table import Table
 
+    from tactileskin import fileio
     from tactileskin.mesh import FORMATS, build_mesh
     from tactileskin.errors import ParameterError
 
     if out is not None and not any(out.lower().endswith(s) for s in FORMATS):
         raise ParameterError("--out", out, "a file name ending in " + ", ".join(FORMATS))
+    if out is not None:
+        fileio.claim_file(out)  # before meshing: a user's file of that name is refused
     scene = scene_from_options(scene_opts, "mesh")
     sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
@@ -53,4 +56,5 @@ def command(out, cell, scene_opts):
     console.print(table)
     if out is not None:
         path = sm.write(out)
+        fileio.record_file(path)
         console.print(f"wrote {escape(str(path))}")
