@@ -10,7 +10,7 @@ from tactileskin.errors import ParameterError
 from tactileskin.fe import Dirichlet, make_result, model_for_scene, run
 from tactileskin.fe.model import Model
 from tactileskin.fe.output import map_planes, plane_profile, surface_grid
-from tactileskin.results import OWN_NAMES, BoneMap, Result, read_bone_map
+from tactileskin.results import OWN_FILES, BoneMap, Result, read_bone_map
 from tactileskin.scene import Scene
 
 # t = 3 silicone under the flat plate, elastic, 0.1 mm travel, on a 1.5 mm slab (quarter
@@ -155,7 +155,7 @@ def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
     out = res.write(tmp_path / "r")
     # every owned name but the time series (result.pvd, result_steps/), written only with a
     # history, sensors.csv (a scene without sensors) and history.csv (one loading segment)
-    assert {p.name for p in out.iterdir()} == set(OWN_NAMES) - {"result.pvd", "result_steps", "sensors.csv",
+    assert {p.name for p in out.iterdir()} == set(OWN_FILES) - {"result.pvd", "result_steps/step_*.vtu", "sensors.csv",
                                                                 "history.csv"}
     bm = read_bone_map(out / "bone_map.csv", section_z=res.bone_map.section_z)
     np.testing.assert_allclose(bm.s, res.bone_map.s, rtol=1e-9, atol=1e-12)

@@ -90,6 +90,58 @@ def test_solve_rewrites_its_own_folder_and_refuses_unmarked_lookalikes(tmp_path,
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d", "user"]  # no staging siblings
 
 
+def test_a_failed_solve_write_leaves_the_earlier_result_whole(tmp_path, capsys, fake_solve, monkeypatch):
+    import errno
+
+    import tactileskin.results as results
+
+    d = tmp_path / "d"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    (d / "notes.txt").write_text("mine")  # a user's file in our folder stays whatever happens
+    before = {p.name: p.read_bytes() for p in d.iterdir()}
+
+    def full_disk(path, *a, **k):
+        with fileio.os_errors(path):  # as atomic_path turns it
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(results, "_write_vtu", full_disk)  # fails after profile.csv and contact.csv
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    assert "no space left" in _err(capsys)
+    assert {p.name: p.read_bytes() for p in d.iterdir()} == before  # the old result, whole
+    assert _temporaries(d) == [] and sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+
+
+def test_a_new_solve_removes_the_earlier_2d_comparison(tmp_path, capsys, fake_solve):
+    d = tmp_path / "d"
+    assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0
+    assert (d / "compare_2d.json").is_file() and (d / "section_2d" / "summary.json").is_file()
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # another result: its comparison goes with it
+    assert not (d / "compare_2d.json").exists() and not (d / "section_2d").exists()
+
+
+def test_staged_files_replace_one_result_with_the_next(tmp_path):
+    d = tmp_path / "d"
+    with fileio.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
+        for name in ("a.csv", "map.csv", "summary.json"):
+            (tmp / name).write_text("1")
+        (tmp / "steps").mkdir()
+        (tmp / "steps" / "s_0.vtu").write_text("1")
+    (d / "steps" / "mine.txt").write_text("mine")
+    with fileio.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
+        (tmp / "a.csv").write_text("2")  # no map, no steps this time
+        (tmp / "summary.json").write_text("2")
+    assert sorted(f.relative_to(d).as_posix() for f in d.rglob("*")) == ["a.csv", "steps", "steps/mine.txt",
+                                                                       "summary.json"]
+    assert (d / "a.csv").read_text() == "2" and (d / "summary.json").read_text() == "2"
+    with pytest.raises(RuntimeError), fileio.staged_files(d, ("a.csv", "summary.json")) as tmp:
+        (tmp / "a.csv").write_text("3")
+        raise RuntimeError("the body failed")
+    assert (d / "a.csv").read_text() == "2" and _temporaries(d) == []
+    with pytest.raises(ValueError, match="other.txt"), fileio.staged_files(d, ("a.csv",)) as tmp:
+        (tmp / "other.txt").write_text("x")  # only owned names are moved in
+    assert not (d / "other.txt").exists()
+
+
 def test_solve_out_dot_works_when_empty_and_refuses_cleanly_otherwise(tmp_path, capsys, monkeypatch, fake_solve):
     empty = tmp_path / "empty"
     empty.mkdir()

@@ -314,6 +314,66 @@ def staged_dir(final) -> Iterator[Path]:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+def _files(root: Path) -> list[str]:
+    """Paths (relative, with "/") of the files under `root`, our temporaries left out."""
+    out = []
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = [d for d in dirnames if not _TMP_RE.match(d)]
+        rel = Path(dirpath).relative_to(root)
+        out += [(rel / f).as_posix() for f in filenames if not _TMP_RE.match(f)]
+    return out
+
+
+@contextlib.contextmanager
+def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iterator[Path]:
+    """Yield an empty staging folder inside `folder` for the body to write one result into.
+
+    On success the result replaces the folder's earlier one: every file the body wrote moves
+    into place, and every file of `folder` that matches an `own` pattern (fnmatch on the path
+    relative to `folder`: "summary.json", "result_steps/step_*.vtu") but was not written this
+    time is removed, so no file of an earlier result outlives it. Other files are left alone,
+    and a folder is removed only once empty. `last` is removed first and moved in last, so a
+    folder holding it holds a complete result. On failure nothing in `folder` changes (a full
+    disk fails while staging, before the first move).
+    """
+    import fnmatch
+
+    own = tuple(own)
+    folder = make_dirs(folder)
+    clean_stale(folder)
+    with os_errors(folder, own_name=False):
+        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "result"), suffix=".partial", dir=folder))
+        os.chmod(tmp, dir_mode())
+    try:
+        yield tmp
+        new = _files(tmp)
+        stray = [f for f in new if not any(fnmatch.fnmatchcase(f, p) for p in own)]
+        if stray:
+            raise ValueError(f"staged files not in the owned patterns: {stray}")
+        old = [f for f in _files(folder) if any(fnmatch.fnmatchcase(f, p) for p in own)]
+        trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "old"), suffix=".partial", dir=folder))
+        try:
+            with os_errors(folder):
+                order = sorted(set(new) | set(old), key=lambda f: f == last)
+                if last in old:
+                    os.replace(folder / last, trash / "last")
+                for i, rel in enumerate(order):
+                    dst = folder / rel
+                    if rel in old and rel != last:
+                        os.replace(dst, trash / f"{i}")
+                    if rel in new:
+                        make_dirs(dst.parent)
+                        os.replace(tmp / rel, dst)
+                # folders of the earlier result that are empty now (deepest first)
+                for rel in sorted({Path(f).parent for f in old} - {Path(".")}, key=lambda d: -len(d.parts)):
+                    with contextlib.suppress(OSError):
+                        (folder / rel).rmdir()
+        finally:
+            shutil.rmtree(trash, ignore_errors=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def fix_tree_modes(root) -> None:
     """Give files written by third-party code inside a staging folder normal permissions."""
     fm, dm = file_mode(), dir_mode()

@@ -312,57 +312,45 @@ class Result:
         return grid
 
     def write(self, directory) -> Path:
-        """Write OWN_NAMES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
+        """Write OWN_FILES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
         displacement_mm and the other fields named with their unit, boundaries by name);
         with a history, result.pvd over result_steps/; with sensors, sensors.csv; 3D: also
         bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
-        where it occurs) into `directory`, creating it; each file is written atomically and
-        only these names are touched (a result.vtu or map of an earlier write is removed when
-        this result has none). Callers writing into a user's folder claim it first
+        where it occurs) into `directory`, creating it. All of them are staged and moved in
+        together (fileio.staged_files): a failed write leaves the folder as it was, and files of
+        an earlier result that this one has not (a map, a field file) are removed; other files
+        are not touched. Callers writing into a user's folder claim it first
         (fileio.claim_dir)."""
         directory = fileio.make_dirs(directory)
+        with fileio.staged_files(directory, OWN_FILES, last="summary.json") as tmp:
+            self._write_files(tmp)
+        return directory
+
+    def _write_files(self, directory: Path) -> None:
         s, p = self._profile()
         fileio.atomic_write_text(directory / "profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
         fileio.atomic_write_text(directory / "contact.csv",
                                  _csv(["x_mm", "contact_pressure_mpa"], self.contact_x, self.contact_pressure))
-        vtu = directory / "result.vtu"
         if self.fields is not None:
-            _write_vtu(vtu, self.fields)
-        else:  # a stale field file would not match the new profile
-            _remove(vtu)
+            _write_vtu(directory / "result.vtu", self.fields)
         _write_steps(directory, self.fields)
         if self.bone_map is not None:
             fileio.atomic_write_text(directory / "bone_map.csv", self.bone_map.to_csv())
             fileio.atomic_write_text(directory / "profile_max_z.csv",
                                      _csv(["s_mm", "pressure_mpa", "z_mm"], *self.bone_map.max_over_z()))
-        else:
-            _remove(directory / "bone_map.csv")
-            _remove(directory / "profile_max_z.csv")
         if self.sensors is not None:
             fileio.atomic_write_text(directory / "sensors.csv", self.sensors.to_csv())
-        else:
-            _remove(directory / "sensors.csv")
         if self.loading is not None and self.history:
             cols = ["t", "d", "reaction", "peak_mpa", "segment"]
             fileio.atomic_write_text(directory / "history.csv", _csv(
                 ["t_s", "travel_mm", "reaction", "peak_bone_pressure_mpa", "segment"],
                 *[np.array([h.get(c, np.nan) for h in self.history], float) for c in cols]))
-        else:
-            _remove(directory / "history.csv")
-        # last: a folder with a summary.json holds a complete result
         fileio.atomic_write_json(directory / "summary.json", self.summary())
-        return directory
 
 
-# the file names Result.write owns in a folder
-OWN_NAMES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
-             "sensors.csv", "history.csv", "result.pvd", "result_steps")
-
-
-def _remove(path: Path) -> None:
-    if path.is_file():
-        with fileio.os_errors(path):
-            path.unlink()
+# the files Result.write owns in a folder (fnmatch patterns, relative paths)
+OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
+             "sensors.csv", "history.csv", "result.pvd", "result_steps/step_*.vtu")
 
 
 def _csv(header: list[str], *cols) -> str:
@@ -429,29 +417,16 @@ STEPS_DIR = "result_steps"  # the .vtu of each increment, listed by result.pvd
 def _write_steps(directory: Path, fields: dict) -> None:
     """result.pvd, a ParaView time series over result_steps/step_NNNN.vtu (the displacement
     of each converged increment on the reference mesh; the final state's stresses and
-    pressure are in result.vtu), or remove those of an earlier write when there are none."""
+    pressure are in result.vtu), when the fields have steps."""
     steps = fields.get("steps") if fields else None
-    sd = directory / STEPS_DIR
     if not steps:
-        _remove(directory / "result.pvd")
-        if sd.is_dir():
-            for p in sd.glob("step_*.vtu"):
-                _remove(p)
-            with fileio.os_errors(sd):
-                if not any(sd.iterdir()):
-                    sd.rmdir()
         return
-    sd = fileio.make_dirs(sd)
-    keep = set()
+    sd = fileio.make_dirs(directory / STEPS_DIR)
     entries = []
     for i, (t, u) in enumerate(steps):
         name = f"step_{i:04d}.vtu"
         _write_vtu(sd / name, fields, {"displacement_mm": u})
-        keep.add(name)
         entries.append(f'    <DataSet timestep="{t:.9g}" group="" part="0" file="{STEPS_DIR}/{name}"/>')
-    for p in sd.glob("step_*.vtu"):  # fewer increments than an earlier write
-        if p.name not in keep:
-            _remove(p)
     fileio.atomic_write_text(directory / "result.pvd",
                              '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
                              "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")

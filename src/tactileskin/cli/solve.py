@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import contextlib
+from pathlib import Path
 
 import click
 
 from tactileskin import results
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
-# every name `solve` writes into its folder
-RESULT_FILES = (*results.OWN_NAMES, "bone_map.png", "sensors.png")
-OWN_NAMES = RESULT_FILES + ("section_2d", "compare_2d.json")
+# every file `solve` writes into its folder (fnmatch patterns; the 2D section of --compare-2d
+# is a result folder of its own)
+RESULT_FILES = (*results.OWN_FILES, "bone_map.png", "sensors.png")
+OWN_FILES = RESULT_FILES + ("compare_2d.json", *(f"section_2d/{n}" for n in results.OWN_FILES))
 
 
 EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see the help text)
@@ -42,6 +44,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     from rich.table import Table
     from rich.text import Text
 
+    from tactileskin import fileio
     from tactileskin.fe import solve
 
     scene = scene_from_options(scene_opts, "solve")
@@ -60,9 +63,17 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)
-        path = res.write(out)
-        _write_map_figure(res, path, scene.label())
-        _write_sensors_figure(res, path, scene.label())
+        r2 = _solve_2d(scene) if compare_2d else None
+        # one result in the folder: staged, then moved in together (summary.json last); files
+        # of an earlier result this one has not (a map, a 2D section) are removed
+        with fileio.staged_files(out, OWN_FILES, last="summary.json") as tmp:
+            res.write(tmp)
+            _write_map_figure(res, tmp, scene.label())
+            _write_sensors_figure(res, tmp, scene.label())
+            if r2 is not None:
+                r2.write(tmp / "section_2d")
+                fileio.atomic_write_json(tmp / "compare_2d.json", _compare_doc(scene, res.summary(), r2))
+        path = Path(out)
     s = res.summary()
     t = Table(title=escape(f"{scene.label()} -> {path}"), show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
@@ -91,7 +102,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                   f"({s['peak_sensor_id']})")
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
-    t.add_row("files", ", ".join(n for n in RESULT_FILES if (path / n).exists()))
+    t.add_row("files", ", ".join(sorted({n.split("/")[0] for n in RESULT_FILES if any(path.glob(n))})))
     if "min_J" in s:
         t.add_row("min volume ratio J / max |stress|",
                   f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")
@@ -104,8 +115,8 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         console.print(Text("warning: suspect result (exit status 3): ", style="bold yellow")
                       + Text(s["status"].split(": ", 1)[-1]), highlight=False)
         rc = EXIT_SUSPECT
-    if compare_2d:
-        _compare_2d(scene, s, out)
+    if r2 is not None:
+        _print_compare_2d(_compare_doc(scene, s, r2), r2.summary())
     return rc
 
 
@@ -132,16 +143,10 @@ def solve_progress(label: str):
 
 def _write_figure(data, png, draw: str, title: str) -> None:
     """png drawn by `draw` ("module:function", imported only when there is something to draw:
-    matplotlib stays out of a plain 2D solve) when the result has `data`; without it, a png
-    left there by an earlier solve is removed (the folder holds one result's files)."""
+    matplotlib stays out of a plain 2D solve) when the result has `data`."""
     import importlib
 
-    from tactileskin import fileio
-
     if data is None:
-        if png.is_file():
-            with fileio.os_errors(png):
-                png.unlink()
         return
     module, func = draw.split(":")
     getattr(importlib.import_module(module), func)(data, png, title=title)
@@ -159,35 +164,38 @@ def _write_sensors_figure(res, path, label: str) -> None:
                   f"sensor readings, {label}")
 
 
-def _compare_2d(scene, s3, out) -> None:
-    """Solve the 2D section of a 3D scene; print and write (compare_2d.json) the differences."""
-    import os
+def _solve_2d(scene):
+    """The 2D section of a 3D scene, solved at the default 2D mesh."""
+    from tactileskin.fe import solve
 
+    sc2 = scene.replace(dim=2)  # default 2D mesh sizes are re-derived on the dim change
+    with solve_progress(sc2.label()) as show:
+        return solve(sc2, progress=show)
+
+
+def _compare_doc(scene, s3: dict, r2) -> dict:
+    """compare_2d.json: the 2D section's peak and span against the 3D result's."""
+    s2 = r2.summary()
+    # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN
+    rows = {k: (s2[k], s3[k], (s2[k] - s3[k]) / s3[k] if s3[k] > 0 else None)
+            for k in ("peak_mpa", "span_mm")}
+    return {"scene_3d": scene.label(), "scene_2d": scene.replace(dim=2).label(),
+            **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
+
+
+def _print_compare_2d(doc: dict, s2: dict) -> None:
     from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
     from rich.text import Text
 
-    from tactileskin.fe import solve
-    from tactileskin.fileio import atomic_write_json
-
-    sc2 = scene.replace(dim=2)  # default 2D mesh sizes are re-derived on the dim change
-    with solve_progress(sc2.label()) as show:
-        r2 = solve(sc2, progress=show)
-    r2.write(os.path.join(out, "section_2d"))
-    s2 = r2.summary()
-    # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN
-    rows = {k: (s2[k], s3[k], (s2[k] - s3[k]) / s3[k] if s3[k] > 0 else None)
-            for k in ("peak_mpa", "span_mm")}
-    t = Table(title=escape(f"2D section ({sc2.label()}) against 3D; difference = (2D - 3D) / 3D"))
+    t = Table(title=escape(f"2D section ({doc['scene_2d']}) against 3D; difference = (2D - 3D) / 3D"))
     for c in ("", "2D", "3D", "difference"):
         t.add_column(c)
-    for k, (a, b, d) in rows.items():
+    for k in ("peak_mpa", "span_mm"):
+        a, b, d = doc[k]["2d"], doc[k]["3d"], doc[k]["relative_difference"]
         t.add_row(k, f"{a:.4g}", f"{b:.4g}", "n/a (3D is 0)" if d is None else f"{100 * d:+.1f} %")
     Console().print(t)
     if s2.get("status", "ok") != "ok":
         Console().print(Text(f"warning: the 2D section is suspect: {s2['status']}", style="bold yellow"),
                         highlight=False)
-    doc = {"scene_3d": scene.label(), "scene_2d": sc2.label(),
-           **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
-    atomic_write_json(os.path.join(out, "compare_2d.json"), doc)
