@@ -75,6 +75,30 @@ def test_a_scene_file_is_a_sweep_of_one_case_and_options_override_it(tmp_path):
     assert all(s.dim == 3 and not s.viscoelastic and s.refinement == 2.5 and s.rate == 2.0 for s in scenes)
 
 
+def test_file_paths_in_a_scene_file_are_relative_to_the_file_not_the_working_folder(tmp_path, monkeypatch):
+    from tactileskin import sweep
+    from tactileskin.materials import get_material
+
+    gel = "[hyperfoam]\nmu = [{mu}]\nalpha = [8.0]\nnu = 0.45\n"
+    (tmp_path / "sw").mkdir()
+    (tmp_path / "other").mkdir()
+    (tmp_path / "sw" / "gel.toml").write_text(gel.format(mu=0.05))
+    (tmp_path / "other" / "gel.toml").write_text(gel.format(mu=0.5))  # same name, another folder
+    f = tmp_path / "sw" / "scene.toml"
+    f.write_text('material = "gel.toml"\nthickness = 2.0\n')
+    monkeypatch.chdir(tmp_path / "other")
+    mine = str(tmp_path / "sw" / "gel.toml")
+    sc = scene_from_options(_scene_opts(scene_file="../sw/scene.toml"))
+    assert sc.material == mine and get_material(sc.material).law.mu0 == pytest.approx(0.05)
+    f.write_text('[scene]\nmaterial = "gel.toml"\n[sweep]\nthicknesses = [1.0]\nmaterials = ["gel.toml"]\n')
+    spec = sweep.load_spec("../sw/scene.toml")
+    assert spec["base"].material == mine and list(spec["materials"]) == [mine]
+    # saved and read back from another folder, a scene names the same file
+    Scene(thickness=1.0, material=mine).to_toml(tmp_path / "other" / "deep" / "s.toml")
+    assert "../../sw/gel.toml" in (tmp_path / "other" / "deep" / "s.toml").read_text()
+    assert Scene.from_toml(tmp_path / "other" / "deep" / "s.toml").material == mine
+
+
 def test_solve_refuses_a_sweep_file_of_several_cases_and_says_what_to_run(tmp_path, capsys):
     f = tmp_path / "grid.toml"
     f.write_text("[sweep]\nthicknesses = [1.0, 3.0]\n")

@@ -372,14 +372,17 @@ class Scene:
         import tomli_w
 
         from tactileskin import fileio
+        from tactileskin.scenefile import relative_paths
 
-        fileio.atomic_write_text(path, tomli_w.dumps(self.to_dict()))
+        # file paths relative to the TOML's folder, as from_toml reads them
+        fileio.atomic_write_text(path, tomli_w.dumps(relative_paths(self.to_dict(), path)))
 
     @classmethod
     def from_toml(cls, path: str | Path) -> "Scene":
         from tactileskin.params import read_toml
+        from tactileskin.scenefile import resolve_paths
 
-        return cls.from_dict(read_toml(path, "scene file"))
+        return cls.from_dict(resolve_paths(read_toml(path, "scene file"), path))
 
 
 from tactileskin import scene_doc as _scene_doc  # noqa: E402 (needs the class)

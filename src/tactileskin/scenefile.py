@@ -38,6 +38,55 @@ class SceneFile:
     path: str = ""
 
 
+# Scene fields that name a file (material: when it is a path ending in .toml)
+PATH_FIELDS = ("indenter_file", "skin_file")
+
+
+def _resolve(value, base: Path):
+    import os
+
+    if isinstance(value, str) and value and not Path(value).expanduser().is_absolute():
+        return os.path.normpath(base / value)
+    return value
+
+
+def resolve_paths(fields: dict, source) -> dict:
+    """`fields` with the relative file paths it names (indenter_file, skin_file, a .toml
+    material, a sweep's .toml materials) resolved against the folder of the file `source`
+    they were read from, not the working folder: a scene file then means the same files
+    wherever it is run from (as film calibration CSVs name their images)."""
+    base = Path(source).expanduser().absolute().parent
+    out = dict(fields)
+    for k in PATH_FIELDS:
+        if k in out:
+            out[k] = _resolve(out[k], base)
+    if isinstance(out.get("material"), str) and out["material"].endswith(".toml"):
+        out["material"] = _resolve(out["material"], base)
+    if isinstance(out.get("materials"), (list, tuple)):
+        out["materials"] = type(out["materials"])(_resolve(m, base) if isinstance(m, str) and m.endswith(".toml")
+                                                  else m for m in out["materials"])
+    return out
+
+
+def relative_paths(fields: dict, target) -> dict:
+    """`fields` with their file paths written relative to the folder of the file `target` they
+    are saved in (the inverse of resolve_paths; a path on another drive stays absolute)."""
+    import os
+
+    base = Path(target).expanduser().absolute().parent
+    out = dict(fields)
+    keys = [k for k in PATH_FIELDS if isinstance(out.get(k), str) and out[k]]
+    if isinstance(out.get("material"), str) and out["material"].endswith(".toml"):
+        keys.append("material")
+    for k in keys:
+        p = Path(out[k]).expanduser().absolute()
+        try:
+            out[k] = Path(os.path.relpath(p, base)).as_posix()
+        except ValueError:
+            out[k] = str(p)
+    return out
+
+
 def read(path: str | Path | None) -> SceneFile:
     """Parse a scene or sweep file (None: an empty one). ParameterError names the bad key."""
     if path is None:
@@ -50,13 +99,13 @@ def read(path: str | Path | None) -> SceneFile:
     both = sorted(set(top) & set(scene_tab))
     if both:
         raise ParameterError(f"scene field {both[0]}", str(path), "given once (top level or [scene], not both)")
-    fields = {**top, **scene_tab}
+    fields = resolve_paths({**top, **scene_tab}, path)
     quality = fields.pop("quality", None)
     if quality is not None:
         from tactileskin.presets import check_quality
 
         check_quality(quality)
-    axes = sweep_lists(data["sweep"]) if "sweep" in data else {}
+    axes = resolve_paths(sweep_lists(data["sweep"]), path) if "sweep" in data else {}
     for f, ax in AXES.items():
         if f in fields and ax in axes:
             raise ParameterError(f"scene field {f}", str(path), f"either {f} or sweep.{ax}, not both")

@@ -177,11 +177,11 @@ def load_spec(path: str | Path) -> dict:
 
     data = read_toml(path, "sweep file")
     validate.known_keys(data, ("sweep", "scene"), "sweep file table")
-    from tactileskin.scenefile import sweep_lists
+    from tactileskin.scenefile import resolve_paths, sweep_lists
 
-    spec: dict = sweep_lists(data.get("sweep", {}))
+    spec: dict = resolve_paths(sweep_lists(data.get("sweep", {})), path)
     if "scene" in data:
-        spec["base"] = Scene.from_dict(validate.table(data["scene"], "[scene]"))
+        spec["base"] = Scene.from_dict(resolve_paths(validate.table(data["scene"], "[scene]"), path))
     return spec
 
 

@@ -27,7 +27,9 @@ def load_config(path) -> dict:
     bad = sorted(set(table) - KEYS)
     if bad or not isinstance(table, dict):
         raise ParameterError("config [array] key", bad[0] if bad else table, ", ".join(sorted(KEYS)))
-    return {k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}
+    from tactileskin.scenefile import resolve_paths
+
+    return resolve_paths({k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}, path)
 
 
 @click.command("array")
