@@ -99,6 +99,16 @@ def test_file_paths_in_a_scene_file_are_relative_to_the_file_not_the_working_fol
     assert Scene.from_toml(tmp_path / "other" / "deep" / "s.toml").material == mine
 
 
+def test_a_sweep_takes_an_indenter_kinds_own_options_from_the_file_and_the_command_line(tmp_path):
+    f = tmp_path / "cyl.toml"
+    f.write_text('indenter = "cylinder"\nindenter_radius = 2.0\nthickness = 1.0\nmaterial = "silicone"\n')
+    (sc,) = scenes_from_options(_scene_opts(scene_file=str(f)))
+    assert sc.indenter_kind.name == "cylinder" and sc.indenter_radius == 2.0
+    scenes = scenes_from_options(_scene_opts(indenter="cylinder,sphere", indenter_radius=2.0, thickness="1",
+                                             material="silicone"))
+    assert [(s.indenter_kind.name, s.indenter_radius) for s in scenes] == [("cylinder", 2.0), ("sphere", 2.0)]
+
+
 def test_solve_refuses_a_sweep_file_of_several_cases_and_says_what_to_run(tmp_path, capsys):
     f = tmp_path / "grid.toml"
     f.write_text("[sweep]\nthicknesses = [1.0, 3.0]\n")

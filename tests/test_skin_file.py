@@ -164,3 +164,13 @@ def test_step_block_solves_like_the_pad_block(tmp_path):
     full = solve(Scene(skin="file", skin_file=str(path), **kw))
     quarter = solve(Scene(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, dim=3, **kw))
     assert full.reaction == pytest.approx(4.0 * quarter.reaction, rel=1e-3)
+
+
+def test_a_sweep_of_a_skin_file_takes_its_thickness_not_the_papers(tmp_path):
+    from tactileskin.cli._common import PHYSICS_KEYS, SCENE_KEYS
+    from tactileskin.cli.sweep import scenes_from_options
+
+    f = _gmsh_block(tmp_path / "skin.msh", dim=2, t=2.0)
+    opts = {k: None for k in SCENE_KEYS + PHYSICS_KEYS}
+    scenes = scenes_from_options({**opts, "skin_file": str(f), "indenter": "flat", "material": "silicone"})
+    assert [s.thickness for s in scenes] == [pytest.approx(2.0)]  # not 1, 3, 5 (each refused)

@@ -99,18 +99,22 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     fields = dict(sf.fields)
     axes = dict(sf.axes)
     for f, ax in scenefile.AXES.items():
-        if f in fields:
-            axes[ax] = (fields.pop(f),)
+        if f in fields:  # kept in the base too: its own fields (indenter_radius) need it there
+            axes[ax] = (fields[f],)
     mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
     mesh.update({k: o[k] for k in scenefile.MESH_FIELDS if o.get(k) is not None})
     single = {k: v for k, v in o.items() if k not in ("thickness", "material", "indenter", "depth", "braille_text")}
-    base = Scene.from_dict(fields).replace(**_field_changes(single))
+    changes = _field_changes(single)
+    if o.get("indenter"):  # the base takes the kind's own options (--indenter-radius) with it
+        axes["indenters"] = _names(o["indenter"], "indenter")
+        changes["indenter"] = axes["indenters"][0]
+    base = Scene.from_dict(fields).replace(**changes)
+    if base.skin_kind.fixes_thickness and "thicknesses" not in axes:
+        axes["thicknesses"] = (base.thickness,)  # a skin file fixes it: not the paper's 1, 3, 5
     if o.get("thickness"):
         axes["thicknesses"] = parse_values(o["thickness"], "thickness")
     if o.get("material"):
         axes["materials"] = _names(o["material"], "material")
-    if o.get("indenter"):
-        axes["indenters"] = _names(o["indenter"], "indenter")
     if o.get("depth"):
         axes["depths"] = parse_values(o["depth"], "depth")
     if o.get("braille_text"):

@@ -32,6 +32,8 @@ class Skin:
     order: ClassVar[int] = 9
     scene_params: ClassVar[tuple[str, ...]] = ()
     fixed_boundaries: ClassVar[tuple[str, ...]] = ("bone_interface",)
+    # the geometry fixes the thickness (a user's file): a sweep does not vary it by default
+    fixes_thickness: ClassVar[bool] = False
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
 
     @classmethod

@@ -164,6 +164,7 @@ class FileSkin(Skin):
     order = 3
     scene_params = ("skin_file", "skin_bonded", "skin_outer")
     fixed_boundaries = ("bone_interface",)
+    fixes_thickness = True
 
     @classmethod
     def check_scene(cls, scene) -> dict:
