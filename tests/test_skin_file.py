@@ -174,3 +174,15 @@ def test_a_sweep_of_a_skin_file_takes_its_thickness_not_the_papers(tmp_path):
     opts = {k: None for k in SCENE_KEYS + PHYSICS_KEYS}
     scenes = scenes_from_options({**opts, "skin_file": str(f), "indenter": "flat", "material": "silicone"})
     assert [s.thickness for s in scenes] == [pytest.approx(2.0)]  # not 1, 3, 5 (each refused)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_mesh_command_reports_a_skin_file(tmp_path, capsys, dim):
+    from tactileskin.cli import main
+
+    f = _gmsh_block(tmp_path / "skin.msh", dim=dim, t=2.0)
+    assert main(["mesh", "--skin-file", str(f), "-i", "cylinder", "--indenter-radius", "2"]) == 0
+    out = " ".join(capsys.readouterr().out.split())  # the table wraps at the terminal's width
+    assert "as meshed in" in out and "Traceback" not in out
+    area = 4.0 if dim == 2 else 16.0  # the block's bottom: w (x w)
+    assert f"bonded boundary measure (mm^{dim - 1}) │ {area:g} │" in out

@@ -32,24 +32,30 @@ def command(out, cell, scene_opts):
     sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
 
-    table = Table(title=escape(f"skin mesh {scene.label()} (mesh_size {scene.mesh_size:g} mm, "
-                               f"refinement {scene.refinement:g})"))
+    sizes = (f"as meshed in {scene.skin_file}" if scene.skin_kind.fixes_thickness
+             else f"mesh_size {scene.mesh_size:g} mm, refinement {scene.refinement:g}")
+    table = Table(title=escape(f"skin mesh {scene.label()} ({sizes})"))
     table.add_column("quantity")
     table.add_column("value", justify="right")
     shape = {"tri": {2: "triangles", 3: "tetrahedra"}[sm.dim], "quad": "quadrilaterals"}[sm.cell]
     kind = f"{'Q' if sm.cell == 'quad' else 'P'}{sm.order} {shape}"
     table.add_row("cells", f"{q['elements']} {kind}")
     table.add_row("nodes (vertices)", f"{q['nodes']} ({q['vertices']})")
-    table.add_row("refined size (mm)", f"{sm.sizes['fine']:.4g}")
-    table.add_row("min / mean SICN (shape)", f"{q['min_sicn']:.3f} / {q['mean_sicn']:.3f}")
+    if "fine" in sm.sizes:  # a user's skin file comes meshed: no size plan
+        table.add_row("refined size (mm)", f"{sm.sizes['fine']:.4g}")
+    if "min_sicn" in q:  # gmsh's shape measure: not computed for a user's mesh file
+        table.add_row("min / mean SICN (shape)", f"{q['min_sicn']:.3f} / {q['mean_sicn']:.3f}")
     table.add_row("min scaled Jacobian (curved)", f"{q['min_scaled_jacobian']:.3f}")
-    lz = 1.0 if sm.dim == 2 else (0.5 if sm.z_symmetric else 1.0) * sm.length
-    L = sm.boundary_measure("bone_interface") / lz
-    table.add_row("bone interface length (mm)",
-                  f"{L:.6f} (CAD {sec.interface_length:.6f}, rel. err {abs(L / sec.interface_length - 1):.1e})")
+    if scene.skin_kind.fixes_thickness:  # a user's file: no CAD section to compare with
+        table.add_row("bonded boundary measure (mm^%d)" % (sm.dim - 1), f"{sm.boundary_measure('bone_interface'):.6g}")
+    else:
+        lz = 1.0 if sm.dim == 2 else (0.5 if sm.z_symmetric else 1.0) * sm.length
+        L = sm.boundary_measure("bone_interface") / lz
+        table.add_row("bone interface length (mm)",
+                      f"{L:.6f} (CAD {sec.interface_length:.6f}, rel. err {abs(L / sec.interface_length - 1):.1e})")
     for name, f in sm.boundaries.items():
         table.add_row(f"facets: {name}", str(len(f)))
-    if sm.dim == 3:
+    if sm.dim == 3 and not scene.skin_kind.fixes_thickness:
         table.add_row("z symmetry", "yes (end_back is z = 0)" if sm.z_symmetric else "no")
     table.add_row("wall time (s)", f"{q['wall_s']:.2f}")
     console = Console()
