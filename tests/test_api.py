@@ -110,3 +110,14 @@ def test_parallel_sweep_in_a_script_without_main_guard(tmp_path):
                        cwd=tmp_path, env=env)
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout.count("RUNS") == 1 and "RUNS 1 ok" in r.stdout
+
+
+def test_a_misspelt_grid_key_or_an_empty_axis_is_a_parameter_error_not_a_silent_empty_sweep():
+    from tactileskin.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="thick"):
+        ts.scenes({"thick": [1]})
+    with pytest.raises(ParameterError, match="at least one value"):
+        ts.sweep({"thickness": []}, serial=True)
+    with pytest.raises(ParameterError, match="scene field"):
+        ts.Scene().replace(thick=1.0)

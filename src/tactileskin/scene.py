@@ -302,6 +302,10 @@ class Scene:
         """A changed copy. Changing `dim`, `indenter` or `thickness` re-derives mesh defaults
         left at default (3D Braille's depend on the thickness); changing `indenter` drops kind
         parameters the new kind does not read."""
+        names = [f.name for f in dataclasses.fields(self)]
+        unknown = sorted(set(changes) - set(names))
+        if unknown:
+            raise ParameterError("scene field", unknown[0], "one of " + ", ".join(names))
         new_dim = changes.get("dim", self.dim)
         new_skin = changes.get("skin", self.skin)
         if new_skin != self.skin:

@@ -106,6 +106,8 @@ def expand_grid(
                        ("forces", forces)):
         if isinstance(axis, (str, bytes)):  # would iterate as one-letter values
             raise ParameterError(name, axis, "a sequence of values, not a string")
+        if axis is not None and len(axis) == 0:  # would be a sweep of no case, silently
+            raise ParameterError(name, list(axis), "at least one value")
     if any(f is not None for f in forces) and any(d is not None for d in depths):
         raise ParameterError("forces", list(forces), "either forces or depths, not both",
                              "a case is pressed to a depth or to a force")
