@@ -180,6 +180,22 @@ def test_parse_values_refuses_non_finite(text):
         sweep.parse_values(text, "thickness")
 
 
+@pytest.mark.parametrize("text, says", [("", "none of them empty"), ("1,,2", "none of them empty"),
+                                         ("2,", "none of them empty"), ("0.5:5:1e-6", "at most 1000 values")])
+def test_parse_values_names_what_is_wrong(text, says):
+    with pytest.raises(ParameterError, match=says):  # a tiny positive step is not "step > 0"
+        sweep.parse_values(text, "thickness")
+
+
+def test_sweep_options_given_empty_are_refused_not_the_default_axes(tmp_path, capsys):
+    from tactileskin.cli import main
+
+    for opt in (["-t", ""], ["-m", ""], ["-i", "flat,,curved"]):
+        assert main(["sweep", *opt, "--no-render", "--out", str(tmp_path / "o")]) == 2
+        assert "none of them empty" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
 def test_grid_resolves_every_material_before_any_work():
     t0 = time.perf_counter()
     with pytest.raises(ParameterError, match="material='bogus'"):

@@ -67,7 +67,8 @@ def flags(summary: dict) -> list[Flag]:
     stress = _num(summary, "max_abs_stress_mpa")
     if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "
-                        "(material law outside its range: hyperfoam volumetric lock-up)"))
+                        "(more than a skin elastomer bears: the material law or its parameters are outside their "
+                        "range, e.g. a hyperfoam's volumetric lock-up or a modulus far above an elastomer's)"))
     J = _num(summary, "min_J")
     lo, hi = J_RANGE
     if J is not None and not (lo <= J <= hi):

@@ -47,21 +47,23 @@ def parse_values(text: str, name: str) -> list[float]:
     out: list[float] = []
     for part in str(text).split(","):
         part = part.strip()
-        if not part:
-            continue
+        if not part:  # "1,,2": a value left out by mistake, not nothing
+            raise ParameterError(name, text, "comma-separated finite numbers, none of them empty")
         try:
             if ":" in part:
                 a, b, c = (float(x) for x in part.split(":"))
                 if not all(np.isfinite((a, b, c))) or c <= 0 or b < a:
                     raise ValueError
                 n = int(np.floor((b - a) / c + 1e-9)) + 1
-                if n > 1000:
-                    raise ParameterError(name, text, "at most 1000 values")
+                if n > MAX_AXIS_VALUES:
+                    raise ParameterError(name, text, f"at most {MAX_AXIS_VALUES} values (a larger step)")
                 out.extend(round(a + i * c, 10) for i in range(n))
             else:
                 out.append(float(part))
                 if not np.isfinite(out[-1]):
                     raise ValueError
+        except ParameterError:
+            raise
         except ValueError:
             raise ParameterError(name, text, "comma-separated finite numbers or start:stop:step with step > 0") from None
     if not out:

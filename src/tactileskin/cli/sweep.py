@@ -105,17 +105,17 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     mesh.update({k: o[k] for k in scenefile.MESH_FIELDS if o.get(k) is not None})
     single = {k: v for k, v in o.items() if k not in ("thickness", "material", "indenter", "depth", "braille_text")}
     changes = _field_changes(single)
-    if o.get("indenter"):  # the base takes the kind's own options (--indenter-radius) with it
+    if o.get("indenter") is not None:  # the base takes the kind's own options (--indenter-radius) with it
         axes["indenters"] = _names(o["indenter"], "indenter")
         changes["indenter"] = axes["indenters"][0]
     base = Scene.from_dict(fields).replace(**changes)
     if base.skin_kind.fixes_thickness and "thicknesses" not in axes:
         axes["thicknesses"] = (base.thickness,)  # a skin file fixes it: not the paper's 1, 3, 5
-    if o.get("thickness"):
+    if o.get("thickness") is not None:
         axes["thicknesses"] = parse_values(o["thickness"], "thickness")
-    if o.get("material"):
+    if o.get("material") is not None:
         axes["materials"] = _names(o["material"], "material")
-    if o.get("depth"):
+    if o.get("depth") is not None:
         axes["depths"] = parse_values(o["depth"], "depth")
     if o.get("braille_text"):
         axes["braille_texts"] = tuple(o["braille_text"])
@@ -138,7 +138,7 @@ def _case_status(cache, oc) -> str:
 
 
 def _names(text: str, name: str) -> tuple[str, ...]:
-    items = tuple(x.strip() for x in text.split(",") if x.strip())
-    if not items:
-        raise ParameterError(name, text, "a comma-separated list of names")
+    items = tuple(x.strip() for x in text.split(","))
+    if not all(items):  # "" or "a,,b": a name left out by mistake
+        raise ParameterError(name, text, "a comma-separated list of names, none of them empty")
     return items
