@@ -28,7 +28,7 @@ import numpy as np
 from tactileskin import fileio
 from tactileskin.errors import ParameterError
 from tactileskin.film.inputs import read_text
-from tactileskin.film.scan import (ANALYZE_NAMES, COMPARE_NAMES, FilmProfile, fold_profile,
+from tactileskin.film.scan import (COMPARE_NAMES, FilmProfile, fold_profile,
                                    profile_metrics)
 
 log = logging.getLogger(__name__)
@@ -134,21 +134,18 @@ class Comparison:
         else:
             fileio.claim_dir(out, "film-compare")
         doc = json.loads(json.dumps(self.to_dict(), default=str))
-        fileio.atomic_write_json(out / "comparison.json", _finite_or_none(doc))
-        plots.overlay(self, out / "overlay.png")
+        with fileio.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
+            fileio.atomic_write_json(tmp / "comparison.json", _finite_or_none(doc))
+            plots.overlay(self, tmp / "overlay.png")
         return {"comparison": out / "comparison.json", "overlay": out / "overlay.png"}
 
 
 def _is_analyze_folder(out: Path) -> bool:
-    """A folder `film analyze` wrote: its marker says so, or (written before markers) it
-    holds profile.csv and summary.json (claim_dir still checks every name is ours)."""
-    marker = out / fileio.MARKER
-    if marker.is_file():
-        try:
-            return json.loads(marker.read_text()).get("kind") == "film-analyze"
-        except (OSError, ValueError, AttributeError):
-            return False
-    return (out / "profile.csv").is_file() and (out / "summary.json").is_file()
+    """A folder `film analyze` wrote: its marker says so."""
+    try:
+        return json.loads((out / fileio.MARKER).read_text()).get("kind") == "film-analyze"
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def _finite_or_none(o):

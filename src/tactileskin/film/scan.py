@@ -195,9 +195,10 @@ class FilmProfile:
     def write(self, out, *, cmap: str = "viridis") -> dict[str, Path]:
         """Write profile.csv, summary.json and pressure_map.png into ``out``.
 
-        ``out`` must be new, empty or a `film analyze` folder (fileio.claim_dir); each file
-        is written atomically. A comparison left there by an earlier `film compare` is
-        removed: it describes the previous profile.
+        ``out`` must be new, empty or a `film analyze` folder (fileio.claim_dir). The files
+        are staged and moved in together (fileio.staged_files): a failed write leaves the
+        folder as it was. A comparison left there by an earlier `film compare` is removed: it
+        describes the previous profile.
         """
         from tactileskin.film import plots
 
@@ -210,12 +211,10 @@ class FilmProfile:
             hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
             lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},"
                          f"{self.pressure_sd[k]:.6g},{lo},{hi}")
-        for stale in COMPARE_NAMES:
-            with fileio.os_errors(out / stale):
-                (out / stale).unlink(missing_ok=True)
-        fileio.atomic_write_text(out / names["profile"], "\n".join(lines) + "\n")
-        fileio.atomic_write_json(out / names["summary"], self.summary())
-        plots.pressure_map(self, out / names["map"], cmap=cmap)
+        with fileio.staged_files(out, ANALYZE_NAMES + COMPARE_NAMES, last=names["summary"]) as tmp:
+            fileio.atomic_write_text(tmp / names["profile"], "\n".join(lines) + "\n")
+            fileio.atomic_write_json(tmp / names["summary"], self.summary())
+            plots.pressure_map(self, tmp / names["map"], cmap=cmap)
         return {k: out / v for k, v in names.items()}
 
 
