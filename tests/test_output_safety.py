@@ -266,6 +266,18 @@ def counted_cases(monkeypatch):
     return calls
 
 
+def test_a_sweep_replaces_its_outputs_whole_and_leaves_a_users_file(tmp_path, capsys, counted_cases):
+    out = tmp_path / "out"
+    argv = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
+    assert main(argv) == 1  # the (faked) case failed; the outputs are written
+    (out / "fig9_t5-silicone-flat-2d.png").write_bytes(b"a render of an earlier sweep")
+    (out / "notes.txt").write_text("mine")
+    assert main(argv) == 1
+    assert not (out / "fig9_t5-silicone-flat-2d.png").exists()  # not this sweep's: it would mislead
+    assert (out / "notes.txt").read_text() == "mine" and (out / "report.md").is_file()
+    assert _temporaries(out) == []
+
+
 def test_sweep_refuses_a_foreign_folder_before_solving(tmp_path, capsys, counted_cases):
     out = tmp_path / "out"
     out.mkdir()

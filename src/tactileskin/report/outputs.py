@@ -9,7 +9,7 @@ import re
 from pathlib import Path
 
 from tactileskin import quality
-from tactileskin.fileio import atomic_write_text, make_dirs
+from tactileskin.fileio import atomic_write_text, make_dirs, staged_files
 
 log = logging.getLogger(__name__)
 
@@ -74,12 +74,32 @@ def _write_parquet(path: Path, columns: list[str], rows) -> None:
         pq.write_table(table, tmp)
 
 
+# the files a sweep writes into its folder (fnmatch patterns; fig9_: one render per material)
+SWEEP_FILES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md",
+               *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span",
+                                              "fig13_auc") for ext in ("png", "svg")),
+               "metrics_vs_thickness.pdf", "fig9_*.png")
+
+
 def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = True,
                   figures: bool = True) -> dict:
+    """The sweep's tables, figures and report in `out` (claimed by the caller: claim_dir),
+    staged and moved in together (report.md last): a failed write leaves the earlier outputs
+    as they were, and figures of an earlier sweep this one has not are removed."""
+    out = make_dirs(out)
+    with staged_files(out, SWEEP_FILES, last="report.md") as tmp:
+        res = _write_outputs(tmp, outcomes, cache, wall_s, render=render, figures=figures)
+    for k in ("results", "profiles", "report"):
+        res[k] = out / res[k].name
+    res["figures"] = [out / p.name for p in res["figures"]]
+    res["renders"] = [out / p.name for p in res["renders"]]
+    return res
+
+
+def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
     from tactileskin.report.figures import all_figures
     from tactileskin.report.markdown import build_report
 
-    out = make_dirs(out)  # the CLI has claimed it (fileio.claim_dir)
     records, rows, failures = collect(outcomes, cache)
 
     buf = io.StringIO()
