@@ -236,8 +236,19 @@ def _cell(a: float) -> str:
     return f"**{a:.2f}**" if a >= GOOD else f"{a:.2f}"
 
 
+# the files `array` writes into its folder (fnmatch patterns)
+ARRAY_FILES = ("accuracies.csv", "array_chart.md", "array_*.png", "array_*.svg")
+
+
 def write_outputs(chart, out: Path, validation=None, method: str = "template") -> dict:
-    """accuracies.csv, array_chart.md and the figures into `out` (claimed by the caller)."""
-    atomic_write_text(out / "accuracies.csv", chart.to_csv())
-    atomic_write_text(out / "array_chart.md", markdown(chart, validation, method) + "\n")
-    return {"csv": out / "accuracies.csv", "report": out / "array_chart.md", "figures": write_figures(chart, out, method)}
+    """accuracies.csv, array_chart.md and the figures into `out` (claimed by the caller),
+    staged and moved in together (the report last): a failed write leaves the earlier chart,
+    and figures of an earlier chart this one has not are removed."""
+    from tactileskin.fileio import staged_files
+
+    with staged_files(out, ARRAY_FILES, last="array_chart.md") as tmp:
+        atomic_write_text(tmp / "accuracies.csv", chart.to_csv())
+        atomic_write_text(tmp / "array_chart.md", markdown(chart, validation, method) + "\n")
+        figures = write_figures(chart, tmp, method)
+    return {"csv": out / "accuracies.csv", "report": out / "array_chart.md",
+            "figures": [out / p.name for p in figures]}
