@@ -140,6 +140,17 @@ def test_staged_files_replace_one_result_with_the_next(tmp_path):
     with pytest.raises(ValueError, match="other.txt"), fileio.staged_files(d, ("a.csv",)) as tmp:
         (tmp / "other.txt").write_text("x")  # only owned names are moved in
     assert not (d / "other.txt").exists()
+    # a link where a subfolder of ours goes: refused, nothing written through it
+    (tmp_path / "users").mkdir()
+    (d / "steps" / "mine.txt").unlink()
+    (d / "steps").rmdir()
+    (d / "steps").symlink_to(tmp_path / "users")
+    with pytest.raises(fileio.OutputError, match="link"), \
+            fileio.staged_files(d, ("a.csv", "steps/s_*.vtu")) as tmp:
+        (tmp / "a.csv").write_text("4")
+        (tmp / "steps").mkdir()
+        (tmp / "steps" / "s_0.vtu").write_text("4")
+    assert list((tmp_path / "users").iterdir()) == [] and (d / "a.csv").read_text() == "2"
 
 
 def test_solve_out_dot_works_when_empty_and_refuses_cleanly_otherwise(tmp_path, capsys, monkeypatch, fake_solve):

@@ -351,6 +351,11 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
         if stray:
             raise ValueError(f"staged files not in the owned patterns: {stray}")
         old = [f for f in _files(folder) if any(fnmatch.fnmatchcase(f, p) for p in own)]
+        for rel in new:  # a linked subfolder would take our files into a folder we do not own
+            for parent in list(Path(rel).parents)[:-1]:
+                if (folder / parent).is_symlink() or ((folder / parent).exists() and not (folder / parent).is_dir()):
+                    raise OutputError(folder / parent, "it is a link or a file where tactileskin writes a folder "
+                                                       "of its own; move it away")
         trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "old"), suffix=".partial", dir=folder))
         try:
             with os_errors(folder):
