@@ -111,6 +111,37 @@ def test_a_failed_solve_write_leaves_the_earlier_result_whole(tmp_path, capsys, 
     assert _temporaries(d) == [] and sorted(p.name for p in tmp_path.iterdir()) == ["d"]
 
 
+def test_staged_files_undo_a_move_that_fails_halfway(tmp_path, monkeypatch):
+    import errno
+
+    d = tmp_path / "d"
+    own = ("a.csv", "b.csv", "c.csv", "summary.json")
+    with fileio.staged_files(d, own, last="summary.json") as tmp:
+        for name in own:
+            (tmp / name).write_text("old")
+    before = {p.name: p.read_text() for p in d.iterdir()}
+    real, calls = os.replace, []
+
+    def flaky(src, dst):
+        calls.append(dst)
+        if len(calls) == 4:  # after summary.json aside and a.csv swapped: mid-way through b.csv
+            raise OSError(errno.EIO, "I/O error", str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky)
+    with pytest.raises(fileio.OutputError), fileio.staged_files(d, own, last="summary.json") as tmp:
+        for name in own:
+            (tmp / name).write_text("new")
+    monkeypatch.setattr(os, "replace", real)
+    assert {p.name: p.read_text() for p in d.iterdir()} == before and _temporaries(d) == []
+
+
+def test_temporaries_of_long_names_fit_the_file_system(tmp_path):
+    name = "a" * 240 + ".inp"  # valid (244 bytes); its temporary must be too
+    fileio.atomic_write_text(tmp_path / name, "x")
+    assert (tmp_path / name).read_text() == "x"
+
+
 def test_a_new_solve_removes_the_earlier_2d_comparison(tmp_path, capsys, fake_solve):
     d = tmp_path / "d"
     assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0

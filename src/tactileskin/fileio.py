@@ -90,7 +90,9 @@ def os_errors(path, *, own_name: bool = True) -> Iterator[None]:
 
 
 def _tmp_prefix(path: Path) -> str:
-    return f".{path.name}.tsk{os.getpid()}-"
+    # the name cut short: a name near the file system's 255-byte limit is valid, its
+    # temporary (about 25 characters longer) would not be
+    return f".{path.name[:64]}.tsk{os.getpid()}-"
 
 
 def is_temporary(name: str) -> bool:
@@ -357,24 +359,36 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
                     raise OutputError(folder / parent, "it is a link or a file where tactileskin writes a folder "
                                                        "of its own; move it away")
         trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "old"), suffix=".partial", dir=folder))
+        aside, moved_in = [], []  # (where it was, where it is): undone in reverse on a failure
         try:
             with os_errors(folder):
                 order = sorted(set(new) | set(old), key=lambda f: f == last)
                 if last in old:
                     os.replace(folder / last, trash / "last")
+                    aside.append((folder / last, trash / "last"))
                 for i, rel in enumerate(order):
                     dst = folder / rel
                     if rel in old and rel != last:
                         os.replace(dst, trash / f"{i}")
+                        aside.append((dst, trash / f"{i}"))
                     if rel in new:
                         make_dirs(dst.parent)
                         os.replace(tmp / rel, dst)
-                # folders of the earlier result that are empty now (deepest first)
-                for rel in sorted({Path(f).parent for f in old} - {Path(".")}, key=lambda d: -len(d.parts)):
-                    with contextlib.suppress(OSError):
-                        (folder / rel).rmdir()
+                        moved_in.append((tmp / rel, dst))
+        except BaseException:
+            for src, dst in reversed(moved_in):  # the earlier result back as it was
+                with contextlib.suppress(OSError):
+                    os.replace(dst, src)
+            for orig, parked in reversed(aside):
+                with contextlib.suppress(OSError):
+                    os.replace(parked, orig)
+            raise
         finally:
             shutil.rmtree(trash, ignore_errors=True)
+        # folders of the earlier result that are empty now (deepest first)
+        for rel in sorted({Path(f).parent for f in old} - {Path(".")}, key=lambda d: -len(d.parts)):
+            with contextlib.suppress(OSError):
+                (folder / rel).rmdir()
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
