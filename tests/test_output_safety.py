@@ -430,3 +430,16 @@ def test_geometry_override_still_works(tmp_path, monkeypatch):
     monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(tmp_path))
     assert params.geometry_dir() == tmp_path
     assert params.read_toml(params.geometry_dir() / "fingertip.toml", "p") == {"x": {"y": 1}}
+
+
+def test_result_write_refuses_a_users_folder(tmp_path):
+    user = tmp_path / "user"
+    (user / "result_steps").mkdir(parents=True)
+    (user / "summary.json").write_text("MY DATA")
+    (user / "result_steps" / "step_0001.vtu").write_text("MINE")
+    with pytest.raises(fileio.OutputError, match="did not write"):
+        fake_result().write(user)
+    assert (user / "summary.json").read_text() == "MY DATA"
+    assert (user / "result_steps" / "step_0001.vtu").read_text() == "MINE"
+    out = fake_result().write(tmp_path / "new")  # a new folder: claimed, written, rewritten
+    assert fake_result().write(out) == out and (out / "summary.json").is_file()

@@ -45,7 +45,7 @@ class _Written:
     def __init__(self, fail=False):
         self.fail = fail
 
-    def write(self, d):
+    def write_owned(self, d):
         d.mkdir(parents=True, exist_ok=True)  # Result.write creates the folder or writes into it
         (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1.5\n1,0.5\n")
         if self.fail:

@@ -223,11 +223,11 @@ class ResultCache:
 
     # --- writing ------------------------------------------------------------------------
     def store(self, scene: Scene, result, key: str | None = None) -> Path:
-        """Write `result` (has .write(dir)) under the scene's key, atomically."""
+        """Write `result` (has .write_owned(dir)) under the scene's key, atomically."""
         key = key or self.key(scene)
         final = self.root / key
         with fileio.os_errors(final), fileio.staged_dir(final) as tmp:
-            result.write(tmp)
+            result.write_owned(tmp)
             scene.to_toml(tmp / "scene.toml")
             (tmp / "cache.json").write_text(json.dumps(
                 {"schema": SCHEMA_VERSION, "key": key, "version": __version__}, indent=2) + "\n",

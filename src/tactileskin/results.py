@@ -312,6 +312,13 @@ class Result:
         return grid
 
     def write(self, directory) -> Path:
+        """Write the result into `directory`: a new or empty folder, or one tactileskin marked
+        as a solve's (fileio.claim_dir; a folder of other files is refused, OutputError, and
+        left as it is). See write_owned for the files."""
+        fileio.claim_dir(directory, "solve", what="directory")
+        return self.write_owned(directory)
+
+    def write_owned(self, directory) -> Path:
         """Write OWN_FILES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
         displacement_mm and the other fields named with their unit, boundaries by name);
         with a history, result.pvd over result_steps/; with sensors, sensors.csv; 3D: also
@@ -319,8 +326,8 @@ class Result:
         where it occurs) into `directory`, creating it. All of them are staged and moved in
         together (fileio.staged_files): a failed write leaves the folder as it was, and files of
         an earlier result that this one has not (a map, a field file) are removed; other files
-        are not touched. Callers writing into a user's folder claim it first
-        (fileio.claim_dir)."""
+        are not touched. For folders the caller owns (a cache entry, a staging folder): `write`
+        claims a user's folder first."""
         directory = fileio.make_dirs(directory)
         with fileio.staged_files(directory, OWN_FILES, last="summary.json") as tmp:
             self._write_files(tmp)

@@ -67,11 +67,11 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         # one result in the folder: staged, then moved in together (summary.json last); files
         # of an earlier result this one has not (a map, a 2D section) are removed
         with fileio.staged_files(out, OWN_FILES, last="summary.json") as tmp:
-            res.write(tmp)
+            res.write_owned(tmp)
             _write_map_figure(res, tmp, scene.label())
             _write_sensors_figure(res, tmp, scene.label())
             if r2 is not None:
-                r2.write(tmp / "section_2d")
+                r2.write_owned(tmp / "section_2d")
                 fileio.atomic_write_json(tmp / "compare_2d.json", _compare_doc(scene, res.summary(), r2))
         path = Path(out)
     s = res.summary()
