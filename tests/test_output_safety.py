@@ -443,3 +443,22 @@ def test_result_write_refuses_a_users_folder(tmp_path):
     assert (user / "result_steps" / "step_0001.vtu").read_text() == "MINE"
     out = fake_result().write(tmp_path / "new")  # a new folder: claimed, written, rewritten
     assert fake_result().write(out) == out and (out / "summary.json").is_file()
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="reads the signal mask from /proc")
+def test_meshing_keeps_the_sigterm_handler_that_unwinds_the_cli():
+    # gmsh's initialize installs C-level handlers over Python's: a SIGTERM then killed the
+    # process in place, leaving its staging folder behind
+    from tactileskin.mesh import build_mesh
+    from tactileskin.scene import Scene
+
+    def caught() -> bool:
+        line = next(x for x in open("/proc/self/status") if x.startswith("SigCgt:"))
+        return bool(int(line.split()[1], 16) & (1 << (signal.SIGTERM - 1)))
+
+    previous = signal.signal(signal.SIGTERM, lambda *a: None)
+    try:
+        build_mesh(Scene(thickness=1.0, mesh_size=1.0, refinement=2.0))
+        assert caught()
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -41,7 +41,8 @@ def session(name: str, params: dict):
     with _LOCK:
         owned = not gmsh.isInitialized()
         if owned:
-            gmsh.initialize(interruptible=False)
+            with _signals_kept():
+                gmsh.initialize(interruptible=False)
         try:
             gmsh.option.setNumber("General.Terminal", 1 if logger.isEnabledFor(logging.DEBUG) else 0)
             gmsh.option.setNumber("General.Verbosity", 5 if logger.isEnabledFor(logging.DEBUG) else 2)
@@ -64,7 +65,27 @@ def session(name: str, params: dict):
                 gmsh.model.remove()
         finally:
             if owned:
-                gmsh.finalize()
+                with _signals_kept():
+                    gmsh.finalize()
+
+
+@contextlib.contextmanager
+def _signals_kept():
+    """Re-install Python's SIGINT / SIGTERM handlers after the block: gmsh's initialize puts
+    its own C-level handlers in their place (Python still reports its own), so a SIGTERM
+    killed the process outright, leaving its staging folder, instead of unwinding (cli)."""
+    import signal
+    import threading
+
+    keep = {}
+    if threading.current_thread() is threading.main_thread():
+        keep = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in keep.items():
+            if handler is not None:
+                signal.signal(sig, handler)
 
 
 def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]], cell: str = "tri"):
