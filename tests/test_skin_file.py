@@ -119,6 +119,24 @@ def test_cache_key_follows_bytes_not_path(tmp_path):
     assert cache.cache_key(Scene(skin="file", skin_file=str(b))) != ka  # edited: new key
 
 
+def test_a_cached_result_of_a_moved_skin_file_is_reused_not_called_damaged(tmp_path, caplog):
+    import numpy as np
+
+    from tactileskin.results import Result
+
+    a = _gmsh_block(tmp_path / "a.msh", dim=2)
+    rc = cache.ResultCache(tmp_path / "cache")
+    res = Result(s=np.array([0.0, 1.0]), pressure=np.array([0.2, 0.0]), contact_x=np.zeros(0),
+                 contact_pressure=np.zeros(0), reaction=0.1, stats={"dofs": 6})
+    rc.store(Scene(skin="file", skin_file=str(a)), res)
+    b = tmp_path / "sub" / "b.msh"
+    b.parent.mkdir()
+    shutil.move(a, b)  # same bytes, another name: the same key, and the entry is still good
+    rec = rc.load(Scene(skin="file", skin_file=str(b)))
+    assert rec is not None and rec.summary["peak_mpa"] == 0.2
+    assert "damaged" not in caplog.text
+
+
 def _step_block(path, w=4.0, t=2.0, open_=False):
     import build123d as bd
 

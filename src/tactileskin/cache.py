@@ -113,6 +113,25 @@ def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return s, p
 
 
+def _plain(d: dict) -> dict:
+    """As TOML reads it back (tuples as lists)."""
+    return json.loads(json.dumps(d))
+
+
+def _stored_fields(path: Path, scene: Scene) -> dict:
+    """The fields an entry's scene.toml records, without those whose file contents are in the
+    key (as _scene_fields). Read as written, not rebuilt into a Scene: rebuilding would read
+    the files it names, and a moved or renamed file (same bytes, same key) would read as a
+    damaged entry."""
+    from tactileskin.params import read_toml
+
+    d = read_toml(path, "cache entry scene.toml")
+    d.pop("material", None)
+    for name in (*scene.indenter_kind.cache_content(scene), *scene.skin_kind.cache_content(scene)):
+        d.pop(name, None)
+    return _plain(d)
+
+
 def _scene_fields(scene: Scene) -> dict:
     d = scene.to_dict()
     d.pop("material")  # its content is in the key; the file may have been renamed
@@ -200,8 +219,7 @@ class ResultCache:
             if np.any(np.diff(s) <= 0):
                 raise ValueError("s is not increasing")
             name = "scene.toml"
-            stored = Scene.from_toml(p / name)
-            if _scene_fields(stored) != _scene_fields(scene):
+            if _stored_fields(p / name, scene) != _plain(_scene_fields(scene)):
                 raise ValueError("describes another scene")
         except FileNotFoundError:
             return None, f"{name} is missing"
