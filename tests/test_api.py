@@ -121,3 +121,31 @@ def test_a_misspelt_grid_key_or_an_empty_axis_is_a_parameter_error_not_a_silent_
         ts.sweep({"thickness": []}, serial=True)
     with pytest.raises(ParameterError, match="scene field"):
         ts.Scene().replace(thick=1.0)
+
+
+@pytest.mark.parametrize("call, names", [
+    (lambda r: ts.scenes({1: [1]}), "grid key"),
+    (lambda r: ts.scenes({"thickness": [1]}, base={"thickness": 1}), "base"),
+    (lambda r: ts.scenes({"thickness": {1: 2}}), "thickness"),  # was: the dict's keys
+    (lambda r: ts.scenes({"thickness": b"1"}), "thickness"),    # was: thickness 49
+    (lambda r: ts.sweep([]), "grid"),
+    (lambda r: ts.sweep({"thickness": [1]}, workers="x"), "workers"),
+    (lambda r: ts.sweep({"thickness": [1]}, cache=5), "cache"),
+    (lambda r: ts.solve(thickness=1, progress=5), "progress"),  # before meshing, not after
+    (lambda r: ts.solve(thickness=1, history="yes"), "history"),
+    (lambda r: ts.Scene.from_toml(5), "scene file"),            # not read as file descriptor 5
+    (lambda r: r.write(5), "directory"),
+    (lambda r: r.plot(ax=5), "ax"),
+])
+def test_api_mistakes_are_parameter_errors_naming_the_argument(call, names):
+    from tactileskin.errors import ParameterError
+
+    r = Result(s=np.array([0.0, 1.0]), pressure=np.array([0.2, 0.0]), contact_x=np.zeros(0),
+               contact_pressure=np.zeros(0), reaction=0.1, stats={"dofs": 6})
+    with pytest.raises(ParameterError, match=names):
+        call(r)
+
+
+def test_the_force_axis_is_a_grid_key():
+    scs = ts.scenes({"force": [0.1, 0.2], "thickness": [1], "material": ["silicone"], "indenter": ["flat"]})
+    assert [s.force for s in scs] == [0.1, 0.2]

@@ -21,7 +21,27 @@ from tactileskin.errors import ParameterError
 
 # sweep(grid) keys: a Scene field (one value or a list) or a sweep list name
 _GRID_ALIASES = {"thickness": "thicknesses", "material": "materials", "indenter": "indenters",
-                 "depth": "depths", "braille_text": "braille_texts", "braille_dim": "braille_dims"}
+                 "depth": "depths", "braille_text": "braille_texts", "braille_dim": "braille_dims",
+                 "force": "forces"}
+
+
+def _path_or_none(name: str, value):
+    if value is not None and not isinstance(value, (str, os.PathLike)):
+        raise ParameterError(name, repr(value), "a folder path (str or os.PathLike) or None")
+    return value
+
+
+def _axis_values(name: str, v) -> list:
+    """One grid axis: a single value or a list / tuple / range / 1-D array of values."""
+    import numpy as np
+
+    if isinstance(v, (str, int, float)) or v is None:
+        return [v]
+    if isinstance(v, np.ndarray) and v.ndim == 1:
+        return v.tolist()
+    if isinstance(v, (list, tuple, range)):
+        return list(v)
+    raise ParameterError(name, repr(v), "a value or a list of values (not a dict, set or bytes)")
 
 
 def default_cache_dir() -> Path:
@@ -43,6 +63,10 @@ def solve(scene=None, *, quality: str | None = None, history: bool = False, prog
     from tactileskin import scenefile
     from tactileskin.fe import solve as fe_solve
 
+    if not isinstance(history, bool):
+        raise ParameterError("history", repr(history), "True or False")
+    if progress is not None and not callable(progress):
+        raise ParameterError("progress", repr(progress), "a callable taking an IncrementInfo, or None")
     sc, file_quality, mesh = _scene(scene, fields)
     if quality or file_quality:
         sc = scenefile.apply_quality(sc, quality or file_quality, mesh)
@@ -75,6 +99,10 @@ def scenes(grid=None, *, quality: str | None = None, base=None) -> list:
     from tactileskin.scene import Scene
     from tactileskin.sweep import expand_grid
 
+    if base is not None and not isinstance(base, Scene):
+        raise ParameterError("base", repr(base), "a Scene or None")
+    if isinstance(grid, (list, tuple)) and len(grid) == 0:
+        raise ParameterError("grid", "[]", "at least one Scene (or a dict of axes, a TOML path, None)")
     if isinstance(grid, (list, tuple)) and all(isinstance(s, Scene) for s in grid):
         if quality is None:
             return list(grid)
@@ -88,9 +116,11 @@ def scenes(grid=None, *, quality: str | None = None, base=None) -> list:
                 axes[ax] = (fields.pop(f),)
     elif isinstance(grid, dict):
         for k, v in grid.items():
+            if not isinstance(k, str):
+                raise ParameterError("grid key", repr(k), "a name: " + ", ".join(_GRID_ALIASES) + " or a Scene field")
             ax = _GRID_ALIASES.get(k, k)
             if ax in _GRID_ALIASES.values():
-                axes[ax] = [v] if isinstance(v, (str, int, float)) or v is None else list(v)
+                axes[ax] = _axis_values(k, v)
             else:
                 fields[k] = v  # a Scene field, the same in every case
     elif grid is not None:
@@ -128,6 +158,10 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     from tactileskin.report.outputs import collect, profile_rows
     from tactileskin.sweep import run_sweep
 
+    _path_or_none("out", out)
+    _path_or_none("cache", cache)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ParameterError("workers", repr(workers), "a whole number >= 1, or None (one per core)")
     scs = scenes(grid, quality=quality, base=base)
     if cache is None:
         cache = Path(out) / "cache" if out is not None else default_cache_dir()

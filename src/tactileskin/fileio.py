@@ -73,6 +73,8 @@ def _cause(e: OSError) -> str:
         return "a part of the path is a file, not a folder"
     if e.errno == errno.EISDIR:
         return "it is a folder"
+    if e.errno == errno.EEXIST:
+        return "a file is in the way where a folder is needed"
     return e.strerror or type(e).__name__
 
 

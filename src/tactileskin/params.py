@@ -76,6 +76,8 @@ def _parse(raw: bytes, path, what: str) -> dict:
 def read_toml(path: str | Path, what: str) -> dict:
     """Parse a user's TOML file; a missing, unreadable, oversized (> MAX_TOML_BYTES), non-UTF-8
     or malformed file is a ParameterError naming `what`."""
+    if not isinstance(path, (str, os.PathLike)):  # an int would be read as an open descriptor
+        raise ParameterError(what, repr(path), "a file path (str or os.PathLike)")
     return _parse(_read_capped(path, what), path, what)
 
 
