@@ -318,12 +318,14 @@ def staged_dir(final) -> Iterator[Path]:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _files(root: Path) -> list[str]:
-    """Paths (relative, with "/") of the files under `root`, our temporaries left out."""
+def _files(root: Path, subfolders=None) -> list[str]:
+    """Paths (relative, with "/") of the files under `root`, our temporaries left out; with
+    `subfolders`, only those top-level folders are entered (not a sweep's cache)."""
     out = []
     for dirpath, dirnames, filenames in os.walk(root):
-        dirnames[:] = [d for d in dirnames if not _TMP_RE.match(d)]
         rel = Path(dirpath).relative_to(root)
+        dirnames[:] = [d for d in dirnames if not _TMP_RE.match(d)
+                       and (subfolders is None or rel != Path(".") or d in subfolders)]
         out += [(rel / f).as_posix() for f in filenames if not _TMP_RE.match(f)]
     return out
 
@@ -354,7 +356,8 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
         stray = [f for f in new if not any(fnmatch.fnmatchcase(f, p) for p in own)]
         if stray:
             raise ValueError(f"staged files not in the owned patterns: {stray}")
-        old = [f for f in _files(folder) if any(fnmatch.fnmatchcase(f, p) for p in own)]
+        tops = {p.split("/")[0] for p in own if "/" in p}
+        old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
         for rel in new:  # a linked subfolder would take our files into a folder we do not own
             for parent in list(Path(rel).parents)[:-1]:
                 if (folder / parent).is_symlink() or ((folder / parent).exists() and not (folder / parent).is_dir()):
