@@ -150,6 +150,21 @@ def test_a_new_solve_removes_the_earlier_2d_comparison(tmp_path, capsys, fake_so
     assert not (d / "compare_2d.json").exists() and not (d / "section_2d").exists()
 
 
+def test_a_failed_2d_comparison_keeps_the_3d_result(tmp_path, capsys, monkeypatch):
+    from tactileskin.errors import ConvergenceError
+
+    def solve(scene, **kw):
+        if scene.dim == 2:
+            raise ConvergenceError("no convergence in this test", {})
+        return fake_result()
+
+    monkeypatch.setattr(tactileskin.fe, "solve", solve)
+    d = tmp_path / "d"
+    assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0
+    assert (d / "summary.json").is_file() and not (d / "compare_2d.json").exists()
+    assert "2D section could not be solved" in capsys.readouterr().out
+
+
 def test_staged_files_replace_one_result_with_the_next(tmp_path):
     d = tmp_path / "d"
     with fileio.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:

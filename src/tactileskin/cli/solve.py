@@ -45,6 +45,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     from rich.text import Text
 
     from tactileskin import fileio
+    from tactileskin.errors import TactileSkinError
     from tactileskin.fe import solve
 
     scene = scene_from_options(scene_opts, "solve")
@@ -63,7 +64,12 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)
-        r2 = _solve_2d(scene) if compare_2d else None
+        r2, r2_error = None, None
+        if compare_2d:
+            try:
+                r2 = _solve_2d(scene)
+            except TactileSkinError as e:  # the 3D result (minutes of solving) is kept
+                r2_error = e
         # one result in the folder: staged, then moved in together (summary.json last); files
         # of an earlier result this one has not (a map, a 2D section) are removed
         with fileio.staged_files(out, OWN_FILES, last="summary.json") as tmp:
@@ -117,6 +123,10 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         rc = EXIT_SUSPECT
     if r2 is not None:
         _print_compare_2d(_compare_doc(scene, s, r2), r2.summary())
+    if r2_error is not None:
+        console.print(Text("warning: --compare-2d: the 2D section could not be solved, so there is no "
+                           "compare_2d.json: ", style="bold yellow") + Text(str(r2_error).splitlines()[0]),
+                      highlight=False)
     return rc
 
 
