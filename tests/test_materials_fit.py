@@ -89,6 +89,27 @@ def test_bad_data_rejected(lam, P, match):
         fit("neo_hookean", lam, P)
 
 
+@pytest.mark.parametrize("P, match", [(np.zeros(8), "all zero"), (-0.1 * (np.linspace(1.05, 2, 8) - 1), "wrong sign")])
+def test_stress_of_no_test_is_refused_before_fitting(P, match):
+    # all zero: least_squares raised a bare ValueError; the wrong sign fitted mu = 1e-12 with
+    # R^2 = -4, a file that then solved to a "peak" of 1e-12 MPa, reported ok
+    for law in ("neo_hookean", "mooney_rivlin", "ogden"):
+        with pytest.raises(FitDataError, match=match):
+            fit(law, np.linspace(1.05, 2, 8), P)
+
+
+def test_a_fit_that_explains_nothing_or_an_unstable_law_is_refused():
+    from tactileskin.materials.fit import FitError, _check_stable
+
+    lam = np.linspace(1.05, 2.0, 12)
+    P = 0.02 * np.sin(6.0 * (lam - 1.0))  # rises and falls: no hyperelastic uniaxial curve
+    with pytest.raises(FitError, match="explains none|not stable"):
+        fit("neo_hookean", lam, P)
+    with pytest.raises(FitError, match="not stable"):  # c01 < 0: compression pulls the wrong way
+        _check_stable("mooney_rivlin", MooneyRivlin(0.1, -0.08, 1.0), lam, None)
+    _check_stable("mooney_rivlin", MooneyRivlin(0.01, 0.004, 1.0), lam, None)  # a real silicone's
+
+
 def test_bad_options_rejected():
     from tactileskin.errors import ParameterError
 

@@ -135,6 +135,14 @@ def check_data(stretch, stress, n_params: int):
                            "strictly increasing or decreasing (one loading branch, no repeats)")
     if np.max(np.abs(lam - 1.0)) < 1e-4:
         raise FitDataError("stretch", "all within 1e-4 of 1", "a test beyond 0.01 % strain")
+    if not np.any(P != 0.0):
+        raise FitDataError("stress", "all zero", "the measured nominal stresses (MPa), not all zero")
+    # an elastomer pulls back: positive nominal stress in tension, negative in compression
+    wrong = int(np.sum(P * (lam - 1.0) < 0.0))
+    if wrong > lam.size // 2:
+        raise FitDataError("stress", f"of the wrong sign at {wrong} of {lam.size} points",
+                           "positive in tension (stretch > 1), negative in compression (MPa)",
+                           "is the stress column the nominal stress of this test, with its sign?")
     order = np.argsort(lam)
     return lam[order], P[order]
 
@@ -210,8 +218,32 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
     if not np.all(ok) or not np.all(np.isfinite(pred)):
         raise FitError(f"fit of {law} did not converge to an admissible law ({sol.message})")
     q = _quality(P, pred, n_params)
+    if not q["r2"] > 0.0:  # worse than the data's mean: the law does not describe this test
+        raise FitError(f"fit of {law} explains none of the data (R^2 = {q['r2']:.3g}, RMSE "
+                       f"{q['rmse_mpa']:.3g} MPa): try another law, or check the data's columns and units")
+    _check_stable(law, mat, lam, nu)
     q["nfev"] = int(sol.nfev)
     return Fit(law=mat, stretch=lam, stress=P, predicted=pred, nu=nu, quality=q)
+
+
+def _check_stable(law: str, mat, lam, nu) -> None:
+    """FitError unless the fitted law stiffens with stretch in uniaxial tension and compression
+    over the data's range and a margin (0.7 to 1.5 at least): a law whose stress falls with
+    stretch (a negative c01, a wrong-signed Ogden term) fits the points but has no stable
+    solution, and a solve with it would not converge."""
+    grid = np.linspace(min(0.7, float(lam.min())), max(1.5, float(lam.max())), 81)
+    with np.errstate(all="ignore"):
+        try:
+            P, ok = uniaxial_nominal(mat, grid, nu)
+        except (ParameterError, FloatingPointError, OverflowError):
+            P, ok = np.full(grid.shape, np.nan), np.zeros(grid.shape, bool)
+    bad = ~(np.asarray(ok) & np.isfinite(P))
+    bad[1:] |= np.diff(P) <= 0.0
+    if np.any(bad):
+        at = float(grid[int(np.argmax(bad))])
+        raise FitError(f"the fitted {law} law is not stable: its uniaxial stress does not rise with stretch "
+                       f"at stretch {at:.3g} ({mat.to_dict() if hasattr(mat, 'to_dict') else mat}); "
+                       "try another law or fewer terms")
 
 
 def _alpha_seeds(terms):
