@@ -239,6 +239,10 @@ def test_scene_default_has_no_sensors_and_sensors_enter_the_key(tmp_path):
     ({"s": [0.0], "depth": 3.5}, 2, r"depth.*\[0, 3\] mm"),
     ({"s": [0.0], "height": -0.1}, 2, r"height.*\[0, 3\] mm"),
     ({"s": [99.0], "depth": 1.0}, 2, r"'x' s.*\[-\d"),
+    # within the bone's arc length, but below the surface the skin ends earlier, at the nail cut
+    # (this one passed the check and failed after the solve, "sample point ... inside the mesh")
+    ({"s": [9.4], "depth": 1.0}, 2, r"'x' s=9.4.*\[-9.17\d*, 9.17\d*\] mm at depth 1 mm \(the skin ends at the nail\)"),
+    ({"s": [-9.45], "depth": 1.0}, 3, "ends at the nail"),
     ({"kind": "line", "s": [0, 3], "pitch": 1.0, "depth": 1.0, "z": [0, 1]}, 2, "one z"),
     ({"kind": "grid", "s": [0, 3], "z": [0, 1], "pitch": 1.0, "depth": 1.0}, 2, "grid"),
     ({"s": [0.0], "z": [1.0], "depth": 1.0}, 2, "omitted in 2D"),

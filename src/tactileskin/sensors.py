@@ -215,6 +215,38 @@ class SectionCoordinates:
         jac = (1.0 - depth * kap) / (1.0 - self.thickness * kap)
         return p, n, tang, jac
 
+    def s_limit(self, depth: float) -> float:
+        """The largest |s| whose point at `depth` lies in the skin: the skin ends at the nail
+        in a cut that is not along the outer normal, so below the surface it ends before
+        s_max (t = 3: at depth 1, s <= about 9.3 of 9.45 mm)."""
+        poly = self.section.polygon(800)
+
+        def inside(s_):
+            p = self.frame(np.array([s_]), np.array([depth]))[0][0]  # s_ >= 0: the half x >= 0
+            return _inside(poly, p)
+
+        if inside(self.s_max):
+            return self.s_max
+        lo, hi = 0.0, self.s_max
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if inside(mid) else (lo, mid)
+        return lo
+
+
+def _inside(poly: np.ndarray, p: np.ndarray, tol: float = 1e-4) -> bool:
+    """Whether point p lies in the closed polygon (ray casting; a point within tol (mm) of an
+    edge counts as inside: the surface and the bone are in the skin, and the sampled outline's
+    chords cut under the curve by ~1e-5 mm)."""
+    a, b = poly, np.roll(poly, -1, axis=0)
+    ab = b - a
+    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+    if np.min(np.linalg.norm(a + t[:, None] * ab - p, axis=1)) <= tol:
+        return True
+    cross = (a[:, 1] > p[1]) != (b[:, 1] > p[1])
+    x_at = a[:, 0] + (p[1] - a[:, 1]) * ab[:, 0] / np.where(ab[:, 1] == 0, 1e-300, ab[:, 1])
+    return bool(np.sum(cross & (p[0] < x_at)) % 2)
+
 
 class FlatCoordinates:
     """A flat layer: s = x in [-half_width, half_width], depth below y = top. For blocks
@@ -284,11 +316,11 @@ def _to3(p):
     return p if p.shape[1] == 3 else np.column_stack([p, np.zeros(len(p))])
 
 
-def _check_range(where, what, v, lo, hi, unit="mm"):
+def _check_range(where, what, v, lo, hi, unit="mm", note=""):
     v = np.atleast_1d(v)
     bad = (v < lo - _TOL) | (v > hi + _TOL)
     if np.any(bad):
-        raise ParameterError(f"{where} {what}", float(v[bad][0]), f"[{lo:.6g}, {hi:.6g}] {unit}")
+        raise ParameterError(f"{where} {what}", float(v[bad][0]), f"[{lo:.6g}, {hi:.6g}] {unit}{note}")
 
 
 def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) -> Sites:
@@ -310,7 +342,9 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
             _check_range(where, "height", lay.height, 0.0, t)
         s, z = lay.positions()
         h = 0.5 * lay.taxel
-        _check_range(where, "s" + (" +- taxel/2" if h else ""), np.concatenate([s - h, s + h]), -smax, smax)
+        lim = coords.s_limit(d) if hasattr(coords, "s_limit") else smax
+        _check_range(where, "s" + (" +- taxel/2" if h else ""), np.concatenate([s - h, s + h]), -lim, lim,
+                     note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
         if dim == 3 and z_range is not None:
             _check_range(where, "z" + (" +- taxel/2" if h else ""), np.concatenate([z - h, z + h]), *z_range)
         n0 = len(ids)
