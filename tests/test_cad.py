@@ -339,7 +339,8 @@ def test_refuses_to_replace_a_folder_with_other_files(builds, tmp_path):
 
 
 def test_kernel_failure_names_the_parameters(monkeypatch):
-    # a stem fillet larger than the stem cannot be made: OCC fails, we get a CadError
+    # a stem of no length cannot be made: OCC fails, we get a CadError (the fillet, which once
+    # served here, is now kept within the room the face leaves)
     from tactileskin import params
 
     real = params.load
@@ -347,12 +348,12 @@ def test_kernel_failure_names_the_parameters(monkeypatch):
     def load(name):
         p = real(name)
         if name == "indenters":
-            p = {**p, "stem": {**p["stem"], "fillet": 50.0}}
+            p = {**p, "stem": {**p["stem"], "length": 0.0}}
         return p
 
     monkeypatch.setattr(solids.params, "load", load)
     ind = make_indenter("flat", y0=7.0, dim=3)
-    with pytest.raises(CadError, match=r"stem_fillet=50.*kind='flat'"):
+    with pytest.raises(CadError, match=r"stem_length=0.*kind='flat'"):
         solids.indenter_solid(ind)
 
 
