@@ -85,6 +85,13 @@ def test_fewer_than_three_points_is_an_error():
         fit_calibration([50, 150], [0.7, 0.3])
 
 
+def test_presses_a_scan_cannot_tell_apart_are_rejected():
+    # 1e-4 gray levels apart: fitted a slope of 1e4 MPa per level (overflow warnings), and
+    # read 82 % of a normal scan as saturated
+    with pytest.raises(ParameterError, match=r"calibration gray=.*200.0001, 200.0003.*at least 2 gray levels"):
+        fit_calibration([200.0001, 200.0002, 200.0003], [0.3, 0.17, 0.02])
+
+
 def test_flat_or_v_shaped_presses_are_rejected():
     x = np.array([40, 80, 120, 160, 200.0])
     with pytest.raises(ParameterError, match="monotonic"):

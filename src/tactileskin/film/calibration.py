@@ -278,6 +278,9 @@ def _direction(model: str, params, gs_range) -> int:
     return 0
 
 
+MIN_GRAY_SPAN = 2.0  # gray levels the presses must span: a scan quantises to 1
+
+
 def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted",
                     unit: str = "MPa", activation_range=None, extra_points: dict | None = None
                     ) -> Calibration:
@@ -306,6 +309,10 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
     if np.ptp(x) == 0:
         raise ParameterError("calibration gray", f"all {x[0]:g}", "at least two distinct values",
                              hint="every press has the same grayscale")
+    if np.ptp(x) < MIN_GRAY_SPAN:  # a scan resolves one gray level: the slope would be noise
+        raise ParameterError("calibration gray", f"[{x.min():.8g}, {x.max():.8g}]",
+                             f"a span of at least {MIN_GRAY_SPAN:g} gray levels (8-bit scans step by 1)",
+                             hint="the presses are indistinguishable on a scan; press harder or softer")
     if np.ptp(y) == 0:
         raise ParameterError("calibration pressure", f"all {y[0]:g} {unit}",
                              "at least two distinct pressures",
