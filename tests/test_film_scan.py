@@ -71,6 +71,22 @@ def test_peak_centring_finds_the_true_centre():
         assert mid.origin_mm == pytest.approx(centre, abs=0.5 / PPM)
 
 
+@pytest.mark.parametrize("noise", [0, 2])
+def test_a_flat_topped_press_is_centred_on_its_middle(tmp_path, noise):
+    # a plate's (or a saturated) press: gray 100 from 6.25 to 18.75 mm. The parabola over the
+    # top put the origin at 13.7 mm (8.1 mm with +-2 gray of noise), folding the profile off-centre
+    px = 8
+    x = (np.arange(25 * px) + 0.5) / px
+    img = np.full((60, x.size), 250.0)
+    img[:, (x >= 6.25) & (x <= 18.75)] = 100.0
+    img += np.random.default_rng(1).integers(-noise, noise + 1, img.shape)
+    path = tmp_path / "plateau.png"
+    Image.fromarray(np.clip(img, 0, 255).astype(np.uint8)).save(path)
+    fp = analyze_scan(str(path), px_per_mm=px)
+    assert fp.origin_mm == pytest.approx(12.5, abs=1.0 / px)
+    assert fp.folded["asymmetry"] < 0.05
+
+
 def test_saturation_clips_at_the_activation_range():
     # a peak of 1.5 MPa/mm exceeds Eq. 8's range (0.978 at GS = 0): the top reads 0.978
     # minus the rectified noise at black, E[max(0, N)] = 0.4 sigma gray levels

@@ -114,9 +114,15 @@ def fold_profile(s, p):
     return sh, ph, asym
 
 
+# A flat top: the samples within FLAT_TOP of the maximum span more than FLAT_SPAN of the
+# window >= PEAK_WINDOW; a rounded (parabolic) peak's 2 % band spans about a third of it.
+FLAT_TOP, FLAT_SPAN = 0.02, 0.6
+
+
 def _peak_position(x, p) -> float:
     """Sub-sample position of the maximum: LSQ parabola over the contiguous samples >= 80 %
-    of the maximum around the argmax (at least its neighbours), vertex kept in that window."""
+    of the maximum around the argmax (at least its neighbours), vertex kept in that window;
+    a flat top's middle (FLAT_TOP, FLAT_SPAN)."""
     i = int(np.argmax(p))
     thr = PEAK_WINDOW * p[i]
     a = i
@@ -128,8 +134,13 @@ def _peak_position(x, p) -> float:
     a, b = min(a, max(i - 1, 0)), max(b, min(i + 1, p.size - 1))
     if b - a < 2:
         return float(x[i])
+    top = np.flatnonzero(p[a:b + 1] >= (1.0 - FLAT_TOP) * p[i]) + a
+    if x[top[-1]] - x[top[0]] > FLAT_SPAN * (x[b] - x[a]):
+        # a flat top (a plate's press, a saturated film): the argmax is wherever the noise puts
+        # it and a parabola has no vertex to find; the middle of the top is the centre
+        return float(0.5 * (x[top[0]] + x[top[-1]]))
     c2, c1, _ = np.polyfit(x[a:b + 1] - x[i], p[a:b + 1], 2)
-    if c2 >= 0:  # flat or noisy: no interior maximum
+    if c2 >= 0:  # noisy: no interior maximum
         return float(x[i])
     return float(np.clip(x[i] - c1 / (2 * c2), x[a], x[b]))
 
