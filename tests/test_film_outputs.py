@@ -87,3 +87,18 @@ def test_calibrate_out_under_a_file(tmp_path, capsys):
     err = capsys.readouterr().err.replace("\n", "")
     assert "cannot write" in err and "Traceback" not in err
     assert (tmp_path / "f").read_text() == "a file"
+
+
+def test_compare_refuses_a_result_without_contact_and_warns_of_a_suspect_one(tmp_path, capsys, scan, sim):
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    (sim / "summary.json").write_text(json.dumps({"status": "suspect: no contact"}))
+    np.savetxt(sim / "profile.csv", np.column_stack([S, 0.0 * S]), delimiter=",",
+               header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+    assert main(["film", "compare", str(film), str(sim)]) == 2  # was: -100 % everywhere, exit 0
+    assert "zero everywhere" in capsys.readouterr().err and not (film / "comparison.json").exists()
+    np.savetxt(sim / "profile.csv", np.column_stack([S, gaussian_profile(0.4, 1.0)(S)]), delimiter=",",
+               header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+    (sim / "summary.json").write_text(json.dumps({"status": "suspect: volume ratio J = 0.8"}))
+    assert main(["film", "compare", str(film), str(sim)]) == 0
+    assert "warning: the simulated result is suspect" in capsys.readouterr().err

@@ -122,4 +122,7 @@ def compare(film_dir, sim_dir, out):
     for k in ("peak", "span_mm", "auc"):
         click.echo(f"{k:<8} {comp.film_metrics[k]:>10.4g} {comp.sim_metrics[k]:>10.4g} "
                    f"{comp.percent_diff[k]:>+8.1f}")
+    status = str(comp.sim_meta.get("status", "ok"))
+    if status != "ok":  # comparison.json carries it too (sim_meta)
+        click.echo(f"warning: the simulated result is {status}", err=True)
     click.echo(f"wrote {out or film_dir}")

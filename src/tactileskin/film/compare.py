@@ -170,6 +170,9 @@ def compare(film, sim) -> Comparison:
     else:
         ss, sp = (np.asarray(a, float) for a in sim)
         smeta = {}
+    if not np.any(sp > 0):  # a result without contact: every difference would read -100 %
+        raise ParameterError("simulated profile", "zero everywhere", "a result with bone pressure",
+                             hint=f"its status: {smeta.get('status', 'not recorded')}")
     if ss[0] < -1e-9:  # a full (two-sided) simulated profile: fold it the same way
         ss, sp, _ = fold_profile(ss, sp)
     hs, hp, asym = fold_profile(fs, fpr)
