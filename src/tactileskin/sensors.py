@@ -32,12 +32,15 @@ stresses; the solver's is `fe.probe.stress_sampler`.
 from __future__ import annotations
 
 import io
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from tactileskin import validate
 from tactileskin.errors import ParameterError
+
+log = logging.getLogger(__name__)
 
 KINDS = ("points", "line", "grid")
 MAX_SENSORS = 20000          # all layouts of a scene together
@@ -114,6 +117,13 @@ class SensorLayout:
         lay = cls(name, kind, s, z, depth, height, pitch, taxel, tp)
         if lay.count() > MAX_SENSORS:
             raise ParameterError(f"{where} sensors", lay.count(), f"<= {MAX_SENSORS} (a larger pitch)")
+        if kind != "points" and taxel > min(pitch) + 1e-9:  # allowed (a smoothing study), but no array
+            log.warning("%s: taxels of %g mm at a %g mm pitch overlap (no array can be built so)",
+                        where, taxel, min(pitch))
+        if kind == "points":
+            ps, zs = lay.positions()
+            if len(set(zip(np.round(ps, 9), np.round(zs, 9)))) < len(ps):
+                log.warning("%s: two sensors at the same place (s, z); they read the same", where)
         return lay
 
     def to_dict(self) -> dict:
