@@ -110,6 +110,15 @@ def test_a_fit_that_explains_nothing_or_an_unstable_law_is_refused():
     _check_stable("mooney_rivlin", MooneyRivlin(0.01, 0.004, 1.0), lam, None)  # a real silicone's
 
 
+def test_a_strain_column_in_percent_is_refused_and_a_very_long_stretch_warned(caplog):
+    lam = np.linspace(1.5, 51.0, 12)  # "strain" 50 % typed as 50
+    with pytest.raises(FitDataError, match="percent"):
+        fit("neo_hookean", lam, 0.01 * (lam - lam**-2))
+    lam = np.linspace(1.2, 12.0, 12)
+    fit("neo_hookean", lam, 0.01 * (lam - lam**-2))
+    assert "beyond the break" in caplog.text
+
+
 def test_bad_options_rejected():
     from tactileskin.errors import ParameterError
 

@@ -109,6 +109,11 @@ def _quality(stress, pred, n_params) -> dict:
             "n_points": int(len(stress)), "n_params": int(n_params)}
 
 
+# Stretches of a uniaxial test: soft elastomers break at about 10 (900 % elongation, the
+# softest silicones); beyond 50 the strain column is surely in percent.
+PLAUSIBLE_STRETCH, MAX_STRETCH = 10.0, 50.0
+
+
 def check_data(stretch, stress, n_params: int):
     """(stretch, stress) as float arrays ordered by increasing stretch, or FitDataError."""
     try:
@@ -135,6 +140,12 @@ def check_data(stretch, stress, n_params: int):
                            "strictly increasing or decreasing (one loading branch, no repeats)")
     if np.max(np.abs(lam - 1.0)) < 1e-4:
         raise FitDataError("stretch", "all within 1e-4 of 1", "a test beyond 0.01 % strain")
+    if lam.max() > MAX_STRETCH:
+        raise FitDataError("stretch", float(lam.max()), f"<= {MAX_STRETCH:g} (stretch = 1 + strain)",
+                           "a strain column in percent? give it as a fraction (0.5 for 50 %)")
+    if lam.max() > PLAUSIBLE_STRETCH:
+        log.warning("stretch up to %.3g: beyond the break of soft elastomers (about %g); is the strain a "
+                    "fraction (0.5 for 50 %%)?", lam.max(), PLAUSIBLE_STRETCH)
     if not np.any(P != 0.0):
         raise FitDataError("stress", "all zero", "the measured nominal stresses (MPa), not all zero")
     # an elastomer pulls back: positive nominal stress in tension, negative in compression
