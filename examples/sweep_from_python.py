@@ -36,7 +36,7 @@ else:
 
 df, profiles = ts.sweep({"thickness": [1.0, 2.0, 3.0], "material": "silicone", "indenter": "flat"},
                         quality="preview", workers=2, out=out, profiles=True)
-print(df[["case", "status", "peak_mpa", "span_mm", "auc"]].to_string(index=False))
+print(df[["case", "status", "peak_mpa", "span_mm", "auc_mpa_mm"]].to_string(index=False))
 print(f"{len(profiles)} profile points in long form; report: {out / 'report.md'}")
 
 peak = df.set_index("thickness_mm").peak_mpa

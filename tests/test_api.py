@@ -149,3 +149,14 @@ def test_api_mistakes_are_parameter_errors_naming_the_argument(call, names):
 def test_the_force_axis_is_a_grid_key():
     scs = ts.scenes({"force": [0.1, 0.2], "thickness": [1], "material": ["silicone"], "indenter": ["flat"]})
     assert [s.force for s in scs] == [0.1, 0.2]
+
+
+def test_summary_keys_carry_their_units_and_a_3d_reaction_is_in_newtons():
+    from tactileskin.results import reaction_of
+
+    kw = dict(s=np.array([0.0, 1.0]), pressure=np.array([0.2, 0.0]), contact_x=np.zeros(0),
+              contact_pressure=np.zeros(0), reaction=0.1, stats={"dofs": 6})
+    s2, s3 = Result(**kw, scene={"dim": 2}).summary(), Result(**kw, scene={"dim": 3}).summary()
+    assert "reaction_n_per_mm" in s2 and "reaction_n" not in s2  # plane strain: per mm of depth
+    assert "reaction_n" in s3 and "reaction_n_per_mm" not in s3  # 3D: the force on the model
+    assert reaction_of(s2) == reaction_of(s3) == 0.1 and s2["auc_mpa_mm"] == pytest.approx(0.1)

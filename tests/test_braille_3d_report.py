@@ -105,7 +105,7 @@ def _case(t, ind, peak, w, *, dim=2, mat="silicone", summary=None, depth=None):
     row = dict(status=quality.status(rec.summary), material=mat, thickness_mm=t, indenter=ind,
                braille_text="", dim=dim, paper=markdown.at_paper_conditions(sc), depth_mm=sc.indentation,
                rate_mm_s=sc.rate, reaction_n_per_mm=None,
-               peak_mpa=float(p.max()), span_mm=w * np.sqrt(np.log(10)), auc=float(np.trapezoid(p, S)))
+               peak_mpa=float(p.max()), span_mm=w * np.sqrt(np.log(10)), auc_mpa_mm=float(np.trapezoid(p, S)))
     return rec, row
 
 

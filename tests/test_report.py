@@ -20,7 +20,7 @@ def _records(widths):
         recs.append(CaseRecord(sc, s, p, {}, Path(".")))
         span = w * np.sqrt(np.log(10))
         rows.append(dict(status="ok", material=mat, thickness_mm=t, indenter=ind, braille_text="",
-                         peak_mpa=peak, span_mm=span, auc=float(np.trapezoid(p, s))))
+                         peak_mpa=peak, span_mm=span, auc_mpa_mm=float(np.trapezoid(p, s))))
     return recs, rows
 
 

@@ -28,7 +28,7 @@ def _grid():
                 p = pk / (1 + t) * np.exp(-(s / w) ** 2)
                 recs.append(CaseRecord(Scene(thickness=t, material=mat, indenter=ind), s, p, {}, Path(".")))
                 rows.append(dict(status="ok", material=mat, thickness_mm=t, indenter=ind, braille_text="",
-                                 peak_mpa=float(p.max()), span_mm=1.5 * w, auc=float(np.trapezoid(p, s))))
+                                 peak_mpa=float(p.max()), span_mm=1.5 * w, auc_mpa_mm=float(np.trapezoid(p, s))))
     return recs, rows
 
 

@@ -160,7 +160,7 @@ def test_report_lists_failed_and_suspect_first_and_keeps_suspect_out_of_checks()
         summ = {**NORMAL, "peak_mpa": peak, **extra}
         recs.append(CaseRecord(sc, s, peak * np.exp(-s ** 2), summ, Path(".")))
         rows.append(dict(case=sc.label(), status=quality.status(summ), material="silicone", thickness_mm=1.0,
-                         indenter=ind, braille_text="", depth_mm=0.2, peak_mpa=peak, span_mm=1.0, auc=0.1,
+                         indenter=ind, braille_text="", depth_mm=0.2, peak_mpa=peak, span_mm=1.0, auc_mpa_mm=0.1,
                          reaction_n_per_mm=0.1))
     rows.append(dict(case="t3-x", status=quality.failed_status("did not converge"), material="silicone",
                      thickness_mm=3.0, indenter="flat", braille_text=""))

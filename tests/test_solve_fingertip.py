@@ -56,7 +56,7 @@ def test_result_write_is_complete(flat_1mm, tmp_path):
     s = np.array([float(a) for a, _ in rows[1:]])
     assert np.all(np.diff(s) > 0)
     summ = json.loads((out / "summary.json").read_text())
-    for k in ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "dofs", "newton_iterations",
+    for k in ("peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "dofs", "newton_iterations",
               "increments", "wall_s"):
         assert k in summ
     assert summ["peak_mpa"] == pytest.approx(flat_1mm.peak)

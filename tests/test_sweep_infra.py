@@ -50,7 +50,7 @@ class _Written:
         (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1.5\n1,0.5\n")
         if self.fail:
             raise OSError(28, "No space left on device")
-        (d / "summary.json").write_text(json.dumps({"peak_mpa": 1.5, "span_mm": 1.0, "auc": 1.0}))
+        (d / "summary.json").write_text(json.dumps({"peak_mpa": 1.5, "span_mm": 1.0, "auc_mpa_mm": 1.0}))
 
 
 def test_cache_store_is_atomic(tmp_path):

@@ -206,7 +206,7 @@ class ResultCache:
             summary = json.loads((p / name).read_text(encoding="utf-8"))
             if not isinstance(summary, dict):
                 raise ValueError("not a JSON object")
-            for k in ("peak_mpa", "span_mm", "auc"):
+            for k in ("peak_mpa", "span_mm", "auc_mpa_mm"):
                 v = summary.get(k)
                 if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                     raise ValueError(f"{k} = {v!r}, expected a finite number")

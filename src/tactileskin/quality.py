@@ -48,11 +48,12 @@ def _num(summary: dict, key: str):
 def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
-    Keys read: peak_mpa, reaction_n_per_mm, contact_points, min_J, max_abs_stress_mpa (a
+    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa (a
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []
-    peak, reaction = _num(summary, "peak_mpa"), _num(summary, "reaction_n_per_mm")
+    rkey = "reaction_n" if "reaction_n" in summary else "reaction_n_per_mm"
+    peak, reaction = _num(summary, "peak_mpa"), _num(summary, rkey)
     npts = _num(summary, "contact_points")
     none = []
     if npts is not None and npts <= 0:
@@ -74,7 +75,7 @@ def flags(summary: dict) -> list[Flag]:
     if J is not None and not (lo <= J <= hi):
         out.append(Flag("volume_range", f"volume ratio J = {J:.4g} outside [{lo:g}, {hi:g}] "
                         "(material law outside its range)"))
-    for key in ("peak_mpa", "reaction_n_per_mm"):
+    for key in ("peak_mpa", rkey):
         v = _num(summary, key)
         if v is not None and not math.isfinite(v):
             out.append(Flag("non_finite", f"{key} is {v}"))

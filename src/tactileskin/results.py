@@ -215,6 +215,12 @@ class Result:
                 f"{int(self.stats.get('dofs', 0))} dofs{extra}>")
 
     @property
+    def dim(self) -> int:
+        """2 or 3: the scene's, else 3 when the result has a bone map."""
+        d = (self.scene or {}).get("dim")
+        return int(d) if d in (2, 3) else (3 if self.bone_map is not None else 2)
+
+    @property
     def peak(self) -> float:
         return peak(*self._profile())
 
@@ -240,8 +246,8 @@ class Result:
         out = {
             "peak_mpa": self.peak,
             "span_mm": self.span,
-            "auc": self.auc,
-            "reaction_n_per_mm": float(self.reaction),
+            "auc_mpa_mm": self.auc,
+            reaction_key(self.dim): float(self.reaction),
             "contact_points": int(len(self.contact_x)),
             # extremes of the material law's state (fe.output.law_state)
             **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa")
@@ -360,9 +366,23 @@ class Result:
         if self.loading is not None and self.history:
             cols = ["t", "d", "reaction", "peak_mpa", "segment"]
             fileio.atomic_write_text(directory / "history.csv", _csv(
-                ["t_s", "travel_mm", "reaction", "peak_bone_pressure_mpa", "segment"],
+                ["t_s", "travel_mm", reaction_key(self.dim), "peak_bone_pressure_mpa", "segment"],
                 *[np.array([h.get(c, np.nan) for h in self.history], float) for c in cols]))
         fileio.atomic_write_json(directory / "summary.json", self.summary())
+
+
+def reaction_key(dim: int) -> str:
+    """The summary key of the indenter's reaction, named with its unit: per mm of depth in 2D
+    (plane strain), the force on the modelled part of the slab in 3D."""
+    return "reaction_n" if int(dim) == 3 else "reaction_n_per_mm"
+
+
+def reaction_of(summary: dict):
+    """The reaction of a summary (either key), or None."""
+    for k in ("reaction_n_per_mm", "reaction_n"):
+        if k in summary:
+            return summary[k]
+    return None
 
 
 # the files Result.write owns in a folder (fnmatch patterns, relative paths)

@@ -39,8 +39,9 @@ from tactileskin.skins import registry as _skins
 # directions recomputed with the held contact points (and 2D short steps retried): other
 # increment sequences on the 2D Braille, curved and flat cases, peaks within 0.10 %; 11: the
 # 3D Braille bone patches at most 2.3 x the dot patch size (mesh.sizing.BONE_SCALE_MAX):
-# other meshes from t = 3.3 mm)
-SCHEMA_VERSION = 11
+# other meshes from t = 3.3 mm; 12: summary keys named with their units: auc_mpa_mm, and the
+# reaction reaction_n_per_mm (2D) or reaction_n (3D), which 3D results had called per mm)
+SCHEMA_VERSION = 12
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).

@@ -420,8 +420,9 @@ def shallow_scene(dot):
 
 def dot_exponent(rec, rec_shallow) -> float:
     """surrogate.load_exponent of the lone dot's two solves (their reactions)."""
-    return surrogate.load_exponent(float(rec.summary["reaction_n_per_mm"]),
-                                   float(rec_shallow.summary["reaction_n_per_mm"]))
+    from tactileskin.results import reaction_of
+
+    return surrogate.load_exponent(float(reaction_of(rec.summary)), float(reaction_of(rec_shallow.summary)))
 
 
 def letter_scenes(cfg: ChartConfig, material: str, t: float, full: bool = False) -> dict:

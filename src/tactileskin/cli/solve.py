@@ -84,7 +84,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     t = Table(title=escape(f"{scene.label()} -> {path}"), show_header=False)
     t.add_row("peak bone pressure", f"{s['peak_mpa']:.4g} MPa")
     t.add_row("span (P >= 10 % of peak)", f"{s['span_mm']:.3g} mm")
-    t.add_row("area under P(s)", f"{s['auc']:.4g} MPa mm")
+    t.add_row("area under P(s)", f"{s['auc_mpa_mm']:.4g} MPa mm")
     if scene.dim == 3:
         t.add_row("bone profile on plane", f"z = {res.stats.get('profile_plane_z', 0.0):g} mm")
         if "peak_map_mpa" in s:
@@ -93,9 +93,9 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         if "peak_map_edge_mpa" in s:
             t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {s['peak_map_edge_s_mm']:.3g} mm, "
                       f"z = {s['peak_map_edge_z_mm']:.3g} mm (a corner singularity: grows with mesh refinement)")
-        t.add_row("reaction (modelled part of the slab)", f"{s['reaction_n_per_mm']:.4g} N")
+        t.add_row("reaction (modelled part of the slab)", f"{results.reaction_of(s):.4g} N")
     else:
-        t.add_row("reaction (half section)", f"{s['reaction_n_per_mm']:.4g} N/mm")
+        t.add_row("reaction (half section)", f"{results.reaction_of(s):.4g} N/mm")
     if "loading" in s:
         lo, unit = s["loading"], "N" if scene.dim == 3 else "N/mm"
         if lo.get("target_force") is not None:

@@ -181,6 +181,8 @@ def _run_history(scene, model, section, program, options, progress):
     last = hist[-1] if hist else {}
     res.loading = {
         "control": program[0].kind, "segments": [g.to_dict() for g in program],
+        # the forces and reactions below: per mm of depth in 2D, on the modelled part in 3D
+        "force_unit": "N" if scene.dim == 3 else "N/mm",
         "target_force": scene.force, "reached_force": best["reaction"] if scene.force is not None else None,
         "profile_state": "peak load",
         "profile_t_s": best["t"], "profile_travel_mm": best["d"], "profile_reaction": best["reaction"],

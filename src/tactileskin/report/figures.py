@@ -169,7 +169,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     return _save(fig, out, stem)
 
 
-METRICS = (("peak_mpa", "peak P (MPa)"), ("span_mm", "span (mm)"), ("auc", "area under P(s) (MPa mm)"))
+METRICS = (("peak_mpa", "peak P (MPa)"), ("span_mm", "span (mm)"), ("auc_mpa_mm", "area under P(s) (MPa mm)"))
 
 
 def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
@@ -213,5 +213,5 @@ def all_figures(records, rows, out: Path) -> list[Path]:
     paths += profiles_figure(records, out)
     paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
     paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)
-    paths += metric_figure(rows, "auc", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)
+    paths += metric_figure(rows, "auc_mpa_mm", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)
     return paths

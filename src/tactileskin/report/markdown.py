@@ -22,6 +22,15 @@ def _fmt(v, nd=3):
     return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{nd}g}"
 
 
+def _reaction(row) -> str:
+    """The row's reaction with its unit: N/mm of depth in 2D, N on the modelled part in 3D."""
+    for key, unit in (("reaction_n_per_mm", "N/mm"), ("reaction_n", "N")):
+        v = row.get(key)
+        if v is not None and v != "" and not (isinstance(v, float) and math.isnan(v)):
+            return f"{_fmt(v)} {unit}"
+    return "n/a"
+
+
 def at_paper_conditions(scene) -> bool:
     """The paper's loading and geometry: 20 % indentation at the default rate, viscoelastic,
     the default fingertip and Braille standard. The paper checks use only these cases."""
@@ -148,7 +157,7 @@ def paper_checks(rows, records, braille_dim: int | None = None) -> list[dict]:
                                verdict="agrees" if shrink else "differs"))
 
     for mat in sorted({k[0] for k in idx}):
-        aucs = [idx[(mat, 5.0, i)]["auc"] for i in ("flat", "curved", "braille") if (mat, 5.0, i) in idx]
+        aucs = [idx[(mat, 5.0, i)]["auc_mpa_mm"] for i in ("flat", "curved", "braille") if (mat, 5.0, i) in idx]
         if len(aucs) == 3:
             spread = (max(aucs) - min(aucs)) / (sum(aucs) / 3)
             checks.append(dict(claim=f"{mat} 5 mm: AUC alike for the three indenters",
@@ -398,7 +407,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                 p.name == "metrics_vs_thickness.png" for p in figures) else []
     out += [""] + run_settings(scenes if scenes is not None else [r.scene for r in records])
     out += ["## Cases", "",
-            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm) | increments | Newton its | wall (s) | status |",
+            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm in 2D, N in 3D) | increments | Newton its | wall (s) | status |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in _status_order(rows):
         k = quality.kind(r.get("status", ""))
@@ -406,7 +415,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
             out.append(f"| {r['case']} | {r['thickness_mm']:g} | {r['material']} | {r['indenter']} | – | failed | | | | | | | failed |")
             continue
         out.append(f"| {r['case']} | {r['thickness_mm']:g} | {r['material']} | {r['indenter']} | {r['depth_mm']:.3g} | "
-                   f"{_fmt(r['peak_mpa'])} | {_fmt(r['span_mm'])} | {_fmt(r['auc'])} | {_fmt(r['reaction_n_per_mm'])} | "
+                   f"{_fmt(r['peak_mpa'])} | {_fmt(r['span_mm'])} | {_fmt(r['auc_mpa_mm'])} | {_reaction(r)} | "
                    f"{r.get('increments', '')} | {r.get('newton_iterations', '')} | {_fmt(r.get('wall_s'), 2)} | "
                    f"{'**suspect**' if k == 'suspect' else 'ok'} |")
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]

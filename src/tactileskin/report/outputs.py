@@ -14,7 +14,7 @@ from tactileskin.fileio import atomic_write_text, make_dirs, staged_files
 log = logging.getLogger(__name__)
 
 RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter", "braille_text",
-                  "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc", "reaction_n_per_mm",
+                  "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n",
                   "min_J", "max_abs_stress_mpa",
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
 
@@ -44,7 +44,7 @@ def collect(outcomes, cache):
             records.append(rec)
             # recomputed from the numbers (not the stored string): the ranges are quality's
             row.update(status=quality.status(rec.summary), **{k: rec.summary.get(k) for k in
-                                       ("peak_mpa", "span_mm", "auc", "reaction_n_per_mm", "min_J",
+                                       ("peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n", "min_J",
                                         "max_abs_stress_mpa", "dofs", "increments",
                                         "newton_iterations", "wall_s")})
             lo = rec.summary.get("loading")
