@@ -477,3 +477,21 @@ def test_meshing_keeps_the_sigterm_handler_that_unwinds_the_cli():
         assert caught()
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def test_a_suspect_case_gets_no_render(tmp_path, capsys, monkeypatch):
+    # a no-contact (suspect) flat case was rendered as the sweep's Fig. 9, unmarked
+    import tactileskin.report.render as render
+
+    rendered = []
+    monkeypatch.setattr(render, "render_case", lambda vtu, png, **kw: rendered.append(png) or png)
+
+    def no_contact(scene):
+        r = fake_result()
+        r.pressure, r.contact_x, r.contact_pressure, r.reaction = np.zeros(3), np.zeros(0), np.zeros(0), 0.0
+        return r
+
+    monkeypatch.setattr(sw, "solve_case", no_contact)
+    out = tmp_path / "out"
+    assert main(["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--out", str(out)]) == 3
+    assert rendered == [] and not list(out.glob("fig9_*"))

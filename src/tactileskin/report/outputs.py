@@ -122,11 +122,13 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     if render and records:
         from tactileskin.report.render import render_case
 
+        # a suspect case (no contact, the law out of its range) is not shown as a result
+        shown = [r for r in records if quality.status(r.summary) == "ok"]
         thinnest = {}
-        for r in records:
+        for r in shown:
             m = r.scene.material
             thinnest[m] = min(thinnest.get(m, r.scene.thickness), r.scene.thickness)
-        for rec in records:  # one Fig. 9A-style render per material at the thinnest skin, flat plate
+        for rec in shown:  # one Fig. 9A-style render per material at the thinnest skin, flat plate
             sc = rec.scene
             vtu = rec.path / "result.vtu"
             if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
