@@ -1,5 +1,6 @@
 """Report plumbing on synthetic sweep records: verdict logic, figures, files."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -99,3 +100,13 @@ def test_only_the_claims_of_the_run_cases_are_checked():
     # the 1 mm silicone flat peak and the span trend over 1 -> 3 mm; nothing about
     # polyurethane, Braille, 5 mm or discrimination (one indenter)
     assert claims == ["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm", "silicone, flat: span shrinks as the skin thickens"]
+
+
+def test_a_distance_below_the_threshold_does_not_read_as_equal_and_one_profile_gets_no_verdict():
+    from tactileskin.report.markdown import _discrimination_cells
+
+    s = np.linspace(0.0, 5.0, 101)
+    p = np.exp(-s**2)
+    d, verdict = _discrimination_cells({"flat": (s, p), "curved": (s, 1.2 * p)})
+    assert verdict == "not distinguishable" and re.search(r"0\.1\d\d\b", d)  # 1 - 1/1.2: 0.167, not "0.17"
+    assert _discrimination_cells({"braille": (s, p)}) == ("n/a", "n/a (one indenter)")

@@ -171,7 +171,7 @@ def paper_checks(rows, records, braille_dim: int | None = None) -> list[dict]:
         v = discriminate(profs)
         expect = t < 5.0
         checks.append(dict(claim=f"{mat} {t:g} mm: indenters " + ("distinguishable" if expect else "indistinguishable"),
-                           ours=f"min pairwise distance {v.min_distance:.2f} (threshold {THRESHOLD})",
+                           ours=f"min pairwise distance {_distance(v.min_distance)} (threshold {THRESHOLD})",
                            verdict="agrees" if v.distinguishable == expect else "differs"))
     return checks
 
@@ -194,8 +194,15 @@ def paper_checks_by_model(rows, records) -> list[dict]:
 
 def _discrimination_cells(profs) -> tuple[str, str]:
     v = discriminate(profs)
-    d = ", ".join(f"{a}–{b} {x:.2f}" for (a, b), x in v.distances.items())
-    return d or "n/a", "distinguishable" if v.distinguishable else "not distinguishable"
+    if not v.distances:  # one profile: nothing to tell apart, no verdict
+        return "n/a", "n/a (one indenter)"
+    d = ", ".join(f"{a}–{b} {_distance(x)}" for (a, b), x in v.distances.items())
+    return d, "distinguishable" if v.distinguishable else "not distinguishable"
+
+
+def _distance(x: float) -> str:
+    """A distance to three places: 0.196 against the threshold 0.2 read '0.20' and 'below it'."""
+    return f"{x:.3f}"
 
 
 NO_CLAIM = ("No paper claim applies to this grid: the paper's claims are about skins of 1, 3 and "
