@@ -300,7 +300,7 @@ def braille_comparison(records) -> list[str]:
              "over the bone surface at least one skin thickness from its bonded edges (at a free "
              "end the pressure has a corner singularity: peak_map_edge_mpa in the case's summary). "
              "Ratios are 2D / 3D. The project measured the ridge "
-             f"at 1.9-3x the peak of a dot (1.9x at t = 5, where the plate presses too) with spans "
+             f"at 1.9-3.1x the peak of a dot (1.9x at t = 5, where the plate presses too) with spans "
              f"within 7 % ({RIDGE_VS_DOTS_SOURCE}).", ""]
     if not pairs:
         lines.append("No Braille case was solved in both dimensions (run the sweep with "
