@@ -461,10 +461,10 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
     assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows, extent=7.6)["status"] == "not validated"
 
 
-def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monkeypatch):
+def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monkeypatch, tmp_path):
     """The report flags (†, a trust table, a Suspect line, a qualified 0.75 mm verdict) every
-    thickness whose letters rest on a surrogate not shown within 5 %."""
-    from tactileskin.report.array_chart import markdown
+    thickness whose letters rest on a surrogate not shown within 5 %; so does accuracies.csv."""
+    from tactileskin.report.array_chart import markdown, write_outputs
 
     _fake_solver(monkeypatch, [])
     monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
@@ -480,6 +480,13 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
     assert "against full solves on the finer 0.8 / 8 mesh" in md
     assert ("**Suspect:** silicone: the letters' surrogate is not shown within 5% of full solves at t = 1 mm "
             "(5.5%); ") in md
+    assert md.index("**Suspect:**") < md.index("### The skin as a spatial filter")  # at the top
+    rows = (write_outputs(ch, tmp_path / "o")["csv"]).read_text().splitlines()
+    assert rows[0].endswith(",status")
+    letters = [r for r in rows[1:] if ",letters," in r and r.startswith("silicone,1,")]
+    assert letters and all(r.endswith('"indicative: the letters\' surrogate is off by 5.5%"') for r in letters
+                           if r.startswith("silicone,1,"))
+    assert all(r.endswith(",ok") for r in rows[1:] if r.startswith("silicone,2,") or ",letters," not in r)
     assert ("| silicone | 0.75 mm pitch reads Braille at t = 1 mm | supported (indicative: the letters' surrogate "
             "is off by 5.5% at t = 1 mm) |") in md
     # the plain sum is judged by the sum's rows (t = 1 8.5 %, t = 2 14.6 %, both against 0.8 / 8): marked

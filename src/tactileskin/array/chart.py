@@ -341,12 +341,17 @@ class Chart:
                 return r["accuracy"]
         return float("nan")
 
-    def to_csv(self) -> str:
+    def to_csv(self, indicative: dict | None = None) -> str:
+        """The accuracy rows; `indicative` {(material, thickness): reason} marks the letters rows
+        whose surrogate is not shown within the tolerance (status "indicative: reason"), as the
+        report's daggers do."""
         cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "noise_fs", "noise_mpa",
                 "full_scale_mpa", "bits", "method", "accuracy", "chance", "n_test"]
-        lines = [",".join(cols)]
+        lines = [",".join(cols + ["status"])]
         for r in self.rows:
-            lines.append(",".join(f"{r[c]:.6g}" if isinstance(r[c], float) else str(r[c]) for c in cols))
+            why = (indicative or {}).get((r["material"], r["thickness_mm"])) if r["set"] == "letters" else None
+            status = f'"indicative: {why}"' if why else "ok"
+            lines.append(",".join([*(f"{r[c]:.6g}" if isinstance(r[c], float) else str(r[c]) for c in cols), status]))
         return "\n".join(lines) + "\n"
 
 

@@ -76,7 +76,8 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     surrogate's validation."""
     cfg = chart.config
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
-    lines = ["## Sensor-array design chart", "",
+    notes = suspect(chart, validation, trust)
+    lines = ["## Sensor-array design chart", "", *(["**Suspect:** " + n for n in notes] + [""] if notes else []),
              f"Skin: letters on the {cfg.skin}, the paper and shapes sets on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
              f"(mesh {_meshes(cfg)}); flat and curved: 2D bone profiles extruded "
              f"along z" + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
@@ -110,9 +111,6 @@ def markdown(chart, validation=None, method: str = "template") -> str:
             lines.append("")
     if "letters" in cfg.sets:
         lines += _trust_section(chart, trust)
-    notes = suspect(chart, validation, trust)
-    if notes:
-        lines += ["**Suspect:** " + n for n in notes] + [""]
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
     for v in verdicts(chart, method):
         m = trust.get((v["material"], 1.0))
@@ -246,8 +244,12 @@ def write_outputs(chart, out: Path, validation=None, method: str = "template") -
     and figures of an earlier chart this one has not are removed."""
     from tactileskin.fileio import staged_files
 
+    trust = letters_trust(chart, validation) if "letters" in chart.config.sets else {}
+    indicative = {k: ("the letters' surrogate is " + ("not validated" if m["error"] is None
+                                                      else f"off by {m['error']:.1%}"))
+                  for k, m in trust.items() if m["status"] not in TRUSTED}
     with staged_files(out, ARRAY_FILES, last="array_chart.md") as tmp:
-        atomic_write_text(tmp / "accuracies.csv", chart.to_csv())
+        atomic_write_text(tmp / "accuracies.csv", chart.to_csv(indicative))
         atomic_write_text(tmp / "array_chart.md", markdown(chart, validation, method) + "\n")
         figures = write_figures(chart, tmp, method)
     return {"csv": out / "accuracies.csv", "report": out / "array_chart.md",
