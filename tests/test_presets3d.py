@@ -161,3 +161,10 @@ def test_a_level_meshed_with_another_bone_layout_does_not_count_for_the_preset()
     # below t = 3.3 mm the rule is unchanged: levels without a recorded scale count
     t1 = presets.load()["cases3d"]["t1-silicone-\u2801"]
     assert "bone_scale" not in t1["levels"][0] and presets.preset_level("t1-silicone-\u2801", t1, "fine")
+
+def test_the_3d_preset_errors_say_which_thicknesses_they_cover():
+    from tactileskin.planner import QUALITY
+
+    # the study is t = 1-5 mm; at t = 0.5 the fingertip cell reads ~9 % low at default
+    # (convergence3d.md), so no error may be claimed there
+    assert QUALITY["default"]["cases3d_thickness_mm"] == (1.0, 5.0)

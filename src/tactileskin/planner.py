@@ -175,7 +175,14 @@ class Plan:
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
 # "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
 # those where it is the finest level, i.e. the reference, so its error there is 0 by
-# construction).
+# construction; "cases3d_thickness_mm" the thicknesses studied, 1-5 mm: not below).
+def _thickness_span(keys) -> tuple[float, float] | None:
+    from tactileskin import presets
+
+    ts = [t for t in (presets.case_thickness(k) for k in keys) if t is not None]
+    return (min(ts), max(ts)) if ts else None
+
+
 def _quality_table() -> dict[str, dict]:
     from tactileskin import presets
 
@@ -187,7 +194,9 @@ def _quality_table() -> dict[str, dict]:
                   "mesh3d": presets.mesh(3, q),
                   "peak_error3d": e3["peak_error"], "map_l2_3d": e3["map_l2"],
                   "cases3d": tuple(e3["cases"]), "cases3d_not_measured": tuple(e3["not_measured"]),
-                  "cases3d_reference": tuple(e3["reference_in"])}
+                  "cases3d_reference": tuple(e3["reference_in"]),
+                  # the skin thicknesses the 3D errors were measured at: none outside them is claimed
+                  "cases3d_thickness_mm": _thickness_span(e3["cases"] + e3["not_measured"])}
     return out
 
 
