@@ -17,18 +17,13 @@ import os
 import sys
 from pathlib import Path
 
+from tactileskin import validate
 from tactileskin.errors import ParameterError
 
 # sweep(grid) keys: a Scene field (one value or a list) or a sweep list name
 _GRID_ALIASES = {"thickness": "thicknesses", "material": "materials", "indenter": "indenters",
                  "depth": "depths", "braille_text": "braille_texts", "braille_dim": "braille_dims",
                  "force": "forces"}
-
-
-def _path_or_none(name: str, value):
-    if value is not None and not isinstance(value, (str, os.PathLike)):
-        raise ParameterError(name, repr(value), "a folder path (str or os.PathLike) or None")
-    return value
 
 
 def _axis_values(name: str, v) -> list:
@@ -63,8 +58,7 @@ def solve(scene=None, *, quality: str | None = None, history: bool = False, prog
     from tactileskin import scenefile
     from tactileskin.fe import solve as fe_solve
 
-    if not isinstance(history, bool):
-        raise ParameterError("history", repr(history), "True or False")
+    validate.boolean(history, "history")
     if progress is not None and not callable(progress):
         raise ParameterError("progress", repr(progress), "a callable taking an IncrementInfo, or None")
     sc, file_quality, mesh = _scene(scene, fields)
@@ -158,8 +152,9 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     from tactileskin.report.outputs import collect, profile_rows
     from tactileskin.sweep import run_sweep
 
-    _path_or_none("out", out)
-    _path_or_none("cache", cache)
+    for name, value in (("out", out), ("cache", cache)):
+        if value is not None:
+            validate.path(value, name, "a folder path (str or os.PathLike) or None")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError("workers", repr(workers), "a whole number >= 1, or None (one per core)")
     scs = scenes(grid, quality=quality, base=base)

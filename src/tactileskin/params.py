@@ -16,6 +16,7 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
+from tactileskin import validate
 from tactileskin.errors import ParameterError
 
 _PACKAGE_DIR = ("data", "geometry")
@@ -76,8 +77,7 @@ def _parse(raw: bytes, path, what: str) -> dict:
 def read_toml(path: str | Path, what: str) -> dict:
     """Parse a user's TOML file; a missing, unreadable, oversized (> MAX_TOML_BYTES), non-UTF-8
     or malformed file is a ParameterError naming `what`."""
-    if not isinstance(path, (str, os.PathLike)):  # an int would be read as an open descriptor
-        raise ParameterError(what, repr(path), "a file path (str or os.PathLike)")
+    validate.path(path, what, "a file path (str or os.PathLike)")
     return _parse(_read_capped(path, what), path, what)
 
 

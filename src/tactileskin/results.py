@@ -7,13 +7,12 @@ two compare like for like. Pure numpy.
 from __future__ import annotations
 
 import io
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio
+from tactileskin import fileio, validate
 from tactileskin.errors import ConvergenceError, ParameterError
 
 
@@ -291,8 +290,8 @@ class Result:
         with the maximum over z, beside the map P(s, z)). Returns (figure, axes); `ax`: draw
         the profile into these axes (2D); `path`: also save it (.png, .svg or .pdf by suffix).
         Writes no file unless `path` is given."""
-        if path is not None and not isinstance(path, (str, os.PathLike)):
-            raise ParameterError("path", repr(path), "a file path (.png, .svg or .pdf) or None")
+        if path is not None:
+            validate.path(path, "path", "a file path (.png, .svg or .pdf) or None")
         if ax is not None:
             from matplotlib.axes import Axes
 
@@ -329,8 +328,7 @@ class Result:
         """Write the result into `directory`: a new or empty folder, or one tactileskin marked
         as a solve's (fileio.claim_dir; a folder of other files is refused, OutputError, and
         left as it is). See write_owned for the files."""
-        if not isinstance(directory, (str, os.PathLike)):
-            raise ParameterError("directory", repr(directory), "a folder path (str or os.PathLike)")
+        validate.path(directory, "directory", "a folder path (str or os.PathLike)")
         fileio.claim_dir(directory, "solve", what="directory")
         return self.write_owned(directory)
 

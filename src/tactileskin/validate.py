@@ -62,6 +62,16 @@ def boolean(v, name: str) -> bool:
     return v
 
 
+def path(v, name: str, valid: str = "a path (str or os.PathLike)"):
+    """A file or folder path: a str or os.PathLike (an int would be taken for an open file
+    descriptor, a number or None for nothing at all)."""
+    import os
+
+    if not isinstance(v, (str, os.PathLike)):
+        raise ParameterError(name, repr(v), valid)
+    return v
+
+
 def string(v, name: str, valid: str = "a string") -> str:
     if not isinstance(v, str):
         raise ParameterError(name, v, valid)
