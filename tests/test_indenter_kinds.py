@@ -220,3 +220,33 @@ def test_sphere_3d_coarse_solve():
     assert p_max > 0
     assert abs(z_at) < 1.5  # under the ball, within ~ the contact half-length 1.5 sqrt(2 R d) = 1.5 mm
     assert indenter_for_scene(s).section_z == 0.0
+
+
+def test_a_file_indenters_long_triangles_are_split_and_the_gap_is_the_same(tmp_path):
+    # a built indenter's mounting stem has triangles 13 mm long against 0.3 mm at the ball: one
+    # global candidate radius made every point test nearly every triangle (a solve ran minutes)
+    trimesh = pytest.importorskip("trimesh")
+    from tactileskin.geometry.indenters.file import _split_long
+
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    stem = trimesh.creation.cylinder(radius=1.0, height=13.0, sections=8)
+    stem.apply_translation([0.0, 0.0, 8.0])
+    part = trimesh.util.concatenate([ball, stem])
+    f = tmp_path / "part.stl"
+    part.export(f)
+    ind = make_indenter("file", y0=Y0, dim=3, indenter_file=str(f))
+    tri = ind.vertices[ind.faces]
+    split = _split_long(tri)
+    reach = np.max(np.linalg.norm(split - split.mean(axis=1)[:, None, :], axis=2), axis=1)
+    assert reach.max() <= 4.0 * np.median(np.max(np.linalg.norm(tri - tri.mean(axis=1)[:, None, :], axis=2), axis=1)) + 1e-12
+    assert np.isclose(np.sum(np.linalg.norm(np.cross(split[:, 1] - split[:, 0], split[:, 2] - split[:, 0]), axis=1)),
+                      np.sum(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)))  # same area
+    # the gap against brute force over the original triangles
+    from trimesh.triangles import closest_point
+
+    p = _points(200, 4.0)
+    g, _ = ind.gap(p, 0.1)
+    q = p + np.array([0.0, 0.1, 0.0])
+    brute = np.array([np.min(np.linalg.norm(closest_point(tri, np.repeat(x[None], len(tri), 0)) - x, axis=1))
+                      for x in q])
+    np.testing.assert_allclose(np.abs(g), brute, atol=1e-9)
