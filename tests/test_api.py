@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -71,6 +72,10 @@ def test_sweep_returns_dataframes_equal_to_the_csv_and_parquet_files(tmp_path):
     # a rerun reads every case from the cache (out/cache) and gives the same numbers
     again = ts.sweep(grid, quality="preview", out=out, serial=True, report=False)
     assert np.array_equal(again.peak_mpa, df.peak_mpa)
+    # the report as the command writes it: its wall time measured (it read 0.0 s)
+    ts.sweep(grid, quality="preview", out=tmp_path / "fresh", serial=True)  # solved, not read
+    wall = float(re.search(r"wall time ([0-9.]+) s", (tmp_path / "fresh" / "report.md").read_text()).group(1))
+    assert wall > 0.0
 
 
 def test_sweep_default_cache_follows_the_environment(monkeypatch, tmp_path):

@@ -15,6 +15,7 @@ import contextlib
 import logging
 import os
 import sys
+import time
 from pathlib import Path
 
 from tactileskin import validate
@@ -131,7 +132,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
           serial: bool = False, scheduler: str | None = None, profiles: bool = False,
           report: bool = True, base=None):
     """Run a cached sweep and return its metrics as a pandas DataFrame (one row per case:
-    case, status, thickness_mm, material, indenter, ..., peak_mpa, span_mm, auc, ...).
+    case, status, thickness_mm, material, indenter, ..., peak_mpa, span_mm, auc_mpa_mm, ...).
 
     grid: {"thickness": [1, 3, 5], "material": [...], "indenter": [...], "depth": [...],
       "braille_text": [...], "braille_dim": [2, 3]} (any subset; other Scene fields such as
@@ -139,8 +140,8 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
       None (the paper's 18 cases).
     quality: mesh preset of each case's dimension ('preview', 'default', 'fine').
     out: also write the folder the `tactileskin sweep` command writes (results.csv and
-      .parquet, profiles.csv and .parquet, figures, report.md); `report=False` skips figures
-      and report. cache: the result cache folder (default out/cache, else default_cache_dir()).
+      .parquet, profiles.csv and .parquet, figures with the Fig. 9 renders, report.md);
+      `report=False` skips figures, renders and report. cache: the result cache folder (default out/cache, else default_cache_dir()).
     workers / serial / scheduler: as the command (default: a local Dask cluster, one worker
       process per core). A script needs no `if __name__ == "__main__":` guard.
     profiles: return (metrics, profiles), profiles in long form (case, s_mm, pressure_mpa).
@@ -165,6 +166,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         from tactileskin.fileio import claim_dir
 
         claim_dir(Path(out), "sweep", what="out")
+    t0 = time.perf_counter()
     with _script_not_rerun():
         outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
     failed = [oc for oc in outcomes if oc.status == "failed"]
@@ -174,7 +176,8 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     if out is not None:
         from tactileskin.report.outputs import write_outputs
 
-        res = write_outputs(Path(out), outcomes, rc, 0.0, render=False, figures=report)
+        # as the command writes it: the wall time, and (with report) the Fig. 9 renders
+        res = write_outputs(Path(out), outcomes, rc, time.perf_counter() - t0, render=report, figures=report)
         rows, records = res["rows"], res["records"]
     else:
         records, rows, _ = collect(outcomes, rc)
