@@ -204,3 +204,13 @@ def test_the_mesh_command_reports_a_skin_file(tmp_path, capsys, dim):
     assert "as meshed in" in out and "Traceback" not in out
     area = 4.0 if dim == 2 else 16.0  # the block's bottom: w (x w)
     assert f"bonded boundary measure (mm^{dim - 1}) │ {area:g} │" in out
+
+
+def test_a_scene_files_skin_file_implies_the_file_skin_as_the_option_does(tmp_path):
+    from tactileskin import scenefile
+
+    f = _gmsh_block(tmp_path / "skin.msh", dim=2, t=2.0)
+    (tmp_path / "s.toml").write_text('skin_file = "skin.msh"\nindenter = "flat"\n')
+    sf = scenefile.read(tmp_path / "s.toml")
+    assert sf.fields["skin"] == "file" and sf.fields["skin_file"] == str(f)
+    assert Scene.from_toml(tmp_path / "s.toml").skin == "file"

@@ -54,9 +54,12 @@ def resolve_paths(fields: dict, source) -> dict:
     """`fields` with the relative file paths it names (indenter_file, skin_file, a .toml
     material, a sweep's .toml materials) resolved against the folder of the file `source`
     they were read from, not the working folder: a scene file then means the same files
-    wherever it is run from (as film calibration CSVs name their images)."""
+    wherever it is run from (as film calibration CSVs name their images). A skin_file without
+    a skin implies skin = "file", as --skin-file does."""
     base = Path(source).expanduser().absolute().parent
     out = dict(fields)
+    if out.get("skin_file") and "skin" not in out:
+        out["skin"] = "file"
     for k in PATH_FIELDS:
         if k in out:
             out[k] = _resolve(out[k], base)
