@@ -157,7 +157,7 @@ def test_the_force_axis_is_a_grid_key():
 
 
 def test_summary_keys_carry_their_units_and_a_3d_reaction_is_in_newtons():
-    from tactileskin.results import reaction_of
+    from tactileskin.quality import reaction_of
 
     kw = dict(s=np.array([0.0, 1.0]), pressure=np.array([0.2, 0.0]), contact_x=np.zeros(0),
               contact_pressure=np.zeros(0), reaction=0.1, stats={"dofs": 6})

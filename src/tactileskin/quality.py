@@ -45,6 +45,16 @@ def _num(summary: dict, key: str):
         return None
 
 
+def reaction_key(summary: dict) -> str:
+    """The summary's reaction key: reaction_n in 3D, reaction_n_per_mm in 2D (results.reaction_key)."""
+    return "reaction_n" if "reaction_n" in summary else "reaction_n_per_mm"
+
+
+def reaction_of(summary: dict):
+    """The reaction of a summary, whichever its dimension, or None."""
+    return summary.get(reaction_key(summary))
+
+
 def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
@@ -52,7 +62,7 @@ def flags(summary: dict) -> list[Flag]:
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []
-    rkey = "reaction_n" if "reaction_n" in summary else "reaction_n_per_mm"
+    rkey = reaction_key(summary)
     peak, reaction = _num(summary, "peak_mpa"), _num(summary, rkey)
     npts = _num(summary, "contact_points")
     none = []

@@ -375,14 +375,6 @@ def reaction_key(dim: int) -> str:
     return "reaction_n" if int(dim) == 3 else "reaction_n_per_mm"
 
 
-def reaction_of(summary: dict):
-    """The reaction of a summary (either key), or None."""
-    for k in ("reaction_n_per_mm", "reaction_n"):
-        if k in summary:
-            return summary[k]
-    return None
-
-
 # the files Result.write owns in a folder (fnmatch patterns, relative paths)
 OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
              "sensors.csv", "history.csv", "result.pvd", "result_steps/step_*.vtu")

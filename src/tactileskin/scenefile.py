@@ -15,6 +15,7 @@ a scene. A field given both ways (`thickness` and `sweep.thicknesses`) is refuse
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -43,8 +44,6 @@ PATH_FIELDS = ("indenter_file", "skin_file")
 
 
 def _resolve(value, base: Path):
-    import os
-
     if isinstance(value, str) and value and not Path(value).expanduser().is_absolute():
         return os.path.normpath(base / value)
     return value
@@ -74,8 +73,6 @@ def resolve_paths(fields: dict, source) -> dict:
 def relative_paths(fields: dict, target) -> dict:
     """`fields` with their file paths written relative to the folder of the file `target` they
     are saved in (the inverse of resolve_paths; a path on another drive stays absolute)."""
-    import os
-
     base = Path(target).expanduser().absolute().parent
     out = dict(fields)
     keys = [k for k in PATH_FIELDS if isinstance(out.get(k), str) and out[k]]

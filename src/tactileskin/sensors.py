@@ -244,6 +244,8 @@ class SectionCoordinates:
         return lo
 
 
+# Own point-in-polygon (a few lines of numpy): matplotlib's Path.contains_points would pull
+# matplotlib into every Scene that has sensors (sensors are validated when the scene is made).
 def _inside(poly: np.ndarray, p: np.ndarray, tol: float = 1e-4) -> bool:
     """Whether point p lies in the closed polygon (ray casting; a point within tol (mm) of an
     edge counts as inside: the surface and the bone are in the skin, and the sampled outline's

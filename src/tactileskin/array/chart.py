@@ -425,7 +425,7 @@ def shallow_scene(dot):
 
 def dot_exponent(rec, rec_shallow) -> float:
     """surrogate.load_exponent of the lone dot's two solves (their reactions)."""
-    from tactileskin.results import reaction_of
+    from tactileskin.quality import reaction_of
 
     return surrogate.load_exponent(float(reaction_of(rec.summary)), float(reaction_of(rec_shallow.summary)))
 

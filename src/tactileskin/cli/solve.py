@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin import results
+from tactileskin import quality, results
 from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
 
 # every file `solve` writes into its folder (fnmatch patterns; the 2D section of --compare-2d
@@ -93,9 +93,9 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         if "peak_map_edge_mpa" in s:
             t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {s['peak_map_edge_s_mm']:.3g} mm, "
                       f"z = {s['peak_map_edge_z_mm']:.3g} mm (a corner singularity: grows with mesh refinement)")
-        t.add_row("reaction (modelled part of the slab)", f"{results.reaction_of(s):.4g} N")
+        t.add_row("reaction (modelled part of the slab)", f"{quality.reaction_of(s):.4g} N")
     else:
-        t.add_row("reaction (half section)", f"{results.reaction_of(s):.4g} N/mm")
+        t.add_row("reaction (half section)", f"{quality.reaction_of(s):.4g} N/mm")
     if "loading" in s:
         lo, unit = s["loading"], "N" if scene.dim == 3 else "N/mm"
         if lo.get("target_force") is not None:
