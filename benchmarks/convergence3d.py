@@ -147,9 +147,21 @@ def map_l2(maps, ref_index: int = -1, grid_index: int = 0, z_margin: float = 0.0
 
 # --- one level, in a child process ---------------------------------------------------------
 
+SPHERE = "sphere:"  # a case's "text" naming a sphere indenter of that radius (--sphere R)
+
+
+def scene_kwargs(text: str) -> dict:
+    """Scene fields of a case's indenter: a Braille text, or "sphere:R"."""
+    if text.startswith(SPHERE):
+        return {"indenter": "sphere", "indenter_radius": float(text[len(SPHERE):])}
+    return {"indenter": "braille", "braille_text": text}
+
+
 def case_key(t: float, material: str, text: str) -> str:
     from tactileskin.planner import dot_pattern
 
+    if text.startswith(SPHERE):
+        return f"t{t:g}-{material}-sphere-R{float(text[len(SPHERE):]):g}"
     return f"t{t:g}-{material}-{dot_pattern(text)}"
 
 
@@ -167,8 +179,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     from tactileskin.presets import study_bone_scale
     from tactileskin.scene import Scene
 
-    scene = Scene(dim=3, indenter="braille", thickness=t, material=material, braille_text=text,
-                  mesh_size=h, refinement=r)
+    scene = Scene(dim=3, thickness=t, material=material, mesh_size=h, refinement=r, **scene_kwargs(text))
     c0, w0 = time.process_time(), time.perf_counter()
     res = solve(scene, build_slab_mesh(scene, local=plan == "local"))
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
@@ -177,7 +188,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
         "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
-        **({"bone_scale": study_bone_scale(t)} if plan == "local" else {}),
+        **({"bone_scale": study_bone_scale(t)} if plan == "local" and not text.startswith(SPHERE) else {}),
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),
@@ -315,6 +326,7 @@ def main(argv=None) -> int:
     ap.add_argument("--thickness", type=float, default=1.0)
     ap.add_argument("--material", default="silicone")
     ap.add_argument("--text", default="", help='Braille text ("" single dot, "\\u283f" full cell)')
+    ap.add_argument("--sphere", type=float, help="a sphere indenter of this radius (mm) instead of Braille")
     ap.add_argument("--levels", default="1.6/8,1.2/8,0.8/8")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "convergence3d.md")
     ap.add_argument("--presets", type=Path, default=PRESETS)
@@ -324,6 +336,8 @@ def main(argv=None) -> int:
                     help="size plan: local refinement at the dots (default) or the former strip plan")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.sphere is not None:
+        args.text = f"{SPHERE}{args.sphere:g}"
     args.raw.mkdir(parents=True, exist_ok=True)
     if args.one:
         h, r = parse_levels(args.one)[0]

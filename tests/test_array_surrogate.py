@@ -301,7 +301,7 @@ def test_shapes_set_adds_a_3d_sphere_on_the_fingertip_and_tells_four_distinct_ma
     ch = chart.compute(cfg, cache=None)
     (sph,) = [sc for sc in asked if sc.indenter == "sphere"]
     assert (sph.dim, sph.skin, sph.indenter_radius, round(sph.indentation, 9)) == (3, "fingertip", 4.0, 0.4)
-    assert (sph.mesh_size, sph.refinement) == quality_mesh("default", "sphere", 3)
+    assert (sph.mesh_size, sph.refinement) == quality_mesh("default", "sphere", 3, sph.thickness)
     assert ch.labels == {"shapes": ["flat", "curved", "braille", "sphere"]}
     assert ch.accuracy("silicone", 3.0, "shapes", 0.5, 0.01) >= 0.95
     from tactileskin.report.array_chart import markdown

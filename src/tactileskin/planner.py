@@ -203,17 +203,20 @@ def _quality_table() -> dict[str, dict]:
 QUALITY: dict[str, dict] = _quality_table()
 
 
-def quality_mesh(quality: str, indenter, dim: int = 2, thickness: float | None = None) -> tuple[float, float]:
-    """(mesh_size, refinement) of a quality preset for an indenter kind, dimension and skin
-    thickness (3D Braille: the preset's thick-skin sizes from their thickness on)."""
+def quality_mesh(quality: str, indenter, dim: int = 2, thickness: float | None = None,
+                 skin: str = "fingertip") -> tuple[float, float]:
+    """(mesh_size, refinement) of a quality preset for an indenter kind, dimension, skin
+    thickness and skin (3D spot contacts on a skin with the local plan, e.g. Braille: the
+    local sizes, thick-skin ones from their thickness on)."""
     if quality not in QUALITY:
         raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
     q = QUALITY[quality]
     from tactileskin import presets
     from tactileskin.geometry.indenters import get_kind
+    from tactileskin.skins import registry as skins
 
     if dim == 3:
-        if get_kind(indenter).name == "braille":
+        if get_kind(indenter).local_3d and skins.get(skin).local_plan:
             return presets.mesh(3, quality, braille=True, thickness=thickness)
         return q["mesh3d"]
     return q["braille_mesh"] if get_kind(indenter).fine_2d_mesh else q["mesh"]
@@ -221,7 +224,7 @@ def quality_mesh(quality: str, indenter, dim: int = 2, thickness: float | None =
 
 def with_quality(scene: Scene, quality: str) -> Scene:
     """The scene meshed at a quality preset of its dimension."""
-    size, ref = quality_mesh(quality, scene.indenter, scene.dim, scene.thickness)
+    size, ref = quality_mesh(quality, scene.indenter, scene.dim, scene.thickness, scene.skin)
     return scene.replace(mesh_size=size, refinement=ref)
 
 

@@ -40,8 +40,10 @@ from tactileskin.skins import registry as _skins
 # increment sequences on the 2D Braille, curved and flat cases, peaks within 0.10 %; 11: the
 # 3D Braille bone patches at most 2.3 x the dot patch size (mesh.sizing.BONE_SCALE_MAX):
 # other meshes from t = 3.3 mm; 12: summary keys named with their units: auc_mpa_mm, and the
-# reaction reaction_n_per_mm (2D) or reaction_n (3D), which 3D results had called per mm)
-SCHEMA_VERSION = 12
+# reaction reaction_n_per_mm (2D) or reaction_n (3D), which 3D results had called per mm;
+# 13: 3D spheres and file indenters meshed by the local plan at their contact spots, as
+# Braille dots: their peaks move by up to 12 %)
+SCHEMA_VERSION = 13
 
 
 # Element size and refinement defaults per dimension (mm, coarse / refined size ratio).
@@ -60,12 +62,13 @@ DEFAULT_MESH_BRAILLE_2D = _presets.mesh(2, "default", braille=True)
 DEFAULT_MESH_BRAILLE_3D = _presets.mesh(3, "default", braille=True)
 
 
-def default_mesh(dim: int, indenter, thickness: float | None = None) -> tuple[float, float]:
-    """(mesh_size, refinement) a scene of this dimension, indenter and skin thickness gets by
-    default (the kind says whether its 2D section needs the finer preset; 3D Braille is
-    refined at the dots, with the preset's thick-skin sizes from its thickness on)."""
+def default_mesh(dim: int, indenter, thickness: float | None = None, skin: str = "fingertip") -> tuple[float, float]:
+    """(mesh_size, refinement) a scene of this dimension, indenter, skin thickness and skin
+    gets by default (the kind says whether its 2D section needs the finer preset; in 3D a kind
+    that touches in spots is refined there on a skin with the local plan, at the local
+    presets' sizes, with the thick-skin sizes from their thickness on)."""
     kind = _indenters.get(indenter)
-    if dim == 3 and kind.name == "braille":
+    if dim == 3 and kind.local_3d and _skins.get(skin).local_plan:
         return _presets.mesh(3, "default", braille=True, thickness=thickness)
     if dim == 2 and kind.fine_2d_mesh:
         return DEFAULT_MESH_BRAILLE_2D
@@ -186,7 +189,7 @@ class Scene:
             # of the mixed formulation equals J: it silently becomes the locking displacement one.
             raise ParameterError("order", 1, "2 with the mixed formulation",
                                  "order 1 locks; use formulation='displacement' to study it")
-        size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness)
+        size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness, self.skin)
         set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
                                       0.01, 5.0, unit="mm"))
         set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
@@ -321,8 +324,10 @@ class Scene:
                 if name not in changes and name not in reads:
                     changes[name] = None
         new_t = changes.get("thickness", self.thickness)
-        if (new_dim != self.dim or new_ind != self.indenter or new_t != self.thickness) and new_dim in DEFAULT_MESH:
-            size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness)
+        new_skin = changes.get("skin", self.skin)
+        if (new_dim != self.dim or new_ind != self.indenter or new_t != self.thickness
+                or new_skin != self.skin) and new_dim in DEFAULT_MESH:
+            size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness, self.skin)
             if "mesh_size" not in changes and self.mesh_size == size0:
                 changes["mesh_size"] = None
             if "refinement" not in changes and self.refinement == ref0:

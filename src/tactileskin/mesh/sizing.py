@@ -174,8 +174,13 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
     """The plan for sizes (coarse, coarse / ratio), with its estimated cell count."""
     # the local plan places its balls on the fingertip's contour or the pad's flat top; other
     # skins keep the strip plan
-    if dim == 3 and local and scene.indenter.value == "braille" and getattr(scene, "skin", "fingertip") in LOCAL_SKINS:
-        return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric)
+    if dim == 3 and local and scene.indenter_kind.local_3d and scene.skin_kind.local_plan:
+        from tactileskin.geometry.indenters import indenter_for_scene
+
+        spots = indenter_for_scene(scene, warn=False).contact_patches(scene.indentation)
+        if spots is not None:
+            return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric,
+                              spots=spots)
     fine = coarse / ratio
     t = section.thickness
     w = contact_halfwidth(scene, section)
@@ -219,7 +224,6 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
 GROWTH_3D = 0.35
 PATCH_RADIUS = 1.25
 BONE_SCALE_MAX = 2.3
-LOCAL_SKINS = ("fingertip", "pad")  # skins whose outer surface `_dot_frame` knows
 
 
 def bone_scale(thickness: float, base_radius: float) -> float:
@@ -249,45 +253,59 @@ def _plate_halfwidth(section, depth_past_dots: float) -> float:
     return min(1.5 * math.sqrt(2.0 * r_top * depth_past_dots), ft.half_width)
 
 
-def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_symmetric: bool) -> SizePlan:
-    """Local size plan of a 3D Braille slab (fingertip) or block (pad): fine = coarse / ratio
-    at the dots' contact patches and (scaled with t) on the bone under them (the pad's bonded
-    bottom y = 0); if the indentation exceeds the dot height the base plate touches along the
+def patch_scale(a: float) -> float:
+    """Element size at a contact spot of radius bound a / the preset's fine size: 1 up to the
+    spot the local presets were chosen on (the standard American dot's base radius), in
+    proportion beyond (the same elements across a wider spot: a large ball, a flat file)."""
+    from tactileskin.geometry import braille
+
+    return max(1.0, a / braille.get_standard("standard_american").base_radius)
+
+
+def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_symmetric: bool,
+               spots=None) -> SizePlan:
+    """Local size plan of a 3D slab (fingertip) or block (pad) pressed in compact spots (the
+    indenter's `contact_patches`: Braille dots, a ball, a file's low pieces): fine = coarse /
+    ratio (times `patch_scale` for spots wider than a dot) at each spot's contact patch and
+    (scaled with t) on the bone under it (the pad's bonded bottom y = 0); if a plate of the
+    indenter presses too (`plate_depth`: Braille past the dot height) it touches along the
     whole slab, and that strip and the bone ROI get the geometric mean of the fine and coarse
     sizes (`strip`)."""
-    from tactileskin.geometry import braille
-    from tactileskin.geometry.indenters import indenter_symmetry
+    from tactileskin.geometry.indenters import indenter_for_scene, indenter_symmetry
 
-    std = braille.get_standard(scene.braille_standard)
-    a0 = std.base_radius
+    ind = indenter_for_scene(scene, warn=False)
+    spots = ind.contact_patches(scene.indentation) if spots is None else spots
     fine = coarse / ratio
     t = section.thickness
     g = GROWTH_3D
-    bone_fine = min(coarse, fine * bone_scale(t, a0))
-    r_patch, r_bone = PATCH_RADIUS * a0, a0 + t
     z0, z1 = (0.0, 0.5 * length) if z_symmetric else (-0.5 * length, 0.5 * length)
     lz = z1 - z0
     # the meshed x range starts at the symmetry plane x = 0, or at -W/2 on a full-width pad
     # (mesh.pad: an x-asymmetric text)
     full = getattr(section, "fingertip", None) is None and not indenter_symmetry(scene)[0]
     x0 = -section.half_width if full else 0.0
+    box = (x0, float(section.half_width), z0, z1)
+    groups: dict = {}   # (ball radius, size, layer) -> lateral centres, per surface
     patches, bones = [], []
-    for x, z in braille.dot_centres(scene.braille_text, std):
+    for x, z, a in spots:
+        h = min(coarse, fine * patch_scale(a))
+        hb = min(coarse, h * bone_scale(t, a))
         po, n = _dot_frame(section, x)
         pb = po - t * n
-        for balls, c, r, h in ((patches, po, r_patch, fine), (bones, pb, r_bone, bone_fine)):
+        for balls, c, r, size, layer in ((patches, po, PATCH_RADIUS * a, h, OUTER_LAYER * h),
+                                          (bones, pb, a + t, hb, ROI_LAYER * hb)):
             if c[0] < x0 - r or z < z0 - r or z > z1 + r:
                 continue  # the ball misses the meshed part (x >= x0, z0 <= z <= z1)
-            balls.append((float(c[0]), float(c[1]), float(z), float(r), float(h)))
-    box = (x0, float(section.half_width), z0, z1)
-    excess = sum(_balls_excess([(b[0], b[2]) for b in balls], min(coarse, t), min(h, t), r, layer, t, g, box)
-                 for balls, r, h, layer in ((patches, r_patch, fine, OUTER_LAYER * fine),
-                                            (bones, r_bone, bone_fine, ROI_LAYER * bone_fine)))
+            balls.append((float(c[0]), float(c[1]), float(z), float(r), float(size)))
+            groups.setdefault((float(r), float(size), float(layer)), []).append((float(c[0]), float(z)))
+    excess = sum(_balls_excess(cs, min(coarse, t), min(h, t), r, layer, t, g, box)
+                 for (r, h, layer), cs in groups.items())
     strip = 0.0
     w = 0.0
-    if scene.indentation > std.height:
+    plate = ind.plate_depth(scene.indentation)
+    if plate > 0.0:
         strip = math.sqrt(fine * coarse)
-        w = _plate_halfwidth(section, scene.indentation - std.height)
+        w = _plate_halfwidth(section, plate)
     s_fine = strip if strip else coarse
     roi = min(ROI_S, section.interface_length)
     p = SizePlan(coarse, fine, g, w, (z0, z1), OUTER_LAYER * s_fine, roi, ROI_LAYER * s_fine,

@@ -34,6 +34,9 @@ class Skin:
     fixed_boundaries: ClassVar[tuple[str, ...]] = ("bone_interface",)
     # the geometry fixes the thickness (a user's file): a sweep does not vary it by default
     fixes_thickness: ClassVar[bool] = False
+    # 3D spot contacts (an indenter kind's `local_3d`) are meshed by mesh.sizing.local_plan,
+    # whose `_dot_frame` knows this skin's outer surface; False: the strip plan
+    local_plan: ClassVar[bool] = False
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
 
     @classmethod

@@ -89,6 +89,7 @@ class PadSection:
 @register
 class PadSkin(Skin):
     name = "pad"
+    local_plan = True
     order = 1
     scene_params = ("pad_width", "pad_length")
     fixed_boundaries = ("bone_interface",)
@@ -132,12 +133,13 @@ class PadSkin(Skin):
     def cache_content(cls, scene) -> dict:
         """An x-asymmetric indenter is solved on the full width (mesh.pad): its key changes
         from the half model's it once had; a 3D Braille scene is meshed by the local plan
-        (mesh.sizing.local_plan: fine at the dots only), not the strip plan it once had; the
-        other scenes keep their keys."""
+        (mesh.sizing.local_plan: fine at the dots only), not the strip plan it once had, and so
+        is any 3D scene of a kind that touches in spots (`local_3d`); the other scenes keep
+        their keys."""
         from tactileskin.geometry.indenters import indenter_symmetry
 
         out = {} if indenter_symmetry(scene)[0] else {"model": "full_width"}
-        if scene.dim == 3 and scene.indenter.value == "braille":
+        if scene.dim == 3 and scene.indenter_kind.local_3d:
             out["mesh_plan"] = "local"
         return out
 

@@ -68,6 +68,9 @@ class Indenter:
     section_2d: ClassVar[str | None] = "exact"
     fine_2d_mesh: ClassVar[bool] = False     # 2D uses the finer preset mesh (small features)
     paper: ClassVar[bool] = False            # one of the paper's indenters (build "all")
+    # 3D: touches in compact spots (`contact_patches`), meshed on the local plan at the local
+    # presets' sizes (data/presets.json "braille_mesh"); False: the strip plan ("mesh")
+    local_3d: ClassVar[bool] = False
 
     @classmethod
     def model_2d(cls, scene) -> str | None:
@@ -153,6 +156,17 @@ class Indenter:
     def contact_zrange(self, depth: float) -> tuple[float, float] | None:
         """z range (mm) of the contact zone in 3D; None: the whole slab."""
         return None
+
+    def contact_patches(self, depth: float) -> tuple[tuple[float, float, float], ...] | None:
+        """(x, z, a) of each compact spot of the face that can touch the skin within `depth` of
+        travel: its centre (x, z) and a bound a on its radius (mm), for the 3D local mesh plan
+        (mesh.sizing.local_plan). None: the contact is a strip along the slab (the strip plan)."""
+        return None
+
+    def plate_depth(self, depth: float) -> float:
+        """How far (mm) a flat part of the face that spans the slab presses at `depth` (the
+        Braille base plate past the dot height); 0: none does."""
+        return 0.0
 
     def contact_planes(self) -> np.ndarray:
         """z planes on which the first touch is sought in 3D (the slab is uniform along z)."""

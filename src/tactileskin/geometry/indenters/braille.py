@@ -46,6 +46,7 @@ class BrailleIndenter(Indenter):
     section_2d = "ridge"
     fine_2d_mesh = True   # the dot's base radius (0.72 mm) needs the finer 2D preset
     paper = True
+    local_3d = True
 
     @classmethod
     def check_scene(cls, scene) -> dict:
@@ -137,6 +138,14 @@ class BrailleIndenter(Indenter):
         _, _, zmin, zmax = _braille.footprint(self.text, self.standard)
         m = self.standard.base_radius
         return zmin - m, zmax + m
+
+    def contact_patches(self, depth):
+        """Every dot, its base radius: the contact radius is at most that."""
+        a = float(self.standard.base_radius)
+        return tuple((float(x), float(z), a) for x, z in self.dots)
+
+    def plate_depth(self, depth):
+        return max(0.0, float(depth) - float(self.standard.height))
 
     def contact_planes(self) -> np.ndarray:
         return self.rows  # a dot's gap is smallest in its own row's plane

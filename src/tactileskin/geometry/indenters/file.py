@@ -41,6 +41,7 @@ MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off")
 STEP_SUFFIXES = (".step", ".stp")
 SIZE_RANGE = (0.1, 1000.0)  # mm: largest bounding-box extent of a plausible indenter
 STEP_TOLERANCE = 0.005      # mm, as geometry/export.py meshes the project's own solids
+MAX_PATCHES = 100           # contact spots the local mesh plan takes; more: the strip plan
 _PAIR_CHUNK = 200_000       # (point, triangle) pairs per closest-point batch (memory)
 _VALID = "a closed triangle surface in mm (" + ", ".join(MESH_SUFFIXES + STEP_SUFFIXES) + ")"
 
@@ -114,6 +115,7 @@ class FileIndenter(Indenter):
     order = 20
     scene_params = ("indenter_file",)
     section_2d = None
+    local_3d = True
 
     @classmethod
     def check_scene(cls, scene) -> dict:
@@ -218,6 +220,35 @@ class FileIndenter(Indenter):
 
     def contact_planes(self) -> np.ndarray:
         return np.array([float(self.vertices[np.argmin(self.vertices[:, 1]), 2])])
+
+    def contact_patches(self, depth):
+        """One spot per connected piece of the surface below y0 + depth (a piece's vertices
+        there and its edges' crossings of that plane): the centre of the piece's (x, z) box and
+        the largest distance of its points from it. None (the strip plan) beyond MAX_PATCHES
+        pieces (a textured face)."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        v, f = self.vertices, self.faces
+        cut = self.y0 + max(float(depth), 0.0)
+        band = f[v[f][:, :, 1].min(axis=1) <= cut]
+        e = np.concatenate([band[:, [0, 1]], band[:, [1, 2]], band[:, [2, 0]]])
+        g = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(len(v), len(v)))
+        _, label = connected_components(g, directed=False)
+        ya, yb = v[e[:, 0], 1], v[e[:, 1], 1]
+        cross = (ya - cut) * (yb - cut) < 0.0
+        w = ((cut - ya[cross]) / (yb[cross] - ya[cross]))[:, None]
+        pts = np.concatenate([v[v[:, 1] <= cut], v[e[cross, 0]] + w * (v[e[cross, 1]] - v[e[cross, 0]])])
+        lab = np.concatenate([label[v[:, 1] <= cut], label[e[cross, 0]]])
+        pieces = np.unique(lab)
+        if len(pieces) > MAX_PATCHES:
+            return None
+        out = []
+        for k in pieces:
+            xz = pts[lab == k][:, [0, 2]]
+            c = 0.5 * (xz.min(axis=0) + xz.max(axis=0))
+            out.append((float(c[0]), float(c[1]), float(np.max(np.linalg.norm(xz - c, axis=1)))))
+        return tuple(out)
 
     def describe(self) -> str:
         return f"indenter from {Path(self.file).name}"

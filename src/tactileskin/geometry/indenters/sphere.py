@@ -5,6 +5,7 @@ Not uniform along the finger, so 3D only: its plane-strain section would be a cy
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +24,7 @@ class SphereIndenter(Indenter):
     order = 11
     scene_params = ("indenter_radius",)
     section_2d = None
+    local_3d = True
 
     @classmethod
     def check_scene(cls, scene) -> dict:
@@ -69,6 +71,12 @@ class SphereIndenter(Indenter):
     def contact_zrange(self, depth):
         a = hertz_halfwidth(self.radius, depth)  # the skin is straight along z
         return -a, a
+
+    def contact_patches(self, depth):
+        """One spot at the pole, of the ball's chord radius at the depth on a flat top (the
+        curved fingertip and the skin's own give make the contact no wider)."""
+        d = min(max(float(depth), 0.0), self.radius)
+        return ((0.0, 0.0, math.sqrt(2.0 * self.radius * d - d * d)),)
 
     def solid(self):
         from tactileskin.geometry import solids
