@@ -47,8 +47,8 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
     length = section.fingertip.sample_length if length is None else length
     zsym = use_z_symmetry and z_symmetric(scene)
     if not x_symmetric(scene):
-        logger.warning("the indenter (braille_text=%r) is not symmetric about x = 0, but the slab "
-                       "is the half x >= 0 with a symmetry plane there", scene.braille_text)
+        logger.warning("the indenter (%s) is not symmetric about x = 0, but the slab is the half "
+                       "x >= 0 with a symmetry plane there", scene.indenter_label())
     plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3,
                        length=length, z_symmetric=zsym, order=order, local=local)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)

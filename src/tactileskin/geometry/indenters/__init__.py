@@ -68,9 +68,10 @@ def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> I
 
 
 def indenter_symmetry(scene) -> tuple[bool, bool]:
-    """(about x = 0, about z = 0): mirror symmetry of the scene's indenter (the kind's
-    answer). The one symmetry test of the 3D mesher and the planner."""
-    return indenter_for_scene(scene, warn=False).symmetry()
+    """(about x = 0, about z = 0): mirror symmetry of the scene's indenter where it can touch
+    the skin within the scene's depth (the kind's answer). The one symmetry test of the 3D
+    mesher and the planner."""
+    return indenter_for_scene(scene, warn=False).symmetry(scene.indentation)
 
 
 def first_contact_travel(scene, samples: int = 4000) -> float:

@@ -144,8 +144,9 @@ class Indenter:
         """(xmin, xmax, zmin, zmax) of the working face, centred on x = 0, z = 0."""
         return (-0.5 * self.width, 0.5 * self.width, -0.5 * self.length, 0.5 * self.length)
 
-    def symmetry(self) -> tuple[bool, bool]:
-        """(about x = 0, about z = 0): mirror symmetry of the indenter."""
+    def symmetry(self, depth: float | None = None) -> tuple[bool, bool]:
+        """(about x = 0, about z = 0): mirror symmetry of the indenter (of the part that can
+        touch the skin within `depth` of travel, where the kind can tell)."""
         return True, True
 
     def contact_halfwidth(self, depth: float, r_top: float) -> float:

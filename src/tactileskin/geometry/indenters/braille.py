@@ -119,7 +119,7 @@ class BrailleIndenter(Indenter):
         """y of the base plane the dots protrude from."""
         return self.y0 + self.standard.height - d
 
-    def symmetry(self) -> tuple[bool, bool]:
+    def symmetry(self, depth=None) -> tuple[bool, bool]:
         """By the dot pattern (to 1e-9 mm)."""
         key = lambda a: {tuple(np.round(r, 9)) for r in a}  # noqa: E731
         xz = self.dots

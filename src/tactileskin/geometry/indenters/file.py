@@ -191,13 +191,17 @@ class FileIndenter(Indenter):
     def _surface_y(self, x, z, d):
         raise ParameterError("surface_y", self.file, "an analytic indenter", "a file indenter has no height map")
 
-    def symmetry(self) -> tuple[bool, bool]:
+    def symmetry(self, depth=None) -> tuple[bool, bool]:
         """A plane is a mirror plane if every mirrored vertex lies on the surface (within
-        1e-5 of the size: STL stores 32-bit floats, ~1e-7 relative)."""
+        1e-5 of the size: STL stores 32-bit floats, ~1e-7 relative); with `depth`, every vertex
+        of the triangles that reach below y0 + 2 depth (what can touch the skin, with room for
+        the skin's bulge): a printed part's stem, tessellated unevenly 20 mm above the face
+        (1e-3 mm off its mirror image), does not make the model the whole slab."""
         tol = 1e-5 * float(np.max(self.vertices.max(axis=0) - self.vertices.min(axis=0)))
+        pts = self.vertices if depth is None else self._band(2.0 * float(depth))
         out = []
         for ax in (0, 2):
-            m = self.vertices.copy()
+            m = pts.copy()
             m[:, ax] *= -1.0
             g, _ = self._gap(m, 0.0)
             out.append(bool(np.max(np.abs(g)) <= tol))
