@@ -256,7 +256,8 @@ def _plate_halfwidth(section, depth_past_dots: float) -> float:
 def patch_scale(a: float) -> float:
     """Element size at a contact spot of radius bound a / the preset's fine size: 1 up to the
     spot the local presets were chosen on (the standard American dot's base radius), in
-    proportion beyond (the same elements across a wider spot: a large ball, a flat file)."""
+    proportion beyond (the same elements across a wider spot: a large ball, a flat file; at
+    most half the far size, local_plan)."""
     from tactileskin.geometry import braille
 
     return max(1.0, a / braille.get_standard("standard_american").base_radius)
@@ -288,7 +289,8 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     groups: dict = {}   # (ball radius, size, layer) -> lateral centres, per surface
     patches, bones = [], []
     for x, z, a in spots:
-        h = min(coarse, fine * patch_scale(a))
+        # a spot much wider than a dot (a flat file face) still gets the strip plan's ratio 2
+        h = max(fine, min(0.5 * coarse, fine * patch_scale(a)))
         hb = min(coarse, h * bone_scale(t, a))
         po, n = _dot_frame(section, x)
         pb = po - t * n
