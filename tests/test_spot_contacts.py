@@ -87,3 +87,20 @@ def test_a_sphere_reads_the_same_on_the_quarter_and_the_whole_slab():
     whole = solve(sc, build_slab_mesh(sc, use_z_symmetry=False))
     assert quarter.stats["dofs"] < 0.7 * whole.stats["dofs"]
     assert quarter.peak == pytest.approx(whole.peak, rel=0.01)
+
+
+def test_a_flat_file_face_is_one_wide_spot_at_half_the_far_size(tmp_path):
+    # a 20 x 20 mm plate: one spot as wide as its face; scaled as a dot it would be coarser than
+    # the far size, so it keeps the strip plan's ratio 2 (solved: 0.2987 MPa at t = 1 against the
+    # analytic flat plate's 0.3015)
+    f = _stl(tmp_path, "plate.stl", trimesh.creation.box(extents=(20.0, 2.0, 20.0)))
+    sc = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=f)
+    sec = sc.section()
+    p = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True)
+    (x, y, z, r, h), = p.patches
+    assert r == pytest.approx(sizing.PATCH_RADIUS * 10.0 * math.sqrt(2.0), rel=1e-6)
+    assert h == pytest.approx(0.5 * sc.mesh_size)
+    # a user's refinement below 2 is kept, not overridden
+    q = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True,
+                    mesh_size=1.0, refinement=1.5)
+    assert q.patches[0][4] == pytest.approx(1.0 / 1.5)
