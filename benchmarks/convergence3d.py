@@ -176,7 +176,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     from tactileskin.fe import solve
     from tactileskin.fileio import atomic_write_json
     from tactileskin.mesh.slab3d import build_slab_mesh
-    from tactileskin.presets import study_bone_scale
+    from tactileskin.presets import study_scales
     from tactileskin.scene import Scene
 
     scene = Scene(dim=3, thickness=t, material=material, mesh_size=h, refinement=r, **scene_kwargs(text))
@@ -188,7 +188,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
         "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
-        **({"bone_scale": study_bone_scale(t)} if plan == "local" and not text.startswith(SPHERE) else {}),
+        **(study_scales(case_key(t, material, text)) if plan == "local" else {}),
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),
@@ -292,20 +292,23 @@ def cheapest_within(levels: list[dict], peak_tol: float = PEAK_TOL, map_tol: flo
     return min(ok, key=lambda d: d["dofs"]) if ok else None
 
 
+SCALES = ("bone_scale", "spot_scale")  # the local plan's scales a level records
+
+
 def write_presets(path: Path, key: str, study: dict) -> None:
     from tactileskin.fileio import atomic_write_json
 
     data = json.loads(path.read_text(encoding="utf-8")) if path.exists() else {}
     cases = data.setdefault("cases3d", {})
     ref = study["reference"]
-    # the bone patch scale a level was meshed with (presets.preset_level matches it): from the
-    # level's raw record, else kept from the file (levels solved before records carried it)
-    known = {(v["mesh_size"], v["refinement"]): v["bone_scale"]
-             for v in cases.get(key, {}).get("levels", []) if "bone_scale" in v}
+    # the patch scales a level was meshed with (presets.preset_level matches them): from the
+    # level's raw record, else kept from the file (levels solved before records carried them)
+    known = {(v["mesh_size"], v["refinement"]): {k: v[k] for k in SCALES if k in v}
+             for v in cases.get(key, {}).get("levels", [])}
 
     def scale(d):
-        b = d.get("bone_scale", known.get((d["mesh_size"], d["refinement"])))
-        return {} if b is None else {"bone_scale": b}
+        kept = known.get((d["mesh_size"], d["refinement"]), {})
+        return {k: d.get(k, kept.get(k)) for k in SCALES if d.get(k, kept.get(k)) is not None}
 
     cases[key] = {
         "plan": study["levels"][-1].get("plan", "strip"),

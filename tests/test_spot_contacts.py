@@ -64,9 +64,9 @@ def test_a_sphere_gets_the_local_plan_and_its_preset():
     p = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True)
     (x, y, z, r, h), = p.patches
     a = math.sqrt(2 * 2.5 * sc.indentation - sc.indentation ** 2)
-    # the spot is wider than a dot (base radius 0.72 mm): its size grows in proportion
+    # the spot is wider than a dot (base radius 0.72 mm): its size grows as the square root
     assert (x, z) == (0.0, 0.0) and r == pytest.approx(sizing.PATCH_RADIUS * a)
-    assert h == pytest.approx(p.fine * a / 0.72) and p.strip == 0.0
+    assert h == pytest.approx(p.fine * math.sqrt(a / 0.72)) and p.strip == 0.0
     (xb, yb, zb, rb, hb), = p.bone_patches
     assert yb == pytest.approx(y - 1.0) and rb == pytest.approx(a + 1.0)
     # a skin without the local plan keeps the strip preset
@@ -76,9 +76,11 @@ def test_a_sphere_gets_the_local_plan_and_its_preset():
 
 def test_a_sphere_reads_the_same_on_the_quarter_and_the_whole_slab():
     """The strip plan read the t = 1 R 2.5 sphere 0.0689 MPa on the quarter and 0.0613 on the
-    whole slab at this preset (12 %: a one-sided bone fit at z = 0 against a smoothing two-sided
-    one, both on 0.43 mm cells); on the local plan 0.06985 / 0.06966 (0.27 %). 1 % is above that
-    layout difference and far below the old one."""
+    whole slab at `preview` (12 %: a one-sided bone fit at z = 0 against a smoothing two-sided
+    one, both on 0.43 mm cells), so a file indenter that is not mirror-symmetric read 12 % low.
+    On the local plan the two read 0.0701 / 0.0681 at this level, 0.0708 / 0.0703 at 0.8 / 8
+    (the whole slab converges from below to the quarter's limit, 0.0707): 4 % holds the
+    recovery's coarse-level difference and catches the strip plan's."""
     from tactileskin.fe import solve
     from tactileskin.mesh.slab3d import build_slab_mesh
 
@@ -86,7 +88,7 @@ def test_a_sphere_reads_the_same_on_the_quarter_and_the_whole_slab():
     quarter = solve(sc, build_slab_mesh(sc))
     whole = solve(sc, build_slab_mesh(sc, use_z_symmetry=False))
     assert quarter.stats["dofs"] < 0.7 * whole.stats["dofs"]
-    assert quarter.peak == pytest.approx(whole.peak, rel=0.01)
+    assert quarter.peak == pytest.approx(whole.peak, rel=0.04)
 
 
 def test_a_flat_file_face_is_one_wide_spot_at_half_the_far_size(tmp_path):

@@ -82,14 +82,33 @@ def case_thickness(key: str) -> float | None:
 def preset_level(key: str, case: dict, quality: str) -> dict | None:
     """The level of convergence-study case `key` (presets.json "cases3d") meshed as the 3D
     Braille preset `quality` at the case's thickness, or None if the study did not solve it.
-    A level that records the bone patch scale it was meshed with ("bone_scale") counts only if
-    the local plan gives that scale now (mesh.sizing.bone_scale): the same sizes with another
-    bone layout are another mesh."""
+    A level that records the patch scales it was meshed with ("bone_scale", "spot_scale")
+    counts only if the local plan gives those scales now (study_scales): the same sizes with
+    another layout are another mesh."""
     t = case_thickness(key)
-    h, r = mesh(3, quality, braille=True, thickness=t)  # the study's cases are Braille
-    now = study_bone_scale(t)
+    h, r = mesh(3, quality, braille=True, thickness=t)  # the local plan's sizes (dots, spheres)
+    now = study_scales(key)
     return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)
-                 and ("bone_scale" not in v or _same(v["bone_scale"], now))), None)
+                 and all(k not in v or _same(v[k], now[k]) for k in now)), None)
+
+
+def study_scales(key: str) -> dict:
+    """The local plan's scales for a convergence-study case key: {"bone_scale"} of the
+    standard American dots, and for a sphere case ("t1-silicone-sphere-R2.5", the scene's
+    default depth) also its "spot_scale" (mesh.sizing.patch_scale of the ball's spot)."""
+    import re
+
+    t = case_thickness(key)
+    ball = re.search(r"-sphere-R([0-9.]+)$", key)
+    if ball is None:
+        return {"bone_scale": study_bone_scale(t)}
+    from tactileskin.geometry.indenters import indenter_for_scene
+    from tactileskin.mesh.sizing import bone_scale, patch_scale
+    from tactileskin.scene import Scene
+
+    sc = Scene(thickness=t, dim=3, indenter="sphere", indenter_radius=float(ball.group(1)))
+    (_, _, a), = indenter_for_scene(sc, warn=False).contact_patches(sc.indentation)
+    return {"bone_scale": round(bone_scale(t, a), 4), "spot_scale": round(patch_scale(a), 4)}
 
 
 def study_bone_scale(thickness: float) -> float:

@@ -51,7 +51,9 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
     for ext in DESIGN_FORMATS if stem in DESIGN_STEMS else FORMATS:
         p = out / f"{stem}.{ext}"
         buf = io.BytesIO()
-        fig.savefig(buf, format=ext, dpi=150, bbox_inches="tight")
+        # every figure has constrained layout, which already keeps its labels inside; a
+        # "tight" bounding box would draw each figure once more per format (~45 % of savefig)
+        fig.savefig(buf, format=ext, dpi=150)
         atomic_write_bytes(p, buf.getvalue())
         paths.append(p)
     _plt().close(fig)
