@@ -233,3 +233,30 @@ def test_flat_and_curved_keep_the_strip_plan(indenter):
     kw = dict(dim=3, length=sec.fingertip.sample_length, z_symmetric=True, **LOCAL)
     assert sizing.plan(sc, sec, **kw) == sizing.plan(sc, sec, local=False, **kw)
     assert not sizing.plan(sc, sec, **kw).patches
+
+
+def test_a_cell_folded_by_its_snapped_mid_nodes_gets_straight_edges(slab_t3):
+    # fold one boundary cell by pushing the mid-node of one of its outer-surface edges through
+    # the cell (what snapping a sliver on the curved surface can do: the t = 5 sphere at
+    # 1.6 / 8 had one cell at -0.16 and was refused): _unfold straightens that cell's edges
+    import dataclasses
+
+    from tactileskin.mesh.skinmesh import MIN_SCALED_JACOBIAN, cell_jacobian_ratios
+    from tactileskin.mesh.slab3d import _unfold
+
+    m = slab_t3.mesh
+    facet = slab_t3.boundaries["outer_surface"][0]
+    cell = int(m.f2t[0, facet])
+    edge = int(m.f2e[0, facet])
+    mid = m.dofs.edge_dofs[0, edge]
+    inner = m.p[:, m.t[:, cell]].mean(axis=1)
+    p = m.doflocs.copy()
+    p[:, mid] += 3.0 * (inner - p[:, mid])           # far past the cell's centre
+    folded = dataclasses.replace(m, doflocs=p)
+    assert cell_jacobian_ratios(folded)[cell] < MIN_SCALED_JACOBIAN
+    fixed, n = _unfold(folded)
+    assert n >= 1 and cell_jacobian_ratios(fixed).min() >= MIN_SCALED_JACOBIAN
+    assert np.allclose(fixed.doflocs[:, mid], m.p[:, m.edges[:, edge]].mean(axis=1))
+    # an unfolded mesh is returned as it is
+    same, n0 = _unfold(m)
+    assert same is m and n0 == 0

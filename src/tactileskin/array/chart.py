@@ -100,8 +100,9 @@ class ChartConfig:
     # thickness's letters in full instead (one 3D solve per letter); False: keep the surrogate,
     # marked indicative
     fallback: bool = True
-    # the shapes set's sphere (mm) and the 3D preset it is meshed at (the strip plan; preview:
-    # peak 2.9 % and span 3.1 % from default at t = 1 silicone, 10 s against 56 s CPU)
+    # the shapes set's sphere (mm) and the 3D preset it is meshed at (the local plan at its
+    # spot; preview at t = 1 silicone, R 2.5: peak -0.8 %, span +3.8 %, map 3.5 % from the
+    # finest level of benchmarks/results/convergence3d.md, 3 s CPU)
     sphere_radius: float = 2.5
     sphere_quality: str = "preview"
 

@@ -153,7 +153,13 @@ def _lattice(dim: int, n: int) -> np.ndarray:
 
 def jacobian_ratio(mesh) -> float:
     """min over cells of (min / max Jacobian determinant over the cell): 1 for
-    straight-sided simplices, <= 0 for an inverted (or folded) curved cell.
+    straight-sided simplices, <= 0 for an inverted (or folded) curved cell
+    (`cell_jacobian_ratios`)."""
+    return float(np.min(cell_jacobian_ratios(mesh)))
+
+
+def cell_jacobian_ratios(mesh) -> np.ndarray:
+    """Per cell, min / max Jacobian determinant over the cell (see `jacobian_ratio`).
 
     det J of a P2 cell is a polynomial (degree 2 in 2D, 3 in 3D) that is often smallest at
     a vertex, where no quadrature point lies: it is evaluated at the quadrature points of
@@ -170,8 +176,7 @@ def jacobian_ratio(mesh) -> float:
     else:  # affine (straight) cells: det J is constant per cell
         d = np.asarray(mapping.detDF(X))
     dmax = d.max(axis=1)
-    ratio = np.where(dmax > 0, d.min(axis=1) / np.where(dmax > 0, dmax, 1.0), -1.0)
-    return float(np.min(ratio))
+    return np.where(dmax > 0, d.min(axis=1) / np.where(dmax > 0, dmax, 1.0), -1.0)
 
 
 def check_quality(quality: dict, sizes: dict) -> None:
