@@ -69,9 +69,11 @@ def test_a_sphere_gets_the_local_plan_and_its_preset():
     assert h == pytest.approx(p.fine * math.sqrt(a / 0.72)) and p.strip == 0.0
     (xb, yb, zb, rb, hb), = p.bone_patches
     assert yb == pytest.approx(y - 1.0) and rb == pytest.approx(a + 1.0)
-    # a skin without the local plan keeps the strip preset
+    # a skin without the local plan keeps the strip preset, also when a scene moves to it
     dome = Scene(thickness=2.0, dim=3, skin="dome", **kw)
     assert (dome.mesh_size, dome.refinement) == default_mesh(3, "flat")
+    moved = Scene(thickness=2.0, dim=3, **kw).replace(skin="dome")
+    assert (moved.mesh_size, moved.refinement) == default_mesh(3, "flat")
 
 
 def test_a_sphere_reads_the_same_on_the_quarter_and_the_whole_slab():
