@@ -108,3 +108,46 @@ def test_a_flat_file_face_is_one_wide_spot_at_half_the_far_size(tmp_path):
     q = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True,
                     mesh_size=1.0, refinement=1.5)
     assert q.patches[0][4] == pytest.approx(1.0 / 1.5)
+
+
+def test_a_file_ball_moved_along_the_finger_reads_its_own_plane_and_the_same_force(tmp_path):
+    """A ball moved 2 mm along z is the same physics on the straight-along-z finger. The
+    profile was read on z = 0, beside the contact (0.00048 MPa against 0.0673 at z = 2, status
+    ok), and the force was the modelled part's (quarter 0.0418 N, half 0.0834 N): now the
+    profile runs through the map's peak and the force is the whole indenter's. The whole slab
+    reads the peak lower than the quarter at this level (2.9 %, the test above): 4 %."""
+    from tactileskin.fe import solve
+
+    ball = trimesh.creation.icosphere(subdivisions=4, radius=2.5)
+    centred = _stl(tmp_path, "c.stl", ball)
+    ball.apply_translation((0.0, 0.0, 2.0))
+    moved = _stl(tmp_path, "m.stl", ball)
+    kw = dict(thickness=1.0, dim=3, indenter="file", mesh_size=1.6, refinement=8.0)
+    a = solve(Scene(indenter_file=centred, **kw))
+    b = solve(Scene(indenter_file=moved, **kw))
+    assert b.stats["dofs"] > 1.5 * a.stats["dofs"]                    # a half, not a quarter
+    assert a.stats["profile_plane_z"] == 0.0 and b.stats["profile_plane_z"] == pytest.approx(2.0, abs=0.1)
+    assert b.reaction == pytest.approx(a.reaction, rel=0.01)
+    assert b.peak == pytest.approx(a.peak, rel=0.04)
+    assert a.status == b.status == "ok"
+
+
+def test_an_x_asymmetric_file_is_flagged_and_a_ball_past_the_slab_end_refused(tmp_path):
+    from tactileskin import quality
+    from tactileskin.errors import ParameterError
+    from tactileskin.geometry.indenters import mirrored_x
+
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    ball.apply_translation((0.3, 0.0, 0.0))
+    off = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=_stl(tmp_path, "x.stl", ball))
+    assert mirrored_x(off) and not mirrored_x(Scene(thickness=1.0, dim=3, indenter="sphere", indenter_radius=2.5))
+    found = quality.flags({"peak_mpa": 0.08, "reaction_n": 0.1, "mirrored_x": True})
+    assert [f.code for f in found] == ["mirrored_x"] and quality.status_of(found).startswith("suspect")
+    # the ball at z = 12 lies past the 20 mm slab's end (z = 10): refused before meshing (it
+    # was meshed at 570k dofs and solved for 110 s to "no contact")
+    ball.apply_translation((-0.3, 0.0, 12.0))
+    far = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=_stl(tmp_path, "z.stl", ball))
+    from tactileskin.geometry.indenters import require_contact
+
+    with pytest.raises(ParameterError, match="no contact"):
+        require_contact(far)

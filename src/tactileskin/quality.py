@@ -30,7 +30,7 @@ J_RANGE = (0.9, 1.1)
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "mirrored_x" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -58,7 +58,7 @@ def reaction_of(summary: dict):
 def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
-    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa (a
+    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa, mirrored_x (a
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []
@@ -85,6 +85,10 @@ def flags(summary: dict) -> list[Flag]:
     if J is not None and not (lo <= J <= hi):
         out.append(Flag("volume_range", f"volume ratio J = {J:.4g} outside [{lo:g}, {hi:g}] "
                         "(material law outside its range)"))
+    if summary.get("mirrored_x"):
+        out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
+                        "half x >= 0: the result is that of the indenter and its mirror image together "
+                        "(a pad skin models the full width)"))
     for key in ("peak_mpa", rkey):
         v = _num(summary, key)
         if v is not None and not math.isfinite(v):

@@ -257,6 +257,8 @@ class Result:
             "wall_s": float(self.stats.get("wall_s", 0.0)),
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
+            # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
+            **({"mirrored_x": True} if self.stats.get("mirrored_x") else {}),
             **self._map_summary(),
             **({"loading": self.loading} if self.loading is not None else {}),
             **(self.sensors.summary() if self.sensors is not None else {}),
@@ -371,7 +373,8 @@ class Result:
 
 def reaction_key(dim: int) -> str:
     """The summary key of the indenter's reaction, named with its unit: per mm of depth in 2D
-    (plane strain), the force on the modelled part of the slab in 3D."""
+    (plane strain, the half section x >= 0), the force on the whole indenter in 3D (the
+    modelled part's times its mirror copies)."""
     return "reaction_n" if int(dim) == 3 else "reaction_n_per_mm"
 
 

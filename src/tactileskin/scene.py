@@ -42,7 +42,8 @@ from tactileskin.skins import registry as _skins
 # other meshes from t = 3.3 mm; 12: summary keys named with their units: auc_mpa_mm, and the
 # reaction reaction_n_per_mm (2D) or reaction_n (3D), which 3D results had called per mm;
 # 13: 3D spheres and file indenters meshed by the local plan at their contact spots, as
-# Braille dots: their peaks move by up to 12 %)
+# Braille dots: their peaks move by up to 12 %; the 3D reaction is the whole indenter's force
+# (it was the modelled half or quarter's); a file indenter's profile runs through the map's peak)
 SCHEMA_VERSION = 13
 
 

@@ -93,7 +93,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         if "peak_map_edge_mpa" in s:
             t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {s['peak_map_edge_s_mm']:.3g} mm, "
                       f"z = {s['peak_map_edge_z_mm']:.3g} mm (a corner singularity: grows with mesh refinement)")
-        t.add_row("reaction (modelled part of the slab)", f"{quality.reaction_of(s):.4g} N")
+        t.add_row("force on the indenter (whole)", f"{quality.reaction_of(s):.4g} N")
     else:
         t.add_row("reaction (half section)", f"{quality.reaction_of(s):.4g} N/mm")
     if "loading" in s:

@@ -39,7 +39,7 @@ import time
 import numpy as np
 
 from tactileskin.fe.model import Contact, Dirichlet, Model
-from tactileskin.fe.output import make_result, reaction
+from tactileskin.fe.output import indenter_force, make_result, reaction
 from tactileskin.fe.solver import IncrementInfo, SolverOptions, run
 
 log = logging.getLogger(__name__)
@@ -93,6 +93,9 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
                   formulation=scene.formulation.value, contact=contact, order=scene.order,
                   stiffness=max(law.K0, law.mu0))
+    if m == 3:  # the whole indenter's force; 2D stays per mm of the half section x >= 0
+        model.force_factor = (2.0 if "symmetry" in mesh.boundaries else 1.0) * (
+            2.0 if getattr(mesh, "z_symmetric", False) else 1.0)
     return model, mesh
 
 
@@ -160,7 +163,7 @@ def _run_history(scene, model, section, program, options, progress):
         return {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
 
     def on_segment(i, seg, ev):
-        F = float(reaction(model, ev)[1])
+        F = indenter_force(model, ev)
         if seg.kind != "hold" and (not best or F > best["reaction"]):
             best.update(reaction=F, t=model.t, d=model.d, segment=i,
                         result=make_result(model, ev, _StatsView(), s_of_point=section.s_of_point,
@@ -181,13 +184,14 @@ def _run_history(scene, model, section, program, options, progress):
     last = hist[-1] if hist else {}
     res.loading = {
         "control": program[0].kind, "segments": [g.to_dict() for g in program],
-        # the forces and reactions below: per mm of depth in 2D, on the modelled part in 3D
+        # the forces and reactions below: per mm of depth of the half section in 2D, on the
+        # whole indenter in 3D
         "force_unit": "N" if scene.dim == 3 else "N/mm",
         "target_force": scene.force, "reached_force": best["reaction"] if scene.force is not None else None,
         "profile_state": "peak load",
         "profile_t_s": best["t"], "profile_travel_mm": best["d"], "profile_reaction": best["reaction"],
         "final": {"t_s": float(model.t), "travel_mm": float(model.d),
-                  "reaction": float(last.get("reaction", reaction(model, ev)[1])),
+                  "reaction": float(last.get("reaction", indenter_force(model, ev))),
                   **({"peak_mpa": last["peak_mpa"]} if "peak_mpa" in last else {})},
     }
     return res, ev, stats
@@ -206,7 +210,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     Raises ParameterError before meshing if the indenter cannot reach the skin (no contact).
     progress: optional callable, given an IncrementInfo (increment, t, T, travel, Newton
     iterations) after each converged increment; nothing is printed either way."""
-    from tactileskin.geometry.indenters import require_contact
+    from tactileskin.geometry.indenters import mirrored_x, require_contact
     from tactileskin.materials import get_material
 
     get_material(scene.material)  # a bad material (name or file) fails before the mesh is made
@@ -225,7 +229,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
 
     def record(model, ev):
         # the displacement of each increment: result.pvd, a time series (fe.output.vtk_fields)
-        return {"d": model.travel(model.t), "reaction": float(reaction(model, ev)[1]),
+        return {"d": model.travel(model.t), "reaction": indenter_force(model, ev),
                 "displacement": model.u.reshape(-1, model.m).copy()}
 
     program = scene.program()
@@ -246,6 +250,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
     if getattr(model, "_linsolve", None) is not None:
         res.stats["linear_solver"] = model._linsolve.describe()
+    if "symmetry" in sm.boundaries and mirrored_x(scene):
+        res.stats["mirrored_x"] = True
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)

@@ -36,11 +36,11 @@ MAX_TRIALS = 16
 
 
 def vertical_reaction(model, ev) -> float:
-    """The indenter's vertical force on the skin = the vertical reaction of the fixed
-    boundaries (N in 3D, N/mm in plane strain), as Result.reaction."""
-    from tactileskin.fe.output import reaction
+    """The indenter's vertical force on the skin (fe.output.indenter_force: N on the whole
+    indenter in 3D, N/mm of the half section in plane strain), as Result.reaction."""
+    from tactileskin.fe.output import indenter_force
 
-    return float(reaction(model, ev)[1])
+    return indenter_force(model, ev)
 
 
 class ForceIncrement:

@@ -141,6 +141,9 @@ class Model:
         self.sdofs = b.element_dofs.T                                   # (E, A)
         self.edofs = vector_dofs(self.sdofs, m).reshape(len(self.sdofs), -1)
         self.stiffness = stiffness  # a modulus (MPa) for scaling penalties and tolerances
+        # copies of the modelled part in the whole 3D skin (its mirror planes; fe.model_for_scene):
+        # the indenter's force is the modelled reaction times this (output.indenter_force)
+        self.force_factor = 1.0
         self.timing = defaultdict(float)  # s spent per phase (residual, tangent, contact)
 
         # Dirichlet dofs

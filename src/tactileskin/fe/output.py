@@ -25,6 +25,13 @@ def reaction(model: Model, ev: Evaluation, names=None) -> np.ndarray:
     return np.bincount(comp, weights=ev.fint[dofs], minlength=model.m)
 
 
+def indenter_force(model: Model, ev: Evaluation) -> float:
+    """The indenter's vertical force on the skin (N in 3D: on the whole indenter, the modelled
+    part's reaction times its mirror copies, `Model.force_factor`; N/mm of the half section
+    x >= 0 in 2D)."""
+    return float(reaction(model, ev)[1]) * float(getattr(model, "force_factor", 1.0))
+
+
 def nodal_fields(model: Model, ev: Evaluation, projector: Projector | None = None,
                  sig: np.ndarray | None = None) -> dict:
     """Nodal (projected) mean pressure and Cauchy stress components; displacement. `sig`:
@@ -254,7 +261,8 @@ def surface_grid(model: Model, nodal: np.ndarray, boundary: str, s_of_point, s: 
 
 def profile_plane_z(model: Model) -> float:
     """z of the section plane of a 3D model: the indenter's 2D section row
-    (`BrailleIndenter.section_z`, the dot row nearest z = 0), else z = 0."""
+    (`BrailleIndenter.section_z`, the dot row nearest z = 0), else z = 0 (a kind with
+    `profile_at_map_peak` moves it to the bone map's peak after the solve, make_result)."""
     ind = getattr(model.contact, "indenter", None)
     return float(getattr(ind, "section_z", 0.0))
 
@@ -371,6 +379,14 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
         # in tests/test_bone_map.py); take the profile's values so that they agree exactly
         grid[int(np.argmin(np.abs(zg - plane_z)))] = p
         bmap = BoneMap(s, zg, grid, plane_z)
+        ind = getattr(model.contact, "indenter", None)
+        if getattr(ind, "profile_at_map_peak", False):
+            # no plane is known before the solve (a file indenter off z = 0, two bumps, a
+            # ring): the profile is the map's row through its peak (>= t from the slab's ends)
+            margin = float((scene or {}).get("thickness", 0.0))
+            plane_z = bmap.interior_peak(margin)[2]
+            p = bmap.row(plane_z).copy()
+            bmap = BoneMap(s, zg, grid, plane_z)
     else:
         bmap = None
         sd, s = path_nodes(model, path, s_of_point)
@@ -395,8 +411,9 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
           "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
-          "reaction_vector": r.tolist()}
-    return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, reaction=float(r[vertical]),
+          "reaction_vector_modelled_part": r.tolist()}
+    return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp,
+                  reaction=indenter_force(model, ev) if vertical == 1 else float(r[vertical]),
                   stats=st, fields=vtk, history=[{k: v for k, v in h.items() if k != "displacement"}
                                                  for h in stats.history], scene=scene,
                   bone_map=bmap)

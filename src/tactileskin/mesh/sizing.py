@@ -179,8 +179,10 @@ def _layout(scene, section, coarse: float, ratio: float, *, dim: int, length: fl
 
         spots = indenter_for_scene(scene, warn=False).contact_patches(scene.indentation)
         if spots is not None:
-            return local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric,
-                              spots=spots)
+            p = local_plan(scene, section, coarse, ratio, length=length, z_symmetric=z_symmetric,
+                           spots=spots)
+            if p.patches or p.bone_patches or p.strip:  # else no spot reaches the meshed part
+                return p
     fine = coarse / ratio
     t = section.thickness
     w = contact_halfwidth(scene, section)

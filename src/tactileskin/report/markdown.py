@@ -23,7 +23,8 @@ def _fmt(v, nd=3):
 
 
 def _reaction(row) -> str:
-    """The row's reaction with its unit: N/mm of depth in 2D, N on the modelled part in 3D."""
+    """The row's reaction with its unit: N/mm of depth of the half section in 2D, N on the
+    whole indenter in 3D."""
     for key, unit in (("reaction_n_per_mm", "N/mm"), ("reaction_n", "N")):
         v = row.get(key)
         if v is not None and v != "" and not (isinstance(v, float) and math.isnan(v)):

@@ -74,6 +74,16 @@ def indenter_symmetry(scene) -> tuple[bool, bool]:
     return indenter_for_scene(scene, warn=False).symmetry(scene.indentation)
 
 
+def mirrored_x(scene) -> bool:
+    """True if the scene's indenter is not mirror-symmetric about x = 0 where it can touch (2D:
+    its section; Braille: the row's dots), so that a half model (x >= 0) solves it together
+    with its mirror image, not as it is."""
+    ind = indenter_for_scene(scene, warn=False)
+    if scene.dim == 2:
+        return not getattr(ind, "section_symmetric", True)
+    return not ind.symmetry(scene.indentation)[0]
+
+
 def first_contact_travel(scene, samples: int = 4000) -> float:
     """Travel (mm) after which the scene's indenter first touches the skin, as the model
     sees it: the smallest gap at the start over the outer contour x >= 0 (the half model),
@@ -85,7 +95,10 @@ def first_contact_travel(scene, samples: int = 4000) -> float:
     sec = scene.section()
     pts = sec.outer_points(samples)
     if scene.dim == 3:
-        pts = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in ind.contact_planes()])
+        # a plane beyond the slab's end (a file indenter placed past it) is read at the end
+        half = 0.5 * scene.sample_length
+        planes = np.clip(np.asarray(ind.contact_planes(), float), -half, half)
+        pts = np.concatenate([np.column_stack([pts, np.full(len(pts), z)]) for z in planes])
     g, _ = ind.gap(pts, 0.0)
     return max(0.0, float(np.min(g)))
 
@@ -110,10 +123,13 @@ def require_contact(scene) -> None:
         symmetric = ind.section_symmetric if scene.dim == 2 else ind.symmetry()[0]
         if not symmetric:
             why += "; the half model (x >= 0) does not see the dots at x < 0"
+    elif scene.dim == 3 and not ind.symmetry(depth)[0]:
+        why += "; the half model (x >= 0) sees the indenter's part at x >= 0 only, mirrored"
     dmax = 0.6 * scene.thickness
     if travel < dmax:
+        hint = " or a text with a dot on the centre line" if isinstance(ind, BrailleIndenter) else ""
         raise ParameterError("depth", depth, f"> {travel:.3g} mm for this indenter, at most {dmax:g} mm",
-                             f"no contact: {why}; use a larger --depth or a text with a dot on the centre line")
+                             f"no contact: {why}; use a larger --depth{hint}")
     # the kind's own parameters place it: name the first (the text, the file), else the kind
     field_ = next(iter(get_kind(scene.indenter).scene_params), "indenter")
     value = getattr(scene, field_) if field_ != "indenter" else scene.indenter.value

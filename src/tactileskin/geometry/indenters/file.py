@@ -116,6 +116,9 @@ class FileIndenter(Indenter):
     scene_params = ("indenter_file",)
     section_2d = None
     local_3d = True
+    # the 3D profile is read through the bone map's peak (fe.output.make_result): a file can
+    # press anywhere along the finger, and z = 0 may not be under it
+    profile_at_map_peak = True
 
     @classmethod
     def check_scene(cls, scene) -> dict:
