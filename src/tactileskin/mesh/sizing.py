@@ -290,7 +290,6 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     full = getattr(section, "fingertip", None) is None and not indenter_symmetry(scene)[0]
     x0 = -section.half_width if full else 0.0
     box = (x0, float(section.half_width), z0, z1)
-    groups: dict = {}   # (ball radius, size, layer) -> lateral centres, per surface
     patches, bones = [], []
     for x, z, a in spots:
         # a spot much wider than a dot (a flat file face) still gets the strip plan's ratio 2
@@ -298,14 +297,12 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
         hb = min(coarse, h * bone_scale(t, a))
         po, n = _dot_frame(section, x)
         pb = po - t * n
-        for balls, c, r, size, layer in ((patches, po, PATCH_RADIUS * a, h, OUTER_LAYER * h),
-                                          (bones, pb, a + t, hb, ROI_LAYER * hb)):
+        for balls, c, r, size in ((patches, po, PATCH_RADIUS * a, h), (bones, pb, a + t, hb)):
             if c[0] < x0 - r or z < z0 - r or z > z1 + r:
                 continue  # the ball misses the meshed part (x >= x0, z0 <= z <= z1)
             balls.append((float(c[0]), float(c[1]), float(z), float(r), float(size)))
-            groups.setdefault((float(r), float(size), float(layer)), []).append((float(c[0]), float(z)))
-    excess = sum(_balls_excess(cs, min(coarse, t), min(h, t), r, layer, t, g, box)
-                 for (r, h, layer), cs in groups.items())
+    excess = sum(_balls_excess([(b[0], b[2], b[3], min(b[4], t)) for b in balls], min(coarse, t), layer, t, g, box)
+                 for balls, layer in ((patches, OUTER_LAYER), (bones, ROI_LAYER)))
     strip = 0.0
     w = 0.0
     plate = ind.plate_depth(scene.indentation)
@@ -327,30 +324,35 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     return dataclasses.replace(p, estimate=n)
 
 
-def _balls_excess(centres, coarse: float, h: float, r: float, layer: float, depth: float, g: float,
+def _balls_excess(balls, coarse: float, layer_factor: float, depth: float, g: float,
                   box: tuple[float, float, float, float]) -> float:
-    """Integral of size^-3 - coarse^-3 over the refined layer of equal balls at lateral centres
-    (x, z), inside box = (x_lo, x_hi, z_lo, z_hi): size = the larger of the surface threshold
-    (h within `layer` of the surface, growing by g per mm of depth) and the balls' (h within
-    lateral distance r of the nearest centre, growing by g beyond), to `depth`. Overlapping
-    balls count once (summing them read a t = 5 mm full cell's bone patches 3x over)."""
-    if not centres:
+    """Integral of size^-3 - coarse^-3 over the refined layer of balls (x, z, r, h) at lateral
+    centres (x, z), inside box = (x_lo, x_hi, z_lo, z_hi): size = the larger of the surface
+    threshold (h0 = the smallest h within layer_factor h0 of the surface, growing by g per mm of
+    depth) and the balls' (the smallest over the balls of h within lateral distance r of the
+    centre, growing by g beyond), to `depth`. Overlapping balls count once (summing them read a
+    t = 5 mm full cell's bone patches 3x over; a ring's overlapping spots 4x)."""
+    if not balls:
         return 0.0
-    ext = r + max(coarse - h, 0.0) / g
+    b = np.asarray(balls, float)
+    c, r, h = b[:, :2], b[:, 2], np.minimum(b[:, 3], coarse)
+    h0 = float(h.min())
+    layer = layer_factor * h0
+    ext = float(np.max(r + np.maximum(coarse - h, 0.0) / g))
     d = np.linspace(0.0, depth, 301)
-    hd = np.minimum(coarse, h + g * np.maximum(d - layer, 0.0))
-    h_tab = np.linspace(h, coarse, 201)
+    hd = np.minimum(coarse, h0 + g * np.maximum(d - layer, 0.0))
+    h_tab = np.linspace(h0, coarse, 201)
     size = np.maximum(h_tab[:, None], hd[None, :])
     per_area = np.trapezoid(np.maximum(size ** -3.0 - coarse ** -3.0, 0.0), d, axis=1)
-    c = np.asarray(centres, float)
     xa, xb = max(box[0], c[:, 0].min() - ext), min(box[1], c[:, 0].max() + ext)
     za, zb = max(box[2], c[:, 1].min() - ext), min(box[3], c[:, 1].max() + ext)
     if xb <= xa or zb <= za:
         return 0.0
     xs, zs = np.linspace(xa, xb, 301), np.linspace(za, zb, 301)
     X, Z = np.meshgrid(xs, zs, indexing="ij")
-    dist = np.min(np.hypot(X[..., None] - c[:, 0], Z[..., None] - c[:, 1]), axis=-1)
-    hr = np.minimum(coarse, h + g * np.maximum(dist - r, 0.0))
+    hr = np.full(X.shape, float(coarse))
+    for (cx, cz), ri, hi in zip(c, r, h):  # running minimum: memory O(grid), not O(grid x balls)
+        np.minimum(hr, hi + g * np.maximum(np.hypot(X - cx, Z - cz) - ri, 0.0), out=hr)
     return float(np.trapezoid(np.trapezoid(np.interp(hr, h_tab, per_area), zs, axis=1), xs))
 
 

@@ -231,8 +231,9 @@ class FileIndenter(Indenter):
     def contact_patches(self, depth):
         """One spot per connected piece of the surface below y0 + depth (a piece's vertices
         there and its edges' crossings of that plane): the centre of the piece's (x, z) box and
-        the largest distance of its points from it. None (the strip plan) beyond MAX_PATCHES
-        pieces (a textured face)."""
+        the largest distance of its points from it; a piece that does not cover its centre (a
+        ring) is covered by spots as wide as the ring instead (`_cover`). None (the strip plan)
+        beyond MAX_PATCHES spots (a textured face)."""
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
@@ -247,14 +248,11 @@ class FileIndenter(Indenter):
         w = ((cut - ya[cross]) / (yb[cross] - ya[cross]))[:, None]
         pts = np.concatenate([v[v[:, 1] <= cut], v[e[cross, 0]] + w * (v[e[cross, 1]] - v[e[cross, 0]])])
         lab = np.concatenate([label[v[:, 1] <= cut], label[e[cross, 0]]])
-        pieces = np.unique(lab)
-        if len(pieces) > MAX_PATCHES:
-            return None
         out = []
-        for k in pieces:
-            xz = pts[lab == k][:, [0, 2]]
-            c = 0.5 * (xz.min(axis=0) + xz.max(axis=0))
-            out.append((float(c[0]), float(c[1]), float(np.max(np.linalg.norm(xz - c, axis=1)))))
+        for k in np.unique(lab):
+            out += _cover(pts[lab == k][:, [0, 2]], v[band[label[band[:, 0]] == k]][:, :, [0, 2]])
+            if len(out) > MAX_PATCHES:
+                return None
         return tuple(out)
 
     def describe(self) -> str:
@@ -262,6 +260,32 @@ class FileIndenter(Indenter):
 
     def solid(self):
         raise CadError(f"the file indenter's printable solid is the user's file itself ({self.file})")
+
+
+def _cover(xz: np.ndarray, tri: np.ndarray) -> list[tuple[float, float, float]]:
+    """Spots (x, z, a) covering a piece's points xz (n, 2) whose (x, z) triangles are tri
+    (T, 3, 2): one around the box centre if a triangle covers it (a ball's cap, a plate);
+    else (a ring) greedy spots as wide as the ring (outer minus inner radius about the centre),
+    so that its size follows the ring's width, not its diameter (a torus of major radius 2 mm
+    was one 2.5 mm spot: 7.9 % low at preview)."""
+    c = 0.5 * (xz.min(axis=0) + xz.max(axis=0))
+    r = np.linalg.norm(xz - c, axis=1)
+    a, b, q = tri[:, 0], tri[:, 1], tri[:, 2]
+    d = (b[:, 0] - a[:, 0]) * (q[:, 1] - a[:, 1]) - (q[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    u = ((b[:, 0] - c[0]) * (q[:, 1] - c[1]) - (q[:, 0] - c[0]) * (b[:, 1] - c[1])) / np.where(d == 0, 1, d)
+    w = ((q[:, 0] - c[0]) * (a[:, 1] - c[1]) - (a[:, 0] - c[0]) * (q[:, 1] - c[1])) / np.where(d == 0, 1, d)
+    covered = np.any((d != 0) & (u >= 0) & (w >= 0) & (u + w <= 1))
+    if covered or len(xz) < 3:
+        return [(float(c[0]), float(c[1]), float(r.max()))]
+    width = max(float(r.max() - r.min()), 1e-9)
+    out, left = [], xz
+    while len(left):
+        near = np.linalg.norm(left - left[0], axis=1) <= width
+        sub = left[near]
+        cc = 0.5 * (sub.min(axis=0) + sub.max(axis=0))
+        out.append((float(cc[0]), float(cc[1]), float(np.max(np.linalg.norm(sub - cc, axis=1)))))
+        left = left[~near]
+    return out
 
 
 def _split_long(tri: np.ndarray, factor: float = 4.0) -> np.ndarray:
