@@ -143,6 +143,10 @@ def test_an_x_asymmetric_file_is_flagged_and_a_ball_past_the_slab_end_refused(tm
     assert mirrored_x(off) and not mirrored_x(Scene(thickness=1.0, dim=3, indenter="sphere", indenter_radius=2.5))
     found = quality.flags({"peak_mpa": 0.08, "reaction_n": 0.1, "mirrored_x": True})
     assert [f.code for f in found] == ["mirrored_x"] and quality.status_of(found).startswith("suspect")
+    from tactileskin.fe import solve
+
+    r = solve(off.replace(mesh_size=1.6, refinement=8.0))
+    assert r.summary()["mirrored_x"] and [f["code"] for f in r.summary()["flags"]] == ["mirrored_x"]
     # the ball at z = 12 lies past the 20 mm slab's end (z = 10): refused before meshing (it
     # was meshed at 570k dofs and solved for 110 s to "no contact")
     ball.apply_translation((-0.3, 0.0, 12.0))
@@ -177,3 +181,36 @@ def test_a_ring_is_covered_by_spots_as_wide_as_the_ring(tmp_path):
     sq = np.array([[[-1, -1], [1, -1], [1, 1]], [[-1, -1], [1, 1], [-1, 1]]], float)
     assert len(_cover(np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float), sq)) == 1
 
+
+
+def test_a_bump_past_the_slab_end_does_not_hide_one_inside_and_a_point_spot_is_meshed(tmp_path):
+    from tactileskin.geometry.indenters import first_contact_travel
+
+    far = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    far.apply_translation((0.0, 0.0, 12.0))
+    near = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    near.apply_translation((0.0, 0.05, 0.0))
+    sc = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=_stl(tmp_path, "two.stl", far, near))
+    # the lowest ball lies past the slab's end (z = 10); the one inside touches after 0.05 mm
+    assert first_contact_travel(sc) == pytest.approx(0.05, abs=1e-4)
+    # a piece whose tip sits exactly at y0 + depth is a spot of radius 0: planned, not a crash
+    assert sizing.bone_scale(1.0, 0.0) == sizing.BONE_SCALE_MAX
+    sec = sc.section()
+    p = sizing.local_plan(sc, sec, 1.6, 8.0, length=20.0, z_symmetric=False,
+                          spots=((0.0, 0.0, 0.98), (0.0, 5.0, 0.0)))
+    assert len(p.patches) == 2 and p.estimate > 0
+
+
+def test_under_force_control_symmetry_is_judged_over_the_whole_travel(tmp_path):
+    # a ball with a bump 0.45 mm above its tip, off x = 0: within 2 x the expected 0.2 mm it is
+    # symmetric, but a force may drive the travel to 0.6 mm, where the bump touches
+    from tactileskin.geometry.indenters import indenter_symmetry, mirrored_x
+
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    bump = trimesh.creation.icosphere(subdivisions=2, radius=0.3)
+    bump.apply_translation((1.6, -2.5 + 0.45 + 0.3 + 0.1, 0.0))
+    f = _stl(tmp_path, "bump.stl", ball, bump)
+    by_depth = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=f)
+    by_force = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=f, force=0.5)
+    assert indenter_symmetry(by_depth)[0] and not mirrored_x(by_depth)
+    assert not indenter_symmetry(by_force)[0] and mirrored_x(by_force)

@@ -169,7 +169,9 @@ class Result:
       written as sensors.csv.
     contact_x, contact_pressure: contact pressure (per current area) at the contact points
       of the outer surface, sorted by the current x.
-    reaction: vertical force the fixed boundaries exert on the modelled (half) domain.
+    reaction: the indenter's vertical force: on the whole indenter in 3D (the fixed
+      boundaries' reaction on the modelled part times its mirror copies), per mm of the half
+      section in 2D.
     stats: dofs, increments, newton_iterations, wall_s (and more).
     fields: optional nodal data for the .vtu (points, cells, cell_type, point_data).
     history: per-increment records when requested.

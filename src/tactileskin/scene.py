@@ -267,6 +267,14 @@ class Scene:
         """Largest travel (mm) a depth may ask or force control may reach: 0.6 t."""
         return 0.6 * self.thickness
 
+    @property
+    def reach(self) -> float:
+        """Largest travel (mm) this scene's loading can take the indenter to: the indentation,
+        or max_travel if a force controls any part of it (the travel is not known before)."""
+        if self.force is not None or any(g.kind == "force" for g in self.loading):
+            return self.max_travel
+        return self.indentation
+
     def program(self) -> list:
         """The loading history as a list of loading.Segment: the first ramp (depth at rate, or
         force in `duration`) then `loading`."""

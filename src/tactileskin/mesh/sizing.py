@@ -230,7 +230,7 @@ BONE_SCALE_MAX = 2.3
 
 def bone_scale(thickness: float, base_radius: float) -> float:
     """Bone patch size / dot patch size of the local plan at a skin thickness."""
-    return min(max(1.0, thickness / (2.0 * base_radius)), BONE_SCALE_MAX)
+    return min(max(1.0, thickness / (2.0 * max(base_radius, 1e-9))), BONE_SCALE_MAX)
 
 
 def _dot_frame(section, x: float) -> tuple[np.ndarray, np.ndarray]:

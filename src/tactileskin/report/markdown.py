@@ -356,11 +356,10 @@ def package_version() -> str:
 
 def quality_name(scene) -> str:
     """The quality preset whose mesh sizes the scene has, or 'custom'."""
-    from tactileskin import presets
+    from tactileskin.planner import quality_mesh
 
-    braille = scene.indenter.value == "braille"
     for q in ("default", "preview", "fine"):  # default first: thick 3D skins share preview's sizes
-        size, ref = presets.mesh(scene.dim, q, braille=braille, thickness=scene.thickness)
+        size, ref = quality_mesh(q, scene.indenter, scene.dim, scene.thickness, scene.skin)
         if math.isclose(size, scene.mesh_size, rel_tol=1e-9) and math.isclose(ref, scene.refinement, rel_tol=1e-9):
             return q
     return "custom"

@@ -37,6 +37,9 @@ class Skin:
     # 3D spot contacts (an indenter kind's `local_3d`) are meshed by mesh.sizing.local_plan,
     # whose `_dot_frame` knows this skin's outer surface; False: the strip plan
     local_plan: ClassVar[bool] = False
+    # modelled as its half x >= 0 whatever the indenter (the pad takes its full width for an
+    # x-asymmetric indenter; a user's file skin is meshed as given)
+    halves_x: ClassVar[bool] = False
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
 
     @classmethod

@@ -102,6 +102,7 @@ class DomeSection:
 @register
 class DomeSkin(Skin):
     name = "dome"
+    halves_x = True
     order = 2
     scene_params = ("dome_length", "dome_tip")
     fixed_boundaries = ("bone_interface", "bone_tip")

@@ -10,6 +10,7 @@ from tactileskin.skins.registry import register
 @register
 class FingertipSkin(Skin):
     name = "fingertip"
+    halves_x = True
     local_plan = True
     order = 0
     scene_params = ("fingertip",)

@@ -71,7 +71,7 @@ def indenter_symmetry(scene) -> tuple[bool, bool]:
     """(about x = 0, about z = 0): mirror symmetry of the scene's indenter where it can touch
     the skin within the scene's depth (the kind's answer). The one symmetry test of the 3D
     mesher and the planner."""
-    return indenter_for_scene(scene, warn=False).symmetry(scene.indentation)
+    return indenter_for_scene(scene, warn=False).symmetry(scene.reach)
 
 
 def mirrored_x(scene) -> bool:
@@ -81,7 +81,7 @@ def mirrored_x(scene) -> bool:
     ind = indenter_for_scene(scene, warn=False)
     if scene.dim == 2:
         return not getattr(ind, "section_symmetric", True)
-    return not ind.symmetry(scene.indentation)[0]
+    return not ind.symmetry(scene.reach)[0]
 
 
 def first_contact_travel(scene, samples: int = 4000) -> float:
@@ -123,7 +123,7 @@ def require_contact(scene) -> None:
         symmetric = ind.section_symmetric if scene.dim == 2 else ind.symmetry()[0]
         if not symmetric:
             why += "; the half model (x >= 0) does not see the dots at x < 0"
-    elif scene.dim == 3 and not ind.symmetry(depth)[0]:
+    elif scene.dim == 3 and scene.skin_kind.halves_x and mirrored_x(scene):
         why += "; the half model (x >= 0) sees the indenter's part at x >= 0 only, mirrored"
     dmax = 0.6 * scene.thickness
     if travel < dmax:

@@ -42,6 +42,7 @@ STEP_SUFFIXES = (".step", ".stp")
 SIZE_RANGE = (0.1, 1000.0)  # mm: largest bounding-box extent of a plausible indenter
 STEP_TOLERANCE = 0.005      # mm, as geometry/export.py meshes the project's own solids
 MAX_PATCHES = 100           # contact spots the local mesh plan takes; more: the strip plan
+MAX_PLANES = 50             # planes of first touch tested (contact_planes)
 _PAIR_CHUNK = 200_000       # (point, triangle) pairs per closest-point batch (memory)
 _VALID = "a closed triangle surface in mm (" + ", ".join(MESH_SUFFIXES + STEP_SUFFIXES) + ")"
 
@@ -226,7 +227,23 @@ class FileIndenter(Indenter):
         return mid - half, mid + half
 
     def contact_planes(self) -> np.ndarray:
-        return np.array([float(self.vertices[np.argmin(self.vertices[:, 1]), 2])])
+        """z of the tips that can touch first (to 0.001 mm, at most MAX_PLANES, lowest first):
+        the vertices lowest in their neighbourhood (each bump's tip), less those with a lower
+        tip at least as near x = 0 (the skin's top falls away from x = 0 and is uniform along
+        z), so a bump past the slab's end does not hide one inside it (first_contact_travel
+        clips the planes to the slab) and a ring gives its tips nearest x = 0, not 50."""
+        v, f = self.vertices, self.faces
+        e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        e = np.concatenate([e, e[:, ::-1]])
+        low = np.full(len(v), np.inf)
+        np.minimum.at(low, e[:, 0], v[e[:, 1], 1])
+        tips = v[v[:, 1] <= low]
+        tips = tips[np.lexsort((np.abs(tips[:, 0]), tips[:, 1]))]
+        ax = np.abs(tips[:, 0])
+        keep = ax <= np.minimum.accumulate(np.concatenate([[np.inf], ax[:-1]])) + 1e-9
+        z = np.round(tips[keep, 2], 3)
+        _, first = np.unique(z, return_index=True)
+        return z[np.sort(first)][:MAX_PLANES]
 
     def contact_patches(self, depth):
         """One spot per connected piece of the surface below y0 + depth (a piece's vertices
