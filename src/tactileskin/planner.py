@@ -168,9 +168,11 @@ class Plan:
 # (benchmarks/preset_accuracy.py, benchmarks/results/preset_accuracy_fit.md): preview
 # -0.12..-3.18 %, default -0.10..-0.47 %, fine +0.03..-0.17 %, every preset reading low;
 # against 5-level series the t = 1 cases read lower still (preset_accuracy_fit_t1.md).
-# 3D: "mesh3d" for flat / curved (the strip plan); Braille meshes on the local plan at the dots
-# (mesh.sizing.local_plan) at sizes that follow the skin thickness, so only quality_mesh
-# (presets.mesh(..., thickness=)) gives them; the Braille levels of the 3D convergence study (benchmarks/convergence3d.py,
+# 3D: "mesh3d" for flat / curved (the strip plan); spot contacts (Braille dots, spheres, file
+# indenters: the kind's local_3d, on a skin with the local plan) mesh on the local plan at
+# their spots (mesh.sizing.local_plan) at sizes that follow the skin thickness, so only
+# quality_mesh (presets.mesh(..., thickness=)) gives them; the levels of the 3D convergence
+# study (Braille dots and cells, the R 2.5 sphere; benchmarks/convergence3d.py,
 # benchmarks/results/convergence3d.md) with their worst measured peak error and bone-map L2
 # over the studied cases ("peak_error3d", "map_l2_3d"; None where no case measured them,
 # "cases3d_not_measured" names the studied cases without that level, "cases3d_reference"
