@@ -73,7 +73,7 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
             click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
             # loading (tactileskin.loading): force control; holds and releases via [[loading]] in --scene
             click.option("--force", type=float, default=None,
-                         help="Force control: target reaction (N in 3D, N/mm in 2D) instead of --depth."),
+                         help="Force control: target force (N on the whole indenter in 3D, N/mm of the half section in 2D) instead of --depth."),
             click.option("--force-rate", type=float, default=None,
                          help="Force rate (N/s, N/mm/s in 2D) for --force."),
             click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
