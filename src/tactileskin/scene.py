@@ -147,7 +147,7 @@ class Scene:
     dome_length: float | None = None       # dome: length of the finger before its dome (mm)
     dome_tip: float | None = None          # dome: semi-axis of the dome along the finger (mm)
     # loading (tactileskin.loading; None / () not given, absent from to_dict so keys are unchanged)
-    force: float | None = None             # force control: target reaction (N in 3D, N/mm in 2D)
+    force: float | None = None             # force control: target force (N on the whole indenter in 3D, N/mm of the half section in 2D)
     force_rate: float | None = None        # N/s (N/mm/s); None: load_time
     load_time: float | None = None         # s to reach `force`; None: depth_fraction * t / rate
     loading: tuple = field(default_factory=tuple)  # loading.Segment after the first ramp, TOML [[loading]]

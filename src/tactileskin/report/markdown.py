@@ -414,7 +414,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                 p.name == "metrics_vs_thickness.png" for p in figures) else []
     out += [""] + run_settings(scenes if scenes is not None else [r.scene for r in records])
     out += ["## Cases", "",
-            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm in 2D, N in 3D) | increments | Newton its | wall (s) | status |",
+            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm of the half section in 2D, N on the whole indenter in 3D) | increments | Newton its | wall (s) | status |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in _status_order(rows):
         k = quality.kind(r.get("status", ""))
