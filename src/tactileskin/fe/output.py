@@ -413,7 +413,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           "reaction_vector_modelled_part": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp,
-                  reaction=indenter_force(model, ev) if vertical == 1 else float(r[vertical]),
+                  reaction=float(r[vertical]) * (model.force_factor if vertical == 1 else 1.0),
                   stats=st, fields=vtk, history=[{k: v for k, v in h.items() if k != "displacement"}
                                                  for h in stats.history], scene=scene,
                   bone_map=bmap)

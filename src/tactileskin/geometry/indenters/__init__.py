@@ -69,8 +69,8 @@ def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> I
 
 def indenter_symmetry(scene) -> tuple[bool, bool]:
     """(about x = 0, about z = 0): mirror symmetry of the scene's indenter where it can touch
-    the skin within the scene's depth (the kind's answer). The one symmetry test of the 3D
-    mesher and the planner."""
+    the skin within the travel its loading can reach (`Scene.reach`; the kind's answer). The
+    one symmetry test of the 3D mesher and the planner."""
     return indenter_for_scene(scene, warn=False).symmetry(scene.reach)
 
 
