@@ -249,7 +249,7 @@ class FileIndenter(Indenter):
         """One spot per connected piece of the surface below y0 + depth (a piece's vertices
         there and its edges' crossings of that plane): the centre of the piece's (x, z) box and
         the largest distance of its points from it; a piece that does not cover its centre (a
-        ring) is covered by spots as wide as the ring instead (`_cover`). None (the strip plan)
+        ring) is covered by spots of the ring's half-width instead (`_cover`). None (the strip plan)
         beyond MAX_PATCHES spots (a textured face)."""
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
@@ -282,9 +282,11 @@ class FileIndenter(Indenter):
 def _cover(xz: np.ndarray, tri: np.ndarray) -> list[tuple[float, float, float]]:
     """Spots (x, z, a) covering a piece's points xz (n, 2) whose (x, z) triangles are tri
     (T, 3, 2): one around the box centre if a triangle covers it (a ball's cap, a plate);
-    else (a ring) greedy spots as wide as the ring (outer minus inner radius about the centre),
-    so that its size follows the ring's width, not its diameter (a torus of major radius 2 mm
-    was one 2.5 mm spot: 7.9 % low at preview)."""
+    else (a ring) greedy spots of the ring's half-width (half the outer minus inner radius about
+    the centre: the chord of its tube), so that their size follows the tube, not the ring's
+    diameter. A torus (radii 2 and 0.8 mm) at t = 1 read 0.0645 MPa at preview as one spot,
+    0.0730 / 0.0779 at 1.6 / 1.2 / 8 with spots of the whole width, and 0.0793 / 0.0764 /
+    0.0757 at 1.6 / 1.2 / 0.8 / 8 with these (from above, +4.8 % at preview)."""
     c = 0.5 * (xz.min(axis=0) + xz.max(axis=0))
     r = np.linalg.norm(xz - c, axis=1)
     a, b, q = tri[:, 0], tri[:, 1], tri[:, 2]
@@ -294,7 +296,7 @@ def _cover(xz: np.ndarray, tri: np.ndarray) -> list[tuple[float, float, float]]:
     covered = np.any((d != 0) & (u >= 0) & (w >= 0) & (u + w <= 1))
     if covered or len(xz) < 3:
         return [(float(c[0]), float(c[1]), float(r.max()))]
-    width = max(float(r.max() - r.min()), 1e-9)
+    width = max(0.5 * float(r.max() - r.min()), 1e-9)  # the half-width of the annulus: its chord
     out, left = [], xz
     while len(left):
         near = np.linalg.norm(left - left[0], axis=1) <= width
