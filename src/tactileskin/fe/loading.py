@@ -52,8 +52,9 @@ class ForceIncrement:
     known yet."""
 
     def __init__(self, target, d_max: float, d_guess, *, f_start: float = 0.0, slope: float | None = None,
-                 rtol: float = FORCE_RTOL):
+                 rtol: float = FORCE_RTOL, goal: float | None = None):
         self.target, self.d_max, self.d_guess, self.rtol = target, float(d_max), d_guess, rtol
+        self.goal = goal  # the segment's final force, named when the skin cannot carry it
         self.f_committed, self.slope = float(f_start), slope
         self.reached = float(f_start)
 
@@ -130,10 +131,12 @@ class ForceIncrement:
             k = (f + F) / d if d > 0 and f + F > 0 else 0.0
         if f < 0:  # below the target: deeper
             if d >= self.d_max * (1 - 1e-12):
+                goal = F if self.goal is None else self.goal
+                on_way = "" if abs(goal - F) <= 1e-9 * max(abs(goal), 1.0) else f" (on the way, at {F:.6g})"
                 raise ConvergenceError(
-                    f"force {F:.6g} not reached: the reaction is {f + F:.6g} at the largest travel "
-                    f"{self.d_max:.6g} mm (0.6 x thickness); the skin cannot carry this force within "
-                    "its depth range", {"force": F, "reached": f + F, "travel_mm": d})
+                    f"force {goal:.6g} not reached: the reaction is {f + F:.6g} at the largest travel "
+                    f"{self.d_max:.6g} mm (0.6 x thickness){on_way}; the skin cannot carry this force "
+                    "within its depth range", {"force": goal, "ramp_force": F, "reached": f + F, "travel_mm": d})
             step = -f / k if k > 0 else d
             return min(d + min(step, 2.0 * max(d - model.d, 1e-3 * self.d_max)), self.d_max)
         step = -f / k if k > 0 else -0.5 * d
@@ -184,7 +187,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
             F0, F1 = f_now, seg.target
             T = t0 + seg.duration(F0)
             force_inc = ForceIncrement(lambda t, F0=F0, F1=F1, t0=t0, T=T: F0 + (F1 - F0) * min(1.0, (t - t0) / (T - t0)),
-                                       d_max, d_guess, f_start=f_now,
+                                       d_max, d_guess, f_start=f_now, goal=F1,
                                        slope=force_inc.slope if force_inc is not None else None)
             increment, control = force_inc, "force"
         else:  # hold
