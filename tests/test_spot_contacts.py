@@ -212,3 +212,19 @@ def test_under_force_control_symmetry_is_judged_over_the_whole_travel(tmp_path):
     by_force = Scene(thickness=1.0, dim=3, indenter="file", indenter_file=f, force=0.5)
     assert indenter_symmetry(by_depth)[0] and not mirrored_x(by_depth)
     assert not indenter_symmetry(by_force)[0] and mirrored_x(by_force)
+
+
+def test_indenters_from_the_same_bytes_share_their_search_trees(tmp_path):
+    # the mesher and the planner ask the symmetry several times, each on a new indenter: the
+    # trees (0.3 s for a built part) are built once per file content; placement is a shift
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=2.5)
+    f = _stl(tmp_path, "b.stl", ball)
+    a = make_indenter("file", y0=Y0, dim=3, indenter_file=f)
+    b = make_indenter("file", y0=Y0 + 1.0, dim=3, indenter_file=f)
+    assert a._trees is b._trees
+    p = np.array([[0.3, Y0 - 0.1, 0.2], [1.0, Y0 + 0.5, -0.4]])
+    ga, _ = a.gap(p, 0.0)
+    gb, _ = b.gap(p + np.array([0.0, 1.0, 0.0]), 0.0)
+    np.testing.assert_allclose(ga, gb, atol=1e-12)
+    c = np.array([0.0, Y0 + 2.5, 0.0])                     # the ball's centre, lowest point at y0
+    np.testing.assert_allclose(ga, np.linalg.norm(p - c, axis=1) - 2.5, atol=0.02)  # facets

@@ -102,7 +102,30 @@ def load_surface(path) -> tuple[np.ndarray, np.ndarray]:
         raise ParameterError("indenter_file", str(path), _VALID, f"unsupported suffix {p.suffix!r}")
     if not p.is_file():
         raise ParameterError("indenter_file", str(path), _VALID, "no such file")
-    return _load(str(p.resolve()), file_digest(p))
+    return _load(*_source(p))
+
+
+def _source(p: Path) -> tuple[str, str]:
+    """(resolved path, sha256): the key the loaded surface and its search trees are cached by."""
+    return str(p.resolve()), file_digest(p)
+
+
+@functools.lru_cache(maxsize=8)
+def _trees_of(path: str, digest: str):
+    """The gap's search structures of a file's surface as loaded (before placement; cached by
+    content: every indenter made from the same bytes shares them, so the mesher's and the
+    planner's symmetry questions do not rebuild them)."""
+    v, f = _load(path, digest)
+    return _search_trees(v[f])
+
+
+def _search_trees(tri: np.ndarray):
+    tri = _split_long(tri)                                 # (T, 3, 3), the same surface
+    cen = tri.mean(axis=1)
+    rmax = float(np.max(np.linalg.norm(tri - cen[:, None, :], axis=2)))
+    nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
+    return cKDTree(tri.reshape(-1, 3)), cKDTree(cen), rmax, tri, nrm
 
 
 @register
@@ -111,6 +134,8 @@ class FileIndenter(Indenter):
     file: str = ""
     vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # placed (lowest y = y0)
     faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), int))
+    source: tuple = ()   # (resolved path, sha256) of the loaded surface: `_trees_of`'s key
+    shift: float = 0.0   # y placement: vertices = loaded vertices + (0, shift, 0)
 
     name = "file"
     order = 20
@@ -142,20 +167,20 @@ class FileIndenter(Indenter):
         if not indenter_file:
             raise ParameterError("indenter_file", indenter_file, _VALID, "the file is required")
         v, f = load_surface(indenter_file)
-        v = v + np.array([0.0, y0 - v[:, 1].min(), 0.0])
+        shift = float(y0 - v[:, 1].min())
+        v = v + np.array([0.0, shift, 0.0])
         ext = v.max(axis=0) - v.min(axis=0)
         return cls(kind=cls.name, y0=y0, dim=dim, width=float(ext[0]), length=float(ext[2]),
-                   file=str(indenter_file), vertices=v, faces=f, **stem_params())
+                   file=str(indenter_file), vertices=v, faces=f, source=_source(Path(indenter_file)),
+                   shift=shift, **stem_params())
 
     # -- geometry ----------------------------------------------------------------------------
     @functools.cached_property
     def _trees(self):
-        tri = _split_long(self.vertices[self.faces])          # (T, 3, 3), the same surface
-        cen = tri.mean(axis=1)
-        rmax = float(np.max(np.linalg.norm(tri - cen[:, None, :], axis=2)))
-        nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
-        return cKDTree(tri.reshape(-1, 3)), cKDTree(cen), rmax, tri, nrm
+        """The search structures in the loaded frame (queries are shifted by -shift)."""
+        if self.source:
+            return _trees_of(*self.source)
+        return _search_trees(self.vertices[self.faces] - np.array([0.0, self.shift, 0.0]))
 
     def _gap(self, p, d):
         """Signed distance to the nearest triangle: candidates are the triangles whose centroid
@@ -166,7 +191,7 @@ class FileIndenter(Indenter):
             p = np.column_stack([p, np.zeros(len(p))])
             g, n = self._gap(p, d)
             return g, n[:, :2]
-        q = p + np.array([0.0, d, 0.0])                        # the indenter moved by -d
+        q = p + np.array([0.0, d - self.shift, 0.0])           # the indenter moved by -d (loaded frame)
         vtree, ctree, rmax, tri, nrm = self._trees
         bound, _ = vtree.query(q)
         cand = ctree.query_ball_point(q, bound * (1 + 1e-12) + rmax + 1e-12)
