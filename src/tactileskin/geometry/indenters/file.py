@@ -236,10 +236,13 @@ class FileIndenter(Indenter):
             out.append(bool(np.max(np.abs(g)) <= tol))
         return out[0], out[1]
 
+    def _band_faces(self, depth: float) -> np.ndarray:
+        """The triangles (vertex indices) that reach below y0 + depth (the part that can touch)."""
+        return self.faces[self.vertices[self.faces][:, :, 1].min(axis=1) <= self.y0 + max(float(depth), 0.0)]
+
     def _band(self, depth: float) -> np.ndarray:
-        """Vertices of the triangles that reach below y0 + depth (the part that can touch)."""
-        low = self.vertices[self.faces][:, :, 1].min(axis=1) <= self.y0 + max(depth, 0.0)
-        return self.vertices[np.unique(self.faces[low])]
+        """Vertices of the triangles that reach below y0 + depth."""
+        return self.vertices[np.unique(self._band_faces(depth))]
 
     def contact_halfwidth(self, depth, r_top):
         b = self._band(depth)
@@ -257,8 +260,8 @@ class FileIndenter(Indenter):
         tip at least as near x = 0 (the skin's top falls away from x = 0 and is uniform along
         z), so a bump past the slab's end does not hide one inside it (first_contact_travel
         clips the planes to the slab) and a ring gives its tips nearest x = 0, not 50."""
-        v, f = self.vertices, self.faces
-        e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        v = self.vertices
+        e = _edges(self.faces)
         e = np.concatenate([e, e[:, ::-1]])
         low = np.full(len(v), np.inf)
         np.minimum.at(low, e[:, 0], v[e[:, 1], 1])
@@ -279,10 +282,10 @@ class FileIndenter(Indenter):
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
-        v, f = self.vertices, self.faces
+        v = self.vertices
         cut = self.y0 + max(float(depth), 0.0)
-        band = f[v[f][:, :, 1].min(axis=1) <= cut]
-        e = np.concatenate([band[:, [0, 1]], band[:, [1, 2]], band[:, [2, 0]]])
+        band = self._band_faces(depth)
+        e = _edges(band)
         g = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(len(v), len(v)))
         _, label = connected_components(g, directed=False)
         ya, yb = v[e[:, 0], 1], v[e[:, 1], 1]
@@ -302,6 +305,11 @@ class FileIndenter(Indenter):
 
     def solid(self):
         raise CadError(f"the file indenter's printable solid is the user's file itself ({self.file})")
+
+
+def _edges(faces: np.ndarray) -> np.ndarray:
+    """(3F, 2) vertex pairs of the triangles' edges (shared edges repeated)."""
+    return np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
 
 
 def _cover(xz: np.ndarray, tri: np.ndarray) -> list[tuple[float, float, float]]:
