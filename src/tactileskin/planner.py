@@ -212,16 +212,9 @@ def quality_mesh(quality: str, indenter, dim: int = 2, thickness: float | None =
     local sizes, thick-skin ones from their thickness on)."""
     if quality not in QUALITY:
         raise ParameterError("quality", quality, "one of " + ", ".join(QUALITY))
-    q = QUALITY[quality]
-    from tactileskin import presets
-    from tactileskin.geometry.indenters import get_kind
-    from tactileskin.skins import registry as skins
+    from tactileskin.scene import preset_mesh
 
-    if dim == 3:
-        if get_kind(indenter).local_3d and skins.get(skin).local_plan:
-            return presets.mesh(3, quality, braille=True, thickness=thickness)
-        return q["mesh3d"]
-    return q["braille_mesh"] if get_kind(indenter).fine_2d_mesh else q["mesh"]
+    return preset_mesh(quality, dim, indenter, thickness, skin)
 
 
 def with_quality(scene: Scene, quality: str) -> Scene:

@@ -68,12 +68,19 @@ def default_mesh(dim: int, indenter, thickness: float | None = None, skin: str =
     gets by default (the kind says whether its 2D section needs the finer preset; in 3D a kind
     that touches in spots is refined there on a skin with the local plan, at the local
     presets' sizes, with the thick-skin sizes from their thickness on)."""
+    return preset_mesh("default", dim, indenter, thickness, skin)
+
+
+def preset_mesh(quality: str, dim: int, indenter, thickness: float | None = None,
+                skin: str = "fingertip") -> tuple[float, float]:
+    """(mesh_size, refinement) of a quality preset (data/presets.json) for a dimension,
+    indenter kind, skin thickness and skin: the "braille_mesh" sizes for a 2D kind with
+    `fine_2d_mesh` and for 3D spot contacts (`local_3d`) on a skin with the local plan."""
     kind = _indenters.get(indenter)
-    if dim == 3 and kind.local_3d and _skins.get(skin).local_plan:
-        return _presets.mesh(3, "default", braille=True, thickness=thickness)
-    if dim == 2 and kind.fine_2d_mesh:
-        return DEFAULT_MESH_BRAILLE_2D
-    return DEFAULT_MESH[dim]
+    if dim == 3:
+        local = kind.local_3d and _skins.get(skin).local_plan
+        return _presets.mesh(3, quality, braille=local, thickness=thickness)
+    return _presets.mesh(dim, quality, braille=kind.fine_2d_mesh)
 
 
 # The registered indenter kinds (geometry/indenters/, one file per kind) as an enum, so
