@@ -82,6 +82,42 @@ def test_key_follows_schema_and_version(monkeypatch):
     assert len({k, k2, cache_key(sc)}) == 3
 
 
+def test_key_follows_the_code_that_computes(tmp_path, monkeypatch):
+    """Another tactileskin (an update, an edited solver) or another mesher version never reuses
+    a result: the key covers the package's files and the solving libraries' versions."""
+    from tactileskin.cache import code_digest
+
+    pkg = tmp_path / "pkg"
+    (pkg / "fe").mkdir(parents=True)
+    (pkg / "fe" / "solver.py").write_text("RTOL = 1e-8\n")
+    (pkg / "data.json").write_text("{}")
+    d0 = code_digest(pkg)
+    (pkg / "__pycache__").mkdir()
+    (pkg / "__pycache__" / "solver.cpython-311.pyc").write_bytes(b"\0compiled")
+    (pkg / "notes.txt").write_text("not code")
+    code_digest.cache_clear()
+    assert code_digest(pkg) == d0                      # byte-code and other files do not count
+    (pkg / "fe" / "solver.py").write_text("RTOL = 1e-6\n")
+    code_digest.cache_clear()
+    d1 = code_digest(pkg)
+    assert d1 != d0                                    # one changed constant: another key
+    (pkg / "fe" / "solver.py").rename(pkg / "solver.py")
+    code_digest.cache_clear()
+    assert code_digest(pkg) not in (d0, d1)            # a moved module is other code too
+
+    code_digest.cache_clear()
+    sc = Scene()
+    k = cache_key(sc)
+    from importlib import metadata
+
+    monkeypatch.setattr(metadata, "version", lambda name: "0.0-other" if name == "gmsh" else "1")
+    code_digest.cache_clear()
+    assert cache_key(sc) != k                          # another gmsh meshes differently
+    monkeypatch.undo()
+    code_digest.cache_clear()
+    assert cache_key(sc) == k
+
+
 def test_edited_material_file_is_recomputed(tmp_path):
     mat = _material_file(tmp_path / "pu.toml")
     sc = Scene(material=str(mat), indenter="curved", **COARSE)

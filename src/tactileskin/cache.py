@@ -10,7 +10,10 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   indenters, Braille standards, molds);
 - the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL) and the
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
-- `scene.SCHEMA_VERSION` and the package version.
+- `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's
+  own source and data files and the versions of the libraries that mesh and solve (gmsh,
+  scikit-fem, numpy, scipy, numba, mkl), so a result computed by other code (an update of
+  tactileskin, a changed mesher) is never reused.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
 time stamp, so an edit within the same second is not missed.
@@ -39,6 +42,7 @@ import math
 import os
 import shutil
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -77,11 +81,44 @@ def material_content(material: str) -> dict:
     return {m.law_name: _floats(m.law.to_dict()), "prony": _floats(m.prony.to_dict())}
 
 
+# the libraries whose version can change a mesh or a solve (distribution names)
+SOLVER_LIBRARIES = ("gmsh", "scikit-fem", "numpy", "scipy", "numba", "mkl", "meshio")
+
+
+@lru_cache(maxsize=1)
+def code_digest(root: Path | None = None) -> str:
+    """SHA-256 of the code that produces a result: the names and bytes of every .py, .json and
+    .toml file of the package (`root`, default the installed package's folder; sorted by path)
+    and the installed versions of SOLVER_LIBRARIES. Computed once per process: it is the
+    code this process imported and runs (~100 files, a few ms)."""
+    from importlib import metadata
+
+    root = Path(__file__).resolve().parent if root is None else Path(root)
+    h = hashlib.sha256()
+    try:
+        paths = sorted(p for p in root.rglob("*") if p.suffix in (".py", ".json", ".toml") and p.is_file()
+                       and "__pycache__" not in p.parts)
+        for p in paths:
+            data = p.read_bytes()
+            h.update(p.relative_to(root).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
+    except OSError as e:  # an unreadable install: the version alone names the code
+        log.warning("package files not readable (%s); cache keys use the version %s only", e, __version__)
+        h.update(b"unreadable")
+    for name in SOLVER_LIBRARIES:
+        try:
+            v = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            v = "-"
+        h.update(f"{name}={v}\0".encode())
+    return h.hexdigest()
+
+
 def cache_key(scene: Scene) -> str:
     """Hash of everything that can change `scene`'s result (see the module docstring)."""
     fields = _scene_fields(scene)
     payload = {"scene": fields, "material": material_content(scene.material),
-               "geometry": params.geometry_digest(), "schema": SCHEMA_VERSION, "version": __version__}
+               "geometry": params.geometry_digest(), "schema": SCHEMA_VERSION, "version": __version__,
+               "code": code_digest()}
     files = scene.indenter_kind.cache_content(scene)
     if files:  # only kinds that read files add the key (the others' keys stay as they were)
         payload["indenter_files"] = files
