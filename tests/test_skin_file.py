@@ -184,6 +184,11 @@ def test_step_block_solves_like_the_pad_block(tmp_path):
     quarter = solve(Scene(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, dim=3, **kw))
     assert quarter.stats["dofs"] < 0.5 * full.stats["dofs"]  # it was the quarter
     assert full.reaction == pytest.approx(quarter.reaction, rel=1e-3)
+    # the whole block's profile runs across the centre: half its extent is the quarter's span
+    # (the plate presses the whole top: the pad's half width); its AUC on these 1 mm cells is
+    # left to the 2D test (test_a_whole_2d_skin_reads_like_the_halved_pad)
+    assert full.sides == 2 and quarter.sides == 1
+    assert full.span == pytest.approx(quarter.span, rel=1e-3) == 4.0
 
 
 def test_a_sweep_of_a_skin_file_takes_its_thickness_not_the_papers(tmp_path):
@@ -216,3 +221,57 @@ def test_a_scene_files_skin_file_implies_the_file_skin_as_the_option_does(tmp_pa
     sf = scenefile.read(tmp_path / "s.toml")
     assert sf.fields["skin"] == "file" and sf.fields["skin_file"] == str(f)
     assert Scene.from_toml(tmp_path / "s.toml").skin == "file"
+
+
+def _gmsh_rectangle(path, w=8.0, t=2.0, h=0.25):
+    """A whole 2D block x in [-w/2, w/2], y in [0, t] (no symmetry group): bottom `bonded`,
+    top `outer_surface`, the ends `sides`."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("rect")
+        occ = gmsh.model.occ
+        occ.addRectangle(-w / 2, 0, 0, w, t)
+        occ.synchronize()
+        groups = {"bonded": [], "outer_surface": [], "sides": []}
+        for _, f in gmsh.model.getEntities(1):
+            c = occ.getCenterOfMass(1, f)
+            groups["bonded" if abs(c[1]) < 1e-9 else "outer_surface" if abs(c[1] - t) < 1e-9 else "sides"].append(f)
+        for name, ents in groups.items():
+            gmsh.model.addPhysicalGroup(1, ents, name=name)
+        gmsh.model.addPhysicalGroup(2, [e for _, e in gmsh.model.getEntities(2)], name="skin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def test_a_whole_2d_skin_reads_like_the_halved_pad(tmp_path):
+    """A 2D skin file without a symmetry group is solved whole; its profile runs across the
+    centre. Its reaction (per mm of the half section), span and AUC are the halved pad's, and
+    a force target presses both alike (before: the whole section's force, span and AUC, twice
+    the pad's, so --force pressed the file skin half as deep). P2 meshes of h = 0.125 mm that
+    differ (gmsh's rectangle, the pad mesher): reaction, span, AUC agree to 0.2 %, the peak to
+    0.5 % (the bone fit at the centre line is one-sided on the halved model: -2.3 % at h = 0.25,
+    converging as h^2), hence 1 %."""
+    path = _gmsh_rectangle(tmp_path / "whole.msh", w=16.0, h=0.125)
+    kw = dict(indenter="cylinder", indenter_radius=2.0, viscoelastic=False, mesh_size=0.125, refinement=1.0)
+    whole_scene = Scene(skin="file", skin_file=str(path), depth=0.1, **kw)
+    half_scene = Scene(skin="pad", pad_width=16.0, thickness=2.0, depth=0.1, **kw)
+    whole, half = solve(whole_scene), solve(half_scene)
+    assert whole.s.min() < -7.9 and half.s.min() > -1e-9      # two-sided against one-sided
+    assert whole.sides == 2 and half.sides == 1
+    assert whole.summary()["profile_sides"] == 2 and "profile_sides" not in half.summary()
+    assert 1.0 < half.span < 4.0                               # the span ends inside the pad
+    for name in ("reaction", "peak", "span", "auc"):
+        assert getattr(whole, name) == pytest.approx(getattr(half, name), rel=0.01), name
+    # force control on h = 0.25 (the reactions there agree to 3e-4)
+    coarse = _gmsh_rectangle(tmp_path / "coarse.msh", w=16.0, h=0.25)
+    target = 0.8 * half.reaction
+    fw = solve(Scene(skin="file", skin_file=str(coarse), **{**kw, "mesh_size": 0.25}, force=target))
+    fh = solve(half_scene.replace(depth=None, mesh_size=0.25, force=target))
+    assert fw.loading["profile_travel_mm"] == pytest.approx(fh.loading["profile_travel_mm"], rel=0.01)

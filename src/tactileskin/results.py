@@ -171,7 +171,7 @@ class Result:
       of the outer surface, sorted by the current x.
     reaction: the indenter's vertical force: on the whole indenter in 3D (the fixed
       boundaries' reaction on the modelled part times its mirror copies), per mm of the half
-      section in 2D.
+      section in 2D (half the whole section's on a model without the x = 0 line).
     stats: dofs, increments, newton_iterations, wall_s (and more).
     fields: optional nodal data for the .vtu (points, cells, cell_type, point_data).
     history: per-increment records when requested.
@@ -226,12 +226,20 @@ class Result:
         return peak(*self._profile())
 
     @property
+    def sides(self) -> int:
+        """1: the profile starts at the symmetry line (a halved model); 2: it runs across the
+        centre (a model without the x = 0 plane: a user's full skin, a full-width pad)."""
+        return 2 if int(self.stats.get("profile_sides", 1)) == 2 else 1
+
+    @property
     def span(self) -> float:
-        return span(*self._profile())
+        """Span (mm); of a two-sided profile half its extent, as the halved model reads it."""
+        return span(*self._profile()) / self.sides
 
     @property
     def auc(self) -> float:
-        return auc(*self._profile())
+        """Area under P(s) (MPa mm); of a two-sided profile half of it (the half section's)."""
+        return auc(*self._profile()) / self.sides
 
     def _profile(self):
         # nodes at (numerically) the same s: keep their mean so that s is strictly increasing
@@ -259,6 +267,8 @@ class Result:
             "wall_s": float(self.stats.get("wall_s", 0.0)),
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
+            # a profile across the centre (no x = 0 plane): span and AUC are half of it
+            **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
             **({"mirrored_x": True} if self.stats.get("mirrored_x") else {}),
             **self._map_summary(),

@@ -93,9 +93,15 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
                   formulation=scene.formulation.value, contact=contact, order=scene.order,
                   stiffness=max(law.K0, law.mu0))
-    if m == 3:  # the whole indenter's force; 2D stays per mm of the half section x >= 0
-        model.force_factor = (2.0 if "symmetry" in mesh.boundaries else 1.0) * (
-            2.0 if getattr(mesh, "z_symmetric", False) else 1.0)
+    halved = len(mesh.boundaries.get("symmetry", ())) > 0
+    # a model without the x = 0 plane (a user's full skin, a full-width pad under an
+    # x-asymmetric indenter) has a profile across the centre: its span and AUC are halved
+    # (Result.span), as its 2D force is, so that a halved and a whole model of one scene agree
+    model.profile_sides = 1 if halved else 2
+    if m == 3:  # the whole indenter's force
+        model.force_factor = (2.0 if halved else 1.0) * (2.0 if getattr(mesh, "z_symmetric", False) else 1.0)
+    else:  # per mm of the half section x >= 0: half the whole section's force
+        model.force_factor = 1.0 if halved else 0.5
     return model, mesh
 
 

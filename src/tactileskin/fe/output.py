@@ -411,6 +411,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
           "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
+          **({"profile_sides": 2} if getattr(model, "profile_sides", 1) == 2 else {}),
           "reaction_vector_modelled_part": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp,
                   reaction=float(r[vertical]) * (model.force_factor if vertical == 1 else 1.0),
