@@ -76,6 +76,49 @@ def test_wrong_law_shows_in_quality():
     assert fit("neo_hookean", lam, P).quality["max_rel_err"] > 0.05 > fit("yeoh", lam, P).quality["max_rel_err"]
 
 
+@pytest.mark.parametrize("name", sorted(TRUE))
+def test_a_right_law_on_tension_data_is_not_called_suspect(name):
+    """No false alarms: each law fitted to its own exact data from a tension-only test (the
+    compression response extrapolated) and to 3 % noisy Yeoh data has no warnings."""
+    law, nu = TRUE[name]
+    lam = np.linspace(1.0, 2.0, 21)
+    P, _ = uniaxial_nominal(law, lam, nu)
+    assert fit(name, lam, P, nu=nu).warnings == []
+    yeoh, _ = TRUE["yeoh"]
+    Py, _ = uniaxial_nominal(yeoh, LAM, None)
+    z = np.random.default_rng(3).standard_normal(LAM.size)
+    assert fit("yeoh", LAM, Py * (1 + 0.03 * z)).warnings == []
+
+
+def test_a_close_fit_with_the_wrong_small_strain_and_compression_is_suspect(tmp_path, capsys):
+    """Ogden fitted to strongly stiffening Yeoh tension data (c = 0.02, 0, 0.05; stretch 1-2):
+    R^2 0.99995 and 2 % largest relative error over the points above 5 % of the largest stress,
+    yet its small-strain slope is 4.3x the data's (the points at stretch 1.05-1.15 are 48-133 %
+    off) and at stretch 0.8 it is 18x as stiff as its own small-strain modulus gives: a solve
+    with it read 15x the bone pressure of the true law. Both are reported and the CLI exits 3."""
+    law = Yeoh((0.02, 0.0, 0.05), 1.0)
+    lam = np.linspace(1.0, 2.0, 21)
+    P, _ = uniaxial_nominal(law, lam, None)
+    f = fit("ogden", lam, P)
+    assert f.quality["r2"] > 0.999
+    assert len(f.warnings) == 2
+    assert "small-strain modulus" in f.warnings[0] and "compression extrapolated" in f.warnings[1]
+    assert "suspect fit" in f.describe()
+    assert fit("yeoh", lam, P).warnings == []
+    # with compression data in the test (stretch 0.7-2) the compression check has nothing to say
+    lam2 = np.linspace(0.7, 2.0, 27)
+    P2, _ = uniaxial_nominal(law, lam2, None)
+    assert not any("compression" in w for w in fit("ogden", lam2, P2).warnings)
+    csv = tmp_path / "stiff.csv"
+    csv.write_text("stretch,nominal_stress_mpa\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(lam, P)))
+    out = tmp_path / "o.toml"
+    assert main(["material", "fit", str(csv), "--law", "ogden", "-o", str(out)]) == 3
+    text = capsys.readouterr().out
+    assert "suspect fit: small-strain modulus" in text and "exit status 3" in text
+    assert "SUSPECT" in out.read_text()                # the material file says so too
+    assert main(["material", "fit", str(csv), "--law", "yeoh", "-o", str(tmp_path / "y.toml")]) == 0
+
+
 @pytest.mark.parametrize("lam,P,match", [
     (LAM[:4], LAM[:4], "points"),
     (np.r_[LAM[:10], np.nan], np.r_[LAM[:10], 1.0], "stretch"),

@@ -99,3 +99,18 @@ def test_fit_of_a_3d_solve_recovers_mu(tmp_path):
     f = fit_indentation("neo_hookean", d, F, radius=R, thickness=T)
     assert f.law.mu == pytest.approx(mu, rel=0.10), (f.law.mu, pts)
     assert f.quality["r2"] > 0.99
+
+
+def test_the_contact_point_row_is_dropped_and_a_falling_force_is_refused():
+    d = np.linspace(0.02, 0.2, 6)
+    F = bonded_sphere_force(0.3, d, R, T)
+    plain = fit_indentation("neo_hookean", d, F, radius=R, thickness=T)
+    with_origin = fit_indentation("neo_hookean", np.r_[0.0, d], np.r_[0.0, F], radius=R, thickness=T)
+    assert with_origin.E == plain.E and with_origin.quality["n_points"] == 6
+    with pytest.raises(FitDataError, match="past first contact"):
+        fit_indentation("neo_hookean", [0.0, 0.1, 0.2], [0.0, 0.01, 0.02], radius=R, thickness=T)
+    # a force that falls with depth (columns swapped, a retraction curve) fits worse than its mean:
+    # refused, not written with R^2 = -1.75 (the fit would still give a positive E)
+    falling = [0.01, 0.008, 0.005, 0.002, 0.001]
+    with pytest.raises(FitDataError, match=r"R\^2 = -1.75.*falls with depth"):
+        fit_indentation("neo_hookean", [0.05, 0.1, 0.15, 0.2, 0.22], falling, radius=R, thickness=2.0)

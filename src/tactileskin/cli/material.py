@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 MARK = "# written by tactileskin material fit"
+EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
 
 @click.group("material")
@@ -87,8 +88,9 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     kin = "incompressible" if nu is None else f"nu = {nu:g}"
     source = (f"fit of {law} to {Path(data).name} (uniaxial nominal stress, {kin}, {q['n_points']} points): "
               f"R^2 = {q['r2']:.5f}, RMSE = {q['rmse_mpa']:.3g} MPa, max relative error "
-              f"{100 * q['max_rel_err']:.2f} %")
+              f"{100 * q['max_rel_err']:.2f} %" + "".join(f"; SUSPECT: {w}" for w in f.warnings))
     mat = f.material(name or Path(data).stem, source)
     fileio.atomic_write_text(outp, MARK + "\n" + mat.to_toml())
     click.echo(f.describe())
-    click.echo(f"wrote {out}")
+    click.echo(f"wrote {out}" + (" (a suspect fit: exit status 3)" if f.warnings else ""))
+    return EXIT_SUSPECT if f.warnings else 0

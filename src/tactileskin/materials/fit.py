@@ -37,6 +37,16 @@ __all__ = ["Fit", "FitDataError", "FitError", "fit", "read_uniaxial_csv", "uniax
 NU_INCOMPRESSIBLE = 0.49   # bulk modulus given to a law fitted as incompressible (K/mu0 = 49.7)
 REL_FLOOR = 0.05           # relative errors only where |stress| >= 5 % of the largest
 MAX_CSV_BYTES = 10 << 20   # a test file is at most a few 10k rows
+# Checks of what the fit's R^2 does not see (Fit.quality["warnings"]): the small-strain modulus,
+# which shallow indentation reads, against the data's from its points within SMALL_STRAIN of
+# stretch 1 (least-squares slope through (1, 0): 5-8 % below the tangent for rubber, hence the
+# loose MODULUS_RATIO); and with no compression in the data, the law's stress at
+# COMPRESSION_STRETCH against its own small-strain slope (neo-Hookean: 1.27x, Ogden and Yeoh
+# fits of rubber 1.1-1.6x), outside COMPRESSION_RATIO an extrapolation artefact
+SMALL_STRAIN = 0.15
+MODULUS_RATIO = 1.5
+COMPRESSION_STRETCH = 0.8
+COMPRESSION_RATIO = (0.5, 2.5)
 
 
 class FitDataError(ParameterError):
@@ -91,11 +101,17 @@ class Fit:
 
         return Material(name=name, law=self.law, prony=Prony.elastic(), source=source)
 
+    @property
+    def warnings(self) -> list[str]:
+        """What makes the fit suspect beyond its R^2 (empty: none found)."""
+        return list(self.quality.get("warnings", ()))
+
     def describe(self) -> str:
         q = self.quality
         return (f"{self.law.law}: {self.law.to_dict()}; R^2 = {q['r2']:.5f}, RMSE = {q['rmse_mpa']:.3g} MPa, "
                 f"max relative error {100 * q['max_rel_err']:.2f} % ({q['n_points']} points, "
-                f"{'incompressible' if self.nu is None else f'nu = {self.nu:g}'})")
+                f"{'incompressible' if self.nu is None else f'nu = {self.nu:g}'})"
+                + "".join(f"\n  suspect fit: {w}" for w in self.warnings))
 
 
 def _quality(stress, pred, n_params) -> dict:
@@ -234,7 +250,47 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
                        f"{q['rmse_mpa']:.3g} MPa): try another law, or check the data's columns and units")
     _check_stable(law, mat, lam, nu)
     q["nfev"] = int(sol.nfev)
+    q["warnings"] = extrapolation_warnings(mat, lam, P, nu)
+    for w in q["warnings"]:  # shown by describe() (the CLI prints it and exits 3)
+        log.info("fit of %s: %s", law, w)
     return Fit(law=mat, stretch=lam, stress=P, predicted=pred, nu=nu, quality=q)
+
+
+def _slope_at_one(mat, nu) -> float:
+    """dP/dstretch of the law's uniaxial nominal stress at stretch 1 (MPa): E, or 3 mu0."""
+    h = 1e-4
+    with np.errstate(all="ignore"):
+        P, _ = uniaxial_nominal(mat, np.array([1.0 - h, 1.0 + h]), nu)
+    return float((P[1] - P[0]) / (2.0 * h))
+
+
+def extrapolation_warnings(mat, lam, P, nu) -> list[str]:
+    """Where a fitted law that matches the test's points would still mislead a solve: its
+    small-strain modulus off the data's, or (no compression in the data) a compression
+    response its small-strain modulus does not explain (see SMALL_STRAIN above)."""
+    out = []
+    e_fit = _slope_at_one(mat, nu)
+    near = (np.abs(lam - 1.0) <= SMALL_STRAIN) & (lam != 1.0)
+    if np.count_nonzero(near) >= 2:
+        x = lam[near] - 1.0
+        e_data = float(np.sum(P[near] * x) / np.sum(x * x))
+        ratio = e_fit / e_data if e_data > 0 else np.inf
+        if not 1.0 / MODULUS_RATIO <= ratio <= MODULUS_RATIO:
+            out.append(f"small-strain modulus off the data's: the fit's slope at stretch 1 is {e_fit:.4g} MPa, the "
+                       f"data's {e_data:.4g} MPa ({ratio:.3g}x; from its {np.count_nonzero(near)} points within "
+                       f"{SMALL_STRAIN:.0%} of stretch 1); a shallow indentation reads this modulus: try another "
+                       "law or fewer terms")
+    if float(lam.min()) > 1.0 - 0.05 and e_fit > 0:  # a tension test: compression is extrapolated
+        with np.errstate(all="ignore"):
+            pc, ok = uniaxial_nominal(mat, np.array([COMPRESSION_STRETCH]), nu)
+        r = float(pc[0] / (e_fit * (COMPRESSION_STRETCH - 1.0))) if bool(ok[0]) else np.inf
+        lo, hi = COMPRESSION_RATIO
+        if not (np.isfinite(r) and lo <= r <= hi):
+            out.append(f"compression extrapolated: the data have no compression, and at stretch "
+                       f"{COMPRESSION_STRETCH:g} the fitted law's stress is {r:.3g}x what its small-strain modulus "
+                       f"gives (neo-Hookean 1.27x; {lo:g}-{hi:g}x expected); an indented skin is compressed: add "
+                       "compression data, or fit fewer terms or a simpler law")
+    return out
 
 
 def _check_stable(law: str, mat, lam, nu) -> None:

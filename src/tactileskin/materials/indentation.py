@@ -84,6 +84,11 @@ def check_indentation(depth, force, radius, thickness):
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
             raise FitDataError(name, f"non-finite value at row {bad[0] + 1}", "finite numbers")
+    # the contact point (0, 0) that most recordings start with carries no information: dropped
+    origin = (d == 0.0) & (F == 0.0)
+    d, F = d[~origin], F[~origin]
+    if d.size < 3:
+        raise FitDataError("data", f"{d.size} points past first contact", ">= 3 points with depth > 0")
     if np.any(d <= 0.0):
         i = int(np.flatnonzero(d <= 0.0)[0])
         raise FitDataError("depth", f"{d[i]:g} at row {i + 1}", "> 0 mm (depth from first contact)")
@@ -120,6 +125,13 @@ def fit_indentation(law: str, depth, force, *, radius: float, thickness: float) 
     mat = NeoHookean.from_fit(np.array([E / 3.0]), NU_INCOMPRESSIBLE)
     pred = E * g
     q = _quality(F, pred, 1)
+    if not q["r2"] > 0.0:  # worse than the data's mean (a force falling with depth, swapped columns)
+        order = np.argsort(d)
+        falls = bool(np.any(np.diff(F[order]) < 0.0))
+        raise FitDataError("force", f"a fit with R^2 = {q['r2']:.3g}",
+                           "forces that rise with depth as a sphere on a layer gives (F ~ d^1.5)",
+                           ("the force falls with depth at some rows; " if falls else "")
+                           + "check the columns (depth_mm, force_n) and their units")
     q["rmse_n"] = q.pop("rmse_mpa")
     q["chi_max"] = float(np.sqrt(R * d.max()) / t)
     q["rel_floor"] = REL_FLOOR
