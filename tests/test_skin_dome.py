@@ -103,3 +103,21 @@ def test_build_cli_exports_watertight_dome_parts(tmp_path):
         assert m.is_watertight and m.is_winding_consistent and m.is_volume, e["name"]
         err = abs(m.volume - exact[e["name"]])
         assert err <= STL_TOLERANCE * m.area, (e["name"], m.volume, exact[e["name"]], STL_TOLERANCE * m.area)
+
+
+def test_asking_a_dome_for_2d_is_refused_not_run_in_3d(tmp_path, capsys):
+    """The dome is 3D: an explicit 2D (option or scene file) is refused with one line before any
+    folder is written, where it silently ran the 3D model under the user's 2D request."""
+    from tactileskin.cli import main
+
+    scene = tmp_path / "dome2.toml"
+    scene.write_text('skin = "dome"\ndim = 2\nthickness = 2\n')
+    for argv in (["solve", "--skin", "dome", "--dim", "2", "-t", "2", "--out", str(tmp_path / "a")],
+                 ["sweep", "--skin", "dome", "--dim", "2", "-t", "2", "-m", "silicone", "-i", "flat",
+                  "--out", str(tmp_path / "b")],
+                 ["solve", "--scene", str(scene), "--out", str(tmp_path / "c")]):
+        assert main(argv) == 2
+        err = " ".join(capsys.readouterr().err.split())
+        assert "dim=2 is invalid; valid: 3 with skin = dome" in err and "Traceback" not in err
+    assert not any((tmp_path / d).exists() for d in "abc")
+    assert Scene(skin="dome", thickness=2.0).dim == 3  # not asked: the dome's own dimension

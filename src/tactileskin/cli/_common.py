@@ -109,6 +109,16 @@ def _field_changes(opts: dict) -> dict:
     return {k: v for k, v in ch.items() if v is not None and v != ()}
 
 
+def check_dim_kept(requested, scene) -> None:
+    """ParameterError if a dimension the user asked for (an option or a scene file's `dim`) is
+    not the scene's: a skin that fixes it (a dome is 3D) would otherwise change it silently."""
+    from tactileskin.errors import ParameterError
+
+    if requested is not None and int(requested) != scene.dim:
+        raise ParameterError("dim", int(requested), f"{scene.dim} with skin = {scene.skin}",
+                             f"the {scene.skin} skin is {scene.dim}D")
+
+
 def scene_from_options(scene_opts: dict, command: str = "solve"):
     """The Scene of `solve`/`mesh`: the file (scene or one-case sweep), the options over it,
     then the quality preset (option, else file) and explicit mesh sizes over that."""
@@ -122,6 +132,7 @@ def scene_from_options(scene_opts: dict, command: str = "solve"):
     if command == "mesh" and changes.get("order") == 1:
         changes["formulation"] = "displacement"  # the mesh does not depend on it; P1 needs it
     base = Scene.from_dict(fields).replace(**changes)
+    check_dim_kept(changes.get("dim", fields.get("dim")), base)
     mesh.update({k: scene_opts[k] for k in scenefile.MESH_FIELDS if scene_opts.get(k) is not None})
     quality = scene_opts.get("quality") or sf.quality
     if quality is None and mesh:  # sizes without a preset: over the defaults, as Scene does

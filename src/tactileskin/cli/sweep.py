@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin.cli._common import _field_changes, claimed_output, scene_options
+from tactileskin.cli._common import _field_changes, check_dim_kept, claimed_output, scene_options
 from tactileskin.errors import ParameterError
 
 
@@ -109,6 +109,7 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
         axes["indenters"] = _names(o["indenter"], "indenter")
         changes["indenter"] = axes["indenters"][0]
     base = Scene.from_dict(fields).replace(**changes)
+    check_dim_kept(changes.get("dim", fields.get("dim")), base)
     if base.skin_kind.fixes_thickness and "thicknesses" not in axes:
         axes["thicknesses"] = (base.thickness,)  # a skin file fixes it: not the paper's 1, 3, 5
     if o.get("thickness") is not None:
