@@ -20,6 +20,33 @@ def test_unknown_config_key(tmp_path, capsys):
     assert "pitchez" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("text, words", [
+    ("thicknesses = [1]\npitches = [1]\n", ["'pitches' outside the [array] table"]),  # no [array]: read as nothing
+    ("foo = 1\n[array]\npitches = [1.0]\n", ["'foo' outside the [array] table"]),
+])
+def test_config_keys_outside_the_array_table_are_refused(tmp_path, capsys, text, words):
+    """Settings outside [array] were ignored, and the whole default chart (36 full 3D letter
+    solves) started; refused before any solve."""
+    cfg = tmp_path / "a.toml"
+    cfg.write_text(text)
+    assert main(["array", "-o", str(tmp_path / "o"), "--config", str(cfg)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert all(w in err for w in words) and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--offsets", "1"], ["n_train (--offsets)=1", ">= 2"]),   # LDA: more readings than classes
+    (["--bits", "0"], ["bits=0", "[1, 32]"]),                   # checked only after the solves before
+])
+def test_classifier_settings_are_checked_before_any_solve(tmp_path, capsys, flags, words):
+    out = tmp_path / "o"
+    assert main(["array", "--set", "paper", "-t", "1", "--pitch", "1", "-o", str(out), *flags]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert all(w in err for w in words) and "Traceback" not in err
+    assert not out.exists()
+
+
 def test_bad_fallback_in_a_config_is_one_line(tmp_path, capsys):
     cfg = tmp_path / "a.toml"
     cfg.write_text('[array]\nfallback = "sometimes"\n')

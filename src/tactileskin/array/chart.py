@@ -134,6 +134,15 @@ class ChartConfig:
             raise ParameterError("skin", self.skin, " or ".join(SKINS))
         if self.max_depth is not None and not (np.isfinite(self.max_depth) and self.max_depth > 0):
             raise ParameterError("max_depth", self.max_depth, "> 0 mm (or None: 20 % of t)")
+        # checked here, before any solve (the classifiers would refuse them after hours of solves)
+        if self.bits is not None and not (isinstance(self.bits, (int, np.integer)) and not isinstance(self.bits, bool)
+                                          and 1 <= self.bits <= 32):
+            raise ParameterError("bits", self.bits, "an integer in [1, 32] or none")
+        # LDA needs more training readings than classes: at least two offsets per stimulus
+        for name, lo in (("n_train", 2), ("n_test", 1)):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= lo):
+                raise ParameterError(f"{name} (--offsets)", v, f"an integer >= {lo}")
         bad = [c for c in self.letters if c not in CHARACTERS]
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")

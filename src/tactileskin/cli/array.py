@@ -23,6 +23,10 @@ def load_config(path) -> dict:
             data = tomllib.load(fh)
     except (OSError, tomllib.TOMLDecodeError) as e:
         raise ParameterError("config", str(path), "a readable TOML file with an [array] table", hint=str(e)) from None
+    outside = sorted(set(data) - {"array"})
+    if outside:  # read as nothing, they would start the whole default chart (hours)
+        raise ParameterError("config", f"{path}: key {outside[0]!r} outside the [array] table",
+                             "every setting under [array]", "e.g. [array] then thicknesses = [1, 3]")
     table = data.get("array", {})
     bad = sorted(set(table) - KEYS)
     if bad or not isinstance(table, dict):
