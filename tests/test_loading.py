@@ -172,3 +172,25 @@ def test_cli_solve_force_and_history(tmp_path, capsys):
     capsys.readouterr()
     assert main(["solve", "--force", "0.1", "--depth", "0.3", "--out", str(tmp_path / "b")]) == 2
     assert "depth" in capsys.readouterr().err and not (tmp_path / "b").exists()
+
+
+def test_history_files_for_force_control_and_a_loading_history(mesh, tmp_path):
+    """`history=True` (`solve --history`) gives result.pvd with the displacement of every
+    increment for force control and for indent-hold-release too (it was ignored there): one
+    step per increment, in time order, the last at the end of the run, all displacements finite;
+    without it none."""
+    from tactileskin.fe import solve
+
+    base = BASE.replace(depth=0.2)
+    target = 0.8 * solve(base, mesh=mesh).reaction
+    for s in (BASE.replace(force=target), base.replace(loading=[{"hold": 1.0}, {"depth": 0.0, "rate": 1.0}])):
+        r = solve(s, mesh=mesh, history=True)
+        steps = r.fields["steps"]
+        assert len(steps) == r.stats["increments"] >= 2
+        t = [x[0] for x in steps]
+        assert np.all(np.diff(t) > 0) and t[-1] == pytest.approx(r.loading["final"]["t_s"])
+        assert all(u.shape == steps[0][1].shape and np.all(np.isfinite(u)) for _, u in steps)
+        assert all("displacement" not in h for h in r.history)   # history.csv keeps its columns
+        out = r.write(tmp_path / f"o{len(s.program())}")
+        assert (out / "result.pvd").is_file() and len(list((out / "result_steps").iterdir())) == len(steps)
+        assert not solve(s, mesh=mesh).fields["steps"]

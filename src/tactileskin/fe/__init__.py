@@ -152,12 +152,13 @@ def read_sensors(scene, model, result, *, z_symmetric: bool = False):
     return sensors.read(sites, sampler)
 
 
-def _run_history(scene, model, section, program, options, progress):
+def _run_history(scene, model, section, program, options, progress, history: bool = False):
     """Run a force-controlled or multi-segment loading history (fe.loading.run_program).
     The Result is the peak-load state: the end of the depth or force ramp with the largest
     reaction (a hold or a release never replaces it, so a full release does not report an
     open contact); `Result.loading` adds the target and reached force, the travel, that
-    state's time and the final state, and `Result.history` the time series (history.csv)."""
+    state's time and the final state, and `Result.history` the time series (history.csv);
+    `history`: also the displacement of every increment (result.pvd), as a depth ramp has."""
     from tactileskin.fe.loading import run_program
     from tactileskin.fe.output import bone_peak
 
@@ -166,7 +167,10 @@ def _run_history(scene, model, section, program, options, progress):
     best = {}
 
     def record(model, ev):
-        return {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
+        out = {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
+        if history:
+            out["displacement"] = model.u.reshape(-1, model.m).copy()
+        return out
 
     def on_segment(i, seg, ev):
         F = indenter_force(model, ev)
@@ -186,7 +190,10 @@ def _run_history(scene, model, section, program, options, progress):
     res = best["result"]
     for k in ("increments", "newton_iterations", "cutbacks", "uzawa_iterations", "force_trials"):
         res.stats[k] = getattr(stats, k)
-    res.history = [dict(h) for h in hist] if multi else []
+    if history and res.fields is not None:
+        res.fields["steps"] = [(float(h["t"]), np.asarray(h["displacement"], float)) for h in hist
+                               if "displacement" in h and "t" in h]
+    res.history = [{k: v for k, v in h.items() if k != "displacement"} for h in hist] if multi else []
     last = hist[-1] if hist else {}
     res.loading = {
         "control": program[0].kind, "segments": [g.to_dict() for g in program],
@@ -244,7 +251,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
             ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
             res = None
         else:
-            res, ev, stats = _run_history(scene, model, section, program, options, progress)
+            res, ev, stats = _run_history(scene, model, section, program, options, progress, history)
     t2 = time.perf_counter()
     if res is None:
         res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
