@@ -13,7 +13,7 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
 `taxel` (mm; 0 = a point sensor) is area-averaged: Gauss-Legendre `taxel_points` per direction
-(taxel_points in 2D, taxel_points**2 in 3D) over the square in (s, z) on the sensor's depth
+(default one per 0.25 mm of the side, 3 to 16; taxel_points in 2D, taxel_points**2 in 3D) over the square in (s, z) on the sensor's depth
 surface, weighted by the surface's area element (exact mean of a field linear over a flat taxel).
 
 Readings, per sensor, from the Cauchy stress sigma of the final state (sampled by interpolation
@@ -44,8 +44,20 @@ log = logging.getLogger(__name__)
 
 KINDS = ("points", "line", "grid")
 MAX_SENSORS = 20000          # all layouts of a scene together
-MAX_TAXEL_POINTS = 8         # Gauss points per direction
-DEFAULT_TAXEL_POINTS = 3     # exact for fields up to degree 5 across a flat taxel
+MAX_TAXEL_POINTS = 16        # Gauss points per direction
+# default Gauss points per direction: one per TAXEL_SPACING of the taxel's side, at least
+# MIN_TAXEL_POINTS. Three for every size read a 2 mm taxel on the bone of a 1 mm ridge 10.6 %
+# high and a 10 mm one under the curved indenter 73 % high (the field varies on the skin's
+# thickness, not on the taxel); one point per 0.25 mm put both within 1 %.
+TAXEL_SPACING = 0.25
+MIN_TAXEL_POINTS = 3
+
+
+def default_taxel_points(taxel: float) -> int:
+    """Gauss points per direction of a taxel of side `taxel` (mm) when none are given."""
+    import math
+
+    return int(min(MAX_TAXEL_POINTS, max(MIN_TAXEL_POINTS, math.ceil(float(taxel) / TAXEL_SPACING - 1e-9))))
 _KEYS = ("name", "kind", "s", "z", "depth", "height", "pitch", "taxel", "taxel_points")
 _TOL = 1e-9                  # mm: positions on a range's end are inside
 
@@ -62,7 +74,7 @@ class SensorLayout:
     height: float | None = None
     pitch: tuple[float, ...] = ()
     taxel: float = 0.0
-    taxel_points: int = DEFAULT_TAXEL_POINTS
+    taxel_points: int = MIN_TAXEL_POINTS
 
     @classmethod
     def from_dict(cls, d, index: int = 0) -> "SensorLayout":
@@ -92,7 +104,7 @@ class SensorLayout:
         taxel = validate.number(d.get("taxel", 0.0), f"{where} taxel")
         if taxel < 0:
             raise ParameterError(f"{where} taxel", taxel, ">= 0 mm (0: a point sensor)")
-        tp = validate.integer(d.get("taxel_points", DEFAULT_TAXEL_POINTS), f"{where} taxel_points",
+        tp = validate.integer(d.get("taxel_points", default_taxel_points(taxel)), f"{where} taxel_points",
                               f"1..{MAX_TAXEL_POINTS}")
         if not 1 <= tp <= MAX_TAXEL_POINTS:
             raise ParameterError(f"{where} taxel_points", tp, f"1..{MAX_TAXEL_POINTS}")
