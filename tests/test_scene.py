@@ -90,3 +90,23 @@ def test_braille_2d_default_mesh_is_finer():
         != DEFAULT_MESH_BRAILLE_3D
     assert b5 == Scene(indenter="braille", dim=3, thickness=5.0) and b5.replace(thickness=1.0) == b3
     assert b3.replace(mesh_size=1.0).replace(thickness=5.0).mesh_size == 1.0
+
+
+def test_a_depth_and_a_depth_fraction_are_not_both_taken(tmp_path, capsys):
+    """Both given: refused (the run used the depth, the record showed the fraction too, e.g.
+    depth 0.4 mm with depth_fraction 0.3 at t = 2). With a depth the fraction is not in effect
+    and not recorded; --depth over a scene file's depth_fraction is the option winning."""
+    from tactileskin.cli import main
+
+    with pytest.raises(ParameterError, match="depth_fraction=0.3 is invalid; valid: not given with depth = 0.4 mm"):
+        Scene(thickness=2.0, depth=0.4, depth_fraction=0.3)
+    s = Scene(thickness=2.0, depth=0.4)
+    assert "depth_fraction" not in s.to_dict() and Scene.from_dict(s.to_dict()) == s
+    assert Scene(thickness=2.0, depth_fraction=0.3).to_dict()["depth_fraction"] == 0.3
+    f = tmp_path / "s.toml"
+    f.write_text("thickness = 2\ndepth = 0.4\ndepth_fraction = 0.3\n")
+    assert main(["mesh", "--scene", str(f), "--quality", "preview", "--out", str(tmp_path / "m.vtu")]) == 2
+    assert "depth_fraction" in capsys.readouterr().err
+    f.write_text("thickness = 2\ndepth_fraction = 0.3\n")
+    assert main(["mesh", "--scene", str(f), "--depth", "0.4", "--quality", "preview",
+                 "--out", str(tmp_path / "m.vtu")]) == 0

@@ -121,6 +121,9 @@ def _fingertip_overrides(value) -> tuple[tuple[str, float], ...]:
     return tuple(sorted((str(k), validate.number(v, f"fingertip.{k}")) for k, v in items))
 
 
+DEPTH_FRACTION = 0.2  # Scene.depth_fraction's default
+
+
 @dataclass(frozen=True)
 class Scene:
     thickness: float = 3.0                 # skin thickness t (mm)
@@ -129,7 +132,7 @@ class Scene:
     braille_text: str = ""                 # empty: a single dot on the symmetry line
     braille_standard: str = "standard_american"
     depth: float | None = None             # indentation (mm); None -> depth_fraction * t
-    depth_fraction: float = 0.2            # the paper's 20 % nominal strain
+    depth_fraction: float = 0.2            # the paper's 20 % nominal strain (DEPTH_FRACTION)
     rate: float = 1.0                      # indentation rate (mm/s)
     dim: int = 2                           # 2: plane-strain half section; 3: extruded slab
     order: int = 2                         # element order
@@ -187,6 +190,9 @@ class Scene:
         set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, 0.6, lo_open=True))
         if self.depth is not None:
             set_("depth", check_range("depth", self.depth, 0.0, 0.6 * self.thickness, lo_open=True, unit="mm"))
+            if self.depth_fraction != DEPTH_FRACTION:  # two depths: the record would show the unused one
+                raise ParameterError("depth_fraction", self.depth_fraction, f"not given with depth = {self.depth:g} mm",
+                                     "give the depth (mm) or the depth_fraction of t, not both")
         set_("rate", check_range("rate", self.rate, 1e-6, 1e6, unit="mm/s"))
         if self.dim not in (2, 3):
             raise ParameterError("dim", self.dim, "2 or 3")
@@ -363,6 +369,8 @@ class Scene:
                 continue
             if f.name == "sensors":  # none: absent, so that scenes without sensors keep their keys
                 v = [lay.to_dict() for lay in v] or None
+            if f.name == "depth_fraction" and self.depth is not None:  # not in effect: not recorded
+                continue
             if f.name == "loading":  # likewise: absent unless the history has more segments
                 v = [g.to_dict() for g in v] or None
             if v is None:
