@@ -210,3 +210,21 @@ def test_cli_material_fit_writes_a_usable_file(tmp_path, capsys):
     assert foreign.read_text() == "# my notes\n"
     assert main(["material", "fit", str(tmp_path / "none.csv"), "--law", "yeoh", "-o", str(tmp_path / "n.toml")]) == 2
     assert not (tmp_path / "n.toml").exists()
+
+
+def test_unit_mistakes_in_the_test_data_are_caught(tmp_path):
+    """Stress in kPa read as MPa fits perfectly at 1000x the modulus: marked suspect, naming
+    the unit. A strain column that holds stretches (1.0 unloaded) is refused, where it fitted
+    silently (R^2 0.5)."""
+    law = NeoHookean(0.05, 1.0)
+    lam = np.linspace(1.0, 2.0, 21)
+    P, _ = uniaxial_nominal(law, lam, None)
+    assert fit("neo_hookean", lam, P).warnings == []
+    kpa = fit("neo_hookean", lam, 1000.0 * P)
+    assert kpa.quality["r2"] > 1 - 1e-12 and any("in kPa or Pa" in w for w in kpa.warnings)
+    f = tmp_path / "t.csv"
+    f.write_text("strain,nominal_stress_mpa\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(lam, P)))
+    with pytest.raises(FitDataError, match="strain.*holds stretches"):
+        read_uniaxial_csv(f)
+    f.write_text("strain,nominal_stress_mpa\n" + "".join(f"{float(a) - 1.0!r},{float(b)!r}\n" for a, b in zip(lam, P)))
+    assert np.allclose(read_uniaxial_csv(f)[0], lam)

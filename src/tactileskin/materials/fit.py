@@ -44,6 +44,9 @@ MAX_CSV_BYTES = 10 << 20   # a test file is at most a few 10k rows
 # COMPRESSION_STRETCH against its own small-strain slope (neo-Hookean: 1.27x, Ogden and Yeoh
 # fits of rubber 1.1-1.6x), outside COMPRESSION_RATIO an extrapolation artefact
 SMALL_STRAIN = 0.15
+# skins are soft elastomers (silicones 0.01-1 MPa, polyurethanes to ~10 MPa shear modulus):
+# a fit far stiffer is most often stress in kPa (1000x) read as MPa
+SOFT_MU_MAX = 30.0
 MODULUS_RATIO = 1.5
 COMPRESSION_STRETCH = 0.8
 COMPRESSION_RATIO = (0.5, 2.5)
@@ -251,6 +254,9 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
     _check_stable(law, mat, lam, nu)
     q["nfev"] = int(sol.nfev)
     q["warnings"] = extrapolation_warnings(mat, lam, P, nu)
+    if mat.mu0 > SOFT_MU_MAX:
+        q["warnings"].append(f"shear modulus {mat.mu0:.4g} MPa: stiffer than the soft elastomers of skins "
+                             f"(up to about {SOFT_MU_MAX:g} MPa); is the stress column in kPa or Pa? MPa is expected")
     for w in q["warnings"]:  # shown by describe() (the CLI prints it and exits 3)
         log.info("fit of %s: %s", law, w)
     return Fit(law=mat, stretch=lam, stress=P, predicted=pred, nu=nu, quality=q)
@@ -359,8 +365,15 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
             P.append(float(r[i_p]))
         except (ValueError, IndexError):
             raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", "two numbers (stretch, stress)") from None
-    lam = np.array(lam)
-    return (1.0 + lam if strain else lam), np.array(P)
+    lam, P = np.array(lam), np.array(P)
+    if strain and lam.size and np.all(np.isfinite(lam)) and np.all(np.isfinite(P)):
+        # the unloaded state of a strain column is strain 0; at strain 1 it is a stretch column
+        rest = float(lam[int(np.argmin(np.abs(P)))])
+        if abs(rest - 1.0) < 0.05 and float(lam.min()) > 0.5:
+            raise FitDataError("strain", f"{path.name}: the least stressed row at strain {rest:g}",
+                               "engineering strain (0 unloaded, 0.5 for 50 %)",
+                               "the column holds stretches: name it 'stretch'")
+    return (1.0 + lam if strain else lam), P
 
 
 def _csv_rows(path: Path, what: str) -> list[list[str]]:
