@@ -35,6 +35,11 @@ PX_PER_MM = 8.0          # the paper's scans (Sec. IV-B: 160 x 80 px for 20 x 10
 # microscope by far; outside it a typo is likelier than a scale.
 PX_PER_MM_RANGE = (0.01, 1e4)
 PEAK_WINDOW = 0.8        # parabola fitted to the samples >= 80 % of the maximum around it
+# the profile averages across the strip, so the pressure must be nearly uniform across it: an
+# automatically found strip whose variation across (pressure-weighted mean of sd / mean over its
+# activated columns) is above AXIS_CV and AXIS_RATIO x that of the strip found along the other
+# axis runs the other way (a transposed scan read along x: 18 % against 2.6 %, peak 17 % low)
+AXIS_CV, AXIS_RATIO = 0.1, 2.0
 ANALYZE_NAMES = ("profile.csv", "summary.json", "pressure_map.png")
 COMPARE_NAMES = ("comparison.json", "overlay.png")
 
@@ -180,10 +185,12 @@ class FilmProfile:
     folded: dict = field(default_factory=dict)
     region: dict = field(default_factory=dict)   # how box_px was chosen
     image_note: str = ""                           # pixel scale applied when reading
+    warnings: list = field(default_factory=list)   # what makes the profile suspect
 
     def summary(self) -> dict:
         cal = self.calibration
         return {
+            "warnings": list(self.warnings),
             "source": self.source, "unit": self.unit, "px_per_mm": self.px_per_mm,
             "box_px": list(self.box_px), "region": self.region, "axis": self.axis,
             "centre": self.centre, "origin_mm": self.origin_mm, "luminance": LUMINANCE_NOTE,
@@ -244,6 +251,17 @@ def _scan_array(scan) -> tuple[str, np.ndarray, str]:
     return "<array>", gray, "array: read as 0-255"
 
 
+def _variation(pmap: np.ndarray) -> float:
+    """Pressure-weighted mean over the columns of the std / mean across the rows (axis 0), over
+    the columns whose mean is at least 10 % of the largest."""
+    m = pmap.mean(axis=0)
+    top = float(m.max()) if m.size else 0.0
+    keep = m >= 0.1 * top if top > 0 else np.zeros(m.shape, bool)
+    if not keep.any():
+        return 0.0
+    return float(np.sum(pmap.std(axis=0)[keep]) / np.sum(m[keep]))
+
+
 def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: float = PX_PER_MM,
                  box_px=None, box_mm=None, axis: str = "x", centre="peak") -> FilmProfile:
     """Scan (path or (H, W) grayscale array) -> FilmProfile.
@@ -276,10 +294,18 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                                                  px_per_mm)
         box = (c0, r0, c1, r1) if axis == "x" else (r0, c0, r1, c1)
         region_info = {"method": "auto", "rule": strip_region.RULE}
+        # the variation across the strip found along the other axis, for the orientation check
+        try:
+            other = oriented.T
+            o0, q0, o1, q1 = strip_region.find_strip(cal.pressure(other), cal.p_range[0], px_per_mm)
+            across_other = _variation(cal.pressure(other[q0:q1, o0:o1]))
+        except ParameterError:
+            across_other = None
         log.info("no region given: analysing the activated strip found at x %d-%d, "
                  "y %d-%d px (pass --box-px/--box-mm to choose another)",
                  box[0], box[2], box[1], box[3])
     else:
+        across_other = None  # the user's box: its orientation is theirs
         _, box = select_region(gray, box_px=box_px, box_mm=box_mm, px_per_mm=px_per_mm)
         region_info = {"method": "box_mm" if box_mm is not None else "box_px",
                        "given": [float(v) for v in (box_mm if box_mm is not None else box_px)]}
@@ -305,9 +331,16 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                              f"than the saturation grayscale {cal.saturation_gs:.1f} "
                              f"(calibration {cal.name})",
                              hint=f"region grayscale {region.min():.1f}-{region.max():.1f}")
+    warnings = []
     if sat > 0:
-        log.warning("%.1f %% of the region is at the film's saturation (%g %s)",
-                    100 * sat, hi, cal.unit)
+        warnings.append(f"{100 * sat:.1f} % of the region is at the film's saturation ({hi:g} {cal.unit})")
+    across = _variation(pmap)
+    if across_other is not None and across > AXIS_CV and across > AXIS_RATIO * across_other:
+        other = "y" if axis == "x" else "x"
+        warnings.append(f"the pressure varies across the strip by {across:.0%} of its mean, across a strip along "
+                        f"{other} by {across_other:.0%}: the strip seems to run along {other}; try --axis {other}")
+    for w in warnings:
+        log.warning("%s", w)
     prof = pmap.mean(axis=0)
     sd = pmap.std(axis=0)
     band = cal.band(region.mean(axis=0))
@@ -329,7 +362,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         saturated_fraction=sat, inactive_fraction=inactive, source=source,
         metrics=profile_metrics(s, prof),
         folded={"s_mm": sh, "pressure": ph, "asymmetry": asym,
-                "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note)
+                "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note, warnings=warnings)
     for k, v in fp.metrics.items():
         if not math.isfinite(v):  # pragma: no cover - inputs are checked finite above
             raise ParameterError(f"metric {k}", v, "finite")
