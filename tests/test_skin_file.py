@@ -189,6 +189,9 @@ def test_step_block_solves_like_the_pad_block(tmp_path):
     # left to the 2D test (test_a_whole_2d_skin_reads_like_the_halved_pad)
     assert full.sides == 2 and quarter.sides == 1
     assert full.span == pytest.approx(quarter.span, rel=1e-3) == 4.0
+    # the flat top's point is on the axis under the plate, not the mesh node nearest it (0.54 mm
+    # off on these cells): s runs from -4 to 4
+    assert (full.s.min(), full.s.max()) == (pytest.approx(-4.0, abs=1e-9), pytest.approx(4.0, abs=1e-9))
 
 
 def test_a_sweep_of_a_skin_file_takes_its_thickness_not_the_papers(tmp_path):

@@ -73,6 +73,12 @@ def measure(skinmesh, groups=()) -> FileGeometry:
     axis = near.copy()
     axis[:, 1] = 0.0
     top = near[np.argmin(np.linalg.norm(axis, axis=1))]
+    lateral = [0] if skinmesh.dim == 2 else [0, 2]
+    if all(near[:, k].min() < 0.0 < near[:, k].max() for k in lateral):
+        # a flat top across the axis: the top point is on the axis, under the indenters (the
+        # node nearest it is up to half a cell off, and s = x - x_top would be shifted by that)
+        top = np.zeros(pts.shape[1])
+        top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
     return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
                         lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
