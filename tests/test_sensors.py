@@ -163,10 +163,12 @@ def test_mirror_half_reads_the_mirror_image(with_sensors):
     assert np.allclose(r.pressure, r.pressure[i], atol=1e-12)
     assert np.allclose(r.sigma_nn, r.sigma_nn[i], atol=1e-12)
     assert np.allclose(r.xyz[:, 0], -r.xyz[i, 0]) and np.allclose(r.xyz[:, 1], r.xyz[i, 1])
-    off = r.s != 0  # tau_1 is odd in s; at s = 0 it reads the model's own sxy on the symmetry line
-    assert np.allclose(r.tau_1[off], -r.tau_1[i][off], atol=1e-12)
-    # which is zero up to the projection's error there (well under 1 % of the pressure)
-    assert abs(r.tau_1[~off][0]) < 1e-2 * r.pressure.max()
+    assert np.allclose(r.tau_1, -r.tau_1[i], atol=1e-12)  # tau_1 is odd in s
+    # so it vanishes on the symmetry line: exactly (the even part of the field there; the
+    # discrete sxy itself is only near zero: ~4 % of the largest shear at preview)
+    assert r.tau_1[r.s == 0][0] == 0.0
+    b = with_sensors[1].sensors.select("bone")
+    assert b.tau_1[np.argmin(np.abs(b.s))] == 0.0 and np.max(np.abs(b.tau_1)) > 0
 
 
 def test_deeper_sensors_see_lower_wider_pressure(with_sensors):

@@ -422,7 +422,8 @@ def sites_for(scene, z_range=None) -> Sites:
 
 def symmetric_sampler(sampler, *, mirror_x: bool = True, mirror_z: bool = False):
     """A sampler of the whole skin from one of the modelled part: a point with x < 0 (z < 0 when
-    mirror_z) is sampled at its mirror image and the tensor reflected (sigma' = R sigma R)."""
+    mirror_z) is sampled at its mirror image and the tensor reflected (sigma' = R sigma R); a
+    point on a mirror plane gets the even part (the shears across the plane zero)."""
 
     def sample(points):
         pts = np.array(points, float)
@@ -438,6 +439,11 @@ def symmetric_sampler(sampler, *, mirror_x: bool = True, mirror_z: bool = False)
             r = np.ones(3)
             r[ax] = -1
             sig[neg] *= r[:, None] * r[None, :]
+            # on the plane itself the field is its own mirror image: the shears across it (odd)
+            # vanish exactly, which the discrete field only approaches (sxy ~4 % of the largest
+            # shear at the symmetry line on a preview mesh)
+            on = np.abs(pts[:, ax]) <= _TOL
+            sig[on] = 0.5 * (sig[on] + sig[on] * (r[:, None] * r[None, :]))
         return sig
 
     return sample

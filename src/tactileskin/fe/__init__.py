@@ -147,8 +147,10 @@ def read_sensors(scene, model, result, *, z_symmetric: bool = False):
     from tactileskin.fe.probe import stress_sampler
 
     sites = sensors.sites_for(scene)
+    # a whole model (no x = 0 line: a full-width pad under an x-asymmetric indenter) has x < 0
+    # itself; mirroring there would read the other side's stress
     sampler = sensors.symmetric_sampler(stress_sampler(model, result.fields["point_data"]),
-                                        mirror_x=True, mirror_z=z_symmetric)
+                                        mirror_x=getattr(model, "profile_sides", 1) == 1, mirror_z=z_symmetric)
     return sensors.read(sites, sampler)
 
 
