@@ -296,3 +296,28 @@ def test_duplicate_layout_names_refused():
     lay = {"name": "a", "s": [0.0], "depth": 1.0}
     with pytest.raises(ParameterError, match="unique"):
         Scene(**COARSE, sensors=[lay, lay])
+
+
+def test_a_sweep_gathers_its_cases_sensors(tmp_path):
+    """A sweep's cases with sensors: their readings in the sweep's sensors.csv, one row per
+    case and sensor with the case id first (they were only inside the cache), equal to each
+    case's own; no sensors.csv when no case has sensors."""
+    import csv
+
+    from tactileskin.cache import ResultCache
+    from tactileskin.report.outputs import write_outputs
+    from tactileskin.sweep import run_sweep
+
+    lays = [{"name": "bone", "kind": "line", "s": [0, 2], "pitch": 1.0, "height": 0.0}]
+    scenes = [Scene(**{**COARSE, "thickness": t}, sensors=lays) for t in (2.0, 3.0)]
+    cache = ResultCache(tmp_path / "cache")
+    outs = run_sweep(scenes, cache, serial=True)
+    res = write_outputs(tmp_path / "o", outs, cache, 1.0, render=False, figures=False)
+    rows = list(csv.DictReader(open(tmp_path / "o" / "sensors.csv", encoding="utf-8")))
+    assert [r["case"] for r in rows] == [c for c in sorted({r["case"] for r in res["rows"]}) for _ in range(3)]
+    for rec in res["records"]:
+        own = list(csv.DictReader(open(rec.path / "sensors.csv", encoding="utf-8")))
+        assert [r["pressure_mpa"] for r in rows if r["case"] == rec.case] == [r["pressure_mpa"] for r in own]
+    plain = run_sweep([Scene(**COARSE)], cache, serial=True)
+    write_outputs(tmp_path / "p", plain, cache, 1.0, render=False, figures=False)
+    assert not (tmp_path / "p" / "sensors.csv").exists()

@@ -75,7 +75,7 @@ def _write_parquet(path: Path, columns: list[str], rows) -> None:
 
 
 # the files a sweep writes into its folder (fnmatch patterns; fig9_: one render per material)
-SWEEP_FILES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md",
+SWEEP_FILES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md", "sensors.csv",
                *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span",
                                               "fig13_auc") for ext in ("png", "svg")),
                "metrics_vs_thickness.pdf", "fig9_*.png")
@@ -94,6 +94,30 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
     res["figures"] = [out / p.name for p in res["figures"]]
     res["renders"] = [out / p.name for p in res["renders"]]
     return res
+
+
+def _write_sensors(path: Path, records) -> None:
+    """sensors.csv of the sweep: every case's sensor readings (the cache entry's sensors.csv)
+    with the case id in front; not written when no case has sensors."""
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    header = None
+    for rec in records:
+        f = rec.path / "sensors.csv"
+        if not f.is_file():
+            continue
+        rows = list(csv.reader(io.StringIO(f.read_text(encoding="utf-8"))))
+        if not rows:
+            continue
+        if header is None:
+            header = rows[0]
+            w.writerow(["case"] + header)
+        elif rows[0] != header:  # one writer (sensors.SensorReadings) made every file
+            log.warning("sensors.csv of %s has other columns; left out of the sweep's sensors.csv", rec.case)
+            continue
+        w.writerows([rec.case] + r for r in rows[1:])
+    if header is not None:
+        atomic_write_text(path, out.getvalue())
 
 
 def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
@@ -117,6 +141,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     atomic_write_text(out / "profiles.csv", buf.getvalue())
     _write_parquet(out / "profiles.parquet", ["case", "s_mm", "pressure_mpa"], prof)
 
+    _write_sensors(out / "sensors.csv", records)
     figures = all_figures(records, rows, out) if records and figures else []
     renders = []
     if render and records:
