@@ -280,10 +280,13 @@ def braille_pairs(records) -> list[tuple]:
 
 
 def _metrics(rec) -> dict:
+    """The case's metrics as its result reports them (Result.span / auc: halved for a whole
+    model's two-sided profile, so a whole and a halved model compare like for like)."""
     from tactileskin import results
 
-    return {"peak": results.peak(rec.s, rec.pressure), "span": results.span(rec.s, rec.pressure),
-            "auc": results.auc(rec.s, rec.pressure)}
+    sides = 2 if int((rec.summary or {}).get("profile_sides", 1)) == 2 else 1
+    return {"peak": results.peak(rec.s, rec.pressure), "span": results.span(rec.s, rec.pressure) / sides,
+            "auc": results.auc(rec.s, rec.pressure) / sides}
 
 
 def _ratio(a: float, b: float) -> str:
