@@ -56,7 +56,7 @@ def test_superposition_of_gaussian_kernel_is_sum_of_gaussians():
 def test_cell_centres_in_the_full_cell_frame():
     full = braille.dot_centres(chr(0x283F))
     a = surrogate.cell_centres(braille.LETTERS["a"])           # dot 1: top left
-    assert np.allclose(a, full[:1]) and a[0, 0] < 0 and a[0, 1] < 0
+    assert np.allclose(a, full[:1]) and a[0, 0] < 0 and a[0, 1] > 0  # top: +z
     assert len(surrogate.cell_centres(braille.LETTERS["y"])) == 5
     with pytest.raises(ParameterError):
         surrogate.cell_centres(0)
@@ -186,7 +186,7 @@ def test_validation_counts_only_the_square_the_arrays_read():
     ext = cfg.read_extent
     assert ext == pytest.approx(4.0 + 0.5 * 4.0 * 1.8)          # window 8, pitch 4, taxels 0.8 x pitch
     ds, dz = surrogate.chart_shift("a", PAD)
-    assert ds == pytest.approx(-1.17) and dz == pytest.approx(-2.34)
+    assert ds == pytest.approx(-1.17) and dz == pytest.approx(2.34)   # dot 1: left, top row (+z)
     exact = surrogate.superpose(kernel, braille.dot_centres("a"), PAD, grid, grid)
     for where, inside in ((ext + 1.5, False), (-ext - 1.5, False), (ext - 1.0, True), (-ext + 1.0, True)):
         bump = 0.2 * _gauss(where - ds, -dz, 0.2)(*np.meshgrid(grid, grid))   # at (where, 0) in the chart frame

@@ -92,14 +92,20 @@ def test_dot_centres_layout():
     sa = get_standard("standard_american")
     assert dot_centres("", sa).tolist() == [[0.0, 0.0]]       # paper default: one dot at the origin
     assert dot_centres("a", sa).tolist() == [[0.0, 0.0]]
-    full = dot_centres("⠿", sa)                                 # dots 1..6 in order
+    full = dot_centres("⠿", sa)                                 # dots 1..6 in order, -z down the lines
     p = sa.dot_pitch / 2
-    np.testing.assert_allclose(full, [[-p, -2 * p], [-p, 0], [-p, 2 * p], [p, -2 * p], [p, 0], [p, 2 * p]], atol=1e-12)
+    np.testing.assert_allclose(full, [[-p, 2 * p], [-p, 0], [-p, -2 * p], [p, 2 * p], [p, 0], [p, -2 * p]], atol=1e-12)
     ab = dot_centres("ab", sa)                                 # a: dot 1; b: dots 1, 2
     c, q = sa.cell_pitch / 2, sa.dot_pitch / 2
-    np.testing.assert_allclose(ab, [[-c, -q], [c, -q], [c, q]], atol=1e-12)
+    np.testing.assert_allclose(ab, [[-c, q], [c, q], [c, -q]], atol=1e-12)
     two_lines = dot_centres("a\na", sa)
-    np.testing.assert_allclose(two_lines, [[0, -sa.line_pitch / 2], [0, sa.line_pitch / 2]], atol=1e-12)
+    np.testing.assert_allclose(two_lines, [[0, sa.line_pitch / 2], [0, -sa.line_pitch / 2]], atol=1e-12)
+    # read from the dots' side (they point to -y, at the skin and the reader) the text is not
+    # mirrored: dot 1 -> dot 4 -> dot 5 of 'd' turns as on paper, (d14 x d45) . (dot direction) < 0
+    d = dot_centres("d", sa)                                   # dots 1, 4, 5
+    as3 = lambda v: np.array([v[0], 0.0, v[1]])  # noqa: E731  (x, z) -> (x, y, z)
+    turn = np.cross(as3(d[1] - d[0]), as3(d[2] - d[1]))
+    assert turn @ np.array([0.0, -1.0, 0.0]) < 0
     word = dot_centres("Braille 2", "marburg_medium")          # bounding box centred on the origin
     np.testing.assert_allclose(word.min(axis=0) + word.max(axis=0), 0.0, atol=1e-12)
     with pytest.raises(ParameterError, match="raised dot"):

@@ -248,7 +248,9 @@ def _measure_dots(mesh):
 
 
 def _expected_layout(text, std):
-    """Dot positions from the spec numbers: (x, z, line, cell, col, row), centred like the indenter."""
+    """Dot positions from the spec numbers: (x, z, line, cell, col, row), centred like the
+    indenter; cells left to right along x, lines and rows down along -z (read from the dots'
+    side, the text is not mirrored)."""
     rows = []
     for li, cells in enumerate(braille.text_to_cells(text)):
         for ci, mask in enumerate(cells):
@@ -256,7 +258,7 @@ def _expected_layout(text, std):
                 if mask >> k & 1:
                     col, row = k // 3, k % 3
                     rows.append((ci * std.cell_pitch + col * std.dot_pitch,
-                                 li * std.line_pitch + row * std.dot_pitch, li, ci, col, row))
+                                 -(li * std.line_pitch + row * std.dot_pitch), li, ci, col, row))
     e = np.array(rows, dtype=float)
     for j in (0, 1):
         e[:, j] -= 0.5 * (e[:, j].min() + e[:, j].max())

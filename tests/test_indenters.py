@@ -180,12 +180,12 @@ def test_surface_profile_and_cap_dimensions():
 
 
 def test_rows_and_section():
-    ind = make_indenter("braille", y0=Y0, braille_text="ab")     # rows z = -1.17 (a1, b1), +1.17 (b2)
+    ind = make_indenter("braille", y0=Y0, braille_text="ab")     # rows z = +1.17 (a1, b1), -1.17 (b2)
     np.testing.assert_allclose(ind.rows, [-1.17, 1.17], atol=1e-12)
-    assert ind.row == 0 and ind.section_z == pytest.approx(-1.17)
+    assert ind.row == 1 and ind.section_z == pytest.approx(1.17)  # the text's upper row
     np.testing.assert_allclose(ind.section_x, [-3.1, 3.1], atol=1e-12)
     assert ind.section_symmetric
-    other = make_indenter("braille", y0=Y0, braille_text="ab", row=1)
+    other = make_indenter("braille", y0=Y0, braille_text="ab", row=0)
     np.testing.assert_allclose(other.section_x, [3.1], atol=1e-12)
     assert not other.section_symmetric
     mid = make_indenter("braille", y0=Y0, braille_text="⠿")

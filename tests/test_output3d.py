@@ -64,11 +64,11 @@ def test_plane_outside_slab_is_an_error(slabs):
         plane_profile(model, model.basis.doflocs[0], "bone_interface", section.s_of_point, 5.0)
 
 
-@pytest.mark.parametrize("text, z", [("a", 0.0), ("\u283f", 0.0), ("b", 1.17), ("e", -1.17)])
+@pytest.mark.parametrize("text, z", [("a", 0.0), ("\u283f", 0.0), ("b", 1.17), ("e", 1.17)])
 def test_profile_plane_is_the_2d_section_row(text, z):
     # the 3D profile is taken where the 2D model cuts its section: the dot row nearest z = 0;
-    # of two such rows, the one at z >= 0 when the pattern is z-symmetric ('b': the quarter
-    # model holds z >= 0 only), else the first ('e': rows differ, the full length is meshed)
+    # of two such rows the text's upper one, at z > 0 (braille.dot_centres: -z down the lines),
+    # which a z-symmetric pattern's quarter model holds ('b'); 'e' (rows differ) is meshed whole
     sc = Scene(thickness=3, indenter="braille", braille_text=text, dim=3)
     model = SimpleNamespace(contact=SimpleNamespace(indenter=indenter_for_scene(sc)))
     assert profile_plane_z(model) == pytest.approx(z)

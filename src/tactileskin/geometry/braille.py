@@ -9,7 +9,8 @@ Cell layout (dot numbers):   1 4
                              3 6
 A cell is a 6-bit mask, bit k-1 set when dot k is raised; the Unicode braille character
 of a cell is chr(0x2800 + mask). Face coordinates (mm): x across the text (left to right),
-z down the lines; the whole dot pattern is centred on the origin.
+-z down the lines, so that the text reads as written from the dots' side (dots toward -y, at
+the skin); the whole dot pattern is centred on the origin.
 """
 
 from __future__ import annotations
@@ -214,8 +215,10 @@ _DOT_POS = np.array([(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2)], dtype=floa
 def dot_centres(text: str, standard: BrailleStandard | str = "standard_american") -> np.ndarray:
     """(n, 2) array of dot centres (x, z) in mm on the indenter face, pattern centred on the origin.
 
-    x runs across the text (cells left to right), z down the lines. The bounding box of the
-    dot centres is centred on (0, 0). Empty text is the paper's default section: a single
+    x runs across the text (cells left to right), -z down the lines (a line's first row at the
+    largest z): seen from the dots' side, the side that touches the skin and that a reader
+    feels, the text reads as written (with z down the lines it read mirrored: "d" as "f", and
+    the cells right to left). The bounding box of the dot centres is centred on (0, 0). Empty text is the paper's default section: a single
     dot at the origin. Text with no raised dot at all (only spaces) raises ParameterError.
     """
     std = get_standard(standard) if isinstance(standard, str) else standard
@@ -228,7 +231,7 @@ def dot_centres(text: str, standard: BrailleStandard | str = "standard_american"
                 if mask >> k & 1:
                     col, row = _DOT_POS[k]
                     pts.append((ci * std.cell_pitch + col * std.dot_pitch,
-                                li * std.line_pitch + row * std.dot_pitch))
+                                -(li * std.line_pitch + row * std.dot_pitch)))
     if not pts:
         raise ParameterError("braille_text", text, "text with at least one raised dot (or empty for one dot)")
     xz = np.asarray(pts, dtype=float)

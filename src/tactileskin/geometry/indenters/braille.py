@@ -75,10 +75,10 @@ class BrailleIndenter(Indenter):
                   plate_thickness=float(q["plate_thickness"]), margin=margin, **stem_params())
         rows = ind.rows
         if row is None:
-            # nearest z = 0; ties -> the smallest z, except for a dot pattern mirror-symmetric
-            # in z: its rows +-z cut the same section, and the 3D quarter model holds only z >= 0
+            # nearest z = 0; of two rows equally near, the text's upper one (the larger z:
+            # braille.dot_centres), which is also the z >= 0 one a 3D quarter model holds
             ties = np.flatnonzero(np.abs(rows) <= np.min(np.abs(rows)) + _ROW_TOL)
-            row = int(ties[-1] if ind.symmetry()[1] else ties[0])
+            row = int(ties[-1])
         elif not (isinstance(row, (int, np.integer)) and 0 <= row < len(rows)):
             raise ParameterError("row", row, f"an integer in [0, {len(rows) - 1}] (dot rows of the text)")
         object.__setattr__(ind, "row", int(row))
