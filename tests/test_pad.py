@@ -201,3 +201,27 @@ def test_pad_parts_and_mold_are_closed_and_the_cavity_is_the_pad(tmp_path):
     assert parts[1].shape.volume == pytest.approx(lower, rel=1e-6)
     with pytest.raises(ParameterError, match="pad_width"):
         get("pad").build_parts(2.0, pad_width=0.2, pad_length=15.0)
+
+
+def test_a_pad_builds_indenters_for_the_pad_as_its_solver_sees_them(tmp_path):
+    """`build --skin pad` prints indenters that stand on the pad's top, as long as the pad and,
+    for plate faces, as wide: the solver presses the whole 40 x 40 pad with its flat plane, and
+    the printed plate was the fingertip's 30 x 20 at y0 = 7 (37.5 % of the pad)."""
+    pytest.importorskip("build123d")
+    from tactileskin.cli import main
+
+    out = tmp_path / "b"
+    assert main(["build", "--skin", "pad", "--pad-width", "40", "--pad-length", "40", "-t", "2", "-i", "all",
+                 "--no-molds", "-o", str(out)]) == 0
+    import json
+
+    parts = {p["name"]: p for p in json.loads((out / "manifest.json").read_text())["parts"]}
+    sc = Scene(skin="pad", pad_width=40.0, pad_length=40.0, thickness=2.0, dim=3)
+    for kind in ("flat", "curved", "braille"):
+        p = parts[f"indenter_{kind}"]
+        solver = indenter_for_scene(sc.replace(indenter=kind))
+        # on the pad's top (a dot's tessellated tip sits 0.5 um above it)
+        assert p["bbox_min"][1] == pytest.approx(solver.y0, abs=1e-3) and solver.y0 == 2.0
+        assert p["bbox_max"][2] - p["bbox_min"][2] == pytest.approx(40.0, abs=1e-6)          # the pad's length
+        if kind != "curved":
+            assert p["bbox_max"][0] - p["bbox_min"][0] >= 40.0 - 1e-6                       # the pad's width

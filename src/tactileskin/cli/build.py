@@ -85,7 +85,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
             parts = get(skin).build_parts(t, molds=not no_molds, **pad)
             parts += build_parts(default_thickness(), indenters=indenter, braille_text=braille_text,
                                  braille_standard=braille_standard, fingertip=False, molds=False,
-                                 indenter_params=ind_params)
+                                 indenter_params=ind_params, skin_scene=sc.replace(dim=3))
         else:
             parts = build_parts(t, indenters=indenter, braille_text=braille_text,
                                 braille_standard=braille_standard, molds=not no_molds, indenter_params=ind_params)

@@ -46,13 +46,26 @@ def resolve_indenters(indenters) -> tuple[str, ...]:
     return kinds
 
 
+def _covering(ind, min_width: float):
+    """The indenter with a plate face (flat, Braille's base plate) at least `min_width` wide in
+    x: the solver presses the skin's whole width with it (a plane), so the printed part must."""
+    import dataclasses
+
+    if min_width > 0 and ind.kind in ("flat", "braille") and getattr(ind, "width", 0.0) < min_width:
+        return dataclasses.replace(ind, width=float(min_width))
+    return ind
+
+
 def build_parts(thickness: float | None = None, *, indenters="all", braille_text: str = "",
                 braille_standard: str = "standard_american", fingertip: bool = True, molds: bool = True,
-                fingertip_overrides: dict | None = None, indenter_params: dict | None = None) -> list[Part]:
+                fingertip_overrides: dict | None = None, indenter_params: dict | None = None,
+                skin_scene=None) -> list[Part]:
     """Build the requested parts (full width) for skin thickness `thickness` (mm).
 
     "all" indenters are the paper's (flat, curved, braille); other kinds are named and take
-    their parameters from `indenter_params` (e.g. {"indenter_radius": 2.5}).
+    their parameters from `indenter_params` (e.g. {"indenter_radius": 2.5}). `skin_scene`: the
+    indenters are for that skin (a pad, a dome: a Scene) as its solver sees them, not for the
+    fingertip: lowest point on its top, as long as its sample, plate faces at least as wide.
 
     Parameters are validated before any CAD work, so a bad value costs no kernel time.
     Raises ParameterError for invalid inputs and CadError if the kernel fails.
@@ -69,8 +82,13 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
         if braille_text:
             _braille.check_text(braille_text)
     opts = {"braille_text": braille_text, "braille_standard": braille_standard, **(indenter_params or {})}
-    inds = [(kind, make_indenter(kind, y0=sec.top, dim=3, sample_length=ft.sample_length,
-                                 **{k: v for k, v in opts.items() if k in get_kind(kind).scene_params}))
+    y0, length, min_width = sec.top, ft.sample_length, 0.0
+    if skin_scene is not None:
+        skin_sec = skin_scene.section()
+        y0, length, min_width = skin_sec.top, skin_scene.sample_length, 2.0 * float(skin_sec.half_width)
+    inds = [(kind, _covering(make_indenter(kind, y0=y0, dim=3, sample_length=length,
+                                           **{k: v for k, v in opts.items() if k in get_kind(kind).scene_params}),
+                             min_width))
             for kind in kinds]  # validates every kind's parameters before any CAD work
     mold_params = _molds.MoldParams.from_params() if molds else None
     if mold_params is not None:
