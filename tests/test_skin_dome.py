@@ -42,11 +42,30 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
     assert parts[0].shape.volume == pytest.approx(v, rel=2.3e-3)
     half = dome_parts.skin_solid(A, B, c, L, t, half=True)
     assert half.volume == pytest.approx(0.5 * v, rel=1.2e-4)
-    # the mold halves and the core fill the block: block = lower + upper + outer body + stem
-    A_, B_ = A + dome_parts.MOLD_WALL, B + dome_parts.MOLD_WALL
-    block = 2 * A_ * 2 * B_ * (L + dome_parts.BONE_STEM + c + dome_parts.MOLD_WALL)
+    # the lower half: its half block less the cavity, plus four pins; the upper half: less the
+    # cavity, the pin holes, and a sprue and two vents through its wall (booleans of the
+    # B-spline cap: 2e-4)
+    from tactileskin.geometry.molds import MoldParams
+
+    mp = MoldParams.from_params()
+    hole = mp.pin_diameter + mp.pin_clearance
+    A_, B_ = A + dome_parts.MOLD_WALL + hole + mp.pin_flange, B + dome_parts.MOLD_WALL
+    half_block = 2 * A_ * B_ * (L + dome_parts.BONE_STEM + c + dome_parts.MOLD_WALL)
     body = dome_parts.body(A, B, c, L).volume + math.pi * (A - t) * (B - t) * dome_parts.BONE_STEM
-    assert parts[2].shape.volume + parts[3].shape.volume + body == pytest.approx(block, rel=4e-4)  # measured 2e-4 (booleans of the B-spline cap)
+    pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
+    holes = 4 * math.pi * (0.5 * hole) ** 2 * (mp.pin_height + mp.pin_depth_clearance)
+    lower, upper = parts[2].shape.volume, parts[3].shape.volume
+    assert lower == pytest.approx(half_block - 0.5 * body + pins, rel=4e-4)
+    # the sprue and the vents: cylinders through the wall above the pulp (3 mm on the straight
+    # part; B_ - y of the cap at z = c/2 for the tip vent); the top's curvature under a 4 mm
+    # sprue moves its length by < 0.2 mm, hence 10 %
+    through = (math.pi * (0.5 * mp.pour_diameter) ** 2 * dome_parts.MOLD_WALL
+               + math.pi * (0.5 * mp.vent_diameter) ** 2 * (dome_parts.MOLD_WALL + B_ - B * math.sqrt(0.75)))
+    assert half_block - 0.5 * body - holes - upper == pytest.approx(through, rel=0.1)
+    # and they open the skin's cavity to the outside: no mold above the pulp there, elsewhere a roof
+    up = parts[3].shape
+    column = lambda z: [up.is_inside((0.0, y, z)) for y in np.linspace(B + 0.05, B_ - 0.05, 12)]  # noqa: E731
+    assert not any(column(-0.5 * L)) and not any(column(-L + mp.vent_inset)) and all(column(-0.25 * L))
 
 
 def test_mesh_named_surfaces_and_volume():
@@ -92,11 +111,18 @@ def test_build_cli_exports_watertight_dome_parts(tmp_path):
     ai, bi = A - t, B - t
     stem = math.pi * ai * bi * dome_parts.BONE_STEM
     outer = math.pi * A * B * L + 2.0 / 3.0 * math.pi * A * B * c
-    half_block = 2 * (A + dome_parts.MOLD_WALL) * (B + dome_parts.MOLD_WALL) * (
+    from tactileskin.geometry.molds import MoldParams
+
+    mp = MoldParams.from_params()
+    hole = mp.pin_diameter + mp.pin_clearance
+    half_block = 2 * (A + dome_parts.MOLD_WALL + hole + mp.pin_flange) * (B + dome_parts.MOLD_WALL) * (
         L + dome_parts.BONE_STEM + c + dome_parts.MOLD_WALL)
+    pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
     exact = {"skin": dome_parts.skin_volume(A, B, c, L, t),
              "bone_core": math.pi * ai * bi * L + stem + 2.0 / 3.0 * math.pi * ai * bi * (c - t),
-             "mold_lower": half_block - 0.5 * (outer + stem), "mold_upper": half_block - 0.5 * (outer + stem)}
+             "mold_lower": half_block - 0.5 * (outer + stem) + pins,
+             # its holes: the CAD solid's volume (test_parts_are_valid_solids_with_the_analytic_volume)
+             "mold_upper": dome_parts.mold(A, B, c, L, t)[1].volume}
     assert [e["name"] for e in man["parts"]] == list(exact)
     for e in man["parts"]:
         m = trimesh.load(str(out / e["stl"]), force="mesh")
@@ -121,3 +147,19 @@ def test_asking_a_dome_for_2d_is_refused_not_run_in_3d(tmp_path, capsys):
         assert "dim=2 is invalid; valid: 3 with skin = dome" in err and "Traceback" not in err
     assert not any((tmp_path / d).exists() for d in "abc")
     assert Scene(skin="dome", thickness=2.0).dim == 3  # not asked: the dome's own dimension
+
+
+def test_a_dome_much_thinner_than_t_somewhere_is_refused():
+    """The bone is the dome with each semi-axis less t, so the skin is t thick at the pulp, the
+    sides and the tip and thinner between: 0.3 % at the default tip (8 mm, t = 2), 17 % at tip
+    20 / t = 3.5 (2.901 mm, as measured on the built STLs: 2.90). Beyond 10 % it is refused."""
+    from tactileskin.skins.dome import min_thickness
+
+    assert min_thickness(A, B, 8.0, 2.0) == pytest.approx(1.9939, abs=2e-4)
+    assert min_thickness(A, B, 20.0, 3.5) == pytest.approx(2.9011, abs=2e-4)
+    # on the section ellipse alone (a very long tip does not matter there): t at the axes' ends
+    assert min_thickness(A, B, 8.0, 2.0) <= 2.0
+    Scene(skin="dome", thickness=2.0, dome_tip=8.0)
+    Scene(skin="dome", thickness=2.0, dome_tip=4.0)               # 8.7 % thinner: taken
+    with pytest.raises(ParameterError, match=r"dome_tip=20.*2.9 mm at its thinnest"):
+        Scene(skin="dome", thickness=3.5, dome_tip=20.0)

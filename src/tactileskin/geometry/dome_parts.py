@@ -7,7 +7,7 @@ z); the rigid bone is the same shape with every semi-axis reduced by the skin th
 `half=True` keeps x >= 0 (the half model the solver meshes, symmetry plane x = 0).
 
 Parts: the skin (cast), the bone core (printed, the mold's insert) and a two-part mold split at
-y = 0 (a block minus the outer body), every part checked closed (solids.check_solid; the STLs
+y = 0 (a block minus the outer body, with alignment pins, a sprue and two vents), every part checked closed (solids.check_solid; the STLs
 by trimesh in export.py).
 """
 
@@ -17,6 +17,7 @@ import math
 
 import build123d as bd
 
+from tactileskin.errors import ParameterError
 from tactileskin.geometry.solids import box, check_solid, occ_guard
 
 MOLD_WALL = 3.0  # mm around the outer body
@@ -61,16 +62,36 @@ def skin_volume(a, b, c, length, t, *, half: bool = False) -> float:
     return 0.5 * v if half else v
 
 
-def mold(a, b, c, length, t):
+def mold(a, b, c, length, t, mp=None):
     """(lower, upper) mold halves split at y = 0: a block around the outer body minus it; the
-    bone core rests in the half-round seats its stem leaves at z < -L."""
+    bone core rests in the half-round seats its stem leaves at z < -L. As the fingertip's mold
+    (molds.toml): four alignment pins on the lower half beside the cavity, in holes of the
+    upper one; a sprue onto the pulp at the middle of the straight part and an air vent near
+    each end of the pulp line (the straight part's end, and half way up the tip), so the skin
+    can be poured and the air leave."""
+    from tactileskin.geometry.molds import MoldParams, _vertical_cylinder
+
+    mp = mp or MoldParams.from_params()
     p = dict(a=a, b=b, c=c, length=length, thickness=t)
-    A, B = a + MOLD_WALL, b + MOLD_WALL
+    hole = mp.pin_diameter + mp.pin_clearance
+    xp = a + MOLD_WALL + 0.5 * hole          # the wall between the cavity and a pin hole
+    A, B = xp + 0.5 * hole + mp.pin_flange, b + MOLD_WALL
     z0, z1 = -length - BONE_STEM, c + MOLD_WALL
+    if mp.pin_height + mp.pin_depth_clearance >= B:
+        raise ParameterError("molds.pins.height", mp.pin_height, f"< {B - mp.pin_depth_clearance:g} mm (the dome "
+                             f"mold's upper half is {B:g} mm thick)")
+    zp = (z0 + 0.5 * hole + mp.pin_flange, z1 - 0.5 * hole - mp.pin_flange)
+    pins = [(sx * xp, z) for sx in (-1, 1) for z in zp]
     with occ_guard("building the dome mold", **p):
         cavity = _one(body(a, b, c, length).fuse(body(a - t, b - t, c - t, length, extra=BONE_STEM)))
-        lower = _one(box(-A, A, -B, 0.0, z0, z1).cut(cavity).clean())
-        upper = _one(box(-A, A, 0.0, B, z0, z1).cut(cavity).clean())
+        lower = box(-A, A, -B, 0.0, z0, z1).cut(cavity).fuse(
+            *[_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in pins])
+        holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance, hole) for x, z in pins]
+        holes += [_vertical_cylinder(0.0, -0.5 * length, 0.0, B + 1.0, mp.pour_diameter)]
+        holes += [_vertical_cylinder(0.0, z, 0.0, B + 1.0, mp.vent_diameter)
+                  for z in (-length + mp.vent_inset, 0.5 * c)]
+        lower = _one(lower.clean())
+        upper = _one(box(-A, A, 0.0, B, z0, z1).cut(cavity, *holes).clean())
     return check_solid(lower, "dome mold lower half", **p), check_solid(upper, "dome mold upper half", **p)
 
 

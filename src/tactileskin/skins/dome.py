@@ -16,6 +16,7 @@ layouts are refused (no sensor frames yet).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -28,6 +29,40 @@ from tactileskin.skins.registry import register
 DEFAULT_LENGTH = 10.0
 LENGTH = (1.0, 200.0)
 TIP = (2.0, 50.0)
+
+
+# the bone is the outer shape with every semi-axis less t, not its inward offset: the skin is t
+# thick at the pulp, the sides and the tip, thinner between (0.3 % at the default tip 8 / t 2,
+# 17 % at tip 20 / t 3.5); a scene thinner than this fraction of t anywhere is refused
+MIN_THICKNESS_FRACTION = 0.9
+
+
+@functools.lru_cache(maxsize=64)
+def min_thickness(a: float, b: float, c: float, t: float, n: int = 120) -> float:
+    """Smallest skin thickness (mm) of the dome: the least distance from the bone's surface
+    (semi-axes a - t, b - t, c - t; a quarter of it, n x n points, the cap's z = 0 row being the
+    straight part's section; cell midpoints) to the outer ellipsoid (a, b, c). Each point's
+    distance is exact:
+    the closest point a_i^2 p_i / (a_i^2 + lam) with lam the root of
+    sum (a_i p_i / (a_i^2 + lam))^2 = 1 in (-min a_i^2, 0) (the point is inside), by bisection."""
+    # cell midpoints: no point on an axis plane, where the root may leave the bracket (the tip of
+    # a long dome lies beyond its centre of curvature: its nearest outer points are off the axis)
+    w = (np.arange(n) + 0.5) * 0.5 * np.pi / n
+    u, v = np.meshgrid(w, w)
+    p = np.column_stack([((a - t) * np.cos(u) * np.cos(v)).ravel(), ((b - t) * np.sin(u) * np.cos(v)).ravel(),
+                         ((c - t) * np.sin(v)).ravel()])
+    ax2 = np.array([a, b, c]) ** 2
+    lo = np.full(len(p), -ax2.min() * (1.0 - 1e-12))
+    hi = np.zeros(len(p))
+    for _ in range(80):
+        lam = 0.5 * (lo + hi)
+        g = np.sum((np.sqrt(ax2) * p / (ax2 + lam[:, None])) ** 2, axis=1) - 1.0
+        inside = g < 0.0  # lam above the root
+        hi = np.where(inside, lam, hi)
+        lo = np.where(inside, lo, lam)
+    lam = 0.5 * (lo + hi)
+    foot = ax2 * p / (ax2 + lam[:, None])
+    return float(np.linalg.norm(foot - p, axis=1).min())
 
 
 def _axes():
@@ -115,7 +150,14 @@ class DomeSkin(Skin):
         c = a if scene.dome_tip is None else scene.dome_tip
         c = check_range("dome_tip", c, *TIP, unit="mm")
         tmax = 0.5 * min(a, b, c)
-        return {"thickness": check_range("thickness", scene.thickness, 0.3, tmax, unit="mm"),
+        t = check_range("thickness", scene.thickness, 0.3, tmax, unit="mm")
+        thinnest = min_thickness(a, b, c, t)
+        if thinnest < MIN_THICKNESS_FRACTION * t:
+            raise ParameterError("dome_tip", c, f"a tip with the skin at least {MIN_THICKNESS_FRACTION:.0%} of "
+                                 f"t = {t:g} mm thick everywhere (it would be {thinnest:.3g} mm at its thinnest)",
+                                 f"the bone is the dome shrunk by t per semi-axis; a tip nearer the section's "
+                                 f"{a:g} / {b:g} mm or a thinner skin keeps it even")
+        return {"thickness": t,
                 "dome_length": check_range("dome_length", length, *LENGTH, unit="mm"),
                 "dome_tip": c, "dim": _dim3(scene), "sensors": _no_sensors(scene)}
 
