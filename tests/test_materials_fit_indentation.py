@@ -107,6 +107,9 @@ def test_the_contact_point_row_is_dropped_and_a_falling_force_is_refused():
     plain = fit_indentation("neo_hookean", d, F, radius=R, thickness=T)
     with_origin = fit_indentation("neo_hookean", np.r_[0.0, d], np.r_[0.0, F], radius=R, thickness=T)
     assert with_origin.E == plain.E and with_origin.quality["n_points"] == 6
+    with pytest.raises(FitDataError, match=r"0\.3 mm at row 5 "):     # the row of the file, (0, 0) counted
+        fit_indentation("neo_hookean", [0.0, 0.05, 0.1, 0.15, 0.3], [0.0, 0.01, 0.02, 0.03, 0.06], radius=R,
+                        thickness=T)
     with pytest.raises(FitDataError, match="past first contact"):
         fit_indentation("neo_hookean", [0.0, 0.1, 0.2], [0.0, 0.01, 0.02], radius=R, thickness=T)
     # a force that falls with depth (columns swapped, a retraction curve) fits worse than its mean:

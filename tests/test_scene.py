@@ -103,6 +103,9 @@ def test_a_depth_and_a_depth_fraction_are_not_both_taken(tmp_path, capsys):
     s = Scene(thickness=2.0, depth=0.4)
     assert "depth_fraction" not in s.to_dict() and Scene.from_dict(s.to_dict()) == s
     assert Scene(thickness=2.0, depth_fraction=0.3).to_dict()["depth_fraction"] == 0.3
+    # a depth given later (replace: the API's overrides, a sweep's depths) replaces the fraction
+    later = Scene(thickness=2.0, depth_fraction=0.3).replace(depth=0.4)
+    assert (later.depth, later.depth_fraction) == (0.4, 0.2)
     f = tmp_path / "s.toml"
     f.write_text("thickness = 2\ndepth = 0.4\ndepth_fraction = 0.3\n")
     assert main(["mesh", "--scene", str(f), "--quality", "preview", "--out", str(tmp_path / "m.vtu")]) == 2

@@ -203,7 +203,6 @@ def test_sensors_csv_and_summary(plain, with_sensors, tmp_path):
     assert not (tmp_path / "sensors.csv").exists()
 
 
-@pytest.mark.slow
 def test_default_taxel_points_follow_the_taxel_not_a_fixed_three():
     """A taxel over a peak narrower than itself (the bone pressure under a 1 mm skin's ridge,
     width ~ t): the default points (one per 0.25 mm of side) average a Gaussian bump of
@@ -212,6 +211,9 @@ def test_default_taxel_points_follow_the_taxel_not_a_fixed_three():
     from math import erf, sqrt
 
     assert [sensors.default_taxel_points(a) for a in (0.1, 0.75, 0.8, 2.0, 4.0, 10.0)] == [3, 3, 4, 8, 16, 16]
+    # the same default for a layout given as an object as for one given as a table
+    as_object = sensors.layouts([sensors.SensorLayout("a", taxel=2.0, height=0.0)])[0]
+    assert as_object.taxel_points == sensors.layouts([{"name": "a", "taxel": 2.0, "height": 0.0}])[0].taxel_points == 8
     sig = 0.3
     coords = sensors.FlatCoordinates(top=2.0, thickness=2.0, half_width=10.0)
 
@@ -233,6 +235,7 @@ def test_default_taxel_points_follow_the_taxel_not_a_fixed_three():
     assert max(errs["three"]) > 0.1
 
 
+@pytest.mark.slow
 def test_3d_bone_points_grid_and_z_mirror():
     # tiny 3D slab (~15k dofs, ~30 s CPU); z-symmetric single dot: z < 0 is read by reflection
     lays = [{"name": "bone", "s": [0.0], "z": [0.0], "height": 0.0},

@@ -12,7 +12,7 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's
   own source and data files and the versions of the libraries that mesh and solve (gmsh,
-  scikit-fem, numpy, scipy, numba, mkl), so a result computed by other code (an update of
+  scikit-fem, numpy, scipy, numba, mkl, meshio), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by

@@ -32,9 +32,25 @@ def _l2(grid: np.ndarray, f: np.ndarray) -> float:
     return float(np.sqrt(np.trapezoid(f * f, grid)))
 
 
+def _folded(s: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A profile across the centre folded onto s >= 0: the mean of P(s) and P(-s)."""
+    order = np.argsort(s)
+    s, p = s[order], p[order]
+    g = np.unique(np.abs(s))
+    return g, 0.5 * (np.interp(g, s, p, left=0.0, right=0.0) + np.interp(-g, s, p, left=0.0, right=0.0))
+
+
 def profile_distance(s1, p1, s2, p2, n: int = 2001) -> float:
-    """Relative L2 distance of two profiles over the union of their s ranges."""
-    s1, p1, s2, p2 = map(np.asarray, (s1, p1, s2, p2))
+    """Relative L2 distance of two profiles over the union of their s ranges. A profile across
+    the centre (a whole model's, s < 0 too) against one from the symmetry line (a halved
+    model's) is folded onto s >= 0 first: the halved model's missing side is no difference."""
+    s1, p1, s2, p2 = (np.asarray(v, float) for v in (s1, p1, s2, p2))
+    tol = 1e-9 * max(np.abs(s1).max(), np.abs(s2).max(), 1.0)
+    two1, two2 = s1.min() < -tol, s2.min() < -tol
+    if two1 and not two2:
+        s1, p1 = _folded(s1, p1)
+    elif two2 and not two1:
+        s2, p2 = _folded(s2, p2)
     lo = min(s1.min(), s2.min())
     hi = max(s1.max(), s2.max())
     grid = np.linspace(lo, hi, n)

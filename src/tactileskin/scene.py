@@ -327,11 +327,13 @@ class Scene:
     def replace(self, **changes) -> "Scene":
         """A changed copy. Changing `dim`, `indenter` or `thickness` re-derives mesh defaults
         left at default (3D Braille's depend on the thickness); changing `indenter` drops kind
-        parameters the new kind does not read."""
+        parameters the new kind does not read; a `depth` replaces a depth_fraction."""
         names = [f.name for f in dataclasses.fields(self)]
         unknown = sorted(set(changes) - set(names))
         if unknown:
             raise ParameterError("scene field", unknown[0], "one of " + ", ".join(names))
+        if changes.get("depth") is not None and "depth_fraction" not in changes:
+            changes["depth_fraction"] = DEPTH_FRACTION  # a depth given now replaces the fraction
         new_dim = changes.get("dim", self.dim)
         new_skin = changes.get("skin", self.skin)
         if new_skin != self.skin:

@@ -56,7 +56,7 @@ FIELDS: dict[str, tuple[str, str, str]] = {
     "skin_outer": ("-", ".msh: physical-group name(s); default outer_surface, else the free rest; file only",
                    "the contact surface"),
     "dome_length": ("mm", "[1, 200]; dome only (default 10)", "finger length before its dome (3D)"),
-    "dome_tip": ("mm", "[2, 50]; dome only (default the section's half width)",
+    "dome_tip": ("mm", "[2, 50], and the skin within 10 % of t everywhere (about 3.5-17 mm); dome only (default the section's half width)",
                  "semi-axis of the dome along the finger"),
 }
 

@@ -74,7 +74,11 @@ class SensorLayout:
     height: float | None = None
     pitch: tuple[float, ...] = ()
     taxel: float = 0.0
-    taxel_points: int = MIN_TAXEL_POINTS
+    taxel_points: int | None = None  # None: default_taxel_points(taxel)
+
+    def __post_init__(self):
+        if self.taxel_points is None:
+            object.__setattr__(self, "taxel_points", default_taxel_points(self.taxel or 0.0))
 
     @classmethod
     def from_dict(cls, d, index: int = 0) -> "SensorLayout":

@@ -306,8 +306,8 @@ def _run_one_safely(scene: Scene, key: str | None = None):
     t0 = time.perf_counter()
     try:
         if key is not None and cache_key(scene) != key:
-            raise TactileSkinError("the material or geometry files (or the package version) seen by the "
-                                   "worker differ from the sweep's; not solved")
+            raise TactileSkinError("the material or geometry files, the tactileskin code or the solving "
+                                   "libraries' versions seen by the worker differ from the sweep's; not solved")
         result = solve_case(scene)
         if key is not None and cache_key(scene) != key:
             raise TactileSkinError("the material or geometry files changed during the solve; rerun the sweep")

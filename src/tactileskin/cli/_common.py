@@ -100,10 +100,6 @@ def _field_changes(opts: dict) -> dict:
                                     "force", "force_rate", "formulation")}
     if ch.get("skin_file") is not None and ch.get("skin") is None:
         ch["skin"] = "file"
-    if ch.get("depth") is not None:  # --depth over a scene file's depth_fraction: the option wins
-        from tactileskin.scene import DEPTH_FRACTION
-
-        ch["depth_fraction"] = DEPTH_FRACTION
     if opts.get("dim") is not None:
         ch["dim"] = int(opts["dim"])
     if opts.get("order") is not None:

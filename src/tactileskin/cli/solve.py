@@ -61,6 +61,8 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         scene = scene.replace(sensors=doc["sensors"])
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
+    if compare_2d and scene.replace(dim=2).dim != 2:  # a dome, a 3D skin file: no 2D section
+        raise click.UsageError(f"--compare-2d needs a skin with a 2D section (fingertip, pad), not {scene.skin}")
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)

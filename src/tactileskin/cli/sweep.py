@@ -123,6 +123,9 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     if o.get("braille_text"):
         axes["braille_texts"] = tuple(o["braille_text"])
     if braille_dim:
+        if 2 in BRAILLE_DIM_CHOICES[braille_dim] and base.replace(dim=2).dim != 2:
+            raise ParameterError("--braille-dim", braille_dim, "3 with skin = " + base.skin,
+                                 f"the {base.skin} skin has no 2D section")
         axes["braille_dims"] = BRAILLE_DIM_CHOICES[braille_dim]
     # the preset per scene (it depends on the indenter and dim), explicit mesh sizes over it
     return expand_grid(base=base, quality=o.get("quality") or sf.quality, overrides=mesh or None, **axes)

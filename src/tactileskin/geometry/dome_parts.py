@@ -81,15 +81,21 @@ def mold(a, b, c, length, t, mp=None):
         raise ParameterError("molds.pins.height", mp.pin_height, f"< {B - mp.pin_depth_clearance:g} mm (the dome "
                              f"mold's upper half is {B:g} mm thick)")
     zp = (z0 + 0.5 * hole + mp.pin_flange, z1 - 0.5 * hole - mp.pin_flange)
+    # a vent near each end of the pulp line, the sprue half way between, 1 mm of mold apart
+    zv = (-length + mp.vent_inset, 0.5 * c)
+    zs = 0.5 * (zv[0] + zv[1])
+    need = mp.pour_diameter + mp.vent_diameter + 2.0
+    if zv[1] - zv[0] < need:
+        raise ParameterError("dome_length", length, f">= {need - 0.5 * c + mp.vent_inset:g} mm with dome_tip "
+                             f"{c:g} mm for the mold's sprue and two vents", "or build without molds (--no-molds)")
     pins = [(sx * xp, z) for sx in (-1, 1) for z in zp]
     with occ_guard("building the dome mold", **p):
         cavity = _one(body(a, b, c, length).fuse(body(a - t, b - t, c - t, length, extra=BONE_STEM)))
         lower = box(-A, A, -B, 0.0, z0, z1).cut(cavity).fuse(
             *[_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in pins])
         holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance, hole) for x, z in pins]
-        holes += [_vertical_cylinder(0.0, -0.5 * length, 0.0, B + 1.0, mp.pour_diameter)]
-        holes += [_vertical_cylinder(0.0, z, 0.0, B + 1.0, mp.vent_diameter)
-                  for z in (-length + mp.vent_inset, 0.5 * c)]
+        holes += [_vertical_cylinder(0.0, zs, 0.0, B + 1.0, mp.pour_diameter)]
+        holes += [_vertical_cylinder(0.0, z, 0.0, B + 1.0, mp.vent_diameter) for z in zv]
         lower = _one(lower.clean())
         upper = _one(box(-A, A, 0.0, B, z0, z1).cut(cavity, *holes).clean())
     return check_solid(lower, "dome mold lower half", **p), check_solid(upper, "dome mold upper half", **p)

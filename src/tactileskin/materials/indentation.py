@@ -84,20 +84,22 @@ def check_indentation(depth, force, radius, thickness):
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
             raise FitDataError(name, f"non-finite value at row {bad[0] + 1}", "finite numbers")
-    # the contact point (0, 0) that most recordings start with carries no information: dropped
-    origin = (d == 0.0) & (F == 0.0)
-    d, F = d[~origin], F[~origin]
+    # the contact point (0, 0) that most recordings start with carries no information: a
+    # leading one is dropped (rows keep their numbers in the messages below)
+    row = np.arange(1, d.size + 1)
+    if d[0] == 0.0 and F[0] == 0.0:
+        d, F, row = d[1:], F[1:], row[1:]
     if d.size < 3:
         raise FitDataError("data", f"{d.size} points past first contact", ">= 3 points with depth > 0")
     if np.any(d <= 0.0):
         i = int(np.flatnonzero(d <= 0.0)[0])
-        raise FitDataError("depth", f"{d[i]:g} at row {i + 1}", "> 0 mm (depth from first contact)")
+        raise FitDataError("depth", f"{d[i]:g} at row {row[i]}", "> 0 mm (depth from first contact)")
     dmax = min(DEPTH_OVER_RADIUS_MAX * R, CHI_MAX ** 2 * t * t / R)
     over = np.flatnonzero(d > dmax)
     if over.size:
         i = int(over[0])
         chi = np.sqrt(R * d[i]) / t
-        raise FitDataError("depth", f"{d[i]:g} mm at row {i + 1} (d/R = {d[i] / R:.3g}, chi = sqrt(R d)/t = {chi:.3g})",
+        raise FitDataError("depth", f"{d[i]:g} mm at row {row[i]} (d/R = {d[i] / R:.3g}, chi = sqrt(R d)/t = {chi:.3g})",
                            f"<= {dmax:.4g} mm for R = {R:g} mm, t = {t:g} mm (d/R <= {DEPTH_OVER_RADIUS_MAX:g}, "
                            f"chi <= {CHI_MAX:g})",
                            "outside the range of the bonded-layer Hertz correction; drop the deeper points")

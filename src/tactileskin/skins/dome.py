@@ -153,10 +153,14 @@ class DomeSkin(Skin):
         t = check_range("thickness", scene.thickness, 0.3, tmax, unit="mm")
         thinnest = min_thickness(a, b, c, t)
         if thinnest < MIN_THICKNESS_FRACTION * t:
+            ok = [x for x in np.arange(TIP[0], TIP[1] + 1e-9, 0.5) if 2.0 * t <= x
+                  and min_thickness(a, b, float(x), t, n=40) >= MIN_THICKNESS_FRACTION * t]
+            where = f"about {min(ok):g}-{max(ok):g} mm at this t" if ok else "none at this t"
             raise ParameterError("dome_tip", c, f"a tip with the skin at least {MIN_THICKNESS_FRACTION:.0%} of "
-                                 f"t = {t:g} mm thick everywhere (it would be {thinnest:.3g} mm at its thinnest)",
-                                 f"the bone is the dome shrunk by t per semi-axis; a tip nearer the section's "
-                                 f"{a:g} / {b:g} mm or a thinner skin keeps it even")
+                                 f"t = {t:g} mm thick everywhere: {where} (here it would be {thinnest:.3g} mm "
+                                 "at its thinnest)",
+                                 f"the bone is the dome shrunk by t per semi-axis, so a tip far from the "
+                                 f"section's {a:g} / {b:g} mm thins the skin between pulp and tip")
         return {"thickness": t,
                 "dome_length": check_range("dome_length", length, *LENGTH, unit="mm"),
                 "dome_tip": c, "dim": _dim3(scene), "sensors": _no_sensors(scene)}
