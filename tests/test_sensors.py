@@ -324,3 +324,19 @@ def test_a_sweep_gathers_its_cases_sensors(tmp_path):
     plain = run_sweep([Scene(**COARSE)], cache, serial=True)
     write_outputs(tmp_path / "p", plain, cache, 1.0, render=False, figures=False)
     assert not (tmp_path / "p" / "sensors.csv").exists()
+
+
+def test_a_line_whose_pitch_misses_its_end_says_so(caplog):
+    """s = [0, 2] at pitch 5 is one sensor at 0: the layout says so once (it was silent)."""
+    import logging
+
+    with caplog.at_level(logging.WARNING, logger="tactileskin.sensors"):
+        lay = sensors.layouts([{"name": "short", "kind": "line", "s": [0, 2], "pitch": 5.0, "depth": 1.0}])[0]
+        assert lay.count() == 1 and lay.positions()[0].tolist() == [0.0]
+        lay.positions()
+    said = [r.getMessage() for r in caplog.records if "short" in r.getMessage()]
+    assert len(said) == 1 and "last sensor is at 0 mm, 2 mm short of the end" in said[0]
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="tactileskin.sensors"):
+        sensors.layouts([{"name": "exact", "kind": "line", "s": [0, 2], "pitch": 0.5, "depth": 1.0}])[0].positions()
+    assert not caplog.records

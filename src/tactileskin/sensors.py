@@ -31,6 +31,7 @@ stresses; the solver's is `fe.probe.stress_sampler`.
 
 from __future__ import annotations
 
+import functools
 import io
 import logging
 from dataclasses import dataclass, field
@@ -159,6 +160,8 @@ class SensorLayout:
 
     def _axis(self, lo, hi, p):
         n = int(np.floor((hi - lo) / p * (1 + 1e-12) + 1e-9)) + 1
+        if lo + p * (n - 1) < hi - _TOL:
+            _short_end(self.name, float(lo), float(hi), float(p))
         return lo + p * np.arange(n)
 
     def positions(self) -> tuple[np.ndarray, np.ndarray]:
@@ -184,6 +187,14 @@ class SensorLayout:
 
     def depth_in(self, thickness: float) -> float:
         return float(self.depth) if self.depth is not None else float(thickness - self.height)
+
+
+@functools.lru_cache(maxsize=256)
+def _short_end(name: str, lo: float, hi: float, p: float) -> None:
+    """Say once per layout that its pitch does not reach the range's end."""
+    n = int(np.floor((hi - lo) / p * (1 + 1e-12) + 1e-9))
+    log.warning("sensor layout %r: the pitch %g mm does not divide [%g, %g]: its last sensor is at %g mm, "
+                "%g mm short of the end", name, p, lo, hi, lo + n * p, hi - lo - n * p)
 
 
 def _numbers(v, name) -> tuple[float, ...]:
