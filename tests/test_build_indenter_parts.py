@@ -78,12 +78,9 @@ def test_sphere_and_cylinder_parts_are_closed_with_the_closed_form_volume(tmp_pa
 def _precise_volume(shape) -> float:
     """OCC's volume integral to 1e-9 (build123d's `.volume` uses the default precision, which
     is off by up to ~6e-4 on a spherical cap)."""
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
+    from tactileskin.geometry.export import cad_volume
 
-    props = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape.wrapped, props, 1e-9, False, False)
-    return props.Mass()
+    return cad_volume(shape)
 
 
 @pytest.mark.parametrize("argv, words", [
