@@ -98,8 +98,12 @@ def test_every_stl_is_a_valid_volume_and_manifest_describes_it(builds, t):
         assert e["volume_mm3"] == pytest.approx(m.volume, rel=1e-12)
         np.testing.assert_allclose(e["bbox_min"], m.bounds[0], atol=1e-9)
         np.testing.assert_allclose(e["bbox_max"], m.bounds[1], atol=1e-9)
-        # chords cut off at most ~(2/3) * 0.005 mm * curved area: < 0.1 % for every part here
-        assert e["volume_mm3"] == pytest.approx(e["cad_volume_mm3"], rel=1e-3), e["name"]
+        # chords cut off at most the chordal deviation (0.005 mm) times the area; against OCC's
+        # volume to 1e-9 (cad_volume_mm3) that is up to 0.104 % (the t = 5 rigid base: its
+        # elliptic faces are all curved), 0.05 % for the others
+        from tactileskin.geometry.export import STL_TOLERANCE
+
+        assert abs(e["volume_mm3"] - e["cad_volume_mm3"]) <= STL_TOLERANCE * m.area, e["name"]
     assert not list(build.folder.parent.glob(f".{build.folder.name}.*"))  # no temp leftovers
 
 

@@ -32,8 +32,9 @@ MANIFEST_KIND = "tactileskin.parts"  # marks a folder this module wrote (and may
 # edge's size): chordal deviation 5 um, angular deflection 0.1 rad. Mesh vertices lie on the
 # exact surfaces and no facet sags more than 0.005 mm from them: half the 0.01 mm
 # surface-accuracy and a quarter of the 0.02 mm Braille-dimension checks. The volume the
-# chords cut off is < 0.05 % for every part (manifest: volume_mm3 vs cad_volume_mm3), well
-# inside the 0.5 % mold-cavity check. 0.1 rad keeps >= 60 facets around a Braille dot.
+# chords cut off is at most that times the part's area (manifest: volume_mm3 vs
+# cad_volume_mm3, OCC's integral to 1e-9): up to 0.1 % (the t = 5 rigid base), well inside
+# the 0.5 % mold-cavity check. 0.1 rad keeps >= 60 facets around a Braille dot.
 # 0.001 mm would triple the export time for no gain these checks can see.
 STL_TOLERANCE = 0.005
 STL_ANGULAR_TOLERANCE = 0.1
