@@ -201,13 +201,17 @@ def test_hyperfoam_lines_wrap_at_eight_values():
         material_lines(four, viscoelastic=False, dialect="calculix")
 
 
-@pytest.mark.parametrize("kind,text", [("flat", ""), ("curved", ""), ("braille", ""), ("braille", "ab")])
+@pytest.mark.parametrize("kind,text", [("flat", ""), ("curved", ""), ("braille", ""), ("braille", "ab"),
+                                       ("cylinder", "")])
 def test_analytic_segments_lie_on_the_indenter_and_face_the_skin(kind, text):
+    """Every 2D kind, the cylinder along z too (it ended in an AttributeError traceback)."""
     from tactileskin.geometry.indenters import indenter_for_scene
 
-    ind = indenter_for_scene(Scene(thickness=3.0, indenter=kind, braille_text=text))
-    segs = analytic_segments(ind, -1.5, 6.0)
-    assert segs[0][0] == "START" and segs[0][1] == 6.0 and segs[-1][1] == -1.5
+    extra = {"indenter_radius": 3.0} if kind == "cylinder" else {}
+    ind = indenter_for_scene(Scene(thickness=3.0, indenter=kind, braille_text=text, **extra))
+    hi = min(6.0, 0.5 * ind.width)  # the face as wide as the kind makes it (a 3 mm cylinder: 2.7)
+    segs = analytic_segments(ind, -1.5, hi)
+    assert segs[0][0] == "START" and segs[0][1] == hi and segs[-1][1] == -1.5
     pts, nrm = segment_points(segs, 41)
     g, n = ind.gap(pts, 0.0)
     assert np.abs(g).max() < 1e-9
@@ -240,6 +244,29 @@ def test_deck_refuses_3d_and_unknown_dialect(scene_mesh):
         deck_text(sc, sm, "nastran")
     with pytest.raises(ParameterError, match="dim"):
         deck_text(sc.replace(dim=3), sm)
+    # one displacement step: force control and loading histories are refused, not dropped
+    for other in (sc.replace(depth=None, force=0.5), sc.replace(depth=0.4, loading=[{"hold": 10.0}])):
+        with pytest.raises(ParameterError, match="loading.*a depth ramp"):
+            deck_text(other, sm)
+
+
+@pytest.mark.parametrize("dialect", ["abaqus", "calculix"])
+@pytest.mark.parametrize("text", ["", "d"])
+def test_a_pad_deck_supports_its_own_boundaries(dialect, text):
+    """A pad's deck fixes its board (it named the fingertip's nail_edge, never defined) and has
+    the x = 0 symmetry support only where the model is halved ('d' on the pad is modelled whole);
+    a whole model's analytic face spans its whole width."""
+    sc = Scene(skin="pad", pad_width=20.0, thickness=2.0, indenter="braille", braille_text=text,
+               mesh_size=1.0, refinement=5.0)
+    sm = build_mesh(sc)
+    text_ = deck_text(sc, sm, dialect).text
+    assert undefined_names(parse_deck(text_)) == []
+    assert "nail_edge" not in text_
+    assert ("symmetry, 1, 1" in text_) == (text == "")
+    if dialect == "abaqus" and text:
+        xs = [float(line.split(",")[1]) for line in text_.split("*SURFACE, TYPE=SEGMENTS")[1].split("*RIGID")[0]
+              .strip().splitlines()[1:]]
+        assert min(xs) <= -10.0 and max(xs) >= 10.0
 
 
 def test_cli_export_writes_the_deck_and_rejects_bad_requests(tmp_path, capsys):

@@ -131,9 +131,12 @@ def analytic_segments(indenter, x_lo: float, x_hi: float) -> list[tuple]:
     y = lambda x: float(indenter.surface_y(np.array([x]))[0])  # noqa: E731
     if kind == "flat":
         return [("START", x_hi, y(x_hi)), ("LINE", x_lo, y(x_lo))]
-    if kind == "curved":
+    if kind in ("curved", "cylinder"):  # a cylinder along z is the 2D section's circle
         R = indenter.radius
         return [("START", x_hi, y(x_hi)), ("CIRCL", x_lo, y(x_lo), 0.0, indenter.y0 + R)]
+    if kind != "braille":
+        raise ParameterError("indenter", kind, "flat, curved, cylinder or braille for a deck",
+                             "other kinds are 3D only")
     std = indenter.standard
     R, yb = std.sphere_radius, indenter.base_plane(0.0)
     yc, a = yb + std.centre_offset, 0.5 * std.base_diameter
@@ -146,10 +149,11 @@ def analytic_segments(indenter, x_lo: float, x_hi: float) -> list[tuple]:
     return segs
 
 
-def _x_lo(indenter) -> float:
-    """Left end of the modelled face: 1 mm past the symmetry line (nothing at x < 0 can
-    touch the half model), extended to take in whole Braille dots that straddle it."""
-    x = -1.0
+def _x_lo(indenter, x_min: float = 0.0) -> float:
+    """Left end of the modelled face: 1 mm past the skin's left end (x_min: the symmetry line
+    of a half model, else the whole model's edge), extended to take in whole Braille dots that
+    straddle it."""
+    x = float(x_min) - 1.0
     if indenter.kind == "braille":
         a = 0.5 * indenter.standard.base_diameter
         x = min([x] + [c - a - 0.5 for c in indenter.section_x if c + a > x])
@@ -272,13 +276,20 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     _check_dim(scene.dim if scene.dim != 2 else skinmesh.dim)
     if not (isinstance(increments, int) and 1 <= increments <= 10000):
         raise ParameterError("increments", increments, "an integer in [1, 10000]")
+    program = scene.program()
+    if len(program) != 1 or program[0].kind != "depth":
+        raise ParameterError("loading", "force control" if scene.force is not None else "a loading history",
+                             "a depth ramp (the deck has one displacement step)",
+                             "force control and [[loading]] histories are not written to decks yet; export "
+                             "the scene with its depth")
     mat = get_material(scene.material)
     visco = scene.viscoelastic if viscoelastic is None else bool(viscoelastic)
     ind = indenter_for_scene(scene)
     etype, pts, cells = abaqus_cells(skinmesh)
     n_nodes, n_cells = len(pts), len(cells)
     T, depth = scene.duration, scene.indentation
-    x_lo = _x_lo(ind)
+    halved = len(skinmesh.boundaries.get("symmetry", ())) > 0
+    x_lo = _x_lo(ind, 0.0 if halved else float(pts[:, 0].min()))
     x_hi = min(0.5 * ind.width, float(pts[:, 0].max()) + 1.0)
     h_fine = float(skinmesh.sizes.get("fine", scene.mesh_size / scene.refinement))
     hf = mat.hyperfoam
@@ -351,8 +362,9 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     w("outer_surface_faces, indenter_face\n")
     w(f"*AMPLITUDE, NAME=travel\n0., 0., {_num(T)}, 1.\n")
 
-    w("**\n** Supports: bone, stiff tissue and nail fixed; symmetry line x = 0\n")
-    w("*BOUNDARY\nbone_interface, 1, 2\nnail_edge, 1, 2\nsymmetry, 1, 1\n")
+    fixed = [b for b in scene.skin_kind.fixed_boundaries if b in skinmesh.boundaries]
+    w("**\n** Supports: " + ", ".join(fixed) + " fixed" + ("; symmetry line x = 0" if halved else "") + "\n")
+    w("*BOUNDARY\n" + "".join(f"{b}, 1, 2\n" for b in fixed) + ("symmetry, 1, 1\n" if halved else ""))
     if dialect == "abaqus":
         w(f"{moved}, 1, 1\n{moved}, 6, 6\n")
     else:
