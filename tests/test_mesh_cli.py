@@ -15,6 +15,15 @@ def test_mesh_command_writes_vtu_and_prints_table(tmp_path, capsys):
     assert "P2 triangles" in text and "bone_interface" in text and "min scaled Jacobian" in text
     m = meshio.read(out)
     assert len(m.get_cells_type("triangle6")) > 100
+    # the boundaries keep their names (VTK field data: name -> [gmsh physical id, dim]), as in
+    # result.vtu; the file had bare integers only
+    import re
+
+    names = dict(re.findall(r'<DataArray type="Int32" Name="(\w+)" NumberOfTuples="1" NumberOfComponents="2" '
+                            r'format="ascii">(\d+) 1</DataArray>', out.read_text()))
+    assert {"bone_interface", "outer_surface", "symmetry", "nail_edge"} <= set(names)
+    ids = m.cell_data["gmsh:physical"][1]                 # the boundary facets' ids
+    assert {int(v) for v in names.values()} == set(ids.tolist())
 
 
 def test_mesh_command_3d(tmp_path, capsys):

@@ -441,10 +441,11 @@ def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None
     with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
         mesh.write(tmp, file_format="vtu")
         if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it
-            _add_field_data(Path(tmp), field_data)
+            add_vtu_field_data(Path(tmp), field_data)
 
 
-def _add_field_data(path: Path, field_data: dict) -> None:
+def add_vtu_field_data(path: Path, field_data: dict) -> None:
+    """Add {name: [id, dim]} to a .vtu as VTK field data (meshio's VTU writer drops it)."""
     arrays = "".join(f'<DataArray type="Int32" Name="{name}" NumberOfTuples="1" NumberOfComponents="2" '
                      f'format="ascii">{v[0]} {v[1]}</DataArray>\n' for name, v in field_data.items())
     data = path.read_bytes()

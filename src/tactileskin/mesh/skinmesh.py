@@ -94,7 +94,9 @@ class SkinMesh:
         if fmt is None:
             raise ParameterError("path", str(path), "a file name ending in " + ", ".join(FORMATS))
         out = self.to_meshio()
-        if fmt == "vtu":
+        names = {}
+        if fmt == "vtu":  # the boundary names go in as VTK field data after meshio (it drops them)
+            names = out.field_data
             out.cell_sets, out.point_sets, out.field_data = {}, {}, {}
         with fileio.atomic_path(path) as tmp, fileio.os_errors(path):  # a .tmp name, known to clean_stale
             try:
@@ -107,6 +109,10 @@ class SkinMesh:
                     out.write(tmp, file_format="gmsh22", binary=False)
                 else:
                     out.write(tmp, file_format=fmt)
+                    if names:
+                        from tactileskin.results import add_vtu_field_data
+
+                        add_vtu_field_data(Path(tmp), names)
             except OSError:
                 raise  # an OutputError naming the path (os_errors)
             except Exception as e:
