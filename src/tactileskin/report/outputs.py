@@ -127,7 +127,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     records, rows, failures = collect(outcomes, cache)
 
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=RESULT_COLUMNS, extrasaction="ignore")
+    w = csv.DictWriter(buf, fieldnames=RESULT_COLUMNS + ["dim", "variant"], extrasaction="ignore")
     w.writeheader()
     w.writerows(rows)
     atomic_write_text(out / "results.csv", buf.getvalue())
