@@ -321,6 +321,9 @@ def test_a_sweep_gathers_its_cases_sensors(tmp_path):
     for rec in res["records"]:
         own = list(csv.DictReader(open(rec.path / "sensors.csv", encoding="utf-8")))
         assert [r["pressure_mpa"] for r in rows if r["case"] == rec.case] == [r["pressure_mpa"] for r in own]
+    # results.csv names each case's dimension and variant, as results.parquet does
+    table = list(csv.DictReader(open(tmp_path / "o" / "results.csv", encoding="utf-8")))
+    assert [r["dim"] for r in table] == ["2", "2"] and all("variant" in r for r in table)
     plain = run_sweep([Scene(**COARSE)], cache, serial=True)
     write_outputs(tmp_path / "p", plain, cache, 1.0, render=False, figures=False)
     assert not (tmp_path / "p" / "sensors.csv").exists()
