@@ -43,6 +43,11 @@ def test_result_repr_is_one_short_line():
     text = repr(r)
     assert "\n" not in text and len(text) < 300
     assert "t1-silicone-flat-2d" in text and "peak=1 MPa" in text and "2000 profile points" in text
+    assert "reaction=1.5 N/mm" in text                   # with its unit (2D: per mm of depth)
+    # named as the scene labels itself (the CLI, summary.json): the Braille text too
+    braille = Result(s=s, pressure=np.exp(-s), contact_x=s, contact_pressure=s, reaction=1.5, stats={},
+                     scene={"thickness": 1.0, "indenter": "braille", "braille_text": "a", "dim": 3})
+    assert "t1-silicone-braille[a]-3d" in repr(braille) and "reaction=1.5 N," in repr(braille)
 
 
 def test_solve_takes_fields_and_a_quality_preset():

@@ -206,12 +206,19 @@ class Result:
         sc = self.scene or {}
         name = (f"t{sc['thickness']:g}-{sc.get('material', '?')}-{sc.get('indenter', '?')}-{sc.get('dim', 2)}d"
                 if "thickness" in sc else "scene ?")
+        try:  # the scene's own label (Braille text, skin), as the CLI and summary.json name it
+            from tactileskin.scene import Scene
+
+            name = Scene.from_dict(dict(sc)).label()
+        except Exception:  # noqa: BLE001 - a scene this version cannot rebuild keeps the short name
+            pass
         try:
             metrics = f"peak={self.peak:.4g} MPa, span={self.span:.3g} mm, auc={self.auc:.4g} MPa*mm"
         except ParameterError:  # a profile too short for the metrics
             metrics = "no profile"
         extra = ", bone_map" if self.bone_map is not None else ""
-        return (f"<Result {name}: {metrics}, reaction={self.reaction:.4g}, status={self.status!r}; "
+        unit = "N" if self.dim == 3 else "N/mm"
+        return (f"<Result {name}: {metrics}, reaction={self.reaction:.4g} {unit}, status={self.status!r}; "
                 f"{self.s.size} profile points, {self.contact_x.size} contact points, "
                 f"{int(self.stats.get('dofs', 0))} dofs{extra}>")
 
