@@ -113,3 +113,11 @@ def test_a_depth_and_a_depth_fraction_are_not_both_taken(tmp_path, capsys):
     f.write_text("thickness = 2\ndepth_fraction = 0.3\n")
     assert main(["mesh", "--scene", str(f), "--depth", "0.4", "--quality", "preview",
                  "--out", str(tmp_path / "m.vtu")]) == 0
+
+
+def test_an_unknown_material_name_is_refused_when_the_scene_is_made():
+    """'SILICONE' made a scene (labelled t3-SILICONE-flat-2d) and failed only at the solve."""
+    with pytest.raises(ParameterError, match=r"material='SILICONE' is invalid.*did you mean 'silicone'"):
+        Scene(material="SILICONE")
+    assert Scene(material="polyurethane").material == "polyurethane"
+    assert Scene(material="my_gel.toml").material == "my_gel.toml"  # a file: read at the solve

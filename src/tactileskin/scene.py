@@ -210,6 +210,13 @@ class Scene:
                                        1.0, 20.0))
         if not self.material:
             raise ParameterError("material", self.material, "a material preset name")
+        if not str(self.material).endswith(".toml"):  # a preset name: known now, not at the solve
+            from tactileskin.materials import list_materials
+
+            names = list_materials()
+            if self.material not in names:
+                raise ParameterError("material", self.material, "one of " + ", ".join(names) + ", or a path to "
+                                     "a .toml file", validate.did_you_mean(str(self.material).lower(), names))
         kind = self.indenter_kind
         for name in ("indenter_radius", "indenter_axis", "indenter_file"):
             if getattr(self, name) is not None and name not in kind.scene_params:
