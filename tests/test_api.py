@@ -64,6 +64,8 @@ def test_sweep_returns_dataframes_equal_to_the_csv_and_parquet_files(tmp_path):
     df, prof = ts.sweep(grid, quality="preview", out=out, serial=True, profiles=True, report=False)
     assert list(df.case) == ["t1-silicone-flat-2d", "t1-silicone-curved-2d"]
     assert (df.status == "ok").all() and (df.peak_mpa > 0).all()
+    # numeric columns are numbers: a 2D case's 3D reaction is NaN, not None (object dtype)
+    assert df.reaction_n.dtype == float and df.reaction_n.isna().all() and df.reaction_n_per_mm.dtype == float
     with open(out / "results.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
     assert [float(r["peak_mpa"]) for r in rows] == pytest.approx(list(df.peak_mpa), rel=1e-12)
