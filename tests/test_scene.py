@@ -121,3 +121,12 @@ def test_an_unknown_material_name_is_refused_when_the_scene_is_made():
         Scene(material="SILICONE")
     assert Scene(material="polyurethane").material == "polyurethane"
     assert Scene(material="my_gel.toml").material == "my_gel.toml"  # a file: read at the solve
+
+
+def test_a_braille_text_is_only_taken_by_the_braille_indenter():
+    """A text on a flat indenter was accepted and only changed the cache key (the other fields
+    an indenter does not read are refused); switching a Braille scene to another kind drops it."""
+    with pytest.raises(ParameterError, match="braille_text='a' is invalid; valid: only with indenter = braille"):
+        Scene(indenter="flat", braille_text="a")
+    s = Scene(indenter="braille", braille_text="a").replace(indenter="flat")
+    assert s.braille_text == "" and s.key() == Scene(indenter="flat").key()

@@ -223,6 +223,9 @@ class Scene:
                 takers = [k for k in _indenters.names() if name in _indenters.get(k).scene_params]
                 raise ParameterError(name, getattr(self, name), f"only with indenter = {' or '.join(takers)}",
                                      f"the {kind.name} indenter does not take it")
+        if self.braille_text and "braille_text" not in kind.scene_params:  # it would only change the key
+            raise ParameterError("braille_text", self.braille_text, "only with indenter = braille",
+                                 f"the {kind.name} indenter does not take it")
         if self.indenter_axis is not None:
             set_("indenter_axis", validate.string(self.indenter_axis, "indenter_axis", "'z' or 'x'"))
         if self.indenter_file is not None:
@@ -354,6 +357,8 @@ class Scene:
             for name in ("indenter_radius", "indenter_axis", "indenter_file"):
                 if name not in changes and name not in reads:
                     changes[name] = None
+            if "braille_text" not in changes and "braille_text" not in reads:
+                changes["braille_text"] = ""
         new_t = changes.get("thickness", self.thickness)
         new_skin = changes.get("skin", self.skin)
         if (new_dim != self.dim or new_ind != self.indenter or new_t != self.thickness
