@@ -172,3 +172,16 @@ def test_summary_keys_carry_their_units_and_a_3d_reaction_is_in_newtons():
     assert "reaction_n_per_mm" in s2 and "reaction_n" not in s2  # plane strain: per mm of depth
     assert "reaction_n" in s3 and "reaction_n_per_mm" not in s3  # 3D: the force on the model
     assert reaction_of(s2) == reaction_of(s3) == 0.1 and s2["auc_mpa_mm"] == pytest.approx(0.1)
+
+
+def test_contact_csv_gives_each_contact_points_position(tmp_path):
+    """contact.csv: x, y (and z in 3D) of every contact point, in contact_x's order, and its
+    pressure; it had x only, so two 3D points at the same x could not be told apart."""
+    s = np.linspace(0, 4, 50)
+    pts = np.array([[0.1, 6.8, 0.0], [0.1, 6.8, 0.5], [0.3, 6.79, 0.2]])
+    r = Result(s=s, pressure=np.exp(-s), contact_x=pts[:, 0], contact_pressure=np.array([0.3, 0.2, 0.1]),
+               reaction=1.0, stats={}, scene={"thickness": 1.0, "dim": 3}, contact_points=pts)
+    out = r.write(tmp_path / "o")
+    rows = list(csv.DictReader(open(out / "contact.csv", encoding="utf-8")))
+    assert list(rows[0]) == ["x_mm", "y_mm", "z_mm", "contact_pressure_mpa"]
+    assert [(float(x["z_mm"]), float(x["contact_pressure_mpa"])) for x in rows] == [(0.0, 0.3), (0.5, 0.2), (0.2, 0.1)]

@@ -191,6 +191,8 @@ class Result:
     # force control / a loading history (fe.solve): control, target and reached force, the
     # profile's state (peak load: time, travel, reaction) and the final state; None: a plain ramp
     loading: dict | None = None
+    # the contact points' current positions (n, dim), in contact_x's order; None: x only
+    contact_points: np.ndarray | None = None
 
     def __post_init__(self):
         for name in ("s", "pressure", "contact_x", "contact_pressure"):
@@ -253,6 +255,16 @@ class Result:
         s, inv = np.unique(np.round(self.s, 9), return_inverse=True)
         p = np.bincount(inv, weights=self.pressure) / np.bincount(inv)
         return s, p
+
+    def _contact_csv(self) -> str:
+        """contact.csv: the contact points' current position (x, y[, z] mm) and their contact
+        pressure per current area (MPa); x alone for a result without positions."""
+        pts = self.contact_points
+        if pts is None or len(pts) != len(self.contact_x):
+            return _csv(["x_mm", "contact_pressure_mpa"], self.contact_x, self.contact_pressure)
+        pts = np.asarray(pts, float).reshape(len(self.contact_x), -1)
+        names = ["x_mm", "y_mm", "z_mm"][: pts.shape[1]]
+        return _csv(names + ["contact_pressure_mpa"], *pts.T, self.contact_pressure)
 
     def summary(self) -> dict:
         """The result's numbers, with its status ("ok" or "suspect: reasons") and flags
@@ -372,7 +384,7 @@ class Result:
         s, p = self._profile()
         fileio.atomic_write_text(directory / "profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
         fileio.atomic_write_text(directory / "contact.csv",
-                                 _csv(["x_mm", "contact_pressure_mpa"], self.contact_x, self.contact_pressure))
+                                 self._contact_csv())
         if self.fields is not None:
             _write_vtu(directory / "result.vtu", self.fields)
         _write_steps(directory, self.fields)
@@ -403,6 +415,8 @@ OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_m
 
 
 def _csv(header: list[str], *cols) -> str:
+    if not cols or len(np.atleast_1d(cols[0])) == 0:
+        return ",".join(header) + "\n"
     buf = io.StringIO()
     np.savetxt(buf, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
     return buf.getvalue()

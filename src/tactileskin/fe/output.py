@@ -394,12 +394,13 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     if model.surface is not None and ev.contact is not None:
         g, lamN, x, n = ev.contact
         pc = model.surface.current_pressure(model.u, lamN)
-        xs, ps = x[..., 0].ravel(), pc.ravel()
+        pos = np.asarray(x, float).reshape(-1, model.m)
+        xs, ps = pos[:, 0], pc.ravel()
         keep = ps > 0
-        order = np.argsort(xs[keep])
-        cx, cp = xs[keep][order], ps[keep][order]
+        order = np.argsort(xs[keep], kind="stable")
+        cx, cp, cpos = xs[keep][order], ps[keep][order], pos[keep][order]
     else:
-        cx, cp = np.zeros(0), np.zeros(0)
+        cx, cp, cpos = np.zeros(0), np.zeros(0), np.zeros((0, model.m))
     r = reaction(model, ev)
     law = law_state(ev, sig)
     for name, v in fields.items():
@@ -413,7 +414,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           **({"profile_sides": 2} if getattr(model, "profile_sides", 1) == 2 else {}),
           "reaction_vector_modelled_part": r.tolist()}
-    return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp,
+    return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, contact_points=cpos,
                   reaction=float(r[vertical]) * (model.force_factor if vertical == 1 else 1.0),
                   stats=st, fields=vtk, history=[{k: v for k, v in h.items() if k != "displacement"}
                                                  for h in stats.history], scene=scene,
