@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tactileskin.results import fold_profile
+
 THRESHOLD = 0.2
 
 
@@ -28,16 +30,13 @@ def _on_grid(s: np.ndarray, p: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return np.interp(grid, s[order], p[order], left=0.0, right=0.0)
 
 
+def _sorted(s: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(s, kind="stable")
+    return s[order], p[order]
+
+
 def _l2(grid: np.ndarray, f: np.ndarray) -> float:
     return float(np.sqrt(np.trapezoid(f * f, grid)))
-
-
-def _folded(s: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A profile across the centre folded onto s >= 0: the mean of P(s) and P(-s)."""
-    order = np.argsort(s)
-    s, p = s[order], p[order]
-    g = np.unique(np.abs(s))
-    return g, 0.5 * (np.interp(g, s, p, left=0.0, right=0.0) + np.interp(-g, s, p, left=0.0, right=0.0))
 
 
 def profile_distance(s1, p1, s2, p2, n: int = 2001) -> float:
@@ -48,9 +47,9 @@ def profile_distance(s1, p1, s2, p2, n: int = 2001) -> float:
     tol = 1e-9 * max(np.abs(s1).max(), np.abs(s2).max(), 1.0)
     two1, two2 = s1.min() < -tol, s2.min() < -tol
     if two1 and not two2:
-        s1, p1 = _folded(s1, p1)
+        s1, p1, _ = fold_profile(*_sorted(s1, p1))
     elif two2 and not two1:
-        s2, p2 = _folded(s2, p2)
+        s2, p2, _ = fold_profile(*_sorted(s2, p2))
     lo = min(s1.min(), s2.min())
     hi = max(s1.max(), s2.max())
     grid = np.linspace(lo, hi, n)

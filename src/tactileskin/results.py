@@ -62,6 +62,30 @@ def auc(s, p) -> float:
     return float(np.trapezoid(p, s))
 
 
+def fold_profile(s, p):
+    """Fold a two-sided profile about s = 0 onto s >= 0 (to compare with the half model).
+
+    On the grid s_k = k*ds (ds the profile's median spacing) up to max |s|, the folded value
+    is the mean of P(+s_k) and P(-s_k) (linear interpolation) where both sides are measured,
+    else the one that is. Returns (s_half, p_half, asymmetry) with asymmetry =
+    max |P(+s) - P(-s)| / max P over the overlap (0 for a symmetric profile).
+    """
+    s = np.asarray(s, float)
+    p = np.asarray(p, float)
+    ds = float(np.median(np.diff(s)))
+    smax = max(abs(s[0]), abs(s[-1]))
+    sh = np.arange(int(np.floor(smax / ds + 1e-9)) + 1) * ds
+    tol = 1e-9 * ds
+    right = np.where(sh <= s[-1] + tol, np.interp(sh, s, p), np.nan)
+    left = np.where(-sh >= s[0] - tol, np.interp(-sh, s, p), np.nan)
+    both = np.isfinite(right) & np.isfinite(left)
+    ph = np.where(both, 0.5 * (right + left), np.where(np.isfinite(right), right, left))
+    top = float(np.max(p)) if p.size else 0.0
+    asym = float(np.max(np.abs(right[both] - left[both])) / top) if both.any() and top > 0 else 0.0
+    return sh, ph, asym
+
+
+
 # --- solver results ------------------------------------------------------------------------
 
 @dataclass

@@ -119,6 +119,11 @@ def check_dim_kept(requested, scene) -> None:
                              f"the {scene.skin} skin is {scene.dim}D")
 
 
+def has_2d_section(scene) -> bool:
+    """Whether the scene's skin has a 2D section (fingertip, pad; not a dome or a 3D file)."""
+    return scene.replace(dim=2).dim == 2
+
+
 def scene_from_options(scene_opts: dict, command: str = "solve"):
     """The Scene of `solve`/`mesh`: the file (scene or one-case sweep), the options over it,
     then the quality preset (option, else file) and explicit mesh sizes over that."""

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from tactileskin import quality, results
-from tactileskin.cli._common import claimed_output, scene_from_options, scene_options
+from tactileskin.cli._common import claimed_output, has_2d_section, scene_from_options, scene_options
 
 # every file `solve` writes into its folder (fnmatch patterns; the 2D section of --compare-2d
 # is a result folder of its own)
@@ -61,7 +61,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         scene = scene.replace(sensors=doc["sensors"])
     if compare_2d and scene.dim != 3:
         raise click.UsageError("--compare-2d needs a 3D scene (--dim 3)")
-    if compare_2d and scene.replace(dim=2).dim != 2:  # a dome, a 3D skin file: no 2D section
+    if compare_2d and not has_2d_section(scene):
         raise click.UsageError(f"--compare-2d needs a skin with a 2D section (fingertip, pad), not {scene.skin}")
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         with solve_progress(scene.label()) as show:

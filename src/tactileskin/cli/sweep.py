@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin.cli._common import _field_changes, check_dim_kept, claimed_output, scene_options
+from tactileskin.cli._common import _field_changes, check_dim_kept, claimed_output, has_2d_section, scene_options
 from tactileskin.errors import ParameterError
 
 
@@ -123,7 +123,7 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     if o.get("braille_text"):
         axes["braille_texts"] = tuple(o["braille_text"])
     if braille_dim:
-        if 2 in BRAILLE_DIM_CHOICES[braille_dim] and base.replace(dim=2).dim != 2:
+        if 2 in BRAILLE_DIM_CHOICES[braille_dim] and not has_2d_section(base):
             raise ParameterError("--braille-dim", braille_dim, "3 with skin = " + base.skin,
                                  f"the {base.skin} skin has no 2D section")
         axes["braille_dims"] = BRAILLE_DIM_CHOICES[braille_dim]

@@ -85,7 +85,7 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     allc = tuple(range(m))
     # the skin's bonded surfaces are fixed (fingertip: bone and nail; pad: the board)
     bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries]
-    if "symmetry" in mesh.boundaries:  # a user's full (not halved) skin has none
+    if mesh.halved:  # a whole model (a user's full skin, a full-width pad) has none
         bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
@@ -93,7 +93,7 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
                   formulation=scene.formulation.value, contact=contact, order=scene.order,
                   stiffness=max(law.K0, law.mu0))
-    halved = len(mesh.boundaries.get("symmetry", ())) > 0
+    halved = mesh.halved
     # a model without the x = 0 plane (a user's full skin, a full-width pad under an
     # x-asymmetric indenter) has a profile across the centre: its span and AUC are halved
     # (Result.span), as its 2D force is, so that a halved and a whole model of one scene agree
@@ -265,7 +265,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
     if getattr(model, "_linsolve", None) is not None:
         res.stats["linear_solver"] = model._linsolve.describe()
-    if "symmetry" in sm.boundaries and mirrored_x(scene):
+    if sm.halved and mirrored_x(scene):
         res.stats["mirrored_x"] = True
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,

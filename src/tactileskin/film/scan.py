@@ -26,7 +26,7 @@ from tactileskin.film import region as strip_region
 from tactileskin.film.calibration import Calibration, paper_eq8
 from tactileskin.film.image import LUMINANCE_NOTE, load_grayscale, luminance, read_scan  # noqa: F401
 from tactileskin.film.inputs import finite
-from tactileskin.results import auc, peak, span
+from tactileskin.results import auc, fold_profile, peak, span  # noqa: F401  (fold_profile: film's API)
 
 log = logging.getLogger(__name__)
 
@@ -94,29 +94,6 @@ def profile_metrics(s, p) -> dict:
     s = np.asarray(s, float)
     p = np.asarray(p, float)
     return {"peak": float(peak(s, p)), "span_mm": float(span(s, p)), "auc": float(auc(s, p))}
-
-
-def fold_profile(s, p):
-    """Fold a two-sided profile about s = 0 onto s >= 0 (to compare with the half model).
-
-    On the grid s_k = k*ds (ds the profile's median spacing) up to max |s|, the folded value
-    is the mean of P(+s_k) and P(-s_k) (linear interpolation) where both sides are measured,
-    else the one that is. Returns (s_half, p_half, asymmetry) with asymmetry =
-    max |P(+s) - P(-s)| / max P over the overlap (0 for a symmetric profile).
-    """
-    s = np.asarray(s, float)
-    p = np.asarray(p, float)
-    ds = float(np.median(np.diff(s)))
-    smax = max(abs(s[0]), abs(s[-1]))
-    sh = np.arange(int(np.floor(smax / ds + 1e-9)) + 1) * ds
-    tol = 1e-9 * ds
-    right = np.where(sh <= s[-1] + tol, np.interp(sh, s, p), np.nan)
-    left = np.where(-sh >= s[0] - tol, np.interp(-sh, s, p), np.nan)
-    both = np.isfinite(right) & np.isfinite(left)
-    ph = np.where(both, 0.5 * (right + left), np.where(np.isfinite(right), right, left))
-    top = float(np.max(p)) if p.size else 0.0
-    asym = float(np.max(np.abs(right[both] - left[both])) / top) if both.any() and top > 0 else 0.0
-    return sh, ph, asym
 
 
 # A flat top: the samples within FLAT_TOP of the maximum span more than FLAT_SPAN of the

@@ -55,6 +55,12 @@ class SkinMesh:
     def cell(self) -> str:
         return "quad" if "Quad" in type(self.mesh).__name__ else "tri"
 
+    @property
+    def halved(self) -> bool:
+        """The half x >= 0 with its symmetry line / plane x = 0 (else the whole width: a user's
+        skin without a symmetry group, a pad under an x-asymmetric indenter)."""
+        return len(self.boundaries.get("symmetry", ())) > 0
+
     # --- export ----------------------------------------------------------------------
     def to_meshio(self):
         """meshio.Mesh with the cells, the named boundary facets (cell sets, gmsh physical
