@@ -132,7 +132,7 @@ class Scene:
     braille_text: str = ""                 # empty: a single dot on the symmetry line
     braille_standard: str = "standard_american"
     depth: float | None = None             # indentation (mm); None -> depth_fraction * t
-    depth_fraction: float = 0.2            # the paper's 20 % nominal strain (DEPTH_FRACTION)
+    depth_fraction: float = DEPTH_FRACTION  # the paper's 20 % nominal strain
     rate: float = 1.0                      # indentation rate (mm/s)
     dim: int = 2                           # 2: plane-strain half section; 3: extruded slab
     order: int = 2                         # element order

@@ -160,8 +160,9 @@ class SensorLayout:
 
     def _axis(self, lo, hi, p):
         n = int(np.floor((hi - lo) / p * (1 + 1e-12) + 1e-9)) + 1
-        if lo + p * (n - 1) < hi - _TOL:
-            _short_end(self.name, float(lo), float(hi), float(p))
+        last = lo + p * (n - 1)
+        if last < hi - _TOL:
+            _short_end(self.name, float(lo), float(hi), float(p), float(last))
         return lo + p * np.arange(n)
 
     def positions(self) -> tuple[np.ndarray, np.ndarray]:
@@ -190,11 +191,10 @@ class SensorLayout:
 
 
 @functools.lru_cache(maxsize=256)
-def _short_end(name: str, lo: float, hi: float, p: float) -> None:
+def _short_end(name: str, lo: float, hi: float, p: float, last: float) -> None:
     """Say once per layout that its pitch does not reach the range's end."""
-    n = int(np.floor((hi - lo) / p * (1 + 1e-12) + 1e-9))
     log.warning("sensor layout %r: the pitch %g mm does not divide [%g, %g]: its last sensor is at %g mm, "
-                "%g mm short of the end", name, p, lo, hi, lo + n * p, hi - lo - n * p)
+                "%g mm short of the end", name, p, lo, hi, last, hi - last)
 
 
 def _numbers(v, name) -> tuple[float, ...]:

@@ -103,8 +103,6 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
             axes[ax] = (fields[f],)
     mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
     mesh.update({k: o[k] for k in scenefile.MESH_FIELDS if o.get(k) is not None})
-    if o.get("depth") is not None:  # --depth over the file's depth_fraction: the option wins
-        fields.pop("depth_fraction", None)
     single = {k: v for k, v in o.items() if k not in ("thickness", "material", "indenter", "depth", "braille_text")}
     changes = _field_changes(single)
     if o.get("indenter") is not None:  # the base takes the kind's own options (--indenter-radius) with it

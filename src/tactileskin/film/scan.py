@@ -267,15 +267,14 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                              f"{'left' if axis == 'x' else 'top'} edge = 0)")
     if box_px is None and box_mm is None:
         oriented = gray if axis == "x" else gray.T
-        c0, r0, c1, r1 = strip_region.find_strip(cal.pressure(oriented), cal.p_range[0],
-                                                 px_per_mm)
+        p_all = cal.pressure(oriented)
+        c0, r0, c1, r1 = strip_region.find_strip(p_all, cal.p_range[0], px_per_mm)
         box = (c0, r0, c1, r1) if axis == "x" else (r0, c0, r1, c1)
         region_info = {"method": "auto", "rule": strip_region.RULE}
         # the variation across the strip found along the other axis, for the orientation check
         try:
-            other = oriented.T
-            o0, q0, o1, q1 = strip_region.find_strip(cal.pressure(other), cal.p_range[0], px_per_mm)
-            across_other = _variation(cal.pressure(other[q0:q1, o0:o1]))
+            o0, q0, o1, q1 = strip_region.find_strip(p_all.T, cal.p_range[0], px_per_mm)
+            across_other = _variation(p_all.T[q0:q1, o0:o1])
         except ParameterError:
             across_other = None
         log.info("no region given: analysing the activated strip found at x %d-%d, "

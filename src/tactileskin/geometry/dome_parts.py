@@ -66,10 +66,10 @@ def mold(a, b, c, length, t, mp=None):
     """(lower, upper) mold halves split at y = 0: a block around the outer body minus it; the
     bone core rests in the half-round seats its stem leaves at z < -L. As the fingertip's mold
     (molds.toml): four alignment pins on the lower half beside the cavity, in holes of the
-    upper one; a sprue onto the pulp at the middle of the straight part and an air vent near
-    each end of the pulp line (the straight part's end, and half way up the tip), so the skin
-    can be poured and the air leave."""
-    from tactileskin.geometry.molds import MoldParams, _vertical_cylinder
+    upper one; an air vent near each end of the pulp line (the straight part's end, half way up
+    the tip) and a sprue onto the pulp half way between, so the skin can be poured and the air
+    leave (a dome too short to hold the three apart is refused)."""
+    from tactileskin.geometry.molds import MoldParams, vertical_cylinder
 
     mp = mp or MoldParams.from_params()
     p = dict(a=a, b=b, c=c, length=length, thickness=t)
@@ -92,10 +92,10 @@ def mold(a, b, c, length, t, mp=None):
     with occ_guard("building the dome mold", **p):
         cavity = _one(body(a, b, c, length).fuse(body(a - t, b - t, c - t, length, extra=BONE_STEM)))
         lower = box(-A, A, -B, 0.0, z0, z1).cut(cavity).fuse(
-            *[_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in pins])
-        holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance, hole) for x, z in pins]
-        holes += [_vertical_cylinder(0.0, zs, 0.0, B + 1.0, mp.pour_diameter)]
-        holes += [_vertical_cylinder(0.0, z, 0.0, B + 1.0, mp.vent_diameter) for z in zv]
+            *[vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in pins])
+        holes = [vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance, hole) for x, z in pins]
+        holes += [vertical_cylinder(0.0, zs, 0.0, B + 1.0, mp.pour_diameter)]
+        holes += [vertical_cylinder(0.0, z, 0.0, B + 1.0, mp.vent_diameter) for z in zv]
         lower = _one(lower.clean())
         upper = _one(box(-A, A, 0.0, B, z0, z1).cut(cavity, *holes).clean())
     return check_solid(lower, "dome mold lower half", **p), check_solid(upper, "dome mold upper half", **p)

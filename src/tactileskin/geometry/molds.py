@@ -92,7 +92,7 @@ class MoldLayout:
                    pins=tuple((sx * xp, sz * half_l) for sx in (-1, 1) for sz in (-1, 1)))
 
 
-def _vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: float) -> bd.Solid:
+def vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: float) -> bd.Solid:
     return bd.Solid.make_cylinder(0.5 * diameter, y_to - y_from,
                                   plane=bd.Plane((x, y_from, z), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
 
@@ -108,14 +108,14 @@ def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.
              pour_diameter=mp.pour_diameter, vent_diameter=mp.vent_diameter)
     with occ_guard("building the casting mold", **p):
         cavity = contour_solid(sec)
-        pins = [_vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
+        pins = [vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
         lower = box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
         # the upper half: pin holes, a sprue at the ridge's middle and a vent near each end;
         # the holes start at the split plane (inside the cavity) so they open into it
-        holes = [_vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance,
+        holes = [vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance,
                                     mp.pin_diameter + mp.pin_clearance) for x, z in lay.pins]
         zv = 0.5 * ft.sample_length - mp.vent_inset
-        holes += [_vertical_cylinder(0.0, 0.0, 0.0, lay.roof + 1.0, mp.pour_diameter)]
-        holes += [_vertical_cylinder(0.0, s * zv, 0.0, lay.roof + 1.0, mp.vent_diameter) for s in (-1, 1)]
+        holes += [vertical_cylinder(0.0, 0.0, 0.0, lay.roof + 1.0, mp.pour_diameter)]
+        holes += [vertical_cylinder(0.0, s * zv, 0.0, lay.roof + 1.0, mp.vent_diameter) for s in (-1, 1)]
         upper = box(-A, A, 0.0, lay.roof, -Z, Z).cut(cavity, *holes).clean()
     return check_solid(lower, "mold lower half", **p), check_solid(upper, "mold upper half", **p)

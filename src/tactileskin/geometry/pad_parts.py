@@ -15,7 +15,7 @@ from __future__ import annotations
 import build123d as bd
 
 from tactileskin.errors import ParameterError
-from tactileskin.geometry.molds import MoldParams, _vertical_cylinder
+from tactileskin.geometry.molds import MoldParams, vertical_cylinder
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import box, check_solid, occ_guard
 
@@ -41,12 +41,12 @@ def pad_mold(width: float, length: float, thickness: float, mp: MoldParams | Non
     p = dict(width=width, length=length, thickness=thickness, wall=mp.wall)
     with occ_guard("building the pad mold", **p):
         cavity = pad_solid(width, length, thickness)
-        pin_solids = [_vertical_cylinder(x, zz, -mp.pin_height, 0.0, mp.pin_diameter) for x, zz in pins]
+        pin_solids = [vertical_cylinder(x, zz, -mp.pin_height, 0.0, mp.pin_diameter) for x, zz in pins]
         lower = box(-A, A, 0.0, thickness + mp.wall, -Z, Z).cut(cavity).fuse(*pin_solids).clean()
-        holes = [_vertical_cylinder(x, zz, -(mp.pin_height + mp.pin_depth_clearance), 0.0, hole) for x, zz in pins]
+        holes = [vertical_cylinder(x, zz, -(mp.pin_height + mp.pin_depth_clearance), 0.0, hole) for x, zz in pins]
         zv = z - mp.vent_inset
-        holes += [_vertical_cylinder(0.0, 0.0, -lid - 1.0, 0.0, mp.pour_diameter)]
-        holes += [_vertical_cylinder(0.0, s * zv, -lid - 1.0, 0.0, mp.vent_diameter) for s in (-1, 1)]
+        holes += [vertical_cylinder(0.0, 0.0, -lid - 1.0, 0.0, mp.pour_diameter)]
+        holes += [vertical_cylinder(0.0, s * zv, -lid - 1.0, 0.0, mp.vent_diameter) for s in (-1, 1)]
         upper = box(-A, A, -lid, 0.0, -Z, Z).cut(*holes).clean()
     return check_solid(lower, "pad mold lower part", **p), check_solid(upper, "pad mold lid", **p)
 

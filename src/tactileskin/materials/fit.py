@@ -44,12 +44,12 @@ MAX_CSV_BYTES = 10 << 20   # a test file is at most a few 10k rows
 # COMPRESSION_STRETCH against its own small-strain slope (neo-Hookean: 1.27x, Ogden and Yeoh
 # fits of rubber 1.1-1.6x), outside COMPRESSION_RATIO an extrapolation artefact
 SMALL_STRAIN = 0.15
-# skins are soft elastomers (silicones 0.01-1 MPa, polyurethanes to ~10 MPa shear modulus):
-# a fit far stiffer is most often stress in kPa (1000x) read as MPa
-SOFT_MU_MAX = 30.0
 MODULUS_RATIO = 1.5
 COMPRESSION_STRETCH = 0.8
 COMPRESSION_RATIO = (0.5, 2.5)
+# skins are soft elastomers (silicones 0.01-1 MPa, polyurethanes to ~10 MPa shear modulus):
+# a fit far stiffer is most often stress in kPa (1000x) read as MPa
+SOFT_MU_MAX = 30.0
 
 
 class FitDataError(ParameterError):
