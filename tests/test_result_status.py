@@ -218,3 +218,25 @@ def test_jacobian_ratio_sees_a_fold_between_quadrature_points():
     with pytest.raises(MeshError, match="nearly folded"):
         check_quality({"min_scaled_jacobian": 0.5 * MIN_SCALED_JACOBIAN}, {})
     check_quality({"min_scaled_jacobian": MIN_SCALED_JACOBIAN}, {})
+
+
+def test_result_without_contact_writes_its_files(tmp_path):
+    """A result without contact points (positions of shape (0, dim)) writes an empty contact.csv
+    (it ended in a reshape traceback that also aborted a sweep)."""
+    s = np.linspace(0.0, 5.0, 11)
+    for dim in (2, 3):
+        r = Result(s=s, pressure=np.zeros_like(s), contact_x=np.zeros(0), contact_pressure=np.zeros(0),
+                   contact_points=np.zeros((0, dim)), reaction=0.0,
+                   stats={"min_J": 1.0, "max_abs_stress_mpa": 0.0})
+        text = r._contact_csv()
+        assert text.splitlines() == [",".join(["x_mm", "y_mm", "z_mm"][:dim] + ["contact_pressure_mpa"])]
+
+
+def test_cli_solve_touching_nothing_is_suspect_with_exit_3(tmp_path, capsys):
+    out = tmp_path / "graze"
+    rc = main(["solve", "-i", "curved", "-t", "1", "--depth", "0.0001", "--quality", "preview", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 3 and "Traceback" not in err
+    summ = json.loads((out / "summary.json").read_text())
+    assert summ["status"].startswith("suspect: no contact")
+    assert (out / "contact.csv").read_text().startswith("x_mm,y_mm,contact_pressure_mpa")

@@ -286,7 +286,8 @@ class Result:
         pts = self.contact_points
         if pts is None or len(pts) != len(self.contact_x):
             return _csv(["x_mm", "contact_pressure_mpa"], self.contact_x, self.contact_pressure)
-        pts = np.asarray(pts, float).reshape(len(self.contact_x), -1)
+        pts = np.asarray(pts, float)
+        pts = pts.reshape(len(self.contact_x), pts.shape[-1] if pts.ndim == 2 else -1)
         names = ["x_mm", "y_mm", "z_mm"][: pts.shape[1]]
         return _csv(names + ["contact_pressure_mpa"], *pts.T, self.contact_pressure)
 
