@@ -62,7 +62,8 @@ class IndentationFit:
 
     def describe(self) -> str:
         q = self.quality
-        return (f"{self.law.law}: {self.law.to_dict()} (E = {self.E:.5g} MPa); R^2 = {q['r2']:.5f}, "
+        return (f"{self.law.law}: {self.law.to_dict()} (E = 3 mu = {self.E:.5g} MPa, the incompressible "
+                f"formula's; the file's bulk modulus makes nu = {NU_INCOMPRESSIBLE:g}); R^2 = {q['r2']:.5f}, "
                 f"RMSE = {q['rmse_n']:.3g} N, max relative error {100 * q['max_rel_err']:.2f} % "
                 f"({q['n_points']} points, sphere R = {self.radius:g} mm on a bonded layer t = "
                 f"{self.thickness:g} mm, chi <= {q['chi_max']:.3g})")
