@@ -51,6 +51,25 @@ def test_fast_loading_drops_viscoelasticity_within_tolerance():
     assert plan(sc, tolerance=0.5 * c.cost).scene.viscoelastic
 
 
+def test_a_loading_history_keeps_its_relaxation():
+    from tactileskin.materials import get_material
+    from tactileskin.planner import history_time
+
+    fast = Scene(thickness=1.0, material="polyurethane", indenter="curved", depth=0.1, rate=100.0)
+    assert not plan(fast, tolerance=0.01).scene.viscoelastic        # 1 ms: relaxation negligible
+    g = get_material("polyurethane").prony
+    # a hold, then a second ramp: 1 ms + 10 s + 1 ms, and the bound of that whole time
+    held = fast.replace(loading=({"hold": 10.0}, {"depth": 0.2, "rate": 100.0}))
+    assert history_time(held) == pytest.approx(0.001 + 10.0 + 0.001)
+    assert viscoelastic_bound(held) == pytest.approx(1.0 - g.relaxation(10.002), rel=1e-12)
+    p = plan(held, tolerance=0.01)
+    assert p.scene.viscoelastic and p.scene.loading == held.loading
+    # a ramp whose start is known only after solving (force after depth): the whole relaxation
+    mixed = fast.replace(loading=({"force": 0.01, "rate": 1.0},))
+    assert history_time(mixed) == float("inf")
+    assert plan(mixed, tolerance=0.01).scene.viscoelastic
+
+
 def test_elastic_user_material_has_zero_bound(tmp_path):
     path = tmp_path / "gel.toml"
     path.write_text('name = "gel"\n[hyperfoam]\nmu = [0.02]\nalpha = [4.0]\nnu = 0.45\n')

@@ -29,8 +29,10 @@ Aspects:
 - viscoelasticity: QLV gives S(T) = int_0^T g(T - s) dS0(s). For a stress that grows
   monotonically during loading, g(T - s) >= g(T) and so
   (1 - g(T)) S0(T) >= S0(T) - S(T) >= 0: the relaxed fraction is at most
-  `viscoelastic_bound = 1 - g(T)` with T = depth / rate the loading time. The elastic
-  model is used only when that bound is within the tolerance left.
+  `viscoelastic_bound = 1 - g(T)` with T = depth / rate the loading time; with a loading
+  history (holds, further ramps) T is the whole history's time (`history_time`): a hold keeps
+  S0 constant and lets S relax towards g(T) S0. The elastic model is used only when that
+  bound is within the tolerance left.
 """
 
 from __future__ import annotations
@@ -226,14 +228,33 @@ def with_quality(scene: Scene, quality: str) -> Scene:
 # --- individual estimates (pure) ----------------------------------------------------------
 
 def viscoelastic_bound(scene: Scene) -> float:
-    """1 - g(T), T = loading time: upper bound of the relative stress relaxed by the end of a
-    monotone loading (see the module docstring). 0 for an elastic material."""
+    """1 - g(T), T = the whole loading history's time (`history_time`): upper bound of the
+    relative stress relaxed by its end (see the module docstring). 0 for an elastic material."""
     from tactileskin.materials import get_material
 
     prony = get_material(scene.material).prony
     if prony is None or prony.n_terms == 0:
         return 0.0
-    return float(1.0 - prony.relaxation(scene.duration))
+    return float(1.0 - prony.relaxation(history_time(scene)))
+
+
+def history_time(scene: Scene) -> float:
+    """Time (s) of the scene's whole loading history: the first ramp, then every `loading`
+    segment (holds too: a hold is where a skin relaxes). A ramp of the quantity the previous
+    segment did not control starts at a value known only after solving: then infinity, so that
+    the bound above is the whole relaxation 1 - g(inf)."""
+    program = scene.program()
+    total, last = scene.duration, {program[0].kind: program[0].target}
+    for seg in program[1:]:
+        if seg.kind == "hold" or seg.rate is None:
+            total += float(seg.time)
+        elif seg.kind in last:
+            total += seg.duration(last[seg.kind])
+        else:
+            return math.inf
+        if seg.kind != "hold":
+            last = {seg.kind: seg.target}
+    return total
 
 
 def symmetric(scene: Scene) -> tuple[bool, bool]:
@@ -362,11 +383,11 @@ def plan(scene: Scene, tolerance: float = 0.01, *, braille: str = "dots", verify
             out = out.replace(viscoelastic=False)
             budget -= bound
             choices.append(Choice("viscoelasticity", "elastic (relaxation dropped)",
-                                  f"loading time {scene.duration:.3g} s: relaxed fraction <= 1 - g(T) = "
+                                  f"loading time {history_time(scene):.3g} s: relaxed fraction <= 1 - g(T) = "
                                   f"{bound:.3%}", bound, "bound"))
         else:
             choices.append(Choice("viscoelasticity", "kept (QLV Prony series)",
-                                  f"loading time {scene.duration:.3g} s: the bound 1 - g(T) = {bound:.2%} "
+                                  f"loading time {history_time(scene):.3g} s: the bound 1 - g(T) = {bound:.2%} "
                                   f"exceeds the tolerance left ({max(budget, 0):.2%})", 0.0))
     else:
         choices.append(Choice("viscoelasticity", "elastic (as the scene asks)", "scene.viscoelastic is False",
