@@ -205,7 +205,7 @@ def test_cli_writes_and_lists_the_map_figure(tmp_path, monkeypatch, capsys):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
     assert "bone_map.png" in text and "bone_map.csv" in text and "peak of the bone map" in text
     # the same folder solved in 2D: the 3D map files of the earlier run are removed
-    assert main(["solve", "-t", "3", "--mesh-size", "1", "--refinement", "2", "--depth", "0.1", "--elastic",
+    assert main(["solve", "-t", "3", "--mesh-size", "1", "--refinement", "5", "--depth", "0.1", "--elastic",
                  "--out", str(out)]) == 0
     names = {p.name for p in out.iterdir()}
     assert not names & {"bone_map.png", "bone_map.csv", "profile_max_z.csv"} and "profile.csv" in names

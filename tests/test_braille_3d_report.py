@@ -233,9 +233,11 @@ def test_real_sweep_with_both_dims(tmp_path):
     cfg.write_text('[sweep]\nthicknesses = [1]\nmaterials = ["silicone"]\nindenters = ["braille"]\n'
                    'depths = [0.05]\nbraille_dims = [2, 3]\n[scene]\nmesh_size = 2.0\nrefinement = 3.5\n')
     out = tmp_path / "o"
-    assert main(["sweep", "--config", str(cfg), "--serial", "--no-render", "--out", str(out)]) == 0
+    assert main(["sweep", "--config", str(cfg), "--serial", "--no-render", "--out", str(out)]) == 3
     with open(out / "results.csv", newline="") as fh:
         rows = {r["case"]: r for r in csv.DictReader(fh)}
+    # test meshes coarser than the preview's: flagged, and nothing else
+    assert all(r["status"].startswith("suspect: mesh coarser") and ";" not in r["status"] for r in rows.values())
     assert set(rows) == {"t1-silicone-braille-2d", "t1-silicone-braille-3d"}
     p2, p3 = (float(rows[f"t1-silicone-braille-{d}d"]["peak_mpa"]) for d in (2, 3))
     line = next(ln for ln in (out / "report.md").read_text().splitlines()

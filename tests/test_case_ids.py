@@ -59,7 +59,7 @@ def test_material_files_are_named_by_their_file(tmp_path):
 def test_two_depth_sweep_writes_two_rows_profiles_and_bars(tmp_path, capsys, monkeypatch):
     out = tmp_path / "out"
     args = ["sweep", "--out", str(out), "--thickness", "1", "--material", "polyurethane",
-            "--indenter", "flat", "--mesh-size", "1", "--depth", "0.1,0.2", "--serial", "--no-render"]
+            "--indenter", "flat", "--mesh-size", "1", "--refinement", "5", "--depth", "0.1,0.2", "--serial", "--no-render"]
     captured = []
     monkeypatch.setattr(figures, "_save", lambda fig, o, stem: captured.append((stem, fig)) or [])
     assert main(args) == 0

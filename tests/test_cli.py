@@ -56,10 +56,11 @@ def test_solve_compare_2d_reports_ridge_against_dot(tmp_path, capsys):
     out = tmp_path / "dot"
     args = ["solve", "--dim", "3", "--indenter", "braille", "--braille-text", "a", "-t", "1",
             "--depth", "0.05", "--mesh-size", "1.0", "--refinement", "2", "--compare-2d", "--out", str(out)]
-    assert main(args) == 0
+    assert main(args) == 3  # a test mesh coarser than the preview's: flagged, and nothing else
     doc = json.loads((out / "compare_2d.json").read_text())
     s3 = json.loads((out / "summary.json").read_text())
     s2 = json.loads((out / "section_2d" / "summary.json").read_text())
+    assert [f["code"] for f in s3["flags"] + s2["flags"]] == ["coarse_mesh", "coarse_mesh"]
     for k in ("peak_mpa", "span_mm"):
         assert doc[k]["2d"] == s2[k] and doc[k]["3d"] == s3[k]
         assert doc[k]["relative_difference"] == (s2[k] - s3[k]) / s3[k]

@@ -24,7 +24,7 @@ from tactileskin import fileio, params
 from tactileskin.cli import main
 from tactileskin.results import Result
 
-CHEAP = ["--mesh-size", "1", "--refinement", "2", "-t", "1", "--elastic"]
+CHEAP = ["--mesh-size", "1", "--refinement", "5", "-t", "1", "--elastic"]  # the preview sizes
 REPO = Path(__file__).resolve().parents[1]
 
 

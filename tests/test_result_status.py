@@ -240,3 +240,56 @@ def test_cli_solve_touching_nothing_is_suspect_with_exit_3(tmp_path, capsys):
     summ = json.loads((out / "summary.json").read_text())
     assert summ["status"].startswith("suspect: no contact")
     assert (out / "contact.csv").read_text().startswith("x_mm,y_mm,contact_pressure_mpa")
+
+
+# --- the law's compressibility, the element, the mesh, the skin's edge ------------------------
+
+def test_volume_range_is_judged_for_solid_elastomers_only():
+    squashed = {**NORMAL, "min_J": 0.8}
+    assert [f.code for f in quality.flags(squashed)] == ["volume_range"]          # law unknown
+    assert [f.code for f in quality.flags({**squashed, "material_nu0": 0.49})] == ["volume_range"]
+    # a foam's law (nu0 = 0: J = lambda in uniaxial compression) changes volume as its response
+    assert quality.flags({**squashed, "material_nu0": 0.0}) == []
+
+
+def test_linear_displacement_elements_of_an_elastomer_are_flagged_as_locking():
+    solve = pytest.importorskip("tactileskin.fe").solve
+    p2 = solve(Scene(thickness=1, indenter="flat", mesh_size=1, refinement=5))
+    p1 = solve(Scene(thickness=1, indenter="flat", mesh_size=1, refinement=5, order=1, formulation="displacement"))
+    assert p1.peak > 2.5 * p2.peak                      # measured 2.9x: the locking flagged
+    assert p2.status == "ok"
+    assert [f["code"] for f in p1.summary()["flags"]] == ["locking"]
+    assert p1.summary()["material_nu0"] == pytest.approx(0.49, abs=0.02)
+    assert quality.flags({**NORMAL, "element_order": 1, "material_nu0": 0.3}) == []
+
+
+@pytest.mark.parametrize("sizes, coarse", [((1.0, 5.0), False), ((0.6, 2.0), False),   # refined 0.3: 1.5x
+                                           ((1.0, 2.0), True), ((3.0, 1.0), True), ((2.5, 12.5), True)])
+def test_meshes_coarser_than_preview_are_flagged(sizes, coarse):
+    from tactileskin.fe import solve
+
+    r = solve(Scene(thickness=1, indenter="flat", mesh_size=sizes[0], refinement=sizes[1]))
+    codes = [f["code"] for f in r.summary()["flags"]]
+    assert codes == (["coarse_mesh"] if coarse else [])
+    assert r.summary()["mesh_sizes_mm"]["preview_refined"] == pytest.approx(0.2)
+
+
+def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
+    from tactileskin.results import edge_peak
+
+    s = np.linspace(0.0, 10.0, 101)
+    p = 0.17 - 0.001 * s
+    p[-1] = 0.3                                     # the corner's singular value
+    assert edge_peak(s, p, 2.0) == (0.3, 10.0, 0.17, 0.0)
+    assert edge_peak(s, p, 0.0) is None
+    assert edge_peak(s, np.where(s < 9.99, p, 0.1), 2.0) is None             # max inside
+    # a two-sided profile's left end is an edge too; one starting at 0 is a symmetry line
+    s2 = np.linspace(-10.0, 10.0, 201)
+    p2 = 0.17 - 0.001 * np.abs(s2)
+    p2[0] = 0.25
+    assert edge_peak(s2, p2, 2.0)[:2] == (0.25, -10.0)
+    r = Result(s=s, pressure=p, contact_x=np.array([0.0]), contact_pressure=np.array([0.2]), reaction=1.0,
+               stats={"min_J": 0.99, "max_abs_stress_mpa": 0.3}, scene={"thickness": 2.0})
+    summ = r.summary()
+    assert [f["code"] for f in summ["flags"]] == ["edge_peak"]
+    assert summ["peak_interior_mpa"] == pytest.approx(0.17) and summ["peak_edge_s_mm"] == 10.0

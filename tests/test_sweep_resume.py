@@ -15,7 +15,7 @@ import tactileskin
 from tactileskin.cli import main
 
 ARGS = ["--thickness", "1", "--depth", "0.1,0.2", "--material", "polyurethane", "--indenter", "flat,curved",
-        "--mesh-size", "1", "--serial", "--no-render"]
+        "--mesh-size", "1", "--refinement", "5", "--serial", "--no-render"]
 SAME = ("case", "key", "status", "depth_mm", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
         "dofs", "increments", "newton_iterations")
 

@@ -26,11 +26,25 @@ MAX_ABS_STRESS_MPA = 50.0
 # J = 0.96-0.99, 3 mm silicone at 40 % at 0.98. A volume change beyond 10 % is outside anything a solid
 # elastomer undergoes, so there the result reflects the law's volumetric term, not the skin.
 J_RANGE = (0.9, 1.1)
+# ... judged only for a law of a solid elastomer: small-strain Poisson ratio nu0 >= NU_SOLID.
+# A compressible foam's law (a hyperfoam with nu = 0: J = lambda in uniaxial compression,
+# exact to 1e-6 on a pad at 20 %) changes volume as its normal response.
+NU_SOLID = 0.45
+# Linear (P1) displacement elements lock for a nearly incompressible law: the t = 1 mm flat
+# plate read +181 % (silicone) and +92 % (polyurethane) against P2 mixed, +186 % / +101 % at
+# half the size (P2 displacement: +1.1 / +0.7 %, then +0.03 / +0.1 %).
+NU_LOCKING = 0.4
+# A mesh coarser than the `preview` preset (the coarsest whose peak error is measured, <= 3.6 %
+# in 2D) by more than these factors (refined size; global size) is not trusted. On the 2D
+# fingertip (peak against 0.25 / 3): refined 0.5 mm (1.5 / 3 x preview) read -2.7 to -20 %
+# (t = 1 flat / Braille), 1 mm -13 to -80 %, 2 mm -46 to -86 %.
+COARSE_REFINED = 1.5
+COARSE_GLOBAL = 2.0
 
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "mirrored_x" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "mirrored_x" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -58,7 +72,8 @@ def reaction_of(summary: dict):
 def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
-    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa, mirrored_x (a
+    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
+    material_nu0, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm), mirrored_x (a
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []
@@ -80,11 +95,31 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "
                         "(more than a skin elastomer bears: the material law or its parameters are outside their "
                         "range, e.g. a hyperfoam's volumetric lock-up or a modulus far above an elastomer's)"))
-    J = _num(summary, "min_J")
+    J, nu0 = _num(summary, "min_J"), _num(summary, "material_nu0")
     lo, hi = J_RANGE
-    if J is not None and not (lo <= J <= hi):
+    if J is not None and not (lo <= J <= hi) and (nu0 is None or nu0 >= NU_SOLID):
         out.append(Flag("volume_range", f"volume ratio J = {J:.4g} outside [{lo:g}, {hi:g}] "
                         "(material law outside its range)"))
+    if _num(summary, "element_order") == 1 and (nu0 is None or nu0 >= NU_LOCKING):
+        out.append(Flag("locking", f"linear (P1) displacement elements with a nearly incompressible law"
+                        + (f" (nu0 = {nu0:.3g})" if nu0 is not None else "") + " lock: the t = 1 mm flat plate "
+                        "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
+    sizes = summary.get("mesh_sizes_mm")
+    if isinstance(sizes, dict):
+        coarse = [f"{what} size {sizes[k]:g} mm against {sizes['preview_' + k]:g}" for k, what, f in
+                  (("refined", "refined", COARSE_REFINED), ("global", "global", COARSE_GLOBAL))
+                  if _num(sizes, k) is not None and _num(sizes, "preview_" + k) is not None
+                  and sizes[k] > f * sizes["preview_" + k]]
+        if coarse:
+            out.append(Flag("coarse_mesh", "mesh coarser than the preview preset's (" + ", ".join(coarse) +
+                            "), the coarsest whose error is measured: peaks on such meshes read 3-86 % low "
+                            "(use --quality or a smaller mesh size)"))
+    pi = _num(summary, "peak_interior_mpa")
+    if pi is not None and peak is not None:
+        out.append(Flag("edge_peak", f"the peak {peak:.4g} MPa is at s = {_num(summary, 'peak_edge_s_mm'):g} mm, "
+                        "within one skin thickness of where the bonded skin ends: a corner singularity that "
+                        f"grows with mesh refinement; the interior peak is {pi:.4g} MPa at s = "
+                        f"{_num(summary, 'peak_interior_s_mm'):g} mm"))
     if summary.get("mirrored_x"):
         out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
                         "half x >= 0: the result is that of the indenter and its mirror image together "

@@ -34,6 +34,28 @@ def peak(s, p) -> float:
     return float(np.max(p))
 
 
+def edge_peak(s, p, margin: float):
+    """(peak, its s, interior peak, its s) if the profile's largest value lies within `margin`
+    (mm) of an end that is an edge of the bonded skin and is larger than the largest value
+    farther in, else None. A profile starting at s = 0 starts at a symmetry line, not at an edge
+    (as BoneMap.interior_peak). Where the bonded skin ends under load (a pad pressed by a plate
+    wider than itself) the bone pressure has a corner singularity: t = 2 pad, plate, depth 0.1:
+    0.193 / 0.176 / 0.307 MPa at the edge on 0.177 / 3, 0.177 / 6, 0.1 / 6 against 0.1696-0.1698
+    at s = 0."""
+    s, p = _check(s, p)
+    if not margin > 0:
+        return None
+    inner = s <= s[-1] - margin
+    if abs(s[0]) > 1e-9:
+        inner &= s >= s[0] + margin
+    if not inner.any() or inner.all():
+        return None
+    i, j = int(np.argmax(p)), int(np.argmax(np.where(inner, p, -np.inf)))
+    if inner[i] or not p[i] > p[j]:
+        return None
+    return float(p[i]), float(s[i]), float(p[j]), float(s[j])
+
+
 def span(s, p, fraction: float = 0.1) -> float:
     """Extent of s where P >= fraction * peak (mm).
 
@@ -303,8 +325,10 @@ class Result:
             reaction_key(self.dim): float(self.reaction),
             "contact_points": int(len(self.contact_x)),
             # extremes of the material law's state (fe.output.law_state)
-            **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa")
+            **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa", "material_nu0")
                if k in self.stats},
+            **({"element_order": int(self.stats["order"])} if "order" in self.stats else {}),
+            **({"mesh_sizes_mm": dict(self.stats["mesh_sizes_mm"])} if "mesh_sizes_mm" in self.stats else {}),
             "dofs": int(self.stats.get("dofs", 0)),
             "newton_iterations": int(self.stats.get("newton_iterations", 0)),
             "increments": int(self.stats.get("increments", 0)),
@@ -315,6 +339,7 @@ class Result:
             **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
             **({"mirrored_x": True} if self.stats.get("mirrored_x") else {}),
+            **self._edge_summary(),
             **self._map_summary(),
             **({"loading": self.loading} if self.loading is not None else {}),
             **(self.sensors.summary() if self.sensors is not None else {}),
@@ -324,6 +349,15 @@ class Result:
         out["status"] = quality.status_of(found)
         out["flags"] = [f.to_dict() for f in found]
         return out
+
+    def _edge_summary(self) -> dict:
+        """The profile's peak at an edge of the bonded skin (`edge_peak`), with the interior one
+        (quality flags it: the peak is a corner singularity)."""
+        found = edge_peak(*self._profile(), float((self.scene or {}).get("thickness") or 0.0))
+        if found is None:
+            return {}
+        _, se, pi, si = found
+        return {"peak_edge_s_mm": se, "peak_interior_mpa": pi, "peak_interior_s_mm": si}
 
     def _map_summary(self) -> dict:
         """The map's peak one skin thickness or more from the edges of the bonded surface, and

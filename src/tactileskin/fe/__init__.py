@@ -162,13 +162,17 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     state's time and the final state, and `Result.history` the time series (history.csv);
     `history`: also the displacement of every increment (result.pvd), as a depth ramp has."""
     from tactileskin.fe.loading import run_program
-    from tactileskin.fe.output import bone_peak
+    from tactileskin.fe.output import bone_peak, law_state
 
     multi = len(program) > 1
     peak_of = bone_peak(model) if multi else None
     best = {}
+    worst = {}  # the material law's extremes over every increment (a creep hold or a second
+    # ramp can go beyond the peak-load state's: tactileskin.quality flags them)
 
     def record(model, ev):
+        for k, v in law_state(ev, model.stress(ev)).items():
+            worst[k] = v if k not in worst else (min if k == "min_J" else max)(worst[k], v)
         out = {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
         if history:
             out["displacement"] = model.u.reshape(-1, model.m).copy()
@@ -192,6 +196,8 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     res = best["result"]
     for k in ("increments", "newton_iterations", "cutbacks", "uzawa_iterations", "force_trials"):
         res.stats[k] = getattr(stats, k)
+    for k, v in worst.items():
+        res.stats[k] = min(res.stats[k], v) if k == "min_J" else max(res.stats[k], v)
     if history and res.fields is not None:
         res.fields["steps"] = [(float(h["t"]), np.asarray(h["displacement"], float)) for h in hist
                                if "displacement" in h and "t" in h]
@@ -204,12 +210,23 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         "force_unit": "N" if scene.dim == 3 else "N/mm",
         "target_force": scene.force, "reached_force": best["reaction"] if scene.force is not None else None,
         "profile_state": "peak load",
+        "law_state": "extremes over every increment (min_J, max_abs_stress_mpa, max_pressure_mpa)",
         "profile_t_s": best["t"], "profile_travel_mm": best["d"], "profile_reaction": best["reaction"],
         "final": {"t_s": float(model.t), "travel_mm": float(model.d),
                   "reaction": float(last.get("reaction", indenter_force(model, ev))),
                   **({"peak_mpa": last["peak_mpa"]} if "peak_mpa" in last else {})},
     }
     return res, ev, stats
+
+
+def _sizes_against_preview(scene) -> dict:
+    """The scene's global and refined element sizes (mm) and the `preview` preset's for the
+    same dimension, indenter, thickness and skin (the coarsest sizes whose error is measured)."""
+    from tactileskin.scene import preset_mesh
+
+    size, ratio = preset_mesh("preview", scene.dim, scene.indenter, scene.thickness, scene.skin)
+    return {"global": float(scene.mesh_size), "refined": float(scene.mesh_size / scene.refinement),
+            "preview_global": float(size), "preview_refined": float(size / ratio)}
 
 
 class _StatsView:
@@ -228,10 +245,11 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     from tactileskin.geometry.indenters import mirrored_x, require_contact
     from tactileskin.materials import get_material
 
-    get_material(scene.material)  # a bad material (name or file) fails before the mesh is made
+    law = get_material(scene.material).law  # a bad material (name or file) fails before the mesh is made
     require_contact(scene)
     t0 = time.perf_counter()
     t_mesh = 0.0
+    sized = mesh is None  # meshed here at the scene's sizes (tactileskin.quality judges them)
     if mesh is None:
         from tactileskin.mesh import build_mesh
 
@@ -267,6 +285,11 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         res.stats["linear_solver"] = model._linsolve.describe()
     if sm.halved and mirrored_x(scene):
         res.stats["mirrored_x"] = True
+    # tactileskin.quality judges the volume ratio and the element by the law's compressibility
+    res.stats["material_nu0"] = float((3 * law.K0 - 2 * law.mu0) / (2 * (3 * law.K0 + law.mu0)))
+    res.stats["order"] = int(scene.order)
+    if sized and scene.skin != "file":
+        res.stats["mesh_sizes_mm"] = _sizes_against_preview(scene)
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)
