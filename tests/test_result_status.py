@@ -293,3 +293,7 @@ def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
     summ = r.summary()
     assert [f["code"] for f in summ["flags"]] == ["edge_peak"]
     assert summ["peak_interior_mpa"] == pytest.approx(0.17) and summ["peak_edge_s_mm"] == 10.0
+
+
+def test_a_z_half_model_of_a_z_asymmetric_indenter_is_flagged():
+    assert [f.code for f in quality.flags({**NORMAL, "mirrored_z": True})] == ["mirrored_z"]

@@ -76,6 +76,35 @@ def test_msh_of_the_pad_mesh_solves_like_the_pad(tmp_path):
     assert np.allclose(b.pressure, a.pressure, rtol=0, atol=1e-10 * np.abs(a.pressure).max())
 
 
+def test_3d_quarter_pad_written_as_msh_solves_like_the_pad(tmp_path):
+    """A z-symmetric 3D pad mesh (the quarter x, z >= 0) written as .msh names its mid-plane
+    `symmetry_z`, which the file skin reads as u_z = 0: same mesh, same answer (it was read as a
+    free end: a sphere's force 2.5x low and the peak off the axis, status ok)."""
+    kw = dict(indenter="sphere", indenter_radius=2.5, depth=0.2, viscoelastic=False)
+    pad = Scene(skin="pad", pad_width=6.0, pad_length=6.0, thickness=2.0, dim=3, mesh_size=1.0, refinement=3.0,
+                **kw)
+    sm = build_mesh(pad)
+    assert sm.z_symmetric and sm.halved
+    path = sm.write(tmp_path / "quarter.msh")
+    user = Scene(skin="file", skin_file=str(path), **kw)
+    um = build_mesh(user)
+    assert um.z_symmetric and um.halved and "symmetry_z" not in um.boundaries
+    a, b = solve(pad, mesh=sm), solve(user, mesh=um)
+    assert b.reaction == pytest.approx(a.reaction, rel=1e-8)
+    assert b.peak == pytest.approx(a.peak, rel=1e-8)
+    assert b.status == "ok"
+
+
+def test_a_symmetry_group_off_its_plane_is_refused(tmp_path):
+    # the block's x = 0 face named `symmetry_z`: not on z = 0
+    path = tmp_path / "b.msh"
+    _gmsh_block(path)
+    text = path.read_text().replace('"symmetry"', '"symmetry_z"')
+    path.write_text(text)
+    with pytest.raises(ParameterError, match="symmetry_z"):
+        build_mesh(Scene(skin="file", skin_file=str(path), indenter="flat", viscoelastic=False))
+
+
 def test_gmsh_written_block_maps_common_names_and_elevates_order(tmp_path):
     path = _gmsh_block(tmp_path / "block.msh", names=("board", "top"))
     sc = Scene(skin="file", skin_file=str(path), indenter="sphere", indenter_radius=2.0, depth=0.1,

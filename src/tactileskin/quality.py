@@ -44,7 +44,7 @@ COARSE_GLOBAL = 2.0
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "mirrored_x" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "mirrored_x" | "mirrored_z" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -124,6 +124,10 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
                         "half x >= 0: the result is that of the indenter and its mirror image together "
                         "(a pad skin models the full width)"))
+    if summary.get("mirrored_z"):
+        out.append(Flag("mirrored_z", "the indenter is not symmetric about z = 0, but the skin file's model "
+                        "is the half z >= 0 (its symmetry_z group): the result is that of the indenter and "
+                        "its mirror image together"))
     for key in ("peak_mpa", rkey):
         v = _num(summary, key)
         if v is not None and not math.isfinite(v):

@@ -339,6 +339,7 @@ class Result:
             **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
             **({"mirrored_x": True} if self.stats.get("mirrored_x") else {}),
+            **({"mirrored_z": True} if self.stats.get("mirrored_z") else {}),
             **self._edge_summary(),
             **self._map_summary(),
             **({"loading": self.loading} if self.loading is not None else {}),

@@ -242,7 +242,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     Raises ParameterError before meshing if the indenter cannot reach the skin (no contact).
     progress: optional callable, given an IncrementInfo (increment, t, T, travel, Newton
     iterations) after each converged increment; nothing is printed either way."""
-    from tactileskin.geometry.indenters import mirrored_x, require_contact
+    from tactileskin.geometry.indenters import indenter_symmetry, mirrored_x, require_contact
     from tactileskin.materials import get_material
 
     law = get_material(scene.material).law  # a bad material (name or file) fails before the mesh is made
@@ -285,6 +285,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         res.stats["linear_solver"] = model._linsolve.describe()
     if sm.halved and mirrored_x(scene):
         res.stats["mirrored_x"] = True
+    if getattr(sm, "z_symmetric", False) and not indenter_symmetry(scene)[1]:  # a file's symmetry_z
+        res.stats["mirrored_z"] = True
     # tactileskin.quality judges the volume ratio and the element by the law's compressibility
     res.stats["material_nu0"] = float((3 * law.K0 - 2 * law.mu0) / (2 * (3 * law.K0 + law.mu0)))
     res.stats["order"] = int(scene.order)

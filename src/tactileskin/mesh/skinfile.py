@@ -8,7 +8,9 @@ boundary tags, see mesh._gmsh), one cell type (triangles in 2D, tetrahedra in 3D
 the bonded surface(s) (`skin_bonded`, comma-separated names; default the first of
 `BONDED_NAMES` present), the contact surface (`skin_outer`; default the first of
 `OUTER_NAMES`, else every boundary facet not otherwise named), `symmetry` if present (then
-the model is the half x >= 0), other groups kept by name (free).
+the model is the half x >= 0), in 3D `symmetry_z` if present (then the model is the half
+z >= 0: what `tactileskin mesh --dim 3` writes for a z-symmetric indenter), other groups kept
+by name (free). A symmetry group must lie on its plane.
 
 STEP: one closed solid (gmsh's OCC importer, target unit mm), meshed with P2 tetrahedra
 curved onto the CAD (size `mesh_size`, `mesh_size / refinement` in a ball around the top
@@ -34,7 +36,7 @@ import numpy as np
 
 from tactileskin.errors import MeshError, ParameterError
 from tactileskin.mesh import _gmsh
-from tactileskin.mesh.skinmesh import SkinMesh, check_quality, jacobian_ratio
+from tactileskin.mesh.skinmesh import SYMMETRY_Z, SkinMesh, check_quality, jacobian_ratio
 
 logger = logging.getLogger(__name__)
 
@@ -151,8 +153,17 @@ def load_msh(path, *, bonded=None, outer=None, order: int | None = None):
         for name, tags in groups.items():
             ents.setdefault(rename.get(name, name), []).extend(tags)
         mesh, boundaries = _gmsh.to_skfem(gmsh, dim, order, ents)
+    z_sym = dim == 3 and SYMMETRY_Z in boundaries
+    if dim == 2:
+        boundaries.pop(SYMMETRY_Z, None)
+    for name, axis in (("symmetry", 0), (SYMMETRY_Z, 2)):
+        if name in boundaries:
+            _check_plane(mesh, boundaries[name], axis, name, path)
+    if z_sym:  # the model's mid-plane support is on `end_back` (SkinMesh.z_symmetric)
+        boundaries["end_back"] = boundaries.pop(SYMMETRY_Z)
     if "outer_surface" not in boundaries:  # no contact group named: the rest of the boundary
-        named = np.concatenate([boundaries[n] for n in ("bone_interface", "symmetry") if n in boundaries])
+        named = np.concatenate([boundaries[n] for n in ("bone_interface", "symmetry", "end_back")
+                                if n in boundaries and (n != "end_back" or z_sym)])
         rest = np.setdiff1d(mesh.boundary_facets(), named)
         if not rest.size:
             raise MeshError(f"skin_file {path}: no free boundary left for the contact surface")
@@ -162,7 +173,20 @@ def load_msh(path, *, bonded=None, outer=None, order: int | None = None):
                "vertices": int(mesh.nvertices), "min_scaled_jacobian": jacobian_ratio(mesh),
                "wall_s": time.perf_counter() - t0}
     check_quality(quality, {})
-    return SkinMesh(mesh=mesh, boundaries=boundaries, dim=dim, quality=quality), sorted(groups)
+    return (SkinMesh(mesh=mesh, boundaries=boundaries, dim=dim, quality=quality, z_symmetric=z_sym),
+            sorted(groups))
+
+
+def _check_plane(mesh, facets, axis: int, name: str, path) -> None:
+    """ParameterError unless the group's facets lie on the plane x = 0 (axis 0) or z = 0 (2)."""
+    if not len(facets):
+        return
+    X = mesh.p[:, np.unique(mesh.facets[:, facets])]
+    off = float(np.max(np.abs(X[axis])))
+    if off > 1e-6 * float(np.max(np.ptp(mesh.p, axis=1))):
+        raise ParameterError("skin_file", str(path), f"a {name!r} group on the plane {'xyz'[axis]} = 0",
+                             f"its facets reach {'xyz'[axis]} = {off:.4g} mm: a symmetry group must lie on "
+                             "its plane; rename the group if it is a free face")
 
 
 # --- OCC solids (STEP files, built-in CAD skins) ------------------------------------------------

@@ -16,6 +16,7 @@ logger = logging.getLogger(__name__)
 
 BOUNDARIES_2D = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
 BOUNDARIES_3D = BOUNDARIES_2D + ("end_front", "end_back")
+SYMMETRY_Z = "symmetry_z"  # name of a z-symmetric slab's mid-plane z = 0 in written mesh files
 # meshio format names by suffix
 FORMATS = {".msh": "gmsh", ".vtu": "vtu", ".inp": "abaqus"}  # .inp: own writer (abaqus.py)
 
@@ -82,6 +83,9 @@ class SkinMesh:
         cell_sets = {"skin": [np.arange(len(cell_nodes))] + [np.array([], dtype=int)] * len(self.boundaries)}
         point_sets = {}
         for i, (name, facets) in enumerate(self.boundaries.items()):
+            # a z-symmetric slab's end_back is its mid-plane: written under a name that says so
+            # (a file skin reads `symmetry_z` as u_z = 0; an `end_back` would be a free end)
+            name = SYMMETRY_Z if name == "end_back" and self.dim == 3 and self.z_symmetric else name
             fn = facet_nodes(m, facets, self.dim, self.order)
             cells.append((ftype, fn))
             phys.append(np.full(len(fn), i + 1))
