@@ -60,7 +60,9 @@ def test_solve_compare_2d_reports_ridge_against_dot(tmp_path, capsys):
     doc = json.loads((out / "compare_2d.json").read_text())
     s3 = json.loads((out / "summary.json").read_text())
     s2 = json.loads((out / "section_2d" / "summary.json").read_text())
-    assert [f["code"] for f in s3["flags"] + s2["flags"]] == ["coarse_mesh", "coarse_mesh"]
+    assert [f["code"] for f in s3["flags"]] == ["coarse_mesh"] and s2["status"] == "ok"
+    # sizes of no 3D preset: the section at the default 2D mesh (Braille: 0.5 / 6), not at 1.0 / 2
+    assert (s2["scene"]["mesh_size"], s2["scene"]["refinement"]) == (0.5, 6.0)
     for k in ("peak_mpa", "span_mm"):
         assert doc[k]["2d"] == s2[k] and doc[k]["3d"] == s3[k]
         assert doc[k]["relative_difference"] == (s2[k] - s3[k]) / s3[k]
@@ -74,3 +76,17 @@ def test_solve_compare_2d_needs_a_3d_scene(tmp_path, capsys):
                  "--out", str(tmp_path / "o")]) == 2
     assert "--compare-2d" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()  # refused before solving: nothing written
+
+
+def test_compare_2d_section_takes_the_2d_mesh_of_the_3d_quality(monkeypatch):
+    import tactileskin.fe as fe
+    from tactileskin.cli.solve import _solve_2d
+    from tactileskin.planner import with_quality
+    from tactileskin.scene import Scene
+
+    monkeypatch.setattr(fe, "solve", lambda sc, **kw: sc)
+    dot = Scene(dim=3, indenter="braille", braille_text="a", thickness=1)
+    for q, sizes2 in (("preview", (1.0, 5.0)), ("default", (0.5, 6.0)), ("fine", (0.177, 3.0))):
+        sc2 = _solve_2d(with_quality(dot, q))
+        assert sc2.dim == 2 and (sc2.mesh_size, sc2.refinement) == sizes2
+    assert (_solve_2d(dot.replace(mesh_size=1.3, refinement=7)).mesh_size, ) == (0.5,)
