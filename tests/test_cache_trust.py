@@ -183,6 +183,18 @@ def _damage(entry, kind):
         (entry / "cache.json").write_text(json.dumps(d))
     elif kind == "foreign scene":
         Scene(thickness=5.0).to_toml(entry / "scene.toml")
+    elif kind == "profile cut at a line end":  # still a valid-looking profile of 4 rows
+        prof.write_text("\n".join(prof.read_text().splitlines()[:5]) + "\n")
+    elif kind == "missing contact.csv":
+        (entry / "contact.csv").unlink()
+    elif kind == "edited peak":  # a plausible number that the profile does not have
+        d = json.loads(summ.read_text())
+        d["peak_mpa"] = 99.0
+        summ.write_text(json.dumps(d))
+    elif kind == "no file list":
+        d = json.loads((entry / "cache.json").read_text())
+        del d["files"]
+        (entry / "cache.json").write_text(json.dumps(d))
     elif kind == "entry is a file":
         shutil.rmtree(entry)
         entry.write_text("x")
@@ -192,7 +204,7 @@ def _damage(entry, kind):
 
 DAMAGE = ["truncated profile", "empty summary", "corrupt summary", "summary a list", "NaN peak",
           "NaN in profile", "s not increasing", "no cache.json", "old schema", "foreign scene",
-          "entry is a file"]
+          "profile cut at a line end", "missing contact.csv", "edited peak", "no file list", "entry is a file"]
 
 
 @pytest.mark.parametrize("kind", DAMAGE)
@@ -352,3 +364,14 @@ def test_one_entry_shared_by_equal_cases_is_solved_once(tmp_path, monkeypatch):
     outcomes = run_sweep([a, b], cache, serial=True)
     assert [o.status for o in outcomes] == ["done", "cached"] and calls == [a]
     assert outcomes[1].record.summary == outcomes[0].record.summary
+
+
+def test_a_damaged_vtu_reads_as_an_error_not_an_exit(tmp_path):
+    """meshio's VTU reader calls sys.exit on a file it cannot parse: read_vtu raises ValueError
+    (a truncated cached result.vtu ended every later sweep with exit 1 and no report)."""
+    from tactileskin.results import read_vtu
+
+    path = tmp_path / "r.vtu"
+    path.write_text('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1">\n<Unstr')
+    with pytest.raises(ValueError, match="r.vtu"):
+        read_vtu(path)

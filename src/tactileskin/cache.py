@@ -12,7 +12,7 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's
   own source and data files and the versions of the libraries that mesh and solve (gmsh,
-  scikit-fem, numpy, scipy, numba, mkl, meshio), so a result computed by other code (an update of
+  scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
@@ -20,10 +20,13 @@ time stamp, so an edit within the same second is not missed.
 
 Entry. `<cache>/<key>/` holds the files `Result.write` writes (profile.csv,
 summary.json, contact.csv, result.vtu; 3D also bone_map.csv, profile_max_z.csv), scene.toml, and cache.json (schema, key, package
-version). It is staged beside its final name and renamed into place when complete, so a
-killed run leaves no half-written entry. Loading validates it: cache.json names this key
-and schema, summary.json is an object with finite peak/span/auc, profile.csv has >= 2
-finite rows with increasing s, scene.toml describes this scene. A damaged entry (truncated,
+version, and the SHA-256 of every other file of the entry). It is staged beside its final
+name and renamed into place when complete, so a killed run leaves no half-written entry.
+Loading validates it: cache.json names this key and schema, every file it lists is there
+with its bytes unchanged (a profile.csv cut at a line end, a missing result.vtu, an edited
+number: each read as a valid entry before), summary.json is an object with finite
+peak/span/auc, profile.csv has >= 2 finite rows with increasing s, scene.toml describes this
+scene. A damaged entry (truncated,
 empty, corrupt, non-finite, foreign) is logged as a WARNING naming its path, removed, and
 recomputed; it is never used.
 
@@ -81,8 +84,10 @@ def material_content(material: str) -> dict:
     return {m.law_name: _floats(m.law.to_dict()), "prony": _floats(m.prony.to_dict())}
 
 
-# the libraries whose version can change a mesh or a solve (distribution names)
-SOLVER_LIBRARIES = ("gmsh", "scikit-fem", "numpy", "scipy", "numba", "mkl", "meshio")
+# the libraries whose version can change a mesh or a solve (distribution names): trimesh
+# reads a user's STL indenter and its gaps, build123d and OCP (OpenCascade) tessellate a STEP
+SOLVER_LIBRARIES = ("gmsh", "scikit-fem", "numpy", "scipy", "numba", "mkl", "meshio", "trimesh",
+                    "build123d", "cadquery-ocp-novtk")
 
 
 @lru_cache(maxsize=1)
@@ -140,6 +145,14 @@ class CaseRecord:
     path: Path
     case: str = ""      # the case id within its sweep (sweep.case_ids), set by the report
     variant: str = ""   # the id's suffix naming the fields that tell it apart ("d0.2-r2")
+
+
+def _file_sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -239,6 +252,16 @@ class ResultCache:
                 raise ValueError(f"schema {meta.get('schema')!r}, expected {SCHEMA_VERSION}")
             if meta.get("key") != key:
                 raise ValueError(f"written for key {meta.get('key')!r}")
+            files = meta.get("files")
+            if not isinstance(files, dict) or not files:
+                raise ValueError("no list of the entry's files")
+            for fname, digest in files.items():
+                if Path(fname).name != fname or fname == "cache.json":
+                    raise ValueError(f"lists {fname!r}")
+                if not (p / fname).is_file():
+                    raise ValueError(f"{fname} is missing")
+                if _file_sha256(p / fname) != digest:
+                    raise ValueError(f"the bytes of {fname} changed since the entry was written")
             name = "summary.json"
             summary = json.loads((p / name).read_text(encoding="utf-8"))
             if not isinstance(summary, dict):
@@ -284,8 +307,9 @@ class ResultCache:
         with fileio.os_errors(final), fileio.staged_dir(final) as tmp:
             result.write_owned(tmp)
             scene.to_toml(tmp / "scene.toml")
+            files = {f.name: _file_sha256(f) for f in sorted(tmp.iterdir()) if f.is_file()}
             (tmp / "cache.json").write_text(json.dumps(
-                {"schema": SCHEMA_VERSION, "key": key, "version": __version__}, indent=2) + "\n",
+                {"schema": SCHEMA_VERSION, "key": key, "version": __version__, "files": files}, indent=2) + "\n",
                 encoding="utf-8")
             fileio.fix_tree_modes(tmp)
         return final

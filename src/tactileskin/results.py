@@ -474,6 +474,22 @@ OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_m
              "sensors.csv", "history.csv", "result.pvd", "result_steps/step_*.vtu")
 
 
+def read_vtu(path):
+    """meshio.read of a .vtu, with a damaged file raised as ValueError: meshio's VTU reader
+    ends the process (sys.exit) on an XML it cannot parse, which no caller catches as an error
+    (a truncated cached result.vtu aborted every later sweep)."""
+    import contextlib
+
+    import meshio
+
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):  # it prints, then exits
+            return meshio.read(path)
+    except SystemExit:
+        raise ValueError(f"cannot read {path} as VTU (truncated or damaged?)") from None
+
+
 def _csv(header: list[str], *cols) -> str:
     if not cols or len(np.atleast_1d(cols[0])) == 0:
         return ",".join(header) + "\n"

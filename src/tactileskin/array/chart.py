@@ -268,11 +268,12 @@ def surface_deflection(record, top: float):
     """w(dx, dz): the downward deflection of the free surface y = `top` of a single-dot solve
     (its result.vtu; a half or quarter model is mirrored by |dx|, |dz|), linear between the
     surface nodes, 0 beyond the modelled surface."""
-    import meshio
     from scipy.interpolate import LinearNDInterpolator
 
+    from tactileskin.results import read_vtu
+
     try:
-        m = meshio.read(record.path / "result.vtu")
+        m = read_vtu(record.path / "result.vtu")
     except (OSError, ValueError) as e:
         raise TactileSkinError(f"cannot read the single-dot result {record.path}: {e}") from None
     X, u = m.points, m.point_data["displacement_mm"]

@@ -47,9 +47,9 @@ def scale_bar_length(extent: float) -> float:
 
 def _section(vtu: Path):
     """(deformed xy points, linear triangles, pressure, field name) of a 2D result.vtu."""
-    import meshio
+    from tactileskin.results import read_vtu
 
-    m = meshio.read(vtu)
+    m = read_vtu(vtu)
     X = np.asarray(m.points, float)[:, :2]
     if "displacement_mm" in m.point_data:  # reference mesh + displacement (older files: deformed points)
         X = X + np.asarray(m.point_data["displacement_mm"], float)[:, :2]
@@ -127,10 +127,10 @@ def render_case(vtu: Path, png: Path, title: str = "", scene=None) -> Path:
     """Render `vtu` (the solver's result.vtu) deformed, coloured by mean pressure, into `png`
     (atomically). 2D: matplotlib (`render_figure`; `scene` adds the indenter outline); 3D:
     pyvista off-screen (needs the `render` extra; MissingDependency without)."""
-    import meshio
+    from tactileskin.results import read_vtu
 
     vtu = Path(vtu)
-    cells = {b.type for b in meshio.read(vtu).cells}
+    cells = {b.type for b in read_vtu(vtu).cells}
     if cells & {"tetra", "tetra10", "hexahedron", "hexahedron27"}:
         return _render_3d(vtu, png, title)
     import matplotlib.pyplot as plt
