@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -33,3 +35,28 @@ def test_default_stderr_is_quiet_and_v_shows_the_cutbacks(tmp_path):
     assert "INFO tactileskin.fe:" in verbose  # the solve's one-line summary
     assert "Initializing finished" not in verbose  # scikit-fem's own info: -vv
     assert not re.search(r"increment \d+: t =", verbose)  # each increment: -vv
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_whose_exception_was_swallowed_still_ends_the_run(monkeypatch, capsys, signum, code):
+    """The handler's exception is lost when it lands in a __del__ or compiled code (the run went
+    on to exit 0, ~1 SIGTERM in 8): main ends with the signal's status anyway."""
+    import tactileskin.materials as materials
+    from tactileskin.cli import main
+
+    real = materials.list_materials
+
+    def swallowing():
+        try:
+            os.kill(os.getpid(), signum)
+            time.sleep(1.0)  # the handler raises in here
+        except BaseException:  # noqa: BLE001 - as "Exception ignored in __del__" does
+            pass
+        return real()
+
+    monkeypatch.setattr(materials, "list_materials", swallowing)
+    try:
+        rc = main(["material", "list"])
+    except SystemExit as e:
+        rc = e.code
+    assert rc == code

@@ -71,22 +71,45 @@ def cli(verbose: int) -> None:
         logging.getLogger(name).setLevel(logging.WARNING if verbose < 2 else logging.DEBUG)
 
 
-def _on_sigterm(signum, frame):
+# the signals received during this run: an exception raised by a signal handler is lost when
+# it lands in a __del__ or in compiled code ("Exception ignored in ..."), and the run went on
+# to exit 0 (about 1 SIGTERM in 8 during a solve); `raise_if_signalled` raises it again at the
+# next progress step, and `main` returns the signal's exit status in any case
+_signalled: list[int] = []
+
+
+def _on_signal(signum, frame):
     # an exception, so that `finally` blocks remove temporaries and staging folders
+    _signalled.append(signum)
+    _raise_for(signum)
+
+
+def _raise_for(signum):
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise SystemExit(128 + signum)
 
 
+def raise_if_signalled() -> None:
+    """Raise again for a signal whose exception was swallowed (called from progress steps)."""
+    if _signalled:
+        _raise_for(_signalled[-1])
+
+
 @contextlib.contextmanager
-def _sigterm_raises():
-    """SIGTERM (a scheduler's kill, `timeout`) unwinds like Ctrl-C instead of dying in place."""
+def _signals_raise():
+    """SIGTERM (a scheduler's kill, `timeout`) unwinds like Ctrl-C instead of dying in place;
+    both are remembered (`_signalled`)."""
+    _signalled.clear()
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, h in previous.items():
+            signal.signal(s, h)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -96,8 +119,9 @@ def main(argv: list[str] | None = None) -> int:
 
     err = Console(stderr=True)
     try:
-        with _sigterm_raises():
+        with _signals_raise():
             rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)
+            raise_if_signalled()  # a signal whose exception was swallowed: not a normal end
     except TactileSkinError as e:
         # the message quotes user text (names, Braille text, paths): print it as text, not markup
         err.print(f"[bold red]error:[/] {escape(str(e))}", highlight=False, soft_wrap=True)
@@ -107,14 +131,20 @@ def main(argv: list[str] | None = None) -> int:
     except click.ClickException as e:
         e.show()
         return e.exit_code
-    except click.exceptions.Abort:
-        # 128 + SIGINT, the shell's code for Ctrl-C (SIGTERM exits 143, _on_sigterm): not 1,
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        # 128 + SIGINT, the shell's code for Ctrl-C (SIGTERM exits 143, _on_signal): not 1,
         # which `sweep` uses for "some case failed, the others reported"
         err.print("interrupted: no output was left half-written (a sweep keeps its finished cases in its cache)")
         return 130
-    except OSError as e:  # last resort: a file error that no writer turned into an OutputError
-        from rich.markup import escape
-
+    except Exception as e:
+        if _signalled:
+            # the signal's exception came out of compiled code as another one ("SystemError:
+            # CPUDispatcher(...) returned a result with an exception set"): the interruption
+            err.print("interrupted: no output was left half-written (a sweep keeps its finished cases in its cache)")
+            return 130 if _signalled[-1] == signal.SIGINT else 128 + _signalled[-1]
+        if not isinstance(e, OSError):
+            raise
+        # last resort: a file error that no writer turned into an OutputError
         where = f"{e.filename}: " if e.filename else ""
         err.print(f"[bold red]error:[/] {escape(where + str(e.strerror or e))}", highlight=False, soft_wrap=True)
         return 2

@@ -141,12 +141,15 @@ def solve_progress(label: str):
     from rich.markup import escape
     from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
+    from tactileskin.cli import raise_if_signalled
+
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(bar_width=16),
                   TextColumn("{task.fields[info]}"), TimeElapsedColumn(),
                   console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task(escape(label), total=1.0, info="meshing, setting up")
 
         def show(i):  # short: it must fit an 80-column terminal beside the label
+            raise_if_signalled()
             bar.update(task, completed=i.t, total=i.T,
                        info=f"increment {i.increment}, t {i.t:.3g}/{i.T:.3g} s, d {i.travel:.3g} mm, "
                             f"Newton {i.newton} ({i.newton_total})")

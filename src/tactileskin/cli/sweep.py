@@ -43,6 +43,7 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
     from rich.text import Text
 
     from tactileskin import quality as result_quality  # `quality` is the mesh preset option
+    from tactileskin.cli import raise_if_signalled
 
     from tactileskin.report.outputs import write_outputs
     from tactileskin.sweep import ResultCache, check_scheduler, run_sweep
@@ -62,6 +63,7 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
             task = bar.add_task("solving", total=len(scenes))
 
             def on_event(oc):
+                raise_if_signalled()
                 style = {"cached": "dim", "done": "green", "failed": "bold red"}[oc.status]
                 extra = f" ({oc.seconds:.1f} s)" if oc.status == "done" else (f": {oc.error}" if oc.error else "")
                 word, why = oc.status, ""
