@@ -307,3 +307,17 @@ def test_a_whole_2d_skin_reads_like_the_halved_pad(tmp_path):
     fw = solve(Scene(skin="file", skin_file=str(coarse), **{**kw, "mesh_size": 0.25}, force=target))
     fh = solve(half_scene.replace(depth=None, mesh_size=0.25, force=target))
     assert fw.loading["profile_travel_mm"] == pytest.approx(fh.loading["profile_travel_mm"], rel=0.01)
+
+
+def test_a_binary_file_named_msh_is_one_error(tmp_path):
+    """gmsh logs the file's bytes, which its Python API decodes as UTF-8: the one-line error
+    became a traceback (seen from the command line, not under pytest's logging)."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "garbage.msh"
+    path.write_bytes(np.random.default_rng(0).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    run = subprocess.run([sys.executable, "-m", "tactileskin", "solve", "--skin-file", str(path), "-i", "flat",
+                          "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr and "skin_file" in run.stderr
+    assert not (tmp_path / "o").exists()

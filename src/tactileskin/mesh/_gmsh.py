@@ -54,11 +54,11 @@ def session(name: str, params: dict):
             except TactileSkinError:  # MeshError, or a ParameterError on the user's file
                 raise
             except Exception as e:  # gmsh raises plain Exception
-                log = [m for m in gmsh.logger.get() if m.startswith(("Error", "Warning"))][-5:]
+                log = [m for m in _log(gmsh) if m.startswith(("Error", "Warning"))][-5:]
                 raise MeshError(f"gmsh failed to mesh {name} with {params}: {e}"
                                 + (f" (gmsh log: {' | '.join(log)})" if log else "")) from e
             finally:
-                for msg in gmsh.logger.get():
+                for msg in _log(gmsh):
                     if msg.startswith("Warning"):
                         logger.warning("gmsh (%s): %s", name, msg)
                 gmsh.logger.stop()
@@ -67,6 +67,16 @@ def session(name: str, params: dict):
             if owned:
                 with _signals_kept():
                     gmsh.finalize()
+
+
+def _log(gmsh) -> list[str]:
+    """gmsh's log messages; [] if they cannot be decoded (gmsh's Python API decodes them as
+    UTF-8: a binary file merged as .msh puts its bytes in them, and the UnicodeDecodeError
+    replaced the one-line error on the file with a traceback)."""
+    try:
+        return list(gmsh.logger.get())
+    except UnicodeDecodeError:
+        return []
 
 
 @contextlib.contextmanager
