@@ -75,3 +75,64 @@ def test_a_chart_on_an_unvalidated_surrogate_is_written_and_exits_suspect(tmp_pa
     md = (out / "array_chart.md").read_text(encoding="utf-8")
     assert "| 0.5 † | 0.01 |" in md and "not validated: indicative only" in md
     assert "suspect: polyurethane" in capsys.readouterr().err
+
+
+@pytest.fixture
+def no_solves(monkeypatch):
+    """A config that slipped through would start hours of 3D solves: fail the test instead."""
+    from tactileskin.array import chart
+
+    def refuse(*a, **k):
+        raise AssertionError("the chart started solving")
+
+    monkeypatch.setattr(chart, "compute", refuse)
+    monkeypatch.setattr(chart, "validate_surrogate", refuse)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("[array]\nthicknesses = \"x\"\n", ["thicknesses", "a list of numbers > 0 mm"]),   # was a ValueError traceback
+    ("[array]\nseed = \"x\"\n", ["seed='x'", "an integer >= 0"]),                       # ditto
+    ("[array]\npitches = \"abc\"\n", ["pitches", "[0.05, 20] mm"]),                   # was "ufunc 'isfinite'..."
+    ("[array]\nnoise_fs = \"abc\"\n", ["noise_fs", "[0, 10]"]),
+    ("[array]\nmax_depth = \"abc\"\n", ["max_depth='abc'", "> 0 mm"]),
+    ("[array]\nthicknesses = [1, \"x\"]\n", ["thicknesses", "'x'", "> 0 mm"]),
+    ("[array]\ntaxel_fraction = \"a\"\n", ["taxel_fraction", "[0, 1]"]),
+    ("[array]\nletters = 5\n", ["letters=5", "a-z, 0-9"]),
+    ("[array]\nsets = \"papr\"\n", ["sets (--set)='papr'", "paper or letters or shapes"]),  # was set='p'
+    ("[array]\nmaterials = \"silicon\"\n", ["material='silicon'"]),                   # was material='c'
+    ("[array]\nwindow = -1\n", ["window=-1", ">= 0 mm"]),                            # solved 3 cases, then named n
+    ("[array]\ntemplate_grid = 0\n", ["template_grid=0", ">= 1"]),
+    ("[array]\nmesh_size = 0\n", ["mesh_size=0", "[0.01, 5] mm"]),
+    ("[array]\nstandard = 1\n", ["standard=1"]),
+    ("[array]\nvalidate = 3\n", ["validate=3", "a list of strings"]),
+])
+def test_config_values_are_checked_by_key_before_any_solve(tmp_path, capsys, no_solves, text, words):
+    cfg = tmp_path / "a.toml"
+    cfg.write_text(text)
+    assert main(["array", "-o", str(tmp_path / "o"), "--config", str(cfg)]) == 2
+    raw = capsys.readouterr().err
+    err = " ".join(raw.split())
+    assert all(w in err for w in words) and "Traceback" not in err, err
+    assert raw.startswith("error:")
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_binary_config_is_one_line(tmp_path, capsys, no_solves):
+    cfg = tmp_path / "a.toml"
+    cfg.write_bytes(b"\xff\xfe[array]\x00\x81")  # was a UnicodeDecodeError traceback
+    assert main(["array", "-o", str(tmp_path / "o"), "--config", str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert "config=" in err and "a UTF-8 text file" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_single_value_in_a_config_is_a_one_element_list_as_on_the_command_line(tmp_path):
+    """A string was iterated per character (sets = "paper" -> set='p')."""
+    from tactileskin.array.chart import ChartConfig
+    from tactileskin.cli.array import load_config
+
+    p = tmp_path / "a.toml"
+    p.write_text('[array]\nthicknesses = 1\nsets = "paper, letters"\nmaterials = "silicone"\nvalidate = "l"\n')
+    kw = load_config(p)
+    assert kw["thicknesses"] == (1,) and kw["sets"] == ("paper", "letters") and kw["validate"] == ("l",)
+    assert ChartConfig(**{k: v for k, v in kw.items() if k != "validate"}).materials == ("silicone",)

@@ -48,7 +48,7 @@ def check_range(name: str, value: float, lo: float | None = None, hi: float | No
 
     A closed bound is met within a few ulps: bounds are often computed (0.6 * t) and a value
     typed as the printed bound (1.8 for 0.6 * 3 = 1.7999999999999998) must pass."""
-    valid = _range_text(lo, hi, lo_open, hi_open, unit)
+    valid = range_text(lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
     if isinstance(value, (bool, str, bytes)):
         raise ParameterError(name, value, valid, "a number")
     try:
@@ -79,7 +79,10 @@ def fmt_bound(x: float) -> str:
     return repr(x)
 
 
-def _range_text(lo, hi, lo_open, hi_open, unit):
+def range_text(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+               hi_open: bool = False, unit: str = "") -> str:
+    """The valid range as check_range states it, e.g. "[0.05, 20] mm" or "> 0 mm" (for help
+    texts and list checks that quote the same bounds)."""
     u = f" {unit}" if unit else ""
     if lo is not None and hi is not None:
         return f"{'(' if lo_open else '['}{fmt_bound(lo)}, {fmt_bound(hi)}{')' if hi_open else ']'}{u}"

@@ -122,6 +122,11 @@ def _fingertip_overrides(value) -> tuple[tuple[str, float], ...]:
 
 
 DEPTH_FRACTION = 0.2  # Scene.depth_fraction's default
+# valid ranges of Scene's fields (the one source: validation, the array chart and --help read them)
+MAX_DEPTH_FRACTION = 0.6               # depth <= 0.6 t (and depth_fraction <= 0.6)
+MESH_SIZE = (0.01, 5.0)                # mesh_size (mm)
+REFINEMENT = (1.0, 20.0)               # refinement (coarse / refined size ratio)
+RATE = (1e-6, 1e6)                     # rate (mm/s) and force_rate (N/s)
 
 
 @dataclass(frozen=True)
@@ -187,13 +192,15 @@ class Scene:
                                      f"the {skin.name} skin does not take it")
         for name, value in skin.check_scene(self).items():  # thickness and the skin's own fields
             set_(name, value)
-        set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, 0.6, lo_open=True))
+        set_("depth_fraction", check_range("depth_fraction", self.depth_fraction, 0.0, MAX_DEPTH_FRACTION,
+                                                   lo_open=True))
         if self.depth is not None:
-            set_("depth", check_range("depth", self.depth, 0.0, 0.6 * self.thickness, lo_open=True, unit="mm"))
+            set_("depth", check_range("depth", self.depth, 0.0, MAX_DEPTH_FRACTION * self.thickness, lo_open=True,
+                                          unit="mm"))
             if self.depth_fraction != DEPTH_FRACTION:  # two depths: the record would show the unused one
                 raise ParameterError("depth_fraction", self.depth_fraction, f"not given with depth = {self.depth:g} mm",
                                      "give the depth (mm) or the depth_fraction of t, not both")
-        set_("rate", check_range("rate", self.rate, 1e-6, 1e6, unit="mm/s"))
+        set_("rate", check_range("rate", self.rate, *RATE, unit="mm/s"))
         if self.dim not in (2, 3):
             raise ParameterError("dim", self.dim, "2 or 3")
         if self.order not in (1, 2):
@@ -205,9 +212,9 @@ class Scene:
                                  "order 1 locks; use formulation='displacement' to study it")
         size0, ref0 = default_mesh(self.dim, self.indenter, self.thickness, self.skin)
         set_("mesh_size", check_range("mesh_size", size0 if self.mesh_size is None else self.mesh_size,
-                                      0.01, 5.0, unit="mm"))
+                                      *MESH_SIZE, unit="mm"))
         set_("refinement", check_range("refinement", ref0 if self.refinement is None else self.refinement,
-                                       1.0, 20.0))
+                                       *REFINEMENT))
         if not self.material:
             raise ParameterError("material", self.material, "a material preset name")
         if not str(self.material).endswith(".toml"):  # a preset name: known now, not at the solve
@@ -257,7 +264,7 @@ class Scene:
         if self.force_rate is not None and self.load_time is not None:
             raise ParameterError("force_rate", self.force_rate, "force_rate or load_time, not both")
         if self.force_rate is not None:
-            set_("force_rate", check_range("force_rate", self.force_rate, 1e-6, 1e6, unit="N/s (N/mm/s in 2D)"))
+            set_("force_rate", check_range("force_rate", self.force_rate, *RATE, unit="N/s (N/mm/s in 2D)"))
         if self.load_time is not None:
             set_("load_time", check_range("load_time", self.load_time, 0.0, loading.MAX_TIME, lo_open=True,
                                           unit="s"))
@@ -288,7 +295,7 @@ class Scene:
     @property
     def max_travel(self) -> float:
         """Largest travel (mm) a depth may ask or force control may reach: 0.6 t."""
-        return 0.6 * self.thickness
+        return MAX_DEPTH_FRACTION * self.thickness
 
     @property
     def reach(self) -> float:

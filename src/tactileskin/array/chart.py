@@ -36,7 +36,7 @@ import numpy as np
 from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
 from tactileskin.array.sampler import ArraySpec, Readout
-from tactileskin.errors import ParameterError, TactileSkinError, check_range
+from tactileskin.errors import ParameterError, TactileSkinError, check_range, range_text
 from tactileskin.geometry.braille import DIGITS as BRAILLE_DIGITS
 from tactileskin.geometry.braille import LETTERS as BRAILLE_LETTERS
 from tactileskin.geometry.braille import get_standard
@@ -61,6 +61,36 @@ LETTERS_MODELS = ("interaction", "sum", "full")
 # the letters' surrogate is 5.5 % (t = 1, silicone, f) and 5.2 % (t = 0.5) off full solves on
 # finer meshes; on 0.8 / 8 it reads 3.5 and 3.6 % (data/surrogate_validation.json)
 CHART_MESH = (1.2, 8.0)
+
+
+def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:
+    """A non-empty list of numbers within [lo, hi] as a tuple (a string is refused: it would
+    iterate per character)."""
+    from tactileskin import validate
+    from tactileskin.sweep import MAX_AXIS_VALUES
+
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
+    rng = range_text(lo, hi, lo_open=lo_open, unit=unit)
+    items = validate.sequence(v, name, ("numbers in " if rng[0] in "[(" else "numbers ") + rng, MAX_AXIS_VALUES)
+    if not items:
+        raise ParameterError(name, v, "at least one value")
+    return tuple(check_range(name, x, lo, hi, lo_open=lo_open, unit=unit) for x in items)
+
+
+def _names(v, name: str, choices: tuple | None) -> tuple:
+    """A non-empty list of strings (of `choices` where given) as a tuple."""
+    from tactileskin import validate
+    from tactileskin.sweep import MAX_AXIS_VALUES
+
+    kind = "strings" if choices is None else ", ".join(choices[:-1]) + " or " + choices[-1]
+    items = validate.sequence(v, name, kind, MAX_AXIS_VALUES)
+    if not items:
+        raise ParameterError(name, v, "at least one value")
+    for x in items:
+        if not isinstance(x, str) or (choices is not None and x not in choices):
+            raise ParameterError(name, x, "a string" if choices is None else " or ".join(choices))
+    return tuple(items)
 
 
 @dataclass(frozen=True)
@@ -107,42 +137,50 @@ class ChartConfig:
     sphere_quality: str = "preview"
 
     def __post_init__(self):
-        for name in ("thicknesses", "pitches", "noise_fs", "materials", "sets"):
-            if len(getattr(self, name)) == 0:
-                raise ParameterError(name, getattr(self, name), "at least one value")
-        for p in self.pitches:
-            if not (np.isfinite(p) and 0.05 <= p <= 20):
-                raise ParameterError("pitch", p, "[0.05, 20] mm")
-        for v in self.noise_fs:
-            if not (np.isfinite(v) and 0 <= v <= 10):
-                raise ParameterError("noise", v, "[0, 10] x full scale")
-        if not 0 <= self.taxel_fraction <= 1:
-            raise ParameterError("taxel_fraction", self.taxel_fraction, "[0, 1] of the pitch")
-        bad = [s for s in self.sets if s not in SETS]
-        if bad:
-            raise ParameterError("set", bad[0], " or ".join(SETS))
+        # every field's type and range before any solve: a config file's `pitches = "abc"` or
+        # `window = -1` must fail here, naming the key, not after minutes of solves
+        from tactileskin import validate
+        from tactileskin.presets import QUALITIES
+        from tactileskin.scene import MESH_SIZE, REFINEMENT
+
+        set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731 (frozen)
+        for name, flag, lo, hi, lo_open, unit in (("thicknesses", "-t", 0.0, None, True, "mm"),  # the skin: its range
+                                                  ("pitches", "--pitch", 0.05, 20.0, False, "mm"),
+                                                  ("noise_fs", "--noise", 0.0, 10.0, False, "x full scale")):
+            set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
+        for name, flag, choices in (("materials", "-m", None), ("sets", "--set", SETS)):
+            set_(name, _names(getattr(self, name), f"{name} ({flag})", choices))
+        set_("taxel_fraction", check_range("taxel_fraction (--taxel)", self.taxel_fraction, 0.0, 1.0,
+                                           unit="of the pitch"))
+        set_("window", check_range("window", self.window, 0.0, unit="mm (array side)"))
         if not isinstance(self.fallback, bool):
             raise ParameterError("fallback", self.fallback, "true or false")
-        if self.letters_model not in LETTERS_MODELS:
-            raise ParameterError("letters_model", self.letters_model, " or ".join(LETTERS_MODELS))
-        from tactileskin.presets import QUALITIES
-
+        for name, choices in (("letters_model", LETTERS_MODELS), ("sphere_quality", QUALITIES), ("skin", SKINS)):
+            if not isinstance(getattr(self, name), str) or getattr(self, name) not in choices:
+                raise ParameterError(name, getattr(self, name), " or ".join(choices))
         check_range("sphere_radius", self.sphere_radius, 0.1, 1000.0, lo_open=True, unit="mm")  # the sphere kind's range
-        if self.sphere_quality not in QUALITIES:
-            raise ParameterError("sphere_quality", self.sphere_quality, " or ".join(QUALITIES))
-        if self.skin not in SKINS:
-            raise ParameterError("skin", self.skin, " or ".join(SKINS))
-        if self.max_depth is not None and not (np.isfinite(self.max_depth) and self.max_depth > 0):
-            raise ParameterError("max_depth", self.max_depth, "> 0 mm (or None: 20 % of t)")
+        if self.max_depth is not None:
+            set_("max_depth", check_range("max_depth", self.max_depth, 0.0, lo_open=True,
+                                          unit="mm (or none: 20 % of t)"))
+        for name, rng, unit in (("mesh_size", MESH_SIZE, "mm"), ("refinement", REFINEMENT, "")):
+            if getattr(self, name) is not None:  # the Scene's ranges, named by the chart's key
+                set_(name, check_range(name, getattr(self, name), *rng, unit=unit))
+        validate.string(self.standard, "standard", "a Braille standard name")
+        try:
+            get_standard(self.standard)
+        except ParameterError as e:
+            raise ParameterError("standard", self.standard, e.valid) from None
         # checked here, before any solve (the classifiers would refuse them after hours of solves)
         if self.bits is not None and not (isinstance(self.bits, (int, np.integer)) and not isinstance(self.bits, bool)
                                           and 1 <= self.bits <= 32):
             raise ParameterError("bits", self.bits, "an integer in [1, 32] or none")
-        # LDA needs more training readings than classes: at least two offsets per stimulus
-        for name, lo in (("n_train", 2), ("n_test", 1)):
-            v = getattr(self, name)
+        # n_train >= 2: LDA needs more training readings than classes (two offsets per stimulus)
+        for name, lo in (("n_train (--offsets)", 2), ("n_test (--offsets)", 1), ("template_grid", 1), ("seed", 0)):
+            v = getattr(self, name.split()[0])
             if not (isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= lo):
-                raise ParameterError(f"{name} (--offsets)", v, f"an integer >= {lo}")
+                raise ParameterError(name, v, f"an integer >= {lo}")
+        if not isinstance(self.letters, str):
+            raise ParameterError("letters", self.letters, "a string of characters a-z, 0-9, e.g. 'abc1'")
         bad = [c for c in self.letters if c not in CHARACTERS]
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 import click
 
+from tactileskin import validate
 from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
@@ -14,26 +14,41 @@ EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
         "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality"}
+MAX_TEXTS = 100  # Braille texts to validate: each is a full 3D solve per thickness
+
+
+# list-valued keys: a single value is a one-element list, and a string of names is split at
+# commas as the matching CLI option (--set paper,letters) is; a string of numbers is refused
+# by ChartConfig (TOML has numbers: "1,3" there is a mistake)
+NAME_LISTS = {"materials", "sets", "validate"}
+NUMBER_LISTS = {"thicknesses", "pitches", "noise_fs"}
 
 
 def load_config(path) -> dict:
-    """The [array] table of a TOML file; unknown keys raise ParameterError naming them."""
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except (OSError, tomllib.TOMLDecodeError) as e:
-        raise ParameterError("config", str(path), "a readable TOML file with an [array] table", hint=str(e)) from None
+    """The [array] table of a TOML file; an unreadable, non-UTF-8 or malformed file and unknown
+    keys raise ParameterError naming them."""
+    from tactileskin.params import read_toml
+    from tactileskin.scenefile import resolve_paths
+
+    data = read_toml(path, "config")
     outside = sorted(set(data) - {"array"})
     if outside:  # read as nothing, they would start the whole default chart (hours)
         raise ParameterError("config", f"{path}: key {outside[0]!r} outside the [array] table",
                              "every setting under [array]", "e.g. [array] then thicknesses = [1, 3]")
     table = data.get("array", {})
-    bad = sorted(set(table) - KEYS)
-    if bad or not isinstance(table, dict):
-        raise ParameterError("config [array] key", bad[0] if bad else table, ", ".join(sorted(KEYS)))
-    from tactileskin.scenefile import resolve_paths
-
-    return resolve_paths({k: tuple(v) if isinstance(v, list) else v for k, v in table.items()}, path)
+    if not isinstance(table, dict):
+        raise ParameterError("config [array]", table, "a table of settings, e.g. [array] then thicknesses = [1, 3]")
+    validate.known_keys(table, KEYS, "config [array]")
+    out = {}
+    for k, v in table.items():
+        if k in NAME_LISTS and isinstance(v, str):
+            v = [x.strip() for x in v.split(",") if x.strip()]
+        elif k in NUMBER_LISTS and validate.is_number(v):
+            v = [v]
+        out[k] = tuple(v) if isinstance(v, list) else v
+    if "validate" in out:
+        out["validate"] = validate.string_list(out["validate"], "validate", MAX_TEXTS, min_len=1)
+    return resolve_paths(out, path)
 
 
 @click.command("array")
