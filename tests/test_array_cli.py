@@ -136,3 +136,14 @@ def test_a_single_value_in_a_config_is_a_one_element_list_as_on_the_command_line
     kw = load_config(p)
     assert kw["thicknesses"] == (1,) and kw["sets"] == ("paper", "letters") and kw["validate"] == ("l",)
     assert ChartConfig(**{k: v for k, v in kw.items() if k != "validate"}).materials == ("silicone",)
+
+
+@pytest.mark.parametrize("text", ["", "# a chart\n", "[array]\n"])
+def test_an_empty_config_is_refused(tmp_path, capsys, no_solves, text):
+    """An empty config silently started the default chart (36 full 3D solves, hours)."""
+    cfg = tmp_path / "a.toml"
+    cfg.write_text(text)
+    assert main(["array", "-o", str(tmp_path / "o"), "--config", str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert "config=" in err and "at least one setting" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()

@@ -133,3 +133,16 @@ def test_dev_without_arguments_prints_its_usage_and_succeeds():
     assert r.returncode == 0 and "./dev run" in r.stdout
     r = subprocess.run([str(ROOT / "dev"), "nonsense"], capture_output=True, text=True, timeout=30)
     assert r.returncode == 2 and "nonsense" in r.stderr
+
+
+@pytest.mark.parametrize("cmd", ["solve", "sweep", "mesh"])
+@pytest.mark.parametrize("text", ["", "# nothing yet\n", "[scene]\n", "[sweep]\n"])
+def test_an_empty_scene_file_is_refused(tmp_path, capsys, cmd, text):
+    """An empty scene file ran the default scene with exit 0: surely a mistake."""
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    out = tmp_path / ("o.msh" if cmd == "mesh" else "o")
+    assert main([cmd, "--scene", str(f), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "scene file=" in err and "at least one setting" in err and "Traceback" not in err
+    assert not out.exists()

@@ -109,6 +109,9 @@ def read(path: str | Path | None) -> SceneFile:
     for f, ax in AXES.items():
         if f in fields and ax in axes:
             raise ParameterError(f"scene field {f}", str(path), f"either {f} or sweep.{ax}, not both")
+    if not fields and quality is None and not axes:  # surely a mistake: it would run the default scene
+        raise ParameterError("scene file", str(path), "a TOML file with at least one setting",
+                             "it sets nothing; leave out --scene for the default scene")
     if fields:
         from tactileskin.scene import Scene
 

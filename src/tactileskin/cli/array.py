@@ -39,6 +39,9 @@ def load_config(path) -> dict:
     if not isinstance(table, dict):
         raise ParameterError("config [array]", table, "a table of settings, e.g. [array] then thicknesses = [1, 3]")
     validate.known_keys(table, KEYS, "config [array]")
+    if not table:  # surely a mistake: it would start the whole default chart (36 full 3D solves, hours)
+        raise ParameterError("config", str(path), "a TOML file with at least one setting in its [array] table",
+                             "it sets nothing; leave out --config for the default chart")
     out = {}
     for k, v in table.items():
         if k in NAME_LISTS and isinstance(v, str):
