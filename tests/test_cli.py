@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+import pytest
+
 from tactileskin.cli import main
 
 
@@ -90,3 +92,14 @@ def test_compare_2d_section_takes_the_2d_mesh_of_the_3d_quality(monkeypatch):
         sc2 = _solve_2d(with_quality(dot, q))
         assert sc2.dim == 2 and (sc2.mesh_size, sc2.refinement) == sizes2
     assert (_solve_2d(dot.replace(mesh_size=1.3, refinement=7)).mesh_size, ) == (0.5,)
+
+
+@pytest.mark.parametrize("args, text", [
+    (["sweep", "-t", "1:100:0.001"], "thickness='1:100:0.001'"),   # was '1💯0.001'
+    (["sweep", "-m", "foo:smile:"], "material='foo:smile:'"),     # was 'foo😄'
+    (["solve", "-m", "foo:smile:"], "material='foo:smile:'"),
+])
+def test_errors_print_user_text_without_emoji_codes(tmp_path, capsys, args, text):
+    assert main([*args, "-o", str(tmp_path / "o")]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert text in err and "\U0001f4af" not in err and "\U0001f604" not in err

@@ -114,10 +114,11 @@ def _signals_raise():
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI in-process; returns the exit code (tests call this directly)."""
-    from rich.console import Console
     from rich.markup import escape
 
-    err = Console(stderr=True)
+    from tactileskin.cli._console import new_console
+
+    err = new_console(stderr=True)
     try:
         with _signals_raise():
             rv = cli.main(args=argv, prog_name="tactileskin", standalone_mode=False)

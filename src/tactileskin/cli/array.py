@@ -106,15 +106,15 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
     Exit status 0, or 3 when the chart was written but a part of it is suspect (the letters'
     surrogate not shown within 5 % of full solves at some thickness, or the plate touching):
     the report lists them."""
-    from rich.console import Console
     from rich.markup import escape
 
     from tactileskin.array.chart import ChartConfig, compute, validate_surrogate
     from tactileskin.cache import ResultCache
+    from tactileskin.cli._console import new_console
     from tactileskin.report.array_chart import suspect, write_outputs
     from tactileskin.sweep import parse_values
 
-    console = Console(stderr=True)
+    console = new_console(stderr=True)
     kw = load_config(config) if config else {}
     texts = kw.pop("validate", None)
     names = lambda v, n: tuple(x.strip() for x in v.split(",") if x.strip())  # noqa: E731

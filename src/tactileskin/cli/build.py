@@ -39,14 +39,14 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
     watertight flag). Every STL is checked to be a closed, consistently wound volume.
     """
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
 
+    from tactileskin.cli._console import new_console
     from tactileskin.geometry.fingertip import Fingertip
     from tactileskin.geometry.parts import default_thickness, resolve_indenters
 
-    console = Console()
+    console = new_console()
     t = default_thickness() if thickness is None else thickness
     pad = {}
     if skin != "pad" and (pad_width is not None or pad_length is not None):

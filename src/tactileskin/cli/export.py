@@ -16,10 +16,10 @@ from tactileskin.cli._common import scene_from_options, scene_options
 def command(out, dialect, scene_opts):
     """Write the 2D scene (mesh, sets, surfaces, material, supports, indenter, contact, step)
     as an input deck for Abaqus/Standard or CalculiX (units mm, s, N, MPa; per mm of depth)."""
-    from rich.console import Console
     from rich.markup import escape
 
     from tactileskin import fileio
+    from tactileskin.cli._console import new_console
     from tactileskin.errors import ParameterError
     from tactileskin.mesh.deck import write_deck
 
@@ -29,5 +29,5 @@ def command(out, dialect, scene_opts):
     fileio.claim_file(out)  # before meshing: a user's file of that name is refused
     deck = write_deck(scene, out, dialect=dialect)
     fileio.record_file(out)
-    Console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes, "
+    new_console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes, "
                     f"{'viscoelastic' if deck.info['viscoelastic'] else 'elastic'} {dialect} deck")

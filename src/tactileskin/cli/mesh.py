@@ -16,11 +16,11 @@ from tactileskin.cli._common import scene_from_options, scene_options
                    "the solver meshes with triangles).")
 def command(out, cell, scene_opts):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
 
     from tactileskin import fileio
+    from tactileskin.cli._console import new_console
     from tactileskin.mesh import FORMATS, build_mesh
     from tactileskin.errors import ParameterError
 
@@ -58,7 +58,7 @@ def command(out, cell, scene_opts):
     if sm.dim == 3 and not scene.skin_kind.fixes_thickness:
         table.add_row("z symmetry", "yes (end_back is z = 0)" if sm.z_symmetric else "no")
     table.add_row("wall time (s)", f"{q['wall_s']:.2f}")
-    console = Console()
+    console = new_console()
     console.print(table)
     if out is not None:
         path = sm.write(out)

@@ -40,12 +40,12 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
                    "sensors.csv and sensors.png.")
 def command(out, history, compare_2d, scene_opts, sensors_file=None):
     """Solve the finite-strain contact problem of one scene and write the results."""
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
     from rich.text import Text
 
     from tactileskin import fileio
+    from tactileskin.cli._console import new_console
     from tactileskin.errors import TactileSkinError
     from tactileskin.fe import solve
 
@@ -117,7 +117,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                   f"{s['min_J']:.4g} / {s['max_abs_stress_mpa']:.4g} MPa")
     t.add_row("status", Text("ok", style="green") if s["status"] == "ok"
               else Text(s["status"], style="bold yellow"))
-    console = Console()
+    console = new_console()
     console.print(t)
     rc = 0
     if s["status"] != "ok":
@@ -137,15 +137,15 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
 def solve_progress(label: str):
     """A transient progress line on stderr for one solve; yields the callback for
     fe.solve(progress=) (increment, time, travel and Newton iterations)."""
-    from rich.console import Console
     from rich.markup import escape
     from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from tactileskin.cli import raise_if_signalled
+    from tactileskin.cli._console import new_console
 
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(bar_width=16),
                   TextColumn("{task.fields[info]}"), TimeElapsedColumn(),
-                  console=Console(stderr=True), transient=True) as bar:
+                  console=new_console(stderr=True), transient=True) as bar:
         task = bar.add_task(escape(label), total=1.0, info="meshing, setting up")
 
         def show(i):  # short: it must fit an 80-column terminal beside the label
@@ -209,10 +209,11 @@ def _compare_doc(scene, s3: dict, r2) -> dict:
 
 
 def _print_compare_2d(doc: dict, s2: dict) -> None:
-    from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
     from rich.text import Text
+
+    from tactileskin.cli._console import new_console
 
     t = Table(title=escape(f"2D section ({doc['scene_2d']}) against 3D; difference = (2D - 3D) / 3D"))
     for c in ("", "2D", "3D", "difference"):
@@ -220,7 +221,7 @@ def _print_compare_2d(doc: dict, s2: dict) -> None:
     for k in ("peak_mpa", "span_mm"):
         a, b, d = doc[k]["2d"], doc[k]["3d"], doc[k]["relative_difference"]
         t.add_row(k, f"{a:.4g}", f"{b:.4g}", "n/a (3D is 0)" if d is None else f"{100 * d:+.1f} %")
-    Console().print(t)
+    new_console().print(t)
     if s2.get("status", "ok") != "ok":
-        Console().print(Text(f"warning: the 2D section is suspect: {s2['status']}", style="bold yellow"),
+        new_console().print(Text(f"warning: the 2D section is suspect: {s2['status']}", style="bold yellow"),
                         highlight=False)

@@ -37,18 +37,18 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 @click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
 def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
-    from rich.console import Console
     from rich.markup import escape
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.text import Text
 
     from tactileskin import quality as result_quality  # `quality` is the mesh preset option
     from tactileskin.cli import raise_if_signalled
+    from tactileskin.cli._console import new_console
 
     from tactileskin.report.outputs import write_outputs
     from tactileskin.sweep import ResultCache, check_scheduler, run_sweep
 
-    console = Console()
+    console = new_console()
     if scheduler is not None:
         check_scheduler(scheduler)
     scenes = scenes_from_options(scene_opts, braille_dim)
