@@ -36,6 +36,22 @@ def test_help_of_scene_documents_every_field_with_unit_and_range():
     assert "thickness (mm)" in doc and "rate (mm/s)" in doc and "[0.01, 5]" in doc
 
 
+def test_help_and_signature_of_sweep_are_the_api_function():
+    """help(ts.sweep) showed the internal module and inspect.signature() the module's
+    __call__(grid=None, **kw), not the documented API."""
+    import inspect
+    import pydoc
+
+    from tactileskin import api
+
+    assert inspect.signature(ts.sweep) == inspect.signature(api.sweep)
+    assert {"out", "workers", "serial", "scheduler", "profiles", "report"} <= set(inspect.signature(ts.sweep).parameters)
+    text = pydoc.render_doc(ts.sweep, renderer=pydoc.plaintext)
+    assert "pandas DataFrame" in text and "profiles: return (metrics, profiles)" in text
+    assert "tactileskin.sweep(grid=None, *, quality" in text
+    assert callable(ts.sweep.run_sweep) and ts.sweep.__name__ == "tactileskin.sweep"  # still the module
+
+
 def test_result_repr_is_one_short_line():
     s = np.linspace(0, 8, 2000)
     r = Result(s=s, pressure=np.exp(-s), contact_x=s, contact_pressure=s, reaction=1.5,

@@ -508,14 +508,35 @@ def run_sweep(
     return outcomes
 
 
+def _api_sweep():
+    from tactileskin.api import sweep
+
+    return sweep
+
+
 class _CallableModule(type(os)):
-    """`tactileskin.sweep(grid, ...)` runs a sweep from Python (tactileskin.api.sweep) while
-    `tactileskin.sweep` stays this module (run_sweep, expand_grid, ...)."""
+    # `tactileskin.sweep(grid, ...)` runs a sweep from Python (tactileskin.api.sweep) while
+    # `tactileskin.sweep` stays this module (run_sweep, expand_grid, ...). help() and
+    # inspect.signature() of it must describe the call a user makes, so both come from the
+    # API function (pydoc documents any module as a module: its __doc__ is the API's).
 
     def __call__(self, grid=None, **kw):
-        from tactileskin.api import sweep
+        return _api_sweep()(grid, **kw)
 
-        return sweep(grid, **kw)
+    @property
+    def __signature__(self):
+        import inspect
+
+        return inspect.signature(_api_sweep())
+
+    @property
+    def __doc__(self):
+        import inspect
+
+        fn = _api_sweep()
+        own = self.__dict__.get("__doc__") or ""
+        return (f"tactileskin.sweep{inspect.signature(fn)}\n\n{inspect.cleandoc(fn.__doc__ or '')}\n\n"
+                f"(The module tactileskin.sweep behind it, which the CLI uses:)\n\n{own}")
 
 
 import sys as _sys  # noqa: E402
