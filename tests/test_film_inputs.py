@@ -36,6 +36,18 @@ def _fails(capsys, argv, *needles):
     return err
 
 
+def test_a_box_in_mm_outside_the_image_states_the_range_in_mm(tmp_path, capsys, scan):
+    """--box-mm -1 0 2 2 said "valid: 0 <= x0 < x1 <= 128, ... px": pixels for an option in mm."""
+    from PIL import Image
+
+    w, h = Image.open(scan).size
+    err = _fails(capsys, ["film", "analyze", str(scan), "--px-per-mm", "8", "--box-mm", "-1", "0", "2", "2",
+                          "--out", str(tmp_path / "o")], "box_mm")
+    flat = " ".join(err.split())
+    assert f"0 <= x0 < x1 <= {w / 8:.4g}, 0 <= y0 < y1 <= {h / 8:.4g} mm" in flat, flat
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize("opts, needle", [
     (["--px-per-mm", "inf"], "px_per_mm"),
     (["--px-per-mm", "nan"], "px_per_mm"),

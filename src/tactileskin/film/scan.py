@@ -81,11 +81,13 @@ def select_region(gray: np.ndarray, *, box_px=None, box_mm=None, px_per_mm: floa
         box_px = (0, 0, w, h)
     x0, y0, x1, y1 = box_px
     if not (0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h):
-        given = box_mm if box_mm is not None else box_px
-        unit = f" mm at {px_per_mm:g} px/mm" if box_mm is not None else " px"
         why = ("x1 <= x0 or y1 <= y0" if (x1 <= x0 or y1 <= y0) else "region outside the image")
-        raise ParameterError(name, tuple(given), f"0 <= x0 < x1 <= {w}, 0 <= y0 < y1 <= {h} px "
-                             f"(the image is {w} x {h} px)", hint=f"{why}; box given in{unit}")
+        if box_mm is not None:  # the range in the option's unit: the image's size in mm
+            wm, hm = (f"{v / px_per_mm:.4g}" for v in (w, h))
+            raise ParameterError(name, tuple(box_mm), f"0 <= x0 < x1 <= {wm}, 0 <= y0 < y1 <= {hm} mm "
+                                 f"(the image is {wm} x {hm} mm: {w} x {h} px at {px_per_mm:g} px/mm)", hint=why)
+        raise ParameterError(name, tuple(box_px), f"0 <= x0 < x1 <= {w}, 0 <= y0 < y1 <= {h} px "
+                             f"(the image is {w} x {h} px)", hint=why)
     return gray[y0:y1, x0:x1], (x0, y0, x1, y1)
 
 
