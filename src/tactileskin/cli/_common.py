@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin.scene import Formulation, IndenterKind
+from tactileskin.scene import Formulation, IndenterKind, Scene
 
 
 QUALITIES = ("preview", "default", "fine")
@@ -20,6 +20,108 @@ SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text",
 PHYSICS_KEYS = ("rate", "force", "force_rate", "formulation", "elastic")
 
 
+class _RangeHelpOption(click.Option):
+    """An option whose help is a callable, evaluated when --help is shown: the valid ranges
+    and defaults it quotes are read from the constants the validation uses (one source),
+    and the fingertip's range (a parameter file) is not computed on every command."""
+
+    def __init__(self, *args, help=None, **kw):  # noqa: A002 (click's keyword)
+        self._help = help
+        super().__init__(*args, help=None if callable(help) else help, **kw)
+
+    def get_help_record(self, ctx):
+        if callable(self._help):
+            self.help = self._help()
+        return super().get_help_record(ctx)
+
+
+class _HelpText:
+    """Range and default texts of the scene options, from the validation's constants."""
+
+    @staticmethod
+    def thickness() -> str:
+        from tactileskin.errors import range_text
+        from tactileskin.geometry.fingertip import Fingertip
+        from tactileskin.skins import pad
+
+        return (f"fingertip {range_text(*Fingertip.from_params().thickness_bounds)}, "
+                f"pad {range_text(*pad.THICKNESS)}")
+
+    @staticmethod
+    def default(field: str, grid: bool = False) -> str:
+        import dataclasses
+
+        from tactileskin import sweep
+        from tactileskin.errors import fmt_bound
+
+        if grid and field in ("thickness", "material", "indenter"):  # the sweep's paper grid
+            values = {"thickness": sweep.PAPER_THICKNESSES, "material": sweep.PAPER_MATERIALS,
+                      "indenter": sweep.PAPER_INDENTERS}[field]
+        else:
+            values = [{f.name: f.default for f in dataclasses.fields(Scene)}[field]]
+        return ",".join(fmt_bound(v) if isinstance(v, float) else getattr(v, "value", str(v)) for v in values)
+
+    @staticmethod
+    def scene_range(name: str, unit: str = "") -> str:
+        from tactileskin import scene
+        from tactileskin.errors import range_text
+
+        return "in " + range_text(*getattr(scene, name), unit=unit)
+
+    @staticmethod
+    def depth() -> str:
+        from tactileskin.errors import fmt_bound
+        from tactileskin.scene import MAX_DEPTH_FRACTION
+
+        return f"in (0, {fmt_bound(MAX_DEPTH_FRACTION)} t]"
+
+    @staticmethod
+    def depth_default() -> str:
+        from tactileskin.scene import DEPTH_FRACTION
+
+        return f"{DEPTH_FRACTION:.0%} of t".replace("%", " %")
+
+    @staticmethod
+    def radius() -> str:
+        from tactileskin.errors import range_text
+        from tactileskin.geometry.indenters.base import RADIUS
+
+        return "in " + range_text(*RADIUS, lo_open=True)
+
+    @staticmethod
+    def pad_size() -> str:
+        from tactileskin.errors import range_text
+        from tactileskin.skins import pad
+
+        return "in " + range_text(*pad.SIZE)
+
+    @staticmethod
+    def pad(which: str) -> str:
+        from tactileskin.errors import fmt_bound
+        from tactileskin.skins import pad
+
+        return fmt_bound(getattr(pad, f"DEFAULT_{which}"))
+
+    @staticmethod
+    def force() -> str:
+        from tactileskin.errors import range_text
+        from tactileskin.loading import MAX_FORCE
+
+        return "in " + range_text(0.0, MAX_FORCE, lo_open=True, unit="N")
+
+    @staticmethod
+    def formulation() -> str:
+        from tactileskin.scene import Formulation
+
+        default = _HelpText.default("formulation")
+        what = {"mixed": "locking-free", "displacement": "locks; for comparison"}
+        parts = []
+        for k in Formulation:
+            notes = [n for n in (what.get(k.value), "default" if k.value == default else None) if n]
+            parts.append(k.value + (f" ({'; '.join(notes)})" if notes else ""))
+        return " or ".join(parts)
+
+
 def scene_options(f=None, *, grid: bool = False, physics: bool = True):
     """Click options that map onto Scene fields, the same on `solve`, `mesh` and `sweep` (one
     definition, so they cannot drift). The command receives them as one dict `scene_opts`.
@@ -29,54 +131,64 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         return lambda g: scene_options(g, grid=grid, physics=physics)
     many = " (comma-separated list, or start:stop:step)" if grid else ""
     names = " (comma-separated list)" if grid else ""
+    h = _HelpText  # ranges and defaults come from the validation's constants when help is shown
+    opt = functools.partial(click.option, cls=_RangeHelpOption)
     opts = [
         click.option("--scene", "--config", "scene_file", type=click.Path(dir_okay=False), default=None,
                      help="Scene or sweep TOML (Scene fields, optional quality, optional [sweep] lists); "
                           "the options below override it."),
-        click.option("--thickness", "-t", type=str if grid else float, default=None,
-                     help="Skin thickness (mm)" + many + (". Default 1,3,5." if grid else ".")),
-        click.option("--material", "-m", type=str, default=None,
-                     help="Material preset name or .toml file" + names
-                          + (". Default silicone,polyurethane." if grid else ".")),
-        click.option("--indenter", "-i", default=None,
-                     type=str if grid else click.Choice([k.value for k in IndenterKind]),
-                     help=("Indenters: flat, curved, braille" + names + ". Default all three.") if grid
-                     else "Indenter kind."),
+        opt("--thickness", "-t", type=str if grid else float, default=None,
+            help=lambda: f"Skin thickness (mm){many}: {h.thickness()}. Default {h.default('thickness', grid)}."),
+        opt("--material", "-m", type=str, default=None,
+            help=lambda: f"Material preset name or .toml file{names}. Default {h.default('material', grid)}."),
+        opt("--indenter", "-i", default=None,
+            type=str if grid else click.Choice([k.value for k in IndenterKind]),
+            help=lambda: (f"Indenters: {', '.join(k.value for k in IndenterKind)}{names}. "
+                          f"Default {h.default('indenter', grid)}.") if grid else "Indenter kind."),
         click.option("--braille-text", type=str, default=None, multiple=grid,
                      help="Text for a Braille indenter" + (" (repeatable)." if grid else ".")),
         click.option("--braille-standard", type=str, default=None, help="Braille standard name."),
-        click.option("--indenter-radius", type=float, default=None, help="Sphere or cylinder radius (mm)."),
+        opt("--indenter-radius", type=float, default=None,
+            help=lambda: f"Sphere or cylinder radius (mm), {h.radius()}; required by both."),
         click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
                      help="Cylinder axis: z along the finger (2D-exact), x across it (3D)."),
         click.option("--indenter-file", type=str, default=None,
                      help="Closed STL/OBJ/PLY/OFF or STEP surface (mm) of a 'file' indenter."),
-        click.option("--depth", type=str if grid else float, default=None,
-                     help="Indentation depth (mm)" + many + "; default 20 % of t."),
+        opt("--depth", type=str if grid else float, default=None,
+            help=lambda: f"Indentation depth (mm){many}, {h.depth()}; default {h.depth_default()}."),
         click.option("--dim", type=click.Choice(["2", "3"]), default=None,
                      help="2D plane-strain section or 3D slab."),
         click.option("--quality", type=click.Choice(QUALITIES), default=None,
                      help="Mesh preset of the scene's dimension (data/presets.json; "
                           "docs/speed_vs_error.md). Default: the `default` sizes."),
-        click.option("--mesh-size", type=float, default=None, help="Global element size (mm); overrides --quality."),
-        click.option("--refinement", type=float, default=None,
-                     help="Global / refined element size ratio; overrides --quality."),
+        opt("--mesh-size", type=float, default=None,
+            help=lambda: f"Global element size (mm), {h.scene_range('MESH_SIZE')}; overrides --quality."),
+        opt("--refinement", type=float, default=None,
+            help=lambda: f"Global / refined element size ratio, {h.scene_range('REFINEMENT')}; overrides --quality."),
         click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default 2)."),
         click.option("--skin", type=str, default=None,
                      help="Skin geometry: fingertip (default), pad, dome (rounded 3D tip) or file."),
         click.option("--skin-file", type=str, default=None,
                      help="File skin: a gmsh .msh with named groups or a STEP solid (mm); implies --skin file."),
-        click.option("--pad-width", type=float, default=None, help="Pad: x extent of the whole pad (mm)."),
-        click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm)."),
+        opt("--pad-width", type=float, default=None,
+            help=lambda: f"Pad: x extent of the whole pad (mm), {h.pad_size()}. Default {h.pad('WIDTH')}."),
+        opt("--pad-length", type=float, default=None,
+            help=lambda: f"Pad: z extent (mm), {h.pad_size()}. Default {h.pad('LENGTH')}."),
     ]
     if physics:
         opts += [
-            click.option("--rate", type=float, default=None, help="Indentation rate (mm/s)."),
+            opt("--rate", type=float, default=None,
+                help=lambda: f"Indentation rate (mm/s), {h.scene_range('RATE')}. "
+                             f"Default {h.default('rate')}."),
             # loading (tactileskin.loading): force control; holds and releases via [[loading]] in --scene
-            click.option("--force", type=float, default=None,
-                         help="Force control: target force (N on the whole indenter in 3D, N/mm of the half section in 2D) instead of --depth."),
-            click.option("--force-rate", type=float, default=None,
-                         help="Force rate (N/s, N/mm/s in 2D) for --force."),
-            click.option("--formulation", type=click.Choice([k.value for k in Formulation]), default=None),
+            opt("--force", type=float, default=None,
+                help=lambda: f"Force control instead of --depth: target force, {h.force()} (the whole indenter "
+                             "in 3D; N/mm of the half section in 2D)."),
+            opt("--force-rate", type=float, default=None,
+                help=lambda: f"Force rate (N/s, N/mm/s in 2D) for --force, {h.scene_range('RATE')}. "
+                             f"Default: the depth ramp's time ({h.depth_default()} / rate)."),
+            opt("--formulation", type=click.Choice([k.value for k in Formulation]), default=None,
+                help=lambda: f"{h.formulation()}."),
             click.option("--elastic", is_flag=True, default=None,
                          help="Ignore viscoelasticity (the Prony series)."),
         ]

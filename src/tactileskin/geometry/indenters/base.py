@@ -196,7 +196,10 @@ class Indenter:
         raise NotImplementedError
 
 
-def check_radius(value, kind: str, lo: float = 0.1, hi: float = 1000.0) -> float:
+RADIUS = (0.1, 1000.0)  # mm: indenter_radius of a sphere or cylinder, (lo, hi]
+
+
+def check_radius(value, kind: str, lo: float = RADIUS[0], hi: float = RADIUS[1]) -> float:
     if value is None:
         raise ParameterError("indenter_radius", None, f"({lo:g}, {hi:g}] mm for the {kind} indenter",
                              "the radius is required (no default)")
