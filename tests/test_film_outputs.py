@@ -102,3 +102,31 @@ def test_compare_refuses_a_result_without_contact_and_warns_of_a_suspect_one(tmp
     (sim / "summary.json").write_text(json.dumps({"status": "suspect: volume ratio J = 0.8"}))
     assert main(["film", "compare", str(film), str(sim)]) == 0
     assert "warning: the simulated result is suspect" in capsys.readouterr().err
+
+
+def test_calibration_plot_labels_fit_in_the_figure_with_units(tmp_path, monkeypatch):
+    """The residual panel's y-label was cut off at the left edge and had no unit; a CSV named
+    calibration.csv gave the title "calibration calibration"."""
+    from tactileskin.film import plots
+    from tactileskin.film.calibration import calibrate_csv
+
+    gs = [30, 60, 90, 125, 160, 190, 220]
+    force = [30.6, 25.1, 20.2, 14.9, 10.3, 5.2, 2.0]  # residuals ~ +-0.008 MPa: wide tick labels
+    csv = tmp_path / "calibration.csv"
+    csv.write_text("force_n,area_mm2,gray\n" + "".join(f"{f},100,{g}\n" for f, g in zip(force, gs)))
+    cal = calibrate_csv(csv)
+    seen = {}
+    save = plots._save
+
+    def check(fig, path):
+        fig.canvas.draw()
+        r = fig.canvas.get_renderer()
+        seen.update(title=fig.axes[0].get_title(), label=fig.axes[1].get_ylabel(),
+                    x0=min(ax.yaxis.label.get_window_extent(r).x0 for ax in fig.axes[:2]))
+        return save(fig, path)
+
+    monkeypatch.setattr(plots, "_save", check)
+    assert plots.calibration_plot(cal, tmp_path / "cal.png").exists()
+    assert seen["x0"] >= 0, seen
+    assert f"({cal.unit})" in seen["label"] and "residual" in seen["label"]
+    assert "calibration calibration" not in seen["title"] and "calibration" in seen["title"]

@@ -76,7 +76,8 @@ def calibration_plot(cal, path) -> Path:
     plt = _plt()
     pts = cal.report.get("points", {})
     g = np.linspace(*cal.gs_range, 200)
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(6, 6), sharex=True,
+    # constrained layout: the residuals' wider tick labels pushed their y-label off the left edge
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(6, 6), sharex=True, layout="constrained",
                                   gridspec_kw={"height_ratios": [2, 1]})
     if pts:
         ax.plot(pts["gray"], pts["pressure"], "o", label="presses (F/A)")
@@ -85,14 +86,17 @@ def calibration_plot(cal, path) -> Path:
     if band is not None:
         ax.fill_between(g, band[0], band[1], alpha=0.3, label="90 % confidence band")
     ax.set_ylabel(f"P ({cal.unit})")
-    ax.set_title(f"calibration {cal.name}")
+    # a name from a CSV called calibration.csv read "calibration calibration"
+    name = cal.name if "calibration" in cal.name.lower() else f"calibration {cal.name}"
+    ax.set_title(f"{name} ({cal.model} fit)")
     ax.legend(fontsize=8)
     res = cal.report.get("selected_fit", {}).get("residuals")
     if pts and res:
         ax2.axhline(0, color="0.5", lw=0.8)
         ax2.plot(pts["gray"], res, "o")
     ax2.set_xlabel("mean grayscale GS")
-    ax2.set_ylabel("residual")
+    ax2.set_ylabel(f"residual P - fit ({cal.unit})")
+    fig.align_ylabels((ax, ax2))
     return _save(fig, path)
 
 
