@@ -59,6 +59,13 @@ def _temporaries(folder: Path) -> list[str]:
                   or p.name.endswith(".partial"))
 
 
+def _as_written_by_us(path: Path) -> None:
+    """Record `path` in its folder's record as a file tactileskin wrote (an earlier run's)."""
+    rec = fileio._owned(path.parent)
+    rec[path.name] = fileio._digest(path)
+    (path.parent / fileio.OWNED_FILES).write_text(__import__("json").dumps(rec))
+
+
 # --- solve --out ------------------------------------------------------------------------
 
 def test_solve_refuses_a_folder_holding_a_user_file_and_keeps_it(tmp_path, capsys, fake_solve):
@@ -76,8 +83,8 @@ def test_solve_rewrites_its_own_folder_and_refuses_unmarked_lookalikes(tmp_path,
     d = tmp_path / "d"
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # marked as ours: rewritten
-    assert sorted(p.name for p in d.iterdir()) == [".tactileskin", "contact.csv", "profile.csv",
-                                                  "result.vtu", "summary.json"]
+    assert sorted(p.name for p in d.iterdir()) == [".tactileskin", fileio.OWNED_FILES, fileio.RECORD_LOCK,
+                                                  "contact.csv", "profile.csv", "result.vtu", "summary.json"]
     # without our marker, files with solve's names are the user's: refused, left as they are
     user = tmp_path / "user"
     user.mkdir()
@@ -328,6 +335,7 @@ def test_a_sweep_replaces_its_outputs_whole_and_leaves_a_users_file(tmp_path, ca
     argv = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
     assert main(argv) == 1  # the (faked) case failed; the outputs are written
     (out / "fig9_t5-silicone-flat-2d.png").write_bytes(b"a render of an earlier sweep")
+    _as_written_by_us(out / "fig9_t5-silicone-flat-2d.png")
     (out / "notes.txt").write_text("mine")
     assert main(argv) == 1
     assert not (out / "fig9_t5-silicone-flat-2d.png").exists()  # not this sweep's: it would mislead

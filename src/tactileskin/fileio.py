@@ -13,6 +13,9 @@ Rules (issue #12, "never destroy user data"):
   is refused, never emptied.
 - A single output file of the CLI replaces an existing file only if the toolkit wrote it and
   nobody changed it since (`claim_file`, `record_file`: the folder's `.tactileskin-files.json`).
+  The same record lists the files of a result in a marked output folder (`staged_files`): a
+  rerun replaces or removes only those, so a user's file stays whatever its name, and a file
+  of ours the user edited is refused, not overwritten.
 - An OSError becomes an `OutputError` that names the path and the cause in one line.
 """
 
@@ -32,14 +35,29 @@ from tactileskin.errors import TactileSkinError
 
 MARKER = ".tactileskin"
 _TMP_RE = re.compile(r"^\..+\.tsk(\d+)-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
+_TMP_NAME_RE = re.compile(r"^\.(.+)\.tsk\d+-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # group 1: the target's name
 
 
 class OutputError(TactileSkinError):
     """An output could not be written (permissions, no space, a file in the way, ...)."""
 
     def __init__(self, path, cause: str):
-        self.path = str(path)
+        self.path = user_path(path)
         super().__init__(f"cannot write {self.path}: {cause}")
+
+
+def user_path(path) -> str:
+    """`path` as the user knows it: our temporaries in it named by their targets, and the
+    staging folders of staged_files (they stand for the output folder) left out. A write that
+    fails inside staging then names the destination, not `.x.tsk123-abc.partial/...`."""
+    parts = []
+    for part in Path(path).parts:
+        m = _TMP_NAME_RE.match(part)
+        if m is None:
+            parts.append(part)
+        elif m.group(1) != STAGING:
+            parts.append(m.group(1))
+    return str(Path(*parts)) if parts else str(path)
 
 
 def umask() -> int:
@@ -241,6 +259,27 @@ def record_file(path) -> None:
     atomic_write_json(path.parent / OWNED_FILES, rec)
 
 
+# The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,
+# left in place (removing it would race with the next writer's open).
+RECORD_LOCK = ".tactileskin-files.lock"
+
+
+@contextlib.contextmanager
+def _record_lock(folder: Path) -> Iterator[None]:
+    """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
+    OWNED_FILES (waits for another writer into the same folder)."""
+    import fcntl
+
+    with os_errors(folder / OWNED_FILES, own_name=False):
+        fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+    try:
+        with os_errors(folder / OWNED_FILES, own_name=False):
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
 # --- output folders -------------------------------------------------------------------
 
 def _is_ours(folder: Path, kind: str | None) -> bool:
@@ -318,6 +357,11 @@ def staged_dir(final) -> Iterator[Path]:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+# the name staged_files' staging folders are made from (`.tactileskin-staging.tskPID-X.partial`):
+# it stands for the output folder itself, never for a file in it (see user_path)
+STAGING = "tactileskin-staging"
+
+
 def _files(root: Path, subfolders=None) -> list[str]:
     """Paths (relative, with "/") of the files under `root`, our temporaries left out; with
     `subfolders`, only those top-level folders are entered (not a sweep's cache)."""
@@ -330,17 +374,48 @@ def _files(root: Path, subfolders=None) -> list[str]:
     return out
 
 
+def _check_owned(folder: Path, old: list[str], new: list[str], rec: dict) -> list[str]:
+    """Of the pattern-matching files `old` in a marked `folder`, those the toolkit recorded
+    writing and nobody changed since (to replace or remove). A file the new result would
+    replace that is not one of them is refused: it is the user's (not recorded) or the user
+    edited ours. Any other is left where it is."""
+    ours = []
+    for rel in old:
+        p = folder / rel
+        try:
+            same = rel in rec and not p.is_symlink() and _digest(p) == rec[rel]
+        except OSError:
+            same = False
+        if same:
+            ours.append(rel)
+        elif rel in new:
+            why = ("tactileskin wrote it but it was changed since" if rel in rec
+                   else "the file exists and tactileskin did not write it")
+            raise OutputError(p, f"{why}; refusing to overwrite it: move it away, or write to a new folder")
+    for rel in new:  # a name the earlier result did not use, held by a folder or link of the user's
+        p = folder / rel
+        if rel not in old and (p.exists() or p.is_symlink()):
+            raise OutputError(p, "something tactileskin did not write is in the way; refusing to "
+                                 "replace it: move it away, or write to a new folder")
+    return ours
+
+
 @contextlib.contextmanager
 def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iterator[Path]:
     """Yield an empty staging folder inside `folder` for the body to write one result into.
 
     On success the result replaces the folder's earlier one: every file the body wrote moves
-    into place, and every file of `folder` that matches an `own` pattern (fnmatch on the path
-    relative to `folder`: "summary.json", "result_steps/step_*.vtu") but was not written this
-    time is removed, so no file of an earlier result outlives it. Other files are left alone,
-    and a folder is removed only once empty. `last` is removed first and moved in last, so a
-    folder holding it holds a complete result. On failure nothing in `folder` changes (a full
-    disk fails while staging, before the first move).
+    into place, and every file of the earlier result that matches an `own` pattern (fnmatch on
+    the path relative to `folder`: "summary.json", "result_steps/step_*.vtu") but was not
+    written this time is removed, so no file of an earlier result outlives it. In a folder
+    marked as ours (claim_dir) the earlier result is what the folder's OWNED_FILES records
+    (the record is updated with the new files): a user's file stays even if its name matches
+    a pattern, and one the new result would replace (or a file of ours the user edited) is
+    refused (OutputError) before anything moves. An unmarked folder is the caller's entirely
+    (a cache entry, a staging folder): there every matching file is the earlier result's.
+    Other files are left alone, and a folder is removed only once empty. `last` is removed
+    first and moved in last, so a folder holding it holds a complete result. On failure
+    nothing in `folder` changes (a full disk fails while staging, before the first move).
     """
     import fnmatch
 
@@ -348,7 +423,7 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
     folder = make_dirs(folder)
     clean_stale(folder)
     with os_errors(folder, own_name=False):
-        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "result"), suffix=".partial", dir=folder))
+        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
         os.chmod(tmp, dir_mode())
     try:
         yield tmp
@@ -356,46 +431,66 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
         stray = [f for f in new if not any(fnmatch.fnmatchcase(f, p) for p in own)]
         if stray:
             raise ValueError(f"staged files not in the owned patterns: {stray}")
-        tops = {p.split("/")[0] for p in own if "/" in p}
-        old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
-        for rel in new:  # a linked subfolder would take our files into a folder we do not own
-            for parent in list(Path(rel).parents)[:-1]:
-                if (folder / parent).is_symlink() or ((folder / parent).exists() and not (folder / parent).is_dir()):
-                    raise OutputError(folder / parent, "it is a link or a file where tactileskin writes a folder "
-                                                       "of its own; move it away")
-        trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / "old"), suffix=".partial", dir=folder))
-        aside, moved_in = [], []  # (where it was, where it is): undone in reverse on a failure
-        try:
-            with os_errors(folder):
-                order = sorted(set(new) | set(old), key=lambda f: f == last)
-                if last in old:
-                    os.replace(folder / last, trash / "last")
-                    aside.append((folder / last, trash / "last"))
-                for i, rel in enumerate(order):
-                    dst = folder / rel
-                    if rel in old and rel != last:
-                        os.replace(dst, trash / f"{i}")
-                        aside.append((dst, trash / f"{i}"))
-                    if rel in new:
-                        make_dirs(dst.parent)
-                        os.replace(tmp / rel, dst)
-                        moved_in.append((tmp / rel, dst))
-        except BaseException:
-            for src, dst in reversed(moved_in):  # the earlier result back as it was
-                with contextlib.suppress(OSError):
-                    os.replace(dst, src)
-            for orig, parked in reversed(aside):
-                with contextlib.suppress(OSError):
-                    os.replace(parked, orig)
-            raise
-        finally:
-            shutil.rmtree(trash, ignore_errors=True)
-        # folders of the earlier result that are empty now (deepest first)
-        for rel in sorted({Path(f).parent for f in old} - {Path(".")}, key=lambda d: -len(d.parts)):
-            with contextlib.suppress(OSError):
-                (folder / rel).rmdir()
+        marked = (folder / MARKER).is_file()
+        with os_errors(folder):  # the digests the record will hold, before anything moves
+            digests = {rel: _digest(tmp / rel) for rel in new} if marked else {}
+        with _record_lock(folder) if marked else contextlib.nullcontext():
+            _replace_files(folder, tmp, own, new, last, digests if marked else None)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, digests: dict | None) -> None:
+    """staged_files' moves: the earlier result aside, the new one in (and, with `digests`,
+    the folder's record updated), undone in reverse if any step fails."""
+    import fnmatch
+
+    tops = {p.split("/")[0] for p in own if "/" in p}
+    old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
+    rec = None
+    if digests is not None:
+        rec = _owned(folder)
+        old = _check_owned(folder, old, new, rec)
+    for rel in new:  # a linked subfolder would take our files into a folder we do not own
+        for parent in list(Path(rel).parents)[:-1]:
+            if (folder / parent).is_symlink() or ((folder / parent).exists() and not (folder / parent).is_dir()):
+                raise OutputError(folder / parent, "it is a link or a file where tactileskin writes a folder "
+                                                   "of its own; move it away")
+    with os_errors(folder, own_name=False):
+        trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
+    aside, moved_in = [], []  # (where it was, where it is): undone in reverse on a failure
+    try:
+        with os_errors(folder):
+            order = sorted(set(new) | set(old), key=lambda f: f == last)
+            if last in old:
+                os.replace(folder / last, trash / "last")
+                aside.append((folder / last, trash / "last"))
+            for i, rel in enumerate(order):
+                dst = folder / rel
+                if rel in old and rel != last:
+                    os.replace(dst, trash / f"{i}")
+                    aside.append((dst, trash / f"{i}"))
+                if rel in new:
+                    make_dirs(dst.parent)
+                    os.replace(tmp / rel, dst)
+                    moved_in.append((tmp / rel, dst))
+            if rec is not None:  # entries of files gone or replaced dropped, the new ones added
+                keep = {k: v for k, v in rec.items() if k not in old and (folder / k).is_file()}
+                atomic_write_json(folder / OWNED_FILES, {**keep, **digests})  # the last step: no undo
+    except BaseException:
+        for src, dst in reversed(moved_in):  # the earlier result back as it was
+            with contextlib.suppress(OSError):
+                os.replace(dst, src)
+        for orig, parked in reversed(aside):
+            with contextlib.suppress(OSError):
+                os.replace(parked, orig)
+        raise
+    finally:
+        shutil.rmtree(trash, ignore_errors=True)
+    # folders of the earlier result that are empty now (deepest first)
+    for rel in sorted({Path(f).parent for f in old} - {Path(".")}, key=lambda d: -len(d.parts)):
+        with contextlib.suppress(OSError):
+            (folder / rel).rmdir()
 
 
 def fix_tree_modes(root) -> None:

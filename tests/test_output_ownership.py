@@ -1,0 +1,107 @@
+"""An output folder's earlier result is what tactileskin recorded writing there
+(`.tactileskin-files.json`): a user's file stays whatever its name, and a file the user
+edited is not overwritten. The CLI runs in-process; solves are faked (files, not numbers)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+import tactileskin.fe
+from tactileskin import fileio
+from tactileskin.cli import main
+
+from test_output_safety import CHEAP, _err, _temporaries, fake_result
+
+
+@pytest.fixture
+def fake_solve(monkeypatch):
+    monkeypatch.setattr(tactileskin.fe, "solve", lambda scene, **kw: fake_result())
+
+
+def _record(folder: Path) -> dict:
+    return json.loads((folder / fileio.OWNED_FILES).read_text())
+
+
+def test_users_files_with_our_names_stay_in_a_solve_folder(tmp_path, capsys, fake_solve):
+    d = tmp_path / "s1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    assert set(_record(d)) == {"profile.csv", "contact.csv", "summary.json", "result.vtu"}
+    (d / "sensors.csv").write_text("mine\n")
+    (d / "history.csv").write_text("mine\n")
+    (d / "section_2d").mkdir()
+    (d / "section_2d" / "profile.csv").write_text("keep\n")
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    assert (d / "sensors.csv").read_text() == "mine\n" and (d / "history.csv").read_text() == "mine\n"
+    assert (d / "section_2d" / "profile.csv").read_text() == "keep\n"
+    assert "sensors.csv" not in _record(d) and _temporaries(d) == []
+
+
+def test_a_users_file_the_new_result_would_replace_is_refused(tmp_path, capsys, fake_solve):
+    d = tmp_path / "s1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    rec = _record(d)
+    del rec["contact.csv"]  # as if the user had put it there
+    (d / fileio.OWNED_FILES).write_text(json.dumps(rec))
+    (d / "contact.csv").write_text("mine\n")
+    before = {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()}
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert "contact.csv" in err and "did not write" in err and len(err.strip().splitlines()) == 1
+    assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before  # nothing written
+
+
+def test_an_edited_report_is_not_overwritten(tmp_path, capsys, fake_solve):
+    d = tmp_path / "s1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    (d / "summary.json").write_text('{"mine": 1}\n')
+    before = {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()}
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert str(d / "summary.json") in err and "changed since" in err and len(err.strip().splitlines()) == 1
+    assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
+
+
+def test_staged_files_in_a_marked_folder_replace_only_recorded_files(tmp_path):
+    d = fileio.claim_dir(tmp_path / "d", "test")
+    own = ("a.csv", "fig9_*.png", "sub/x_*.csv")
+    with fileio.staged_files(d, own) as tmp:
+        (tmp / "a.csv").write_text("1")
+        (tmp / "fig9_case.png").write_text("1")
+    (d / "fig9_my_notes.png").write_text("mine")
+    (d / "sub").mkdir()
+    (d / "sub" / "x_mine.csv").write_text("mine")
+    with fileio.staged_files(d, own) as tmp:
+        (tmp / "a.csv").write_text("2")  # no figure this time: the recorded one goes
+    assert not (d / "fig9_case.png").exists() and (d / "a.csv").read_text() == "2"
+    assert (d / "fig9_my_notes.png").read_text() == "mine" and (d / "sub" / "x_mine.csv").read_text() == "mine"
+    assert set(_record(d)) == {"a.csv"}
+    # an edited file of ours that the new result does not write is the user's now: it stays
+    with fileio.staged_files(d, own) as tmp:
+        (tmp / "a.csv").write_text("3")
+        (tmp / "fig9_case.png").write_text("3")
+    (d / "fig9_case.png").write_text("edited")
+    with fileio.staged_files(d, own) as tmp:
+        (tmp / "a.csv").write_text("4")
+    assert (d / "fig9_case.png").read_text() == "edited"  # its entry stays: a rewrite says "changed since"
+
+
+def test_a_sweep_leaves_a_users_figure_of_its_pattern(tmp_path, capsys, monkeypatch):
+    import tactileskin.sweep as sw
+    from tactileskin.errors import ConvergenceError
+
+    def fail(scene):
+        raise ConvergenceError("not solved in this test", {})
+
+    monkeypatch.setattr(sw, "solve_case", fail)
+    out = tmp_path / "out"
+    argv = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
+    assert main(argv) == 1
+    (out / "fig9_my_notes.png").write_bytes(b"mine")
+    assert main(argv) == 1
+    assert (out / "fig9_my_notes.png").read_bytes() == b"mine"
+    (out / "report.md").write_text("my edits\n")
+    assert main(argv) == 2
+    assert "report.md" in _err(capsys) and (out / "report.md").read_text() == "my edits\n"
