@@ -204,6 +204,11 @@ def test_cli_material_fit_writes_a_usable_file(tmp_path, capsys):
     assert m.law.law == "mooney_rivlin" and m.name == "gel" and "R^2" in m.source
     assert m.law.c10 == pytest.approx(0.01, rel=1e-6) and m.law.c01 == pytest.approx(0.004, rel=1e-6)
     assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(out)]) == 0  # ours: replaced
+    capsys.readouterr()
+    out.write_text(out.read_text() + "# my edit\n")  # still starts with the tool's line
+    assert main(["material", "fit", str(csv), "--law", "yeoh", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert str(out) in err and len(err.strip().splitlines()) == 1 and out.read_text().endswith("# my edit\n")
     foreign = tmp_path / "mine.toml"
     foreign.write_text("# my notes\n")
     assert main(["material", "fit", str(csv), "--law", "yeoh", "-o", str(foreign)]) == 2

@@ -52,14 +52,9 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     outp = Path(out)
     if outp.suffix != ".toml":
         raise ParameterError("--out", out, "a path ending in .toml")
-    if outp.exists():
-        try:
-            ours = outp.read_text(encoding="utf-8", errors="replace").startswith(MARK)
-        except OSError:
-            ours = False
-        if not ours:
-            raise ParameterError("--out", out, "a new file or one this command wrote",
-                                 "it exists and was not written by tactileskin material fit")
+    # before the fit: only a file this command wrote and nobody changed since is replaced (the
+    # folder's record; the MARK line alone is kept by a hand-edited copy)
+    fileio.claim_file(outp)
     if test == "indentation":
         from tactileskin.materials.indentation import fit_indentation, read_indentation_csv
 
@@ -76,6 +71,7 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
                   f"chi <= {q['chi_max']:.3g}): E = {f.E:.5g} MPa, R^2 = {q['r2']:.5f}, RMSE = {q['rmse_n']:.3g} N, "
                   f"max relative error {100 * q['max_rel_err']:.2f} %")
         fileio.atomic_write_text(outp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
+        fileio.record_file(outp)
         click.echo(f.describe())
         click.echo(f"wrote {out}")
         return
@@ -91,6 +87,7 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
               f"{100 * q['max_rel_err']:.2f} %" + "".join(f"; SUSPECT: {w}" for w in f.warnings))
     mat = f.material(name or Path(data).stem, source)
     fileio.atomic_write_text(outp, MARK + "\n" + mat.to_toml())
+    fileio.record_file(outp)
     click.echo(f.describe())
     click.echo(f"wrote {out}" + (" (a suspect fit: exit status 3)" if f.warnings else ""))
     return EXIT_SUSPECT if f.warnings else 0
