@@ -31,8 +31,8 @@ def test_default_build_makes_every_part(tmp_path, capsys):
     assert main(["build", "--out", str(out), "--thickness", "2", "--indenter", "none", "--no-molds"]) == 0
     m2 = json.loads((out / "manifest.json").read_text())
     assert [e["name"] for e in m2["parts"]] == ["skin", "rigid_base"]
-    assert sorted(p.name for p in out.iterdir()) == ["manifest.json", "rigid_base.step", "rigid_base.stl",
-                                                     "skin.step", "skin.stl"]
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "manifest.json", "rigid_base.step", "rigid_base.stl", "skin.step", "skin.stl"]
 
 
 def test_braille_word_option(tmp_path):

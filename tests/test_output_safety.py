@@ -370,7 +370,7 @@ def test_sweep_refuses_an_unmarked_folder_of_lookalike_names(tmp_path, capsys, c
 
 # --- build --------------------------------------------------------------------------------
 
-def test_build_output_has_umask_permissions_and_refuses_the_current_folder(tmp_path, capsys, monkeypatch):
+def test_build_output_has_umask_permissions_and_writes_into_its_folder(tmp_path, capsys, monkeypatch):
     out = tmp_path / "parts"
     old = os.umask(0o022)
     try:
@@ -379,20 +379,68 @@ def test_build_output_has_umask_permissions_and_refuses_the_current_folder(tmp_p
         os.umask(old)
     assert stat.S_IMODE(out.stat().st_mode) == 0o755
     modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()}
-    assert "manifest.json" in modes and "skin.stl" in modes
+    assert "manifest.json" in modes and "skin.stl" in modes and fileio.MARKER in modes
     assert modes == {n: 0o644 for n in modes}
     assert [p.name for p in tmp_path.iterdir()] == ["parts"]
     capsys.readouterr()
-    monkeypatch.chdir(out)  # a previous build, but replacing it would pull the shell's folder away
-    assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", "."]) == 2
-    assert "current folder" in _err(capsys)
-    assert set(p.name for p in out.iterdir()) == set(modes)
-    monkeypatch.chdir(tmp_path)
-    # the build replaces its folder whole: a file added to a previous build refuses it
+    # the folder itself is kept (its mode bits, group, ACLs; a mount point; the shell's folder)
+    os.chmod(out, 0o2775)
+    inode = out.stat().st_ino
     (out / "notes.txt").write_text("mine")
+    (out / "my.stl").write_text("mine too")  # a build's pattern, not a build's file
+    monkeypatch.chdir(out)
+    assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", "."]) == 0
+    monkeypatch.chdir(tmp_path)
+    assert out.stat().st_ino == inode and stat.S_IMODE(out.stat().st_mode) == 0o2775
+    assert (out / "notes.txt").read_text() == "mine" and (out / "my.stl").read_text() == "mine too"
+    assert set(p.name for p in out.iterdir()) == set(modes) | {"notes.txt", "my.stl"}
+    assert [p.name for p in tmp_path.iterdir()] == ["parts"] and _temporaries(out) == []
+    capsys.readouterr()
+    # an edited part is the user's now: refused, nothing written
+    (out / "skin.stl").write_bytes(b"edited")
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
     assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]) == 2
-    assert "notes.txt" in _err(capsys) and (out / "notes.txt").read_text() == "mine"
-    assert set(p.name for p in out.iterdir()) == set(modes) | {"notes.txt"}
+    err = _err(capsys)
+    assert "skin.stl" in err and "changed since" in err and len(err.strip().splitlines()) == 1
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+
+
+def test_a_build_folder_from_before_the_marker_is_adopted(tmp_path, capsys):
+    out = tmp_path / "parts"
+    argv = ["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]
+    assert main(argv) == 0
+    for n in (fileio.MARKER, fileio.OWNED_FILES, fileio.RECORD_LOCK):
+        (out / n).unlink()  # as an earlier version left it: the manifest's files only
+    assert main(argv) == 0
+    assert (out / fileio.MARKER).is_file() and "skin.stl" in fileio._owned(out)
+
+
+def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monkeypatch):
+    import errno
+
+    final = tmp_path / "entry"
+    with fileio.staged_dir(final) as tmp:
+        (tmp / "a").write_text("1")
+    real = os.replace
+
+    def busy(src, dst):
+        if Path(src) == final:
+            raise OSError(errno.EBUSY, "Device or resource busy", str(src))
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", busy)
+    with pytest.raises(fileio.OutputError), fileio.staged_dir(final) as tmp:
+        (tmp / "a").write_text("2")
+    assert [p.name for p in tmp_path.iterdir()] == ["entry"] and (final / "a").read_text() == "1"
+
+
+def test_build_refuses_another_commands_folder_naming_it(tmp_path, capsys, fake_solve):
+    d = tmp_path / "s"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    capsys.readouterr()
+    assert main(["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(d)]) == 2
+    err = " ".join(_err(capsys).split())
+    assert "another tactileskin command (`solve`)" in err and "did not write" not in err
 
 
 # --- single output files -------------------------------------------------------------------

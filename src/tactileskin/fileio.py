@@ -324,6 +324,40 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
 
 
 @contextlib.contextmanager
+def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
+    """claim_dir `folder` for the body; if the body fails and the folder was created here and
+    holds nothing but our marker (and record lock), remove it again: a refused or failed run
+    leaves no empty folder behind."""
+    folder = Path(folder)
+    existed = folder.exists() or folder.is_symlink()
+    claim_dir(folder, kind, what=what)
+    try:
+        yield folder
+    except BaseException:
+        if not existed:
+            with contextlib.suppress(OSError):
+                names = {p.name for p in folder.iterdir()}
+                if MARKER in names and names <= {MARKER, RECORD_LOCK}:
+                    for n in names:
+                        (folder / n).unlink()
+                    folder.rmdir()
+        raise
+
+
+def adopt_dir(folder, kind: str, names: Iterable[str]) -> None:
+    """Mark `folder` as ours of `kind`, recording `names` in it as files we wrote, as they are
+    now: for a folder an earlier version wrote without the marker and record (the caller has
+    made sure those files are the toolkit's, e.g. listed in its manifest)."""
+    folder = Path(folder)
+    for n in names:
+        if (folder / n).is_file() and not (folder / n).is_symlink():
+            record_file(folder / n)
+    if not (folder / MARKER).is_file():
+        atomic_write_json(folder / MARKER, {"kind": kind, "note": "written by tactileskin; "
+                                            "its commands may replace their own files here"})
+
+
+@contextlib.contextmanager
 def staged_dir(final) -> Iterator[Path]:
     """Yield a new, empty staging folder beside `final`; on success it replaces `final`.
 
@@ -342,12 +376,13 @@ def staged_dir(final) -> Iterator[Path]:
         with os_errors(final):
             if final.exists():
                 old = Path(tempfile.mkdtemp(prefix=_tmp_prefix(final), suffix=".partial", dir=final.parent))
-                os.replace(final, old / "old")
-                try:
-                    os.replace(tmp, final)
-                except BaseException:
-                    os.replace(old / "old", final)
-                    raise
+                try:  # `old` removed however a move fails (it leaked when the first one did)
+                    os.replace(final, old / "old")
+                    try:
+                        os.replace(tmp, final)
+                    except BaseException:
+                        os.replace(old / "old", final)
+                        raise
                 finally:
                     shutil.rmtree(old, ignore_errors=True)
             else:

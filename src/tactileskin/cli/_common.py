@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import functools
 from pathlib import Path
 
@@ -257,22 +256,9 @@ def scene_from_options(scene_opts: dict, command: str = "solve"):
     return scenefile.apply_quality(base, quality, mesh)
 
 
-@contextlib.contextmanager
 def claimed_output(out, kind: str, what: str = "--out"):
-    """Claim the output folder `out` (fileio.claim_dir) for the body; if the body fails and the
-    folder was created here and holds nothing but our marker, remove it again (no empty
-    leftovers from a refused or failed run)."""
+    """Claim the output folder `out` for the body (fileio.claimed: a folder created here and
+    left holding only our marker by a failed body is removed again)."""
     from tactileskin import fileio
 
-    out = Path(out)
-    existed = out.exists()
-    fileio.claim_dir(out, kind, what=what)
-    try:
-        yield out
-    except BaseException:
-        if not existed:
-            with contextlib.suppress(OSError):
-                if [p.name for p in out.iterdir()] == [fileio.MARKER]:
-                    (out / fileio.MARKER).unlink()
-                    out.rmdir()
-        raise
+    return fileio.claimed(out, kind, what=what)

@@ -12,7 +12,8 @@ import click
 @click.option("--thickness", "-t", type=float, default=None,
               help="Skin thickness (mm); default from data/geometry/fingertip.toml.")
 @click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
-              help="Output folder (replaced only if empty or a previous build).")
+              help="Output folder: new, empty or a previous build's (only the files that build wrote "
+                   "are replaced; others stay).")
 @click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "sphere", "cylinder", "all", "none"]),
               default="all", show_default=True,
               help="Which indenter(s) to make ('all': the paper's flat, curved and braille).")

@@ -1,9 +1,11 @@
 """Write parts as binary STL + STEP, check every STL is a valid volume, write manifest.json.
 
-All output goes into a staging folder beside the target (fileio.staged_dir) and is renamed
+All output goes into a staging folder inside the target (fileio.staged_files) and is moved
 into place only once every file is written and checked: a failed build leaves nothing behind
 (an existing previous build in the target stays untouched until the new one is complete).
-Only a new or empty folder or a previous build (our manifest) is ever replaced.
+The target is a new or empty folder or a previous build's; the folder itself (its mode,
+group, ACLs; a mount point) is kept, and only the files the previous build recorded writing
+are replaced: a user's files stay, one of ours the user edited is refused.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ log = logging.getLogger(__name__)
 
 MANIFEST = "manifest.json"
 MANIFEST_KIND = "tactileskin.parts"  # marks a folder this module wrote (and may replace)
+FOLDER_KIND = "build"  # the folder's marker (fileio.claim_dir)
+BUILD_FILES = (MANIFEST, "*.stl", "*.step")  # staged_files patterns: what a build may replace
 
 # Tessellation (absolute, unlike build123d.export_stl whose deflection is relative to each
 # edge's size): chordal deviation 5 um, angular deflection 0.1 rad. Mesh vertices lie on the
@@ -146,29 +150,32 @@ def _previous_build_files(out: Path) -> set[str] | None:
         return None
 
 
-def check_target(out: Path) -> None:
-    """Only a new or empty folder, or a previous parts build (our manifest), may be replaced.
+def _marker_kind(out: Path) -> str | None:
+    try:
+        return str(json.loads((out / fileio.MARKER).read_text()).get("kind"))
+    except (OSError, ValueError, AttributeError):
+        return None
 
-    The build replaces the folder whole, so the current folder (or one holding it) is refused
-    too: the shell would be left in the removed folder."""
+
+def check_target(out: Path) -> None:
+    """Only a new or empty folder, or a previous parts build (our marker, or the manifest of a
+    build from before the marker with nothing added), may be written into."""
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
-    if out.is_dir():
-        with fileio.os_errors(out):
-            entries = list(out.iterdir())
-        ours = _previous_build_files(out)
-        # the build replaces the folder whole: a previous build with anything added to it
-        # (a user's notes, a slicer's files) is refused, not emptied
-        others = sorted(p.name for p in entries if not fileio.is_temporary(p.name)
-                        and (ours is None or p.name not in ours))
-        if others:
-            shown = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
-            raise ParameterError("out", str(out), "a new or empty folder, or the folder of a previous `tactileskin build`",
-                                 hint=f"refusing to replace a folder holding files the build did not write ({shown})")
-        cwd = Path.cwd().resolve()
-        if cwd == out.resolve() or out.resolve() in cwd.parents:
-            raise ParameterError("out", str(out), "a folder that does not hold the current folder",
-                                 hint="the build replaces the folder whole; give a subfolder such as parts/")
+    if not out.is_dir() or ((out / fileio.MARKER).is_file() and _marker_kind(out) == FOLDER_KIND):
+        return
+    with fileio.os_errors(out):
+        entries = [p.name for p in out.iterdir() if not fileio.is_temporary(p.name)]
+    valid = "a new or empty folder, or the folder of a previous `tactileskin build`"
+    if (out / fileio.MARKER).is_file():
+        kind = _marker_kind(out)
+        raise ParameterError("out", str(out), valid, hint="the folder was written by another tactileskin command"
+                             + (f" (`{kind.replace('-', ' ')}`)" if kind and kind != "None" else ""))
+    ours = _previous_build_files(out)
+    others = sorted(n for n in entries if ours is None or n not in ours)
+    if others:
+        shown = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
+        raise ParameterError("out", str(out), valid, hint=f"the folder holds files the build did not write ({shown})")
 
 
 def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE,
@@ -179,7 +186,10 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ParameterError("parts", names, "unique part names")
-    with fileio.staged_dir(out) as tmp:
+    legacy = None if (out / fileio.MARKER).is_file() else _previous_build_files(out)
+    if legacy is not None:  # a build from before the marker: its listed files become recorded ones
+        fileio.adopt_dir(out, FOLDER_KIND, legacy)
+    with fileio.claimed(out, FOLDER_KIND), fileio.staged_files(out, BUILD_FILES, last=MANIFEST) as tmp:
         t0 = time.perf_counter()
         entries = []
         for part in parts:
