@@ -105,3 +105,14 @@ def test_a_sweep_leaves_a_users_figure_of_its_pattern(tmp_path, capsys, monkeypa
     (out / "report.md").write_text("my edits\n")
     assert main(argv) == 2
     assert "report.md" in _err(capsys) and (out / "report.md").read_text() == "my edits\n"
+
+
+def test_an_api_result_written_into_a_cli_solve_folder_replaces_its_whole_result(tmp_path, capsys, fake_solve):
+    d = tmp_path / "s"
+    assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0
+    assert (d / "compare_2d.json").is_file() and (d / "section_2d" / "summary.json").is_file()
+    (d / "notes.txt").write_text("mine")
+    fake_result().write(d)  # Result.write: the same files as `solve`
+    assert not (d / "compare_2d.json").exists() and not (d / "section_2d").exists()
+    assert (d / "notes.txt").read_text() == "mine" and (d / "summary.json").is_file()
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # and the CLI replaces the API's

@@ -420,10 +420,13 @@ class Result:
     def write(self, directory) -> Path:
         """Write the result into `directory`: a new or empty folder, or one tactileskin marked
         as a solve's (fileio.claim_dir; a folder of other files is refused, OutputError, and
-        left as it is). See write_owned for the files."""
+        left as it is). See write_owned for the files; the earlier result there goes whole, a
+        CLI solve's figures, 2D section and comparison included (SOLVE_FILES)."""
         validate.path(directory, "directory", "a folder path (str or os.PathLike)")
-        fileio.claim_dir(directory, "solve", what="directory")
-        return self.write_owned(directory)
+        directory = fileio.claim_dir(directory, "solve", what="directory")
+        with fileio.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
+            self._write_files(tmp)
+        return directory
 
     def write_owned(self, directory) -> Path:
         """Write OWN_FILES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
@@ -469,9 +472,14 @@ def reaction_key(dim: int) -> str:
     return "reaction_n" if int(dim) == 3 else "reaction_n_per_mm"
 
 
-# the files Result.write owns in a folder (fnmatch patterns, relative paths)
+# the files of one result (write_owned; fnmatch patterns, relative paths)
 OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_map.csv", "profile_max_z.csv",
              "sensors.csv", "history.csv", "result.pvd", "result_steps/step_*.vtu")
+# every file of a solve folder, whoever writes it (`tactileskin solve`, Result.write): one list,
+# so that either replaces all of the other's earlier result (a stale map figure or 2D section
+# would look current); --compare-2d's section is a result folder of its own
+SOLVE_FILES = (*OWN_FILES, "bone_map.png", "sensors.png", "compare_2d.json",
+               *(f"section_2d/{n}" for n in OWN_FILES))
 
 
 def read_vtu(path):

@@ -10,10 +10,10 @@ import click
 from tactileskin import quality, results
 from tactileskin.cli._common import claimed_output, has_2d_section, scene_from_options, scene_options
 
-# every file `solve` writes into its folder (fnmatch patterns; the 2D section of --compare-2d
-# is a result folder of its own)
+# every file of a solve folder (results.SOLVE_FILES, shared with Result.write); the ones listed
+# as the result's files after a solve
+OWN_FILES = results.SOLVE_FILES
 RESULT_FILES = (*results.OWN_FILES, "bone_map.png", "sensors.png")
-OWN_FILES = RESULT_FILES + ("compare_2d.json", *(f"section_2d/{n}" for n in results.OWN_FILES))
 
 
 EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see the help text)
