@@ -116,3 +116,19 @@ def test_an_api_result_written_into_a_cli_solve_folder_replaces_its_whole_result
     assert not (d / "compare_2d.json").exists() and not (d / "section_2d").exists()
     assert (d / "notes.txt").read_text() == "mine" and (d / "summary.json").is_file()
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # and the CLI replaces the API's
+
+
+def _write_and_record(path: str) -> None:
+    fileio.atomic_write_text(path, "deck\n")
+    fileio.record_file(path)
+
+
+def test_parallel_single_file_writes_into_one_folder_keep_every_record(tmp_path):
+    import multiprocessing
+
+    names = [str(tmp_path / f"d{i}.inp") for i in range(16)]
+    with multiprocessing.get_context("fork").Pool(8) as pool:
+        pool.map(_write_and_record, names)
+    assert set(_record(tmp_path)) == {Path(n).name for n in names}  # none lost to a race
+    for n in names:
+        fileio.claim_file(n)  # each may be rewritten

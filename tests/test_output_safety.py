@@ -470,7 +470,7 @@ def test_single_file_outputs_replace_only_their_own_unchanged_files(tmp_path, ca
     assert main(["film", "calibrate", "cal.csv", "-o", "c.json", "--plot", "c.png"]) == 0
     assert main(["film", "calibrate", "cal.csv", "-o", "c.json", "--plot", "c.png"]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        ".tactileskin-files.json", "c.json", "c.png", "cal.csv", "deck.inp", "notes.vtu"]
+        ".tactileskin-files.json", ".tactileskin-files.lock", "c.json", "c.png", "cal.csv", "deck.inp", "notes.vtu"]
 
 
 # --- install --------------------------------------------------------------------------------

@@ -253,10 +253,12 @@ def claim_file(path, what: str = "--out") -> Path:
 def record_file(path) -> None:
     """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
     path = Path(path)
-    rec = {k: v for k, v in _owned(path.parent).items() if (path.parent / k).is_file()}
     with os_errors(path):
-        rec[path.name] = _digest(path)
-    atomic_write_json(path.parent / OWNED_FILES, rec)
+        digest = _digest(path)
+    with _record_lock(path.parent):  # two writers into one folder must not lose an entry
+        rec = {k: v for k, v in _owned(path.parent).items() if (path.parent / k).is_file()}
+        rec[path.name] = digest
+        atomic_write_json(path.parent / OWNED_FILES, rec)
 
 
 # The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,
