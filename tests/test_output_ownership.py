@@ -132,3 +132,23 @@ def test_parallel_single_file_writes_into_one_folder_keep_every_record(tmp_path)
     assert set(_record(tmp_path)) == {Path(n).name for n in names}  # none lost to a race
     for n in names:
         fileio.claim_file(n)  # each may be rewritten
+
+
+def test_an_unreachable_scheduler_is_refused_before_the_folder_is_claimed(tmp_path, capsys):
+    import socket
+
+    out = tmp_path / "X"
+    with socket.socket() as s:  # a port nobody listens on: bound, not listening
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+        assert main(["sweep", "--scheduler", f"tcp://127.0.0.1:{port}", "-t", "1", "-m", "silicone", "-i", "flat",
+                     "--no-render", "--out", str(out)]) == 2
+    err = _err(capsys)
+    assert "--scheduler" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+    from tactileskin.sweep import check_reachable
+
+    with socket.socket() as s:  # something listening passes the check
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        check_reachable(f"tcp://127.0.0.1:{s.getsockname()[1]}")

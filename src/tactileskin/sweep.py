@@ -261,6 +261,24 @@ def check_scheduler(address: str) -> str:
     return str(address)
 
 
+def check_reachable(address: str) -> None:
+    """ParameterError unless something listens at the scheduler's host:port (a TCP connect
+    within SCHEDULER_TIMEOUT_S): checked before the output folder is claimed, so that an
+    unreachable scheduler leaves nothing behind. ucx:// is not TCP: left to `connect`."""
+    import re
+    import socket
+
+    check_scheduler(address)
+    m = re.fullmatch(r"(?:([a-z]+)://)?\[?([0-9A-Za-z_.:-]+?)\]?:([0-9]+)/?", address)
+    if m is None or (m.group(1) or "tcp") == "ucx":
+        return
+    try:
+        socket.create_connection((m.group(2), int(m.group(3))), timeout=SCHEDULER_TIMEOUT_S).close()
+    except OSError as e:
+        raise ParameterError("--scheduler", address, "the address of a running Dask scheduler",
+                             f"no connection: {e.strerror or type(e).__name__}") from None
+
+
 def connect(address: str):
     """A dask Client on a running scheduler; an unreachable one is a ParameterError after
     SCHEDULER_TIMEOUT_S, not a traceback."""

@@ -46,11 +46,11 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
     from tactileskin.cli._console import new_console
 
     from tactileskin.report.outputs import write_outputs
-    from tactileskin.sweep import ResultCache, check_scheduler, run_sweep
+    from tactileskin.sweep import ResultCache, check_reachable, run_sweep
 
     console = new_console()
     if scheduler is not None:
-        check_scheduler(scheduler)
+        check_reachable(scheduler)  # before the folder is claimed: a refusal leaves nothing
     scenes = scenes_from_options(scene_opts, braille_dim)
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
