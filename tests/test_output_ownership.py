@@ -152,3 +152,20 @@ def test_an_unreachable_scheduler_is_refused_before_the_folder_is_claimed(tmp_pa
         s.bind(("127.0.0.1", 0))
         s.listen()
         check_reachable(f"tcp://127.0.0.1:{s.getsockname()[1]}")
+
+
+def test_a_write_failing_inside_staging_names_the_destination(tmp_path, capsys, fake_solve, monkeypatch):
+    import errno
+
+    import tactileskin.results as results
+
+    def too_large(path, *a, **k):
+        with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
+            raise OSError(errno.EFBIG, "File too large", str(tmp))
+
+    monkeypatch.setattr(results, "_write_vtu", too_large)
+    d = tmp_path / "uf1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert f"cannot write {d / 'result.vtu'}: File too large" in err and ".tsk" not in err
+    assert fileio.user_path(d / ".x.csv.tsk12-ab.tmp") == str(d / "x.csv")
