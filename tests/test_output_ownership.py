@@ -169,3 +169,11 @@ def test_a_write_failing_inside_staging_names_the_destination(tmp_path, capsys, 
     err = _err(capsys)
     assert f"cannot write {d / 'result.vtu'}: File too large" in err and ".tsk" not in err
     assert fileio.user_path(d / ".x.csv.tsk12-ab.tmp") == str(d / "x.csv")
+
+
+def test_another_commands_folder_is_refused_naming_that_command(tmp_path, capsys, fake_solve):
+    d = fileio.claim_dir(tmp_path / "sw", "sweep")
+    (d / "cache").mkdir()
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = " ".join(_err(capsys).split())
+    assert "written by another tactileskin command (`sweep`)" in err and "did not write" not in err

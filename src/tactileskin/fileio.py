@@ -298,6 +298,24 @@ def _is_ours(folder: Path, kind: str | None) -> bool:
         return False
 
 
+def marker_kind(folder) -> str | None:
+    """The kind our marker in `folder` names ("solve", "film-analyze", ...): "" for a marker
+    without a readable one, None without a marker."""
+    folder = Path(folder)
+    if not (folder / MARKER).is_file():
+        return None
+    try:
+        kind = json.loads((folder / MARKER).read_text()).get("kind")
+    except (OSError, ValueError, AttributeError):
+        kind = None
+    return kind if isinstance(kind, str) else ""
+
+
+def written_by(kind: str) -> str:
+    """`kind` as the message of a refused folder names it: the command (`film analyze`)."""
+    return f"`{kind.replace('-', ' ')}`" if kind else "of an unknown kind"
+
+
 def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     """Make `folder` the toolkit's output folder of `kind`, or refuse it.
 
@@ -314,6 +332,11 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
         with os_errors(folder):
             entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)]
         if entries and not _is_ours(folder, kind):
+            other = marker_kind(folder)
+            if other is not None:  # ours, but another command's: say so, not "did not write"
+                raise OutputError(folder, f"the folder was written by another tactileskin command "
+                                          f"({written_by(other)}); "
+                                          f"refusing to write into it: give {what} a new or empty folder")
             shown = ", ".join(sorted(p.name for p in entries)[:3]) + (", ..." if len(entries) > 3 else "")
             raise OutputError(folder, f"the folder holds files tactileskin did not write ({shown}); "
                                       f"refusing to write into it: give {what} a new or empty folder")

@@ -150,27 +150,20 @@ def _previous_build_files(out: Path) -> set[str] | None:
         return None
 
 
-def _marker_kind(out: Path) -> str | None:
-    try:
-        return str(json.loads((out / fileio.MARKER).read_text()).get("kind"))
-    except (OSError, ValueError, AttributeError):
-        return None
-
-
 def check_target(out: Path) -> None:
     """Only a new or empty folder, or a previous parts build (our marker, or the manifest of a
     build from before the marker with nothing added), may be written into."""
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
-    if not out.is_dir() or ((out / fileio.MARKER).is_file() and _marker_kind(out) == FOLDER_KIND):
+    kind = fileio.marker_kind(out)
+    if not out.is_dir() or kind == FOLDER_KIND:
         return
     with fileio.os_errors(out):
         entries = [p.name for p in out.iterdir() if not fileio.is_temporary(p.name)]
     valid = "a new or empty folder, or the folder of a previous `tactileskin build`"
-    if (out / fileio.MARKER).is_file():
-        kind = _marker_kind(out)
-        raise ParameterError("out", str(out), valid, hint="the folder was written by another tactileskin command"
-                             + (f" (`{kind.replace('-', ' ')}`)" if kind and kind != "None" else ""))
+    if kind is not None:
+        raise ParameterError("out", str(out), valid,
+                             hint=f"the folder was written by another tactileskin command ({fileio.written_by(kind)})")
     ours = _previous_build_files(out)
     others = sorted(n for n in entries if ours is None or n not in ours)
     if others:
