@@ -26,6 +26,7 @@ def sim(tmp_path):
     d.mkdir()
     np.savetxt(d / "profile.csv", np.column_stack([S, gaussian_profile(0.4, 1.0)(S)]),
                delimiter=",", header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+    (d / "summary.json").write_text(json.dumps({"status": "ok"}))  # a complete result
     return d
 
 
@@ -130,3 +131,26 @@ def test_calibration_plot_labels_fit_in_the_figure_with_units(tmp_path, monkeypa
     assert seen["x0"] >= 0, seen
     assert f"({cal.unit})" in seen["label"] and "residual" in seen["label"]
     assert "calibration calibration" not in seen["title"] and "calibration" in seen["title"]
+
+
+def test_compare_refuses_a_simulation_without_its_summary(tmp_path, capsys, scan, sim):
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    (sim / "summary.json").unlink()  # written last: without it the result is incomplete
+    assert main(["film", "compare", str(film), str(sim)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "summary.json" in err and "simulation result" in err and not (film / "comparison.json").exists()
+
+
+def test_a_failed_analyze_leaves_no_folder(tmp_path, capsys, scan, monkeypatch):
+    import errno
+
+    from tactileskin.film import plots
+
+    def too_large(fp, path, **k):
+        raise fileio.OutputError(path, errno.errorcode[errno.EFBIG])
+
+    monkeypatch.setattr(plots, "pressure_map", too_large)
+    out = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(out)]) == 2
+    assert not out.exists() and [p.name for p in tmp_path.iterdir()] == [scan.name]

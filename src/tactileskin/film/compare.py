@@ -58,12 +58,17 @@ def read_profile_csv(path, s_col: str, p_col: str) -> tuple[np.ndarray, np.ndarr
 
 
 def load_simulation(sim_dir) -> tuple[np.ndarray, np.ndarray, dict]:
-    """profile.csv (s_mm, pressure_mpa) and, if present, summary.json of a solver result."""
+    """profile.csv (s_mm, pressure_mpa) and summary.json of a solver result. summary.json is
+    written last (staged_files' `last`): without it the folder holds no complete result (a
+    failed or running write, or a profile the user put there), which is refused."""
     sim_dir = Path(sim_dir)
     s, p = read_profile_csv(sim_dir / "profile.csv", "s_mm", "pressure_mpa")
-    meta = {}
-    if (sim_dir / "summary.json").exists():
-        meta = _read_json(sim_dir / "summary.json", "simulation summary", "valid JSON")
+    summary = sim_dir / "summary.json"
+    if not summary.is_file():
+        raise ParameterError("simulation result", str(sim_dir), "a folder written by `tactileskin solve` "
+                             "(profile.csv and summary.json)",
+                             hint=f"{summary} is missing: no complete result there")
+    meta = _read_json(summary, "simulation summary", "valid JSON")
     return s, p, meta
 
 
