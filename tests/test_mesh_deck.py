@@ -283,4 +283,5 @@ def test_cli_export_writes_the_deck_and_rejects_bad_requests(tmp_path, capsys):
     assert "--out" in err and ".inp" in err and "Traceback" not in err
     assert main(args + ["--dim", "3", "-o", str(tmp_path / "slab.inp")]) == 2
     assert "dim" in capsys.readouterr().err
-    assert sorted(q.name for q in tmp_path.iterdir()) == [".tactileskin-files.json", "case.inp"]  # and its record of what it wrote
+    assert sorted(q.name for q in tmp_path.iterdir()) == [".tactileskin-files.json", ".tactileskin-files.lock",
+                                                          "case.inp"]  # its record of what it wrote, and its lock
