@@ -5,6 +5,7 @@ The CLI runs in-process; solves are faked where the test is about files, not num
 from __future__ import annotations
 
 import fnmatch
+import json
 import os
 import signal
 import stat
@@ -551,3 +552,16 @@ def test_a_suspect_case_gets_no_render(tmp_path, capsys, monkeypatch):
     out = tmp_path / "out"
     assert main(["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--out", str(out)]) == 3
     assert rendered == [] and not list(out.glob("fig9_*"))
+
+
+def test_a_folder_an_earlier_version_wrote_without_the_record_is_rerun(tmp_path):
+    """Before the record (.tactileskin-files.json) a marked folder's pattern-matching files were
+    the earlier result: a rerun into such a folder (yesterday's ./dev run) replaces them as that
+    version did, and starts the record, instead of refusing every file as not ours."""
+    d = tmp_path / "old"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    (d / ".tactileskin-files.json").unlink()
+    (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1\n1,0\n")  # the old result's
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    assert len((d / "profile.csv").read_text().splitlines()) > 3
+    assert "profile.csv" in json.loads((d / ".tactileskin-files.json").read_text())

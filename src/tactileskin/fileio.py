@@ -508,7 +508,11 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     tops = {p.split("/")[0] for p in own if "/" in p}
     old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
     rec = None
-    if digests is not None:
+    if digests is not None and not (folder / OWNED_FILES).exists():
+        # marked by a version before the record (2026-11-26): its pattern-matching files are
+        # the earlier result, as that version took them; the record starts with this one
+        rec = {}
+    elif digests is not None:
         rec = _owned(folder)
         old = _check_owned(folder, old, new, rec)
     for rel in new:  # a linked subfolder would take our files into a folder we do not own
