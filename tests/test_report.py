@@ -110,3 +110,20 @@ def test_a_distance_below_the_threshold_does_not_read_as_equal_and_one_profile_g
     d, verdict = _discrimination_cells({"flat": (s, p), "curved": (s, 1.2 * p)})
     assert verdict == "not distinguishable" and re.search(r"0\.1\d\d\b", d)  # 1 - 1/1.2: 0.167, not "0.17"
     assert _discrimination_cells({"braille": (s, p)}) == ("n/a", "n/a (one indenter)")
+
+
+def test_renders_of_cases_whose_names_clean_alike_do_not_overwrite_each_other(tmp_path):
+    """Case ids that differ only in characters a file name cannot hold ('gel-ä', 'gel-ö') got
+    one fig9 file, which report.md showed for both."""
+    from tactileskin.cli import main
+
+    for n in ("gel-ä", "gel-ö"):
+        (tmp_path / f"{n}.toml").write_text(f'name = "{n}"\n[hyperfoam]\nmu = [0.05]\nalpha = [4.0]\nnu = 0.45\n')
+    mats = ",".join(str(tmp_path / f"{n}.toml") for n in ("gel-ä", "gel-ö"))
+    out = tmp_path / "o"
+    assert main(["sweep", "-t", "1", "-m", mats, "-i", "flat", "--quality", "preview", "--serial",
+                 "--out", str(out)]) == 0
+    renders = sorted(p.name for p in out.glob("fig9_*.png"))
+    assert len(renders) == 2
+    report = (out / "report.md").read_text()
+    assert all(r in report for r in renders)

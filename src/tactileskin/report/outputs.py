@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import logging
 import re
@@ -149,7 +150,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
 
         # a suspect case (no contact, the law out of its range) is not shown as a result
         shown = [r for r in records if quality.status(r.summary) == "ok"]
-        thinnest = {}
+        thinnest, used = {}, set()
         for r in shown:
             m = r.scene.material
             thinnest[m] = min(thinnest.get(m, r.scene.thickness), r.scene.thickness)
@@ -159,6 +160,9 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
             if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
                 try:
                     name = re.sub(r"[^A-Za-z0-9._=,\[\]-]", "_", rec.case)
+                    if name in used:  # two case ids made alike by the substitution ('gel-ä', 'gel-ö')
+                        name += "-" + hashlib.sha256(rec.case.encode()).hexdigest()[:8]
+                    used.add(name)
                     renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case, scene=sc))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
                     log.warning("render of %s failed: %s", rec.case, e)
