@@ -211,3 +211,14 @@ def test_history_files_for_force_control_and_a_loading_history(mesh, tmp_path):
         out = r.write(tmp_path / f"o{len(s.program())}")
         assert (out / "result.pvd").is_file() and len(list((out / "result_steps").iterdir())) == len(steps)
         assert not solve(s, mesh=mesh).fields["steps"]
+
+
+def test_a_force_beyond_the_laws_lock_up_names_the_force(mesh):
+    from tactileskin.fe import solve
+    from tactileskin.fe.solver import SolverOptions
+
+    # 1000 N/mm on a 2 mm skin: the increments shrink to nothing in the lock-up below the travel
+    # cap (it ended as "more than 2000 increments" after 88 s); a short budget reaches the stall
+    with pytest.raises(ParameterError, match="force") as e:
+        solve(BASE.replace(force=1000.0), mesh=mesh, options=SolverOptions(max_increments=40))
+    assert e.value.name == "force" and "stalled at" in str(e.value) and "N/mm" in str(e.value)

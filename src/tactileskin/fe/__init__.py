@@ -161,16 +161,19 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     open contact); `Result.loading` adds the target and reached force, the travel, that
     state's time and the final state, and `Result.history` the time series (history.csv);
     `history`: also the displacement of every increment (result.pvd), as a depth ramp has."""
+    from tactileskin.errors import ConvergenceError, ParameterError
     from tactileskin.fe.loading import run_program
     from tactileskin.fe.output import bone_peak, law_state
 
     multi = len(program) > 1
     peak_of = bone_peak(model) if multi else None
     best = {}
+    last = {}  # the last converged increment's travel and reaction
     worst = {}  # the material law's extremes over every increment (a creep hold or a second
     # ramp can go beyond the peak-load state's: tactileskin.quality flags them)
 
     def record(model, ev):
+        last.update(d=float(model.d), reaction=float(indenter_force(model, ev)))
         for k, v in law_state(ev, model.stress(ev)).items():
             worst[k] = v if k not in worst else (min if k == "min_J" else max)(worst[k], v)
         out = {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
@@ -188,9 +191,21 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     # a travel guess for the first force increment: the scene's expected travel at the full force
     full = max((g.target for g in program if g.kind == "force"), default=1.0)
     d_exp = scene.depth_fraction * scene.thickness
-    ev, stats, hist = run_program(model, program, options, d_max=scene.max_travel,
-                                  d_guess=lambda F: d_exp * min(1.0, F / full), record=record, progress=progress,
-                                  on_segment=on_segment)
+    try:
+        ev, stats, hist = run_program(model, program, options, d_max=scene.max_travel,
+                                      d_guess=lambda F: d_exp * min(1.0, F / full), record=record,
+                                      progress=progress, on_segment=on_segment)
+    except ConvergenceError as e:
+        if scene.force is None or not last or "increments" not in str(e):
+            raise
+        # a force beyond the law's lock-up: the increments shrink to nothing below the travel
+        # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments")
+        unit = "N" if scene.dim == 3 else "N/mm"
+        raise ParameterError("force", scene.force, f"a force the skin carries within its travel (at most "
+                             f"{scene.max_travel:.3g} mm = 0.6 x thickness)",
+                             f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
+                             f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "
+                             f"|stress| up to {worst.get('max_abs_stress_mpa', float('nan')):.3g} MPa") from None
     if not best:  # every ramp ended below zero force: report the final state
         on_segment(0, program[0], ev)
     res = best["result"]
