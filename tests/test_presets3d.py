@@ -168,3 +168,25 @@ def test_the_3d_preset_errors_say_which_thicknesses_they_cover():
     # the study is t = 1-5 mm; at t = 0.5 the fingertip cell reads ~9 % low at default
     # (convergence3d.md), so no error may be claimed there
     assert QUALITY["default"]["cases3d_thickness_mm"] == (1.0, 5.0)
+
+
+def test_a_user_geometry_that_refuses_the_studys_thickness_does_not_break_the_presets(tmp_path):
+    """The preset table measures 3D sphere levels at t = 5; a fingertip override whose skins
+    stop below 5 mm made every command fail at import ("thickness=5.0 is invalid")."""
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import tactileskin
+
+    geo = tmp_path / "geometry"
+    shutil.copytree(Path(tactileskin.__file__).parent / "data" / "geometry", geo)
+    ft = geo / "fingertip.toml"
+    ft.write_text(ft.read_text().replace("half_width = 8.0 ", "half_width = 9.0 ", 1))
+    code = ("from tactileskin import planner; from tactileskin.scene import Scene; "
+            "print(planner.with_quality(Scene(thickness=1), 'preview').mesh_size)")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                         env={**__import__("os").environ, "TACTILESKIN_GEOMETRY": str(geo)})
+    assert run.returncode == 0, run.stderr[-500:]
+    assert run.stdout.strip() == "1.0"

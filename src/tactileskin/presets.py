@@ -102,11 +102,17 @@ def study_scales(key: str) -> dict:
     ball = re.search(r"-sphere-R([0-9.]+)$", key)
     if ball is None:
         return {"bone_scale": study_bone_scale(t)}
+    from tactileskin.errors import ParameterError
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.mesh.sizing import bone_scale, patch_scale
     from tactileskin.scene import Scene
 
-    sc = Scene(thickness=t, dim=3, indenter="sphere", indenter_radius=float(ball.group(1)))
+    try:
+        sc = Scene(thickness=t, dim=3, indenter="sphere", indenter_radius=float(ball.group(1)))
+    except ParameterError:
+        # a user's geometry (TACTILESKIN_GEOMETRY) that does not take the study's thickness:
+        # the study's level is not this geometry's mesh (and every command used to fail here)
+        return {"bone_scale": math.nan, "spot_scale": math.nan}
     (_, _, a), = indenter_for_scene(sc, warn=False).contact_patches(sc.indentation)
     return {"bone_scale": round(bone_scale(t, a), 4), "spot_scale": round(patch_scale(a), 4)}
 
