@@ -184,3 +184,28 @@ def test_material_file_names_its_law(tmp_path):
             Material.from_toml(p)
     with pytest.raises(ParameterError, match="hyperfoam"):
         m.hyperfoam  # the paper-law accessor refuses another law
+
+
+@pytest.mark.parametrize("law, table, needle", [
+    ("hyperfoam", {"mu": [1e300], "alpha": [2.0], "nu": 0.45}, "shear modulus mu0"),
+    ("hyperfoam", {"mu": [1e-300], "alpha": [2.0], "nu": 0.45}, "shear modulus mu0"),
+    ("hyperfoam", {"mu": [0.1], "alpha": [1e6], "nu": 0.45}, r"alpha\[0\]"),
+    ("hyperfoam", {"mu": [0.1], "alpha": [2.0], "nu": 0.499999}, "K0 / mu0"),
+    ("neo_hookean", {"mu": 0.1, "kappa": 1e9}, "K0 / mu0"),
+    ("ogden", {"mu": [0.1], "alpha": [500.0], "kappa": 5.0}, r"alpha\[0\]"),
+])
+def test_implausible_moduli_are_refused_naming_them(law, table, needle):
+    # accepted before, they failed only inside the solver with a message naming no parameter
+    from tactileskin.errors import ParameterError
+    from tactileskin.materials.laws import law_from_dict
+
+    with pytest.raises(ParameterError, match=needle):
+        law_from_dict(law, table, "material 'x'")
+
+
+def test_the_presets_and_a_soft_gel_are_within_the_plausible_moduli():
+    from tactileskin.materials.laws import law_from_dict
+
+    for law, table in (("hyperfoam", {"mu": [0.080, 0.010], "alpha": [0.001, 15.5], "nu": 0.49}),
+                       ("neo_hookean", {"mu": 1e-3, "kappa": 0.5}), ("hyperfoam", {"mu": [0.1], "alpha": [2.0], "nu": 0.0})):
+        law_from_dict(law, table, "material 'x'")

@@ -66,6 +66,9 @@ __all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2",
 # per principal stretch at every quadrature point of every assembly, so 8 leaves headroom
 # while bounding that cost.
 MAX_TERMS = 8
+# |alpha| above this overflows lambda^alpha at moderate stretch (1.5^100 = 4e17); published
+# hyperfoam and Ogden fits stay within +-30
+MAX_ALPHA = 100.0
 
 
 def _as_float_tuple(name, value) -> tuple[float, ...]:
@@ -98,8 +101,8 @@ class Hyperfoam:
         for i, (m, a) in enumerate(zip(mu, alpha)):
             if not math.isfinite(m) or m == 0.0:
                 raise ParameterError(f"mu[{i}]", m, "a finite non-zero number (MPa)")
-            if not math.isfinite(a) or a == 0.0:
-                raise ParameterError(f"alpha[{i}]", a, "a finite non-zero number")
+            if not math.isfinite(a) or a == 0.0 or abs(a) > MAX_ALPHA:
+                raise ParameterError(f"alpha[{i}]", a, f"a non-zero number in [-{MAX_ALPHA:g}, {MAX_ALPHA:g}]")
         try:
             nu = float(self.nu)
         except (TypeError, ValueError):

@@ -44,7 +44,26 @@ def get_law(name: str):
     return getattr(importlib.import_module(f"tactileskin.materials.{mod}"), cls)
 
 
+# Plausible small-strain moduli of a skin material (MPa): 1 Pa (the softest gels) to 10 GPa
+# (past any elastomer), and the bulk-to-shear ratio of nu = 0.4999. Beyond them a file's numbers
+# are a units slip or a typo: mu = 1e300 and 1e-300, nu = 0.499999 were accepted and failed
+# only inside the solver with a message naming no parameter.
+MU0_RANGE = (1e-6, 1e4)
+MAX_BULK_OVER_SHEAR = 5000.0  # nu0 = 0.4999
+
+
 def law_from_dict(name: str, table, what: str):
-    """An instance of law `name` from its parameter table."""
+    """An instance of law `name` from its parameter table, its small-strain moduli checked
+    against MU0_RANGE and MAX_BULK_OVER_SHEAR."""
+    from tactileskin.errors import check_range
+
     cls = get_law(validate.string(name, f"{what} law", "a law name"))
-    return cls.from_dict(table, f"{what} {name}")
+    law = cls.from_dict(table, f"{what} {name}")
+    check_range(f"{what} {name}: small-strain shear modulus mu0", law.mu0, *MU0_RANGE, unit="MPa")
+    check_range(f"{what} {name}: bulk / shear modulus K0 / mu0 (nu0 = {_nu0(law):.6g})", law.K0 / law.mu0,
+                None, MAX_BULK_OVER_SHEAR)
+    return law
+
+
+def _nu0(law) -> float:
+    return (3 * law.K0 - 2 * law.mu0) / (2 * (3 * law.K0 + law.mu0))

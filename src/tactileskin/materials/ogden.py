@@ -22,6 +22,7 @@ from tactileskin.materials._isotropic import InvariantLaw, kappa_from_nu, positi
 __all__ = ["Ogden"]
 
 MAX_TERMS = 6   # Abaqus's limit; published fits use 1-3 terms
+MAX_ALPHA = 100.0  # as the hyperfoam's (materials.hyperfoam.MAX_ALPHA)
 
 
 @dataclass(frozen=True)
@@ -43,8 +44,8 @@ class Ogden(InvariantLaw):
         for i, (m, a) in enumerate(zip(mu, alpha)):
             if m == 0.0:
                 raise ParameterError(f"mu[{i}]", m, "a non-zero number (MPa)")
-            if a == 0.0:
-                raise ParameterError(f"alpha[{i}]", a, "a non-zero number")
+            if a == 0.0 or abs(a) > MAX_ALPHA:
+                raise ParameterError(f"alpha[{i}]", a, f"a non-zero number in [-{MAX_ALPHA:g}, {MAX_ALPHA:g}]")
         if not sum(mu) > 0.0:
             raise ParameterError("mu", mu, "sum(mu_p) > 0 MPa (initial shear modulus)")
         object.__setattr__(self, "mu", tuple(float(m) for m in mu))
