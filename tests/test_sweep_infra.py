@@ -102,3 +102,31 @@ def test_workers_get_their_pardiso_share_and_this_process_keeps_its_environment(
         runner.close()
     assert list(seen.values()) == [(str(available_cpus()), None)]
     assert "TACTILESKIN_THREADS" not in os.environ and "MKL_NUM_THREADS" not in os.environ
+
+
+def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_traceback(monkeypatch):
+    """Ctrl-C during LocalCluster's start left a cluster in Status.init, which dask's exit hook
+    then closed with an AssertionError traceback after 'interrupted'."""
+    import distributed
+    from distributed.deploy.spec import SpecCluster
+
+    from tactileskin import sweep
+
+    made = []
+
+    class Starting:
+        shutdown_on_close = True
+
+        def __init__(self, *a, **kw):
+            made.append(self)
+            SpecCluster._instances.add(self)
+            raise KeyboardInterrupt
+
+        def close(self, timeout=None):
+            raise AssertionError("Status.init")
+
+    monkeypatch.setattr(distributed, "LocalCluster", Starting)
+    runner = sweep._Runner([], [], serial=False, scheduler=None, workers=1)
+    with pytest.raises(KeyboardInterrupt):
+        runner._start(1)
+    assert len(made) == 1 and made[0].shutdown_on_close is False  # the exit hook skips it

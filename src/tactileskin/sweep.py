@@ -396,9 +396,13 @@ class _Runner:
             # at ERROR (seen on `./dev run`); a worker that dies during a case still reaches
             # the sweep as its future's exception, recorded as a failed case
             quiet = logging.ERROR if log.isEnabledFor(logging.INFO) else logging.CRITICAL
-            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, silence_logs=quiet,
-                                        env={"TACTILESKIN_THREADS": worker_threads(n)})
+            try:
+                self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                            dashboard_address=None, silence_logs=quiet,
+                                            env={"TACTILESKIN_THREADS": worker_threads(n)})
+            except BaseException:
+                _close_unfinished_clusters()
+                raise
         self.client = Client(self.cluster)
         return self.client
 
@@ -407,6 +411,19 @@ class _Runner:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
+
+
+def _close_unfinished_clusters() -> None:
+    """Close the clusters a Ctrl-C interrupted while they started: dask's exit hook would
+    close them too, and end in an AssertionError traceback on one still in Status.init."""
+    from distributed.deploy.spec import SpecCluster
+
+    for cluster in list(SpecCluster._instances):
+        try:
+            cluster.close(timeout=5)
+        except BaseException:  # noqa: BLE001 - interrupted already; nothing left to report
+            pass
+        cluster.shutdown_on_close = False
 
 
 def _raise_fd_limit(n: int) -> None:
