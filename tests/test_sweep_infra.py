@@ -125,6 +125,9 @@ def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_tracebac
         def close(self, timeout=None):
             raise AssertionError("Status.init")
 
+    import dask.distributed
+
+    monkeypatch.setattr(dask.distributed, "LocalCluster", Starting)  # what _start imports
     monkeypatch.setattr(distributed, "LocalCluster", Starting)
     runner = sweep._Runner([], [], serial=False, scheduler=None, workers=1)
     with pytest.raises(KeyboardInterrupt):
