@@ -4,6 +4,7 @@ import os
 import stat
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -113,6 +114,25 @@ def test_stale_temporaries_of_a_dead_writer_are_removed_live_ones_kept(tmp_path)
     fileio.atomic_write_text(tmp_path / "r.csv", "new")
     assert not stale.exists() and not stale_dir.exists()
     assert live.exists() and user.exists()
+
+
+def test_another_hosts_temporaries_are_kept_until_a_day_old(tmp_path):
+    """A temporary of another host or PID namespace (a cluster node, a container on the same
+    shared folder) names a PID that means nothing here: it was removed as a dead writer's while
+    that run was writing into it."""
+    ours = fileio.tmp_prefix(tmp_path / "r.csv")
+    assert fileio.is_temporary(ours + "abc.tmp")
+    other = "0" * 8 if fileio._host() != "0" * 8 else "1" * 8
+    fresh = tmp_path / f".case.tsk1h{other}-xyz.partial"
+    fresh.mkdir()
+    old = tmp_path / f".r.csv.tsk1h{other}-abc.tmp"
+    old.write_text("half")
+    day = time.time() - fileio.FOREIGN_STALE_S - 60
+    os.utime(old, (day, day))
+    dead_here = tmp_path / f".r.csv.tsk{2 ** 22 + 7}h{fileio._host()}-def.tmp"  # beyond pid_max
+    dead_here.write_text("half")
+    fileio.clean_stale(tmp_path)
+    assert fresh.exists() and not old.exists() and not dead_here.exists()
 
 
 @pytest.mark.parametrize("err, cause", [(28, "no space left"), (13, "permission denied")])

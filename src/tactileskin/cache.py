@@ -293,7 +293,7 @@ class ResultCache:
             if p.is_symlink() or not p.is_dir():
                 p.unlink()
                 return
-            aside = p.parent / f".{p.name}.tsk{os.getpid()}-bad.partial"  # clean_stale finishes it
+            aside = p.parent / f"{fileio.tmp_prefix(p)}bad.partial"  # clean_stale finishes it
             os.replace(p, aside)
             shutil.rmtree(aside, ignore_errors=True)
         except OSError as e:

@@ -23,19 +23,25 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import functools
 import json
 import os
 import re
 import shutil
 import tempfile
+import time
 from pathlib import Path
 from typing import Iterable, Iterator
 
 from tactileskin.errors import TactileSkinError
 
 MARKER = ".tactileskin"
-_TMP_RE = re.compile(r"^\..+\.tsk(\d+)-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
-_TMP_NAME_RE = re.compile(r"^\.(.+)\.tsk\d+-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # group 1: the target's name
+# `.NAME.tskPID[hHOST]-XXXX[.suffix]`: HOST names the writer's host and PID namespace (`_host`)
+_TMP_RE = re.compile(r"^\..+\.tsk(\d+)(?:h([0-9a-f]{8}))?-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
+_TMP_NAME_RE = re.compile(r"^\.(.+)\.tsk\d+(?:h[0-9a-f]{8})?-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # group 1: the target
+# a temporary of another host or PID namespace (a cluster node or a container writing to the
+# same shared folder) cannot be judged by its PID: it is stale only this long after its last change
+FOREIGN_STALE_S = 24 * 3600.0
 
 
 class OutputError(TactileSkinError):
@@ -109,10 +115,23 @@ def os_errors(path, *, own_name: bool = True) -> Iterator[None]:
         raise OutputError(named, _cause(e)) from e
 
 
-def _tmp_prefix(path: Path) -> str:
+def tmp_prefix(path: Path) -> str:
     # the name cut short: a name near the file system's 255-byte limit is valid, its
-    # temporary (about 25 characters longer) would not be
-    return f".{path.name[:64]}.tsk{os.getpid()}-"
+    # temporary (about 35 characters longer) would not be
+    return f".{path.name[:64]}.tsk{os.getpid()}h{_host()}-"
+
+
+@functools.lru_cache(maxsize=1)
+def _host() -> str:
+    """8 hex digits naming this host and PID namespace: a PID means a process only there."""
+    import hashlib
+    import socket
+
+    try:
+        ns = os.stat("/proc/self/ns/pid").st_ino
+    except OSError:
+        ns = 0
+    return hashlib.sha256(f"{socket.gethostname()}\0{ns}".encode()).hexdigest()[:8]
 
 
 def is_temporary(name: str) -> bool:
@@ -142,7 +161,14 @@ def clean_stale(folder) -> list[Path]:
         return removed
     for p in entries:
         m = _TMP_RE.match(p.name)
-        if m and not _pid_alive(int(m.group(1))):
+        if m and m.group(2) not in (None, _host()):  # another host's: its PID says nothing here
+            try:
+                stale = time.time() - p.lstat().st_mtime > FOREIGN_STALE_S
+            except OSError:
+                continue
+        else:
+            stale = m is not None and not _pid_alive(int(m.group(1)))
+        if stale:
             with contextlib.suppress(OSError):
                 if p.is_dir() and not p.is_symlink():
                     shutil.rmtree(p)
@@ -168,7 +194,7 @@ def atomic_path(path, *, suffix: str = ".tmp") -> Iterator[Path]:
     make_dirs(path.parent)
     clean_stale(path.parent)
     with os_errors(path, own_name=False):
-        fd, tmp = tempfile.mkstemp(prefix=_tmp_prefix(path), suffix=suffix, dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=tmp_prefix(path), suffix=suffix, dir=path.parent)
         os.close(fd)
     tmp = Path(tmp)
     try:
@@ -394,13 +420,13 @@ def staged_dir(final) -> Iterator[Path]:
     make_dirs(final.parent)
     clean_stale(final.parent)
     with os_errors(final):
-        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(final), suffix=".partial", dir=final.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=tmp_prefix(final), suffix=".partial", dir=final.parent))
         os.chmod(tmp, dir_mode())
     try:
         yield tmp
         with os_errors(final):
             if final.exists():
-                old = Path(tempfile.mkdtemp(prefix=_tmp_prefix(final), suffix=".partial", dir=final.parent))
+                old = Path(tempfile.mkdtemp(prefix=tmp_prefix(final), suffix=".partial", dir=final.parent))
                 try:  # `old` removed however a move fails (it leaked when the first one did)
                     os.replace(final, old / "old")
                     try:
@@ -483,7 +509,7 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
     folder = make_dirs(folder)
     clean_stale(folder)
     with os_errors(folder, own_name=False):
-        tmp = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
+        tmp = Path(tempfile.mkdtemp(prefix=tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
         os.chmod(tmp, dir_mode())
     try:
         yield tmp
@@ -521,7 +547,7 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
                 raise OutputError(folder / parent, "it is a link or a file where tactileskin writes a folder "
                                                    "of its own; move it away")
     with os_errors(folder, own_name=False):
-        trash = Path(tempfile.mkdtemp(prefix=_tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
+        trash = Path(tempfile.mkdtemp(prefix=tmp_prefix(folder / STAGING), suffix=".partial", dir=folder))
     aside, moved_in = [], []  # (where it was, where it is): undone in reverse on a failure
     try:
         with os_errors(folder):
