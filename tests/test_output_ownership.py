@@ -177,3 +177,24 @@ def test_another_commands_folder_is_refused_naming_that_command(tmp_path, capsys
     assert main(["solve", *CHEAP, "--out", str(d)]) == 2
     err = " ".join(_err(capsys).split())
     assert "written by another tactileskin command (`sweep`)" in err and "did not write" not in err
+
+
+def test_a_run_stopped_before_its_first_case_leaves_no_folder(tmp_path):
+    """A sweep interrupted before any case finished left its new folder holding the marker and
+    cache/*.lock alone; a folder that held anything else, or existed before, is kept."""
+    from tactileskin.fileio import MARKER, claimed
+
+    out = tmp_path / "new"
+    with pytest.raises(KeyboardInterrupt):
+        with claimed(out, "sweep"):
+            (out / "cache").mkdir()
+            (out / "cache" / "abc.lock").write_text("")
+            raise KeyboardInterrupt
+    assert not out.exists()
+    with pytest.raises(KeyboardInterrupt):
+        with claimed(out, "sweep"):
+            (out / "cache").mkdir()
+            (out / "cache" / "abc.lock").write_text("")
+            (out / "cache" / "key1").mkdir()  # a finished case: kept for the rerun
+            raise KeyboardInterrupt
+    assert (out / MARKER).is_file() and (out / "cache" / "key1").is_dir()

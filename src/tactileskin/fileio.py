@@ -388,6 +388,13 @@ def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
         if not existed:
             with contextlib.suppress(OSError):
                 names = {p.name for p in folder.iterdir()}
+                cache = folder / "cache"  # a sweep stopped before its first case: locks only
+                if "cache" in names and cache.is_dir() and not cache.is_symlink() and all(
+                        p.suffix == ".lock" and p.is_file() for p in cache.iterdir()):
+                    for p in cache.iterdir():
+                        p.unlink()
+                    cache.rmdir()
+                    names.discard("cache")
                 if MARKER in names and names <= {MARKER, RECORD_LOCK}:
                     for n in names:
                         (folder / n).unlink()
