@@ -92,6 +92,10 @@ def test_compare_2d_section_takes_the_2d_mesh_of_the_3d_quality(monkeypatch):
         sc2 = _solve_2d(with_quality(dot, q))
         assert sc2.dim == 2 and (sc2.mesh_size, sc2.refinement) == sizes2
     assert (_solve_2d(dot.replace(mesh_size=1.3, refinement=7)).mesh_size, ) == (0.5,)
+    # at t = 3 the 3D preview and default dots share 1.6 / 8: the section at the 2D default
+    thick = with_quality(dot.replace(thickness=3), "default")
+    assert with_quality(dot.replace(thickness=3), "preview").mesh_size == thick.mesh_size
+    assert (_solve_2d(thick).mesh_size, _solve_2d(thick).refinement) == (0.5, 6.0)
 
 
 @pytest.mark.parametrize("args, text", [

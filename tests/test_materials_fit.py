@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from tactileskin.cli import main
+from tactileskin.cli.material import MARK
 from tactileskin.materials import get_material
 from tactileskin.materials.fit import FitDataError, fit, read_uniaxial_csv, uniaxial_nominal
 from tactileskin.materials.mooney_rivlin import MooneyRivlin
@@ -215,6 +216,12 @@ def test_cli_material_fit_writes_a_usable_file(tmp_path, capsys):
     assert foreign.read_text() == "# my notes\n"
     assert main(["material", "fit", str(tmp_path / "none.csv"), "--law", "yeoh", "-o", str(tmp_path / "n.toml")]) == 2
     assert not (tmp_path / "n.toml").exists()
+    # an earlier version's file (its line, no record): replaced as that version did
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "gel.toml").write_text(MARK + "\nname = 'gel'\n")
+    assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(old / "gel.toml")]) == 0
+    assert get_material(str(old / "gel.toml")).law.law == "neo_hookean"
 
 
 def test_unit_mistakes_in_the_test_data_are_caught(tmp_path):

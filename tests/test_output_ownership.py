@@ -5,6 +5,7 @@ edited is not overwritten. The CLI runs in-process; solves are faked (files, not
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -198,3 +199,61 @@ def test_a_run_stopped_before_its_first_case_leaves_no_folder(tmp_path):
             (out / "cache" / "key1").mkdir()  # a finished case: kept for the rerun
             raise KeyboardInterrupt
     assert (out / MARKER).is_file() and (out / "cache" / "key1").is_dir()
+
+
+def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(tmp_path, monkeypatch):
+    """The record is written before the moves with both versions of each replaced file: a run
+    killed between two renames (old and new files mixed) does not make the next run refuse
+    its own files as 'changed since'."""
+    from tactileskin import fileio
+
+    d = tmp_path / "o"
+    fileio.claim_dir(d, "solve")
+    for text in ("1", "2"):
+        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+            (tmp / "a.csv").write_text("a" + text)
+            (tmp / "b.csv").write_text("b" + text)
+    real, calls = os.replace, []
+
+    def dying(src, dst):  # the process "dies" at the third rename: no undo runs
+        calls.append(dst)
+        if len(calls) == 3:
+            raise SystemExit(137)
+        return real(src, dst)
+
+    monkeypatch.setattr(fileio.os, "replace", dying)
+    monkeypatch.setattr(fileio.contextlib, "suppress", lambda *e: (_ for _ in ()).throw(SystemExit(137)))
+    with pytest.raises(SystemExit):
+        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+            (tmp / "a.csv").write_text("a3")
+            (tmp / "b.csv").write_text("b3")
+    monkeypatch.undo()
+    with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:  # accepted, whatever mix is there
+        (tmp / "a.csv").write_text("a4")
+        (tmp / "b.csv").write_text("b4")
+    assert (d / "a.csv").read_text() == "a4" and (d / "b.csv").read_text() == "b4"
+
+
+def test_the_record_lock_opens_read_only(tmp_path, monkeypatch):
+    # a group-shared folder's lock file is 0644 under umask 022: opened for writing it refused
+    # every other user's rerun ("permission denied")
+    from tactileskin import fileio
+
+    flags = []
+    real = os.open
+    monkeypatch.setattr(fileio.os, "open", lambda p, f, *a: (flags.append((str(p), f)), real(p, f, *a))[1])
+    (tmp_path / "x.inp").write_text("x")
+    fileio.record_file(tmp_path / "x.inp")
+    lock = [f for p, f in flags if p.endswith(fileio.RECORD_LOCK)]
+    assert lock and all(f & (os.O_WRONLY | os.O_RDWR) == 0 for f in lock)
+
+
+def test_a_folder_of_our_bookkeeping_alone_is_empty(tmp_path):
+    from tactileskin import fileio
+
+    d = tmp_path / "d"
+    d.mkdir()
+    (d / "deck.msh").write_text("x")
+    fileio.record_file(d / "deck.msh")
+    (d / "deck.msh").unlink()
+    fileio.claim_dir(d, "solve")  # was refused: "holds files tactileskin did not write (.tactileskin-files.json, ...)"

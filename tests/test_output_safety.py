@@ -555,13 +555,23 @@ def test_a_suspect_case_gets_no_render(tmp_path, capsys, monkeypatch):
 
 
 def test_a_folder_an_earlier_version_wrote_without_the_record_is_rerun(tmp_path):
-    """Before the record (.tactileskin-files.json) a marked folder's pattern-matching files were
-    the earlier result: a rerun into such a folder (yesterday's ./dev run) replaces them as that
-    version did, and starts the record, instead of refusing every file as not ours."""
+    """Before the record of results, a marked folder's pattern-matching files were the earlier
+    result: a rerun into such a folder (yesterday's ./dev run) replaces them as that version did
+    and starts the record, instead of refusing every file as not ours; also when that version
+    recorded a single file there (mesh -o); a folder this version claimed keeps the record's rule."""
     d = tmp_path / "old"
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
-    (d / ".tactileskin-files.json").unlink()
+    marker = json.loads((d / ".tactileskin").read_text())
+    assert marker.get("record") == 1
+    del marker["record"]  # as the earlier version wrote it
+    (d / ".tactileskin").write_text(json.dumps(marker))
+    (d / ".tactileskin-files.json").write_text(json.dumps({"deck.msh": "0" * 64}))
     (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1\n1,0\n")  # the old result's
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     assert len((d / "profile.csv").read_text().splitlines()) > 3
-    assert "profile.csv" in json.loads((d / ".tactileskin-files.json").read_text())
+    rec = json.loads((d / ".tactileskin-files.json").read_text())
+    assert "profile.csv" in rec and "deck.msh" not in rec  # deck.msh is not there
+    assert json.loads((d / ".tactileskin").read_text())["record"] == 1
+    # from now on the record's rule: a user's file of a result's name is refused, not replaced
+    (d / ".tactileskin-files.json").write_text(json.dumps({k: v for k, v in rec.items() if k != "contact.csv"}))
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2

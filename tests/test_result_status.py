@@ -289,10 +289,13 @@ def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
     p2[0] = 0.25
     assert edge_peak(s2, p2, 2.0)[:2] == (0.25, -10.0)
     r = Result(s=s, pressure=p, contact_x=np.array([0.0]), contact_pressure=np.array([0.2]), reaction=1.0,
-               stats={"min_J": 0.99, "max_abs_stress_mpa": 0.3}, scene={"thickness": 2.0})
+               stats={"min_J": 0.99, "max_abs_stress_mpa": 0.3}, scene={"thickness": 2.0, "skin": "pad"})
     summ = r.summary()
     assert [f["code"] for f in summ["flags"]] == ["edge_peak"]
     assert summ["peak_interior_mpa"] == pytest.approx(0.17) and summ["peak_edge_s_mm"] == 10.0
+    # the fingertip's bone runs on into the bonded nail: its profile's end is no free edge
+    r.scene = {"thickness": 2.0}
+    assert r.summary()["flags"] == []
 
 
 def test_a_z_half_model_of_a_z_asymmetric_indenter_is_flagged():

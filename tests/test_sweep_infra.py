@@ -129,7 +129,17 @@ def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_tracebac
 
     monkeypatch.setattr(dask.distributed, "LocalCluster", Starting)  # what _start imports
     monkeypatch.setattr(distributed, "LocalCluster", Starting)
+    class Users:  # a cluster of the user's own (a notebook's): not ours to close
+        shutdown_on_close = True
+
+        def close(self, timeout=None):
+            raise AssertionError("the user's cluster was closed")
+
+    theirs = Users()
+    SpecCluster._instances.add(theirs)
     runner = sweep._Runner([], [], serial=False, scheduler=None, workers=1)
     with pytest.raises(KeyboardInterrupt):
         runner._start(1)
     assert len(made) == 1 and made[0].shutdown_on_close is False  # the exit hook skips it
+    assert theirs.shutdown_on_close is True
+    SpecCluster._instances.discard(theirs)

@@ -87,7 +87,7 @@ def material_content(material: str) -> dict:
 # the libraries whose version can change a mesh or a solve (distribution names): trimesh
 # reads a user's STL indenter and its gaps, build123d and OCP (OpenCascade) tessellate a STEP
 SOLVER_LIBRARIES = ("gmsh", "scikit-fem", "numpy", "scipy", "numba", "mkl", "meshio", "trimesh",
-                    "build123d", "cadquery-ocp-novtk")
+                    "build123d", "cadquery-ocp-novtk", "cadquery-ocp")
 
 
 @lru_cache(maxsize=1)

@@ -25,6 +25,7 @@ import contextlib
 import errno
 import functools
 import json
+import logging
 import os
 import re
 import shutil
@@ -34,6 +35,8 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from tactileskin.errors import TactileSkinError
+
+log = logging.getLogger(__name__)
 
 MARKER = ".tactileskin"
 # `.NAME.tskPID[hHOST]-XXXX[.suffix]`: HOST names the writer's host and PID namespace (`_host`)
@@ -258,6 +261,12 @@ def _owned(folder: Path) -> dict:
         return {}
 
 
+def _recorded(entry, digest: str) -> bool:
+    """Whether a record entry (a digest, or [old, new] while a result is being moved in) has
+    `digest`."""
+    return digest == entry or (isinstance(entry, list) and digest in entry)
+
+
 def claim_file(path, what: str = "--out") -> Path:
     """Refuse `path` as an output file unless it is new or a file the toolkit wrote there and
     nobody changed since (OWNED_FILES); call before the work, `record_file` after writing."""
@@ -267,13 +276,19 @@ def claim_file(path, what: str = "--out") -> Path:
     if path.exists() or path.is_symlink():
         try:
             ours = (not path.is_symlink() and path.is_file()
-                    and _owned(path.parent).get(path.name) == _digest(path))
+                    and _recorded(_owned(path.parent).get(path.name), _digest(path)))
         except OSError:
             ours = False
         if not ours:
             raise OutputError(path, "the file exists and tactileskin did not write it (or it was changed since); "
                                     f"refusing to overwrite it: give {what} a new file name")
     return path
+
+
+def has_record(path) -> bool:
+    """Whether the folder's OWNED_FILES has an entry for `path` (whatever its bytes now)."""
+    path = Path(path)
+    return path.name in _owned(path.parent)
 
 
 def record_file(path) -> None:
@@ -295,14 +310,25 @@ RECORD_LOCK = ".tactileskin-files.lock"
 @contextlib.contextmanager
 def _record_lock(folder: Path) -> Iterator[None]:
     """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
-    OWNED_FILES (waits for another writer into the same folder)."""
-    import fcntl
-
-    with os_errors(folder / OWNED_FILES, own_name=False):
-        fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+    OWNED_FILES (waits for another writer into the same folder). Without flock (no fcntl, a
+    file system without locks) there is no lock, as in the cache."""
     try:
-        with os_errors(folder / OWNED_FILES, own_name=False):
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    # read-only: a group-shared folder's lock file (0644 under umask 022) must open for the
+    # other users too; flock needs no write access
+    with os_errors(folder / OWNED_FILES, own_name=False):
+        fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)  # open applies the umask
+    try:
+        try:
             fcntl.flock(fd, fcntl.LOCK_EX)
+        except OSError as e:
+            if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL):
+                with os_errors(folder / OWNED_FILES, own_name=False):
+                    raise
+            log.warning("no file locks in %s (%s): its record is written without one", folder, e.strerror)
         yield
     finally:
         os.close(fd)  # releases the lock
@@ -356,7 +382,8 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
         raise OutputError(folder, f"{what} must be a folder, and this is a file")
     if folder.is_dir():
         with os_errors(folder):
-            entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)]
+            entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)
+                       and p.name not in (OWNED_FILES, RECORD_LOCK)]  # our bookkeeping of single files
         if entries and not _is_ours(folder, kind):
             other = marker_kind(folder)
             if other is not None:  # ours, but another command's: say so, not "did not write"
@@ -369,9 +396,23 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     make_dirs(folder)
     clean_stale(folder)
     if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, {"kind": kind, "note": "written by tactileskin; "
-                                            "its commands may replace their own files here"})
+        atomic_write_json(folder / MARKER, _marker(kind))
     return folder
+
+
+def _marker(kind: str) -> dict:
+    # "record": its results are in OWNED_FILES (a marker without it is an earlier version's)
+    return {"kind": kind, "record": 1, "note": "written by tactileskin; its commands may replace their "
+                                                "own files here"}
+
+
+def _legacy(folder: Path) -> bool:
+    """Whether our marker in `folder` is from a version before the record of written files:
+    then the folder's pattern-matching files are its earlier result, as that version took them."""
+    try:
+        return json.loads((folder / MARKER).read_text()).get("record") != 1
+    except (OSError, ValueError, AttributeError):
+        return True
 
 
 @contextlib.contextmanager
@@ -411,8 +452,7 @@ def adopt_dir(folder, kind: str, names: Iterable[str]) -> None:
         if (folder / n).is_file() and not (folder / n).is_symlink():
             record_file(folder / n)
     if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, {"kind": kind, "note": "written by tactileskin; "
-                                            "its commands may replace their own files here"})
+        atomic_write_json(folder / MARKER, _marker(kind))
 
 
 @contextlib.contextmanager
@@ -476,7 +516,7 @@ def _check_owned(folder: Path, old: list[str], new: list[str], rec: dict) -> lis
     for rel in old:
         p = folder / rel
         try:
-            same = rel in rec and not p.is_symlink() and _digest(p) == rec[rel]
+            same = rel in rec and not p.is_symlink() and _recorded(rec[rel], _digest(p))
         except OSError:
             same = False
         if same:
@@ -541,10 +581,11 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     tops = {p.split("/")[0] for p in own if "/" in p}
     old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
     rec = None
-    if digests is not None and not (folder / OWNED_FILES).exists():
-        # marked by a version before the record (2026-11-26): its pattern-matching files are
-        # the earlier result, as that version took them; the record starts with this one
-        rec = {}
+    legacy = digests is not None and _legacy(folder)
+    if legacy:
+        # marked by a version before the record of results (2026-11-26): its pattern-matching
+        # files are the earlier result, as that version took them; the record starts here
+        rec = _owned(folder)  # single files (mesh -o, export -o) that version did record
     elif digests is not None:
         rec = _owned(folder)
         old = _check_owned(folder, old, new, rec)
@@ -558,6 +599,9 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     aside, moved_in = [], []  # (where it was, where it is): undone in reverse on a failure
     try:
         with os_errors(folder):
+            if rec is not None:  # a kill during the moves leaves either version of each file: both ours
+                atomic_write_json(folder / OWNED_FILES, {**rec, **{k: [rec[k], v] if isinstance(rec.get(k), str)
+                                                                   else v for k, v in digests.items()}})
             order = sorted(set(new) | set(old), key=lambda f: f == last)
             if last in old:
                 os.replace(folder / last, trash / "last")
@@ -574,6 +618,10 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
             if rec is not None:  # entries of files gone or replaced dropped, the new ones added
                 keep = {k: v for k, v in rec.items() if k not in old and (folder / k).is_file()}
                 atomic_write_json(folder / OWNED_FILES, {**keep, **digests})  # the last step: no undo
+                if legacy:
+                    with contextlib.suppress(OSError, ValueError, AttributeError):
+                        kind = json.loads((folder / MARKER).read_text()).get("kind")
+                        atomic_write_json(folder / MARKER, _marker(kind))
     except BaseException:
         for src, dst in reversed(moved_in):  # the earlier result back as it was
             with contextlib.suppress(OSError):

@@ -354,7 +354,15 @@ class Result:
     def _edge_summary(self) -> dict:
         """The profile's peak at an edge of the bonded skin (`edge_peak`), with the interior one
         (quality flags it: the peak is a corner singularity)."""
-        found = edge_peak(*self._profile(), float((self.scene or {}).get("thickness") or 0.0))
+        from tactileskin.skins import registry
+
+        scene = self.scene or {}
+        try:
+            if not registry.get(scene.get("skin", "fingertip")).profile_ends_free:
+                return {}
+        except ParameterError:  # an unknown skin name: judge the profile as it is
+            pass
+        found = edge_peak(*self._profile(), float(scene.get("thickness") or 0.0))
         if found is None:
             return {}
         _, se, pi, si = found

@@ -396,12 +396,15 @@ class _Runner:
             # at ERROR (seen on `./dev run`); a worker that dies during a case still reaches
             # the sweep as its future's exception, recorded as a failed case
             quiet = logging.ERROR if log.isEnabledFor(logging.INFO) else logging.CRITICAL
+            from distributed.deploy.spec import SpecCluster
+
+            before = set(SpecCluster._instances)  # a user's own clusters (a notebook) stay
             try:
                 self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                             dashboard_address=None, silence_logs=quiet,
                                             env={"TACTILESKIN_THREADS": worker_threads(n)})
             except BaseException:
-                _close_unfinished_clusters()
+                _close_unfinished_clusters(before)
                 raise
         self.client = Client(self.cluster)
         return self.client
@@ -413,12 +416,13 @@ class _Runner:
             self.cluster.close()
 
 
-def _close_unfinished_clusters() -> None:
-    """Close the clusters a Ctrl-C interrupted while they started: dask's exit hook would
-    close them too, and end in an AssertionError traceback on one still in Status.init."""
+def _close_unfinished_clusters(before: set) -> None:
+    """Close the clusters (not in `before`) a Ctrl-C interrupted while they started: dask's
+    exit hook would close them too, and end in an AssertionError traceback on one still in
+    Status.init."""
     from distributed.deploy.spec import SpecCluster
 
-    for cluster in list(SpecCluster._instances):
+    for cluster in [c for c in SpecCluster._instances if c not in before]:
         try:
             cluster.close(timeout=5)
         except BaseException:  # noqa: BLE001 - interrupted already; nothing left to report

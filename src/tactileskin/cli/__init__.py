@@ -100,10 +100,10 @@ def raise_if_signalled() -> None:
 def _signals_raise():
     """SIGTERM (a scheduler's kill, `timeout`) unwinds like Ctrl-C instead of dying in place;
     both are remembered (`_signalled`)."""
-    _signalled.clear()
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _signalled.clear()
     previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     try:
         yield

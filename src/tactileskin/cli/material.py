@@ -7,6 +7,14 @@ from pathlib import Path
 import click
 
 MARK = "# written by tactileskin material fit"
+
+
+def _has_mark(path: Path) -> bool:
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(len(MARK)) == MARK.encode()
+    except OSError:
+        return False
 EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
 
@@ -53,7 +61,10 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     if outp.suffix != ".toml":
         raise ParameterError("--out", out, "a path ending in .toml")
     # before the fit: only a file this command wrote and nobody changed since is replaced (the
-    # folder's record; the MARK line alone is kept by a hand-edited copy)
+    # folder's record; the MARK line alone is kept by a hand-edited copy). A file with the MARK
+    # line and no entry in the record is an earlier version's (it kept no record): replaced as then
+    if outp.is_file() and not outp.is_symlink() and not fileio.has_record(outp) and _has_mark(outp):
+        fileio.record_file(outp)
     fileio.claim_file(outp)
     if test == "indentation":
         from tactileskin.materials.indentation import fit_indentation, read_indentation_csv

@@ -190,7 +190,7 @@ def _solve_2d(scene):
 
     sc2 = scene.replace(dim=2, mesh_size=None, refinement=None)
     sizes = (scene.mesh_size, scene.refinement)
-    for q in ("preview", "default", "fine"):
+    for q in ("default", "fine", "preview"):  # default first: thick Braille's 3D default is its preview
         if preset_mesh(q, 3, scene.indenter, scene.thickness, scene.skin) == sizes:
             sc2 = with_quality(sc2, q)
             break

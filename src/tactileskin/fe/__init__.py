@@ -196,12 +196,14 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                                       d_guess=lambda F: d_exp * min(1.0, F / full), record=record,
                                       progress=progress, on_segment=on_segment)
     except ConvergenceError as e:
-        if scene.force is None or not last or "increments" not in str(e):
+        forced = [g.target for g in program if g.kind == "force"]
+        if not forced or not last or "increments" not in str(e):
             raise
         # a force beyond the law's lock-up: the increments shrink to nothing below the travel
         # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments")
         unit = "N" if scene.dim == 3 else "N/mm"
-        raise ParameterError("force", scene.force, f"a force the skin carries within its travel (at most "
+        raise ParameterError("force", scene.force if scene.force is not None else max(forced),
+                             f"a force the skin carries within its travel (at most "
                              f"{scene.max_travel:.3g} mm = 0.6 x thickness)",
                              f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
                              f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "

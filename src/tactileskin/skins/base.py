@@ -40,6 +40,10 @@ class Skin:
     # modelled as its half x >= 0 whatever the indenter (the pad takes its full width for an
     # x-asymmetric indenter; a user's file skin is meshed as given)
     halves_x: ClassVar[bool] = False
+    # the bonded surface ends free where the bone profile ends (a pad's side): a corner
+    # singularity there is flagged (quality "edge_peak"); False where it continues into another
+    # bonded part (the fingertip's bone into the nail)
+    profile_ends_free: ClassVar[bool] = True
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
 
     @classmethod

@@ -15,6 +15,7 @@ class FingertipSkin(Skin):
     order = 0
     scene_params = ("fingertip",)
     fixed_boundaries = ("bone_interface", "nail_edge")
+    profile_ends_free = False  # the bone runs on into the bonded nail
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
 
     @classmethod
