@@ -300,3 +300,27 @@ def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
 
 def test_a_z_half_model_of_a_z_asymmetric_indenter_is_flagged():
     assert [f.code for f in quality.flags({**NORMAL, "mirrored_z": True})] == ["mirrored_z"]
+
+
+def test_a_map_plane_chosen_away_from_a_load_at_the_skins_end_is_flagged():
+    """A file indenter near the end of the slab: the profile plane came from the map's interior
+    (>= t from the ends), 1.5-3 mm from the load, and read it 3-13x low with status ok."""
+    summ = {**NORMAL, "profile_plane_from_map": True, "profile_plane_z": 7.97, "peak_map_edge_mpa": 0.06,
+            "peak_map_edge_s_mm": 0.0, "peak_map_edge_z_mm": 10.0}
+    assert [f.code for f in quality.flags(summ)] == ["edge_peak"]
+    # a built-in indenter's plane is known (through its dots): the map's edge band is only shown
+    assert quality.flags({k: v for k, v in summ.items() if k != "profile_plane_from_map"}) == []
+
+
+def test_the_domes_tip_end_of_the_map_is_no_edge():
+    """On the dome the bone runs on past z = 0 into the tip: a load there was called a corner
+    singularity and the map's peak taken 2 mm away (5.7x low)."""
+    from tactileskin.results import BoneMap, skin_says
+
+    s, z = np.linspace(0.0, 6.0, 13), np.linspace(-10.0, 0.0, 21)
+    P = np.exp(-(s[None, :] ** 2 + z[:, None] ** 2))
+    m = BoneMap(s, z, P, 0.0)
+    assert m.interior_peak(2.0, z_end_free=True)[2] == pytest.approx(-2.0)
+    assert m.interior_peak(2.0, z_end_free=False)[2] == 0.0
+    assert not skin_says({"skin": "dome"}, "map_z_end_free") and skin_says({"skin": "pad"}, "map_z_end_free")
+    assert not skin_says({}, "profile_ends_free") and skin_says({"skin": "nonesuch"}, "profile_ends_free")

@@ -104,6 +104,13 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("locking", f"linear (P1) displacement elements with a nearly incompressible law"
                         + (f" (nu0 = {nu0:.3g})" if nu0 is not None else "") + " lock: the t = 1 mm flat plate "
                         "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
+    pe = _num(summary, "peak_map_edge_mpa")
+    if summary.get("profile_plane_from_map") and pe is not None:
+        out.append(Flag("edge_peak", f"the bone map's largest value {pe:.4g} MPa is at s = "
+                        f"{_num(summary, 'peak_map_edge_s_mm'):g} mm, z = {_num(summary, 'peak_map_edge_z_mm'):g} mm, "
+                        "within one skin thickness of where the bonded skin ends, and the profile was taken on "
+                        f"the interior's plane z = {_num(summary, 'profile_plane_z'):g} mm: the load is near the "
+                        "skin's end (or that is a corner singularity); move it inward or lengthen the skin"))
     sizes = summary.get("mesh_sizes_mm")
     if isinstance(sizes, dict):
         coarse = [f"{what} size {sizes[k]:g} mm against {sizes['preview_' + k]:g}" for k, what, f in

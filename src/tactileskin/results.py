@@ -148,7 +148,7 @@ class BoneMap:
         j, i = np.unravel_index(int(np.argmax(self.pressure)), self.pressure.shape)
         return float(self.pressure[j, i]), float(self.s[i]), float(self.z[j])
 
-    def interior_peak(self, margin: float) -> tuple[float, float, float]:
+    def interior_peak(self, margin: float, z_end_free: bool = True) -> tuple[float, float, float]:
         """peak() over the points farther than `margin` (mm) from the map's edges, or over the
         whole map if none is. A grid starting at 0 starts at a symmetry plane of the reduced
         model, not at an edge. Why: where the bonded skin ends (a slab's free end, a pad's
@@ -156,8 +156,8 @@ class BoneMap:
         slab: 0.044, 0.056, 0.065 MPa at the end on meshes 1.6, 1.2, 0.8 / 8, against
         0.0348, 0.0352, 0.0353 under the dot; benchmarks/results/convergence3d.md)."""
         keep = []
-        for v in (self.z, self.s):
-            ok = v <= v[-1] - margin
+        for v, end_free in ((self.z, z_end_free), (self.s, True)):
+            ok = v <= v[-1] - margin if end_free else np.ones(v.shape, bool)
             if abs(v[0]) > 1e-9:
                 ok &= v >= v[0] + margin
             keep.append(ok)
@@ -335,6 +335,8 @@ class Result:
             "wall_s": float(self.stats.get("wall_s", 0.0)),
             # 3D: the profile is that of the section plane z = profile_plane_z (fe.output.plane_profile)
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
+            # ... chosen from the map's interior peak (a file indenter): quality judges its edges
+            **({"profile_plane_from_map": True} if self.stats.get("profile_plane_from_map") else {}),
             # a profile across the centre (no x = 0 plane): span and AUC are half of it
             **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
@@ -354,14 +356,9 @@ class Result:
     def _edge_summary(self) -> dict:
         """The profile's peak at an edge of the bonded skin (`edge_peak`), with the interior one
         (quality flags it: the peak is a corner singularity)."""
-        from tactileskin.skins import registry
-
         scene = self.scene or {}
-        try:
-            if not registry.get(scene.get("skin", "fingertip")).profile_ends_free:
-                return {}
-        except ParameterError:  # an unknown skin name: judge the profile as it is
-            pass
+        if not skin_says(scene, "profile_ends_free"):
+            return {}
         found = edge_peak(*self._profile(), float(scene.get("thickness") or 0.0))
         if found is None:
             return {}
@@ -374,7 +371,7 @@ class Result:
         if self.bone_map is None:
             return {}
         margin = float((self.scene or {}).get("thickness") or 0.0)
-        p, s, z = self.bone_map.interior_peak(margin)
+        p, s, z = self.bone_map.interior_peak(margin, skin_says((self.scene or {}), "map_z_end_free"))
         out = {"peak_map_mpa": p, "peak_map_s_mm": s, "peak_map_z_mm": z}
         pe, se, ze = self.bone_map.peak()
         if pe > p:
@@ -488,6 +485,17 @@ OWN_FILES = ("profile.csv", "contact.csv", "summary.json", "result.vtu", "bone_m
 # would look current); --compare-2d's section is a result folder of its own
 SOLVE_FILES = (*OWN_FILES, "bone_map.png", "sensors.png", "compare_2d.json",
                *(f"section_2d/{n}" for n in OWN_FILES))
+
+
+def skin_says(scene: dict, what: str) -> bool:
+    """A skin kind's boolean class attribute (skins.base.Skin) for a scene dict; True for an
+    unknown skin name (its profile and map are judged as they are)."""
+    from tactileskin.skins import registry
+
+    try:
+        return bool(getattr(registry.get(scene.get("skin", "fingertip")), what))
+    except ParameterError:
+        return True
 
 
 def read_vtu(path):

@@ -366,6 +366,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
     the bone map P(s, z) on the grid (profile's s) x `map_planes` (see `surface_grid`)."""
     pj = Projector(model)
     sig = model.stress(ev)
+    plane_from_map = False
     fields = nodal_fields(model, ev, pj, sig)
     if s_of_point is None:
         s_of_point = arc_length
@@ -383,10 +384,13 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
         if getattr(ind, "profile_at_map_peak", False):
             # no plane is known before the solve (a file indenter off z = 0, two bumps, a
             # ring): the profile is the map's row through its peak (>= t from the slab's ends)
+            from tactileskin.results import skin_says
+
             margin = float((scene or {}).get("thickness", 0.0))
-            plane_z = bmap.interior_peak(margin)[2]
+            plane_z = bmap.interior_peak(margin, skin_says(scene or {}, "map_z_end_free"))[2]
             p = bmap.row(plane_z).copy()
             bmap = BoneMap(s, zg, grid, plane_z)
+            plane_from_map = True
     else:
         bmap = None
         sd, s = path_nodes(model, path, s_of_point)
@@ -412,6 +416,7 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           "cutbacks": stats.cutbacks, "uzawa_iterations": stats.uzawa_iterations,
           "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
+          **({"profile_plane_from_map": True} if plane_from_map else {}),
           **({"profile_sides": 2} if getattr(model, "profile_sides", 1) == 2 else {}),
           "reaction_vector_modelled_part": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, contact_points=cpos,

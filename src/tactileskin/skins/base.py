@@ -44,6 +44,9 @@ class Skin:
     # singularity there is flagged (quality "edge_peak"); False where it continues into another
     # bonded part (the fingertip's bone into the nail)
     profile_ends_free: ClassVar[bool] = True
+    # likewise the 3D bone map's largest z: False where the bone runs on past it (the dome's
+    # tip, bonded beyond z = 0), so that a load there is not taken for a corner of the map
+    map_z_end_free: ClassVar[bool] = True
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
 
     @classmethod

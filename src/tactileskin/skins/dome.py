@@ -137,6 +137,7 @@ class DomeSection:
 @register
 class DomeSkin(Skin):
     name = "dome"
+    map_z_end_free = False  # the bone runs on into the tip (bone_tip) past z = 0
     halves_x = True
     order = 2
     scene_params = ("dome_length", "dome_tip")
