@@ -324,3 +324,12 @@ def test_the_domes_tip_end_of_the_map_is_no_edge():
     assert m.interior_peak(2.0, z_end_free=False)[2] == 0.0
     assert not skin_says({"skin": "dome"}, "map_z_end_free") and skin_says({"skin": "pad"}, "map_z_end_free")
     assert not skin_says({}, "profile_ends_free") and skin_says({"skin": "nonesuch"}, "profile_ends_free")
+
+
+def test_a_file_indenter_on_a_skin_file_without_a_map_is_flagged():
+    # the fingertip written as a 3D .msh: s = x - x_top folds where the bone curves back, so
+    # there is no (s, z) map (the solve ended in a ParameterError after solving); without it a
+    # file indenter's profile plane cannot follow the load
+    assert [f.code for f in quality.flags({**NORMAL, "bone_map_missing": True, "profile_plane_unknown": True})] \
+        == ["no_bone_map"]
+    assert quality.flags({**NORMAL, "bone_map_missing": True}) == []  # a built-in indenter's plane is known

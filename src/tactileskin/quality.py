@@ -44,7 +44,7 @@ COARSE_GLOBAL = 2.0
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "mirrored_x" | "mirrored_z" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "mirrored_x" | "mirrored_z" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -104,6 +104,9 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("locking", f"linear (P1) displacement elements with a nearly incompressible law"
                         + (f" (nu0 = {nu0:.3g})" if nu0 is not None else "") + " lock: the t = 1 mm flat plate "
                         "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
+    if summary.get("profile_plane_unknown"):
+        out.append(Flag("no_bone_map", "no bone map of this skin file's bonded surface (not a graph over x: "
+                        "s = x - x_top folds), so the profile is on z = 0, not through the file indenter's load"))
     pe = _num(summary, "peak_map_edge_mpa")
     if summary.get("profile_plane_from_map") and pe is not None:
         out.append(Flag("edge_peak", f"the bone map's largest value {pe:.4g} MPa is at s = "

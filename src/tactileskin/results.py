@@ -337,6 +337,7 @@ class Result:
             **({"profile_plane_z": float(self.stats["profile_plane_z"])} if "profile_plane_z" in self.stats else {}),
             # ... chosen from the map's interior peak (a file indenter): quality judges its edges
             **({"profile_plane_from_map": True} if self.stats.get("profile_plane_from_map") else {}),
+            **{k: True for k in ("bone_map_missing", "profile_plane_unknown") if self.stats.get(k)},
             # a profile across the centre (no x = 0 plane): span and AUC are half of it
             **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)

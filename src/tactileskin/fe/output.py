@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from tactileskin.errors import ConvergenceError, ParameterError
@@ -9,6 +11,8 @@ from tactileskin.fe import kernels
 from tactileskin.fe.model import Evaluation, Model
 from tactileskin.fe.recovery import PointFit, Projector
 from tactileskin.results import BoneMap, Result
+
+logger = logging.getLogger(__name__)
 
 _VTK_CELL = {(2, 6): "triangle6", (2, 3): "triangle", (3, 10): "tetra10", (3, 4): "tetra",
              (2, 9): "quad9", (2, 4): "quad"}
@@ -375,13 +379,25 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
         plane_z = profile_plane_z(model) if plane_z is None else float(plane_z)
         s, p = plane_profile(model, fields["pressure"], path, s_of_point, plane_z)
         zg = map_planes(model, path, plane_z)
-        grid = surface_grid(model, fields["pressure"], path, s_of_point, s, zg)
-        # the section row is the same interpolant as the profile (equal to rounding: checked
-        # in tests/test_bone_map.py); take the profile's values so that they agree exactly
-        grid[int(np.argmin(np.abs(zg - plane_z)))] = p
-        bmap = BoneMap(s, zg, grid, plane_z)
+        try:
+            grid = surface_grid(model, fields["pressure"], path, s_of_point, s, zg)
+        except ParameterError as e:
+            if (scene or {}).get("skin") != "file":
+                raise
+            # a user's bonded surface that is no graph over x (s = x - x_top folds where it
+            # curves back: the fingertip written as a file): the result without its map
+            logger.warning("no bone map for this skin file (%s); the profile is on z = %g", e, plane_z)
+            grid = None
+        if grid is not None:
+            # the section row is the same interpolant as the profile (equal to rounding: checked
+            # in tests/test_bone_map.py); take the profile's values so that they agree exactly
+            grid[int(np.argmin(np.abs(zg - plane_z)))] = p
+        bmap = BoneMap(s, zg, grid, plane_z) if grid is not None else None
         ind = getattr(model.contact, "indenter", None)
-        if getattr(ind, "profile_at_map_peak", False):
+        no_map = bmap is None
+        if no_map and getattr(ind, "profile_at_map_peak", False):
+            plane_from_map = None  # quality: the plane could not follow the load
+        elif getattr(ind, "profile_at_map_peak", False):
             # no plane is known before the solve (a file indenter off z = 0, two bumps, a
             # ring): the profile is the map's row through its peak (>= t from the slab's ends)
             from tactileskin.results import skin_says
@@ -417,6 +433,8 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
           "wall_s": stats.wall_s, "formulation": model.formulation, **law,
           **({"profile_plane_z": plane_z} if model.m == 3 else {}),
           **({"profile_plane_from_map": True} if plane_from_map else {}),
+          **({"bone_map_missing": True} if model.m == 3 and bmap is None else {}),
+          **({"profile_plane_unknown": True} if plane_from_map is None else {}),
           **({"profile_sides": 2} if getattr(model, "profile_sides", 1) == 2 else {}),
           "reaction_vector_modelled_part": r.tolist()}
     return Result(s=s, pressure=p, contact_x=cx, contact_pressure=cp, contact_points=cpos,
