@@ -147,14 +147,6 @@ class CaseRecord:
     variant: str = ""   # the id's suffix naming the fields that tell it apart ("d0.2-r2")
 
 
-def _file_sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:
     with open(path, newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
@@ -260,7 +252,7 @@ class ResultCache:
                     raise ValueError(f"lists {fname!r}")
                 if not (p / fname).is_file():
                     raise ValueError(f"{fname} is missing")
-                if _file_sha256(p / fname) != digest:
+                if fileio.file_sha256(p / fname) != digest:
                     raise ValueError(f"the bytes of {fname} changed since the entry was written")
             name = "summary.json"
             summary = json.loads((p / name).read_text(encoding="utf-8"))
@@ -307,7 +299,7 @@ class ResultCache:
         with fileio.os_errors(final), fileio.staged_dir(final) as tmp:
             result.write_owned(tmp)
             scene.to_toml(tmp / "scene.toml")
-            files = {f.name: _file_sha256(f) for f in sorted(tmp.iterdir()) if f.is_file()}
+            files = {f.name: fileio.file_sha256(f) for f in sorted(tmp.iterdir()) if f.is_file()}
             (tmp / "cache.json").write_text(json.dumps(
                 {"schema": SCHEMA_VERSION, "key": key, "version": __version__, "files": files}, indent=2) + "\n",
                 encoding="utf-8")

@@ -243,7 +243,7 @@ def atomic_write_json(path, obj) -> Path:
 OWNED_FILES = ".tactileskin-files.json"
 
 
-def _digest(path: Path) -> str:
+def file_sha256(path: Path) -> str:
     import hashlib
 
     h = hashlib.sha256()
@@ -276,7 +276,7 @@ def claim_file(path, what: str = "--out") -> Path:
     if path.exists() or path.is_symlink():
         try:
             ours = (not path.is_symlink() and path.is_file()
-                    and _recorded(_owned(path.parent).get(path.name), _digest(path)))
+                    and _recorded(_owned(path.parent).get(path.name), file_sha256(path)))
         except OSError:
             ours = False
         if not ours:
@@ -295,7 +295,7 @@ def record_file(path) -> None:
     """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
     path = Path(path)
     with os_errors(path):
-        digest = _digest(path)
+        digest = file_sha256(path)
     with _record_lock(path.parent):  # two writers into one folder must not lose an entry
         rec = {k: v for k, v in _owned(path.parent).items() if (path.parent / k).is_file()}
         rec[path.name] = digest
@@ -516,7 +516,7 @@ def _check_owned(folder: Path, old: list[str], new: list[str], rec: dict) -> lis
     for rel in old:
         p = folder / rel
         try:
-            same = rel in rec and not p.is_symlink() and _recorded(rec[rel], _digest(p))
+            same = rel in rec and not p.is_symlink() and _recorded(rec[rel], file_sha256(p))
         except OSError:
             same = False
         if same:
@@ -566,7 +566,7 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
             raise ValueError(f"staged files not in the owned patterns: {stray}")
         marked = (folder / MARKER).is_file()
         with os_errors(folder):  # the digests the record will hold, before anything moves
-            digests = {rel: _digest(tmp / rel) for rel in new} if marked else {}
+            digests = {rel: file_sha256(tmp / rel) for rel in new} if marked else {}
         with _record_lock(folder) if marked else contextlib.nullcontext():
             _replace_files(folder, tmp, own, new, last, digests if marked else None)
     finally:
