@@ -63,7 +63,7 @@ def _temporaries(folder: Path) -> list[str]:
 def _as_written_by_us(path: Path) -> None:
     """Record `path` in its folder's record as a file tactileskin wrote (an earlier run's)."""
     rec = fileio._owned(path.parent)
-    rec[path.name] = fileio._digest(path)
+    rec[path.name] = fileio.file_sha256(path)
     (path.parent / fileio.OWNED_FILES).write_text(__import__("json").dumps(rec))
 
 
