@@ -60,3 +60,12 @@ def test_a_signal_whose_exception_was_swallowed_still_ends_the_run(monkeypatch, 
     except SystemExit as e:
         rc = e.code
     assert rc == code
+    # the signal was this run's: a later run in another thread (a notebook's) ends normally
+    import threading
+
+    monkeypatch.setattr(materials, "list_materials", real)
+    later = []
+    th = threading.Thread(target=lambda: later.append(main(["material", "list"])))
+    th.start()
+    th.join()
+    assert later == [0]

@@ -222,6 +222,11 @@ def test_cli_material_fit_writes_a_usable_file(tmp_path, capsys):
     (old / "gel.toml").write_text(MARK + "\nname = 'gel'\n")
     assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(old / "gel.toml")]) == 0
     assert get_material(str(old / "gel.toml")).law.law == "neo_hookean"
+    # ... but in a folder with a record, a hand-edited copy of ours (its line kept) is the user's
+    tuned = old / "gel_tuned.toml"
+    tuned.write_text((old / "gel.toml").read_text() + "# tuned by hand\n")
+    assert main(["material", "fit", str(csv), "--law", "yeoh", "-o", str(tuned)]) == 2
+    assert tuned.read_text().endswith("# tuned by hand\n")
 
 
 def test_unit_mistakes_in_the_test_data_are_caught(tmp_path):

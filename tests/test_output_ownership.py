@@ -223,29 +223,61 @@ def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(t
 
     monkeypatch.setattr(fileio.os, "replace", dying)
     monkeypatch.setattr(fileio.contextlib, "suppress", lambda *e: (_ for _ in ()).throw(SystemExit(137)))
-    with pytest.raises(SystemExit):
-        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
-            (tmp / "a.csv").write_text("a3")
-            (tmp / "b.csv").write_text("b3")
+    for text in ("3", "3b"):  # twice: the second run's record keeps the first's digests
+        calls.clear()
+        with pytest.raises(SystemExit):
+            with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+                (tmp / "a.csv").write_text("a" + text)
+                (tmp / "b.csv").write_text("b" + text)
     monkeypatch.undo()
+    with pytest.raises(KeyboardInterrupt):  # and a run undone cleanly puts the record back too
+        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+            (tmp / "a.csv").write_text("a5")
+            raise KeyboardInterrupt
     with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:  # accepted, whatever mix is there
         (tmp / "a.csv").write_text("a4")
         (tmp / "b.csv").write_text("b4")
     assert (d / "a.csv").read_text() == "a4" and (d / "b.csv").read_text() == "b4"
 
 
-def test_the_record_lock_opens_read_only(tmp_path, monkeypatch):
-    # a group-shared folder's lock file is 0644 under umask 022: opened for writing it refused
-    # every other user's rerun ("permission denied")
+def test_the_record_lock_opens_read_only_where_it_cannot_be_written(tmp_path, monkeypatch):
+    # a group-shared folder's lock file is 0644 under umask 022: another user cannot open it for
+    # writing ("permission denied" refused every rerun); flock needs no write access
     from tactileskin import fileio
 
-    flags = []
-    real = os.open
-    monkeypatch.setattr(fileio.os, "open", lambda p, f, *a: (flags.append((str(p), f)), real(p, f, *a))[1])
+    real, flags = os.open, []
+
+    def opener(p, f, *a):
+        flags.append(f)
+        if str(p).endswith(fileio.RECORD_LOCK) and f & os.O_RDWR:
+            raise PermissionError(13, "Permission denied")
+        return real(p, f, *a)
+
+    monkeypatch.setattr(fileio.os, "open", opener)
     (tmp_path / "x.inp").write_text("x")
     fileio.record_file(tmp_path / "x.inp")
-    lock = [f for p, f in flags if p.endswith(fileio.RECORD_LOCK)]
-    assert lock and all(f & (os.O_WRONLY | os.O_RDWR) == 0 for f in lock)
+    assert any(f & (os.O_WRONLY | os.O_RDWR) == 0 for f in flags)
+    assert "x.inp" in json.loads((tmp_path / fileio.OWNED_FILES).read_text())
+
+
+def test_a_legacy_folder_upgraded_by_one_command_keeps_the_others_files(tmp_path):
+    """A film folder of an earlier version: `film compare` (its own files only) upgraded the
+    marker, and the next `film analyze` refused the earlier analyze files as not ours."""
+    from tactileskin import fileio
+
+    d = tmp_path / "f"
+    fileio.claim_dir(d, "film-analyze")
+    marker = json.loads((d / fileio.MARKER).read_text())
+    del marker["record"]
+    (d / fileio.MARKER).write_text(json.dumps(marker))
+    (d / "profile.csv").write_text("old analyze")
+    (d / "comparison.json").write_text("old compare")
+    with fileio.staged_files(d, ("comparison.json",)) as tmp:
+        (tmp / "comparison.json").write_text("new compare")
+    with fileio.staged_files(d, ("profile.csv", "comparison.json")) as tmp:
+        (tmp / "profile.csv").write_text("new analyze")
+        (tmp / "comparison.json").write_text("newer compare")
+    assert (d / "profile.csv").read_text() == "new analyze"
 
 
 def test_a_folder_of_our_bookkeeping_alone_is_empty(tmp_path):

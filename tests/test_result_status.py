@@ -322,6 +322,11 @@ def test_the_domes_tip_end_of_the_map_is_no_edge():
     m = BoneMap(s, z, P, 0.0)
     assert m.interior_peak(2.0, z_end_free=True)[2] == pytest.approx(-2.0)
     assert m.interior_peak(2.0, z_end_free=False)[2] == 0.0
+    # the fingertip's bone runs on into the nail at its s end: no edge band there either
+    Ps = np.exp(-((s[None, :] - 6.0) ** 2 + (z[:, None] + 5.0) ** 2))
+    edge = BoneMap(s, z, Ps, 0.0)
+    assert edge.interior_peak(2.0)[1] == pytest.approx(4.0)
+    assert edge.interior_peak(2.0, s_end_free=False)[1] == 6.0
     assert not skin_says({"skin": "dome"}, "map_z_end_free") and skin_says({"skin": "pad"}, "map_z_end_free")
     assert not skin_says({}, "profile_ends_free") and skin_says({"skin": "nonesuch"}, "profile_ends_free")
 

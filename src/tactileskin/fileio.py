@@ -121,7 +121,7 @@ def os_errors(path, *, own_name: bool = True) -> Iterator[None]:
 def tmp_prefix(path: Path) -> str:
     # the name cut short: a name near the file system's 255-byte limit is valid, its
     # temporary (about 35 characters longer) would not be
-    return f".{path.name[:64]}.tsk{os.getpid()}h{_host()}-"
+    return f".{path.name.encode()[:64].decode('utf-8', 'ignore')}.tsk{os.getpid()}h{_host()}-"
 
 
 @functools.lru_cache(maxsize=1)
@@ -261,6 +261,11 @@ def _owned(folder: Path) -> dict:
         return {}
 
 
+def _entries(entry) -> list:
+    """The digests of a record entry (a digest, a list of them, or none)."""
+    return list(entry) if isinstance(entry, list) else [entry] if isinstance(entry, str) else []
+
+
 def _recorded(entry, digest: str) -> bool:
     """Whether a record entry (a digest, or [old, new] while a result is being moved in) has
     `digest`."""
@@ -285,10 +290,9 @@ def claim_file(path, what: str = "--out") -> Path:
     return path
 
 
-def has_record(path) -> bool:
-    """Whether the folder's OWNED_FILES has an entry for `path` (whatever its bytes now)."""
-    path = Path(path)
-    return path.name in _owned(path.parent)
+def has_any_record(folder) -> bool:
+    """Whether `folder` has an OWNED_FILES record (this version's writes leave one)."""
+    return (Path(folder) / OWNED_FILES).exists()
 
 
 def record_file(path) -> None:
@@ -317,15 +321,18 @@ def _record_lock(folder: Path) -> Iterator[None]:
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
-    # read-only: a group-shared folder's lock file (0644 under umask 022) must open for the
-    # other users too; flock needs no write access
+    # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
+    # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
     with os_errors(folder / OWNED_FILES, own_name=False):
-        fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)  # open applies the umask
+        try:
+            fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+        except PermissionError:
+            fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)
     try:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX)
         except OSError as e:
-            if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL):
+            if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.EBADF):
                 with os_errors(folder / OWNED_FILES, own_name=False):
                     raise
             log.warning("no file locks in %s (%s): its record is written without one", folder, e.strerror)
@@ -600,8 +607,8 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     try:
         with os_errors(folder):
             if rec is not None:  # a kill during the moves leaves either version of each file: both ours
-                atomic_write_json(folder / OWNED_FILES, {**rec, **{k: [rec[k], v] if isinstance(rec.get(k), str)
-                                                                   else v for k, v in digests.items()}})
+                atomic_write_json(folder / OWNED_FILES, {**rec, **{k: _entries(rec.get(k)) + [v]
+                                                                   for k, v in digests.items()}})
             order = sorted(set(new) | set(old), key=lambda f: f == last)
             if last in old:
                 os.replace(folder / last, trash / "last")
@@ -617,6 +624,12 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
                     moved_in.append((tmp / rel, dst))
             if rec is not None:  # entries of files gone or replaced dropped, the new ones added
                 keep = {k: v for k, v in rec.items() if k not in old and (folder / k).is_file()}
+                if legacy:  # the earlier version's files of its other commands are ours too (a
+                    # film folder's analyze files, upgraded by a compare that writes only its own)
+                    subs = {p.name for p in folder.iterdir() if p.is_dir() and not p.is_symlink() and p.name != "cache"}
+                    keep.update({rel: file_sha256(folder / rel) for rel in _files(folder, subs)
+                                 if rel not in digests and rel not in keep and rel not in (MARKER, OWNED_FILES, RECORD_LOCK)
+                                 and (folder / rel).is_file() and not (folder / rel).is_symlink()})
                 atomic_write_json(folder / OWNED_FILES, {**keep, **digests})  # the last step: no undo
                 if legacy:
                     with contextlib.suppress(OSError, ValueError, AttributeError):
@@ -629,6 +642,9 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
         for orig, parked in reversed(aside):
             with contextlib.suppress(OSError):
                 os.replace(parked, orig)
+        if rec is not None:  # and the record that describes it
+            with contextlib.suppress(OSError):
+                atomic_write_json(folder / OWNED_FILES, rec)
         raise
     finally:
         shutil.rmtree(trash, ignore_errors=True)

@@ -106,7 +106,8 @@ def flags(summary: dict) -> list[Flag]:
                         "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
     if summary.get("profile_plane_unknown"):
         out.append(Flag("no_bone_map", "no bone map of this skin file's bonded surface (not a graph over x: "
-                        "s = x - x_top folds), so the profile is on z = 0, not through the file indenter's load"))
+                        f"s = x - x_top folds), so the profile is on z = {_num(summary, 'profile_plane_z') or 0:g} mm, "
+                        "not through the file indenter's load"))
     pe = _num(summary, "peak_map_edge_mpa")
     if summary.get("profile_plane_from_map") and pe is not None:
         out.append(Flag("edge_peak", f"the bone map's largest value {pe:.4g} MPa is at s = "

@@ -148,7 +148,8 @@ class BoneMap:
         j, i = np.unravel_index(int(np.argmax(self.pressure)), self.pressure.shape)
         return float(self.pressure[j, i]), float(self.s[i]), float(self.z[j])
 
-    def interior_peak(self, margin: float, z_end_free: bool = True) -> tuple[float, float, float]:
+    def interior_peak(self, margin: float, z_end_free: bool = True,
+                      s_end_free: bool = True) -> tuple[float, float, float]:
         """peak() over the points farther than `margin` (mm) from the map's edges, or over the
         whole map if none is. A grid starting at 0 starts at a symmetry plane of the reduced
         model, not at an edge. Why: where the bonded skin ends (a slab's free end, a pad's
@@ -156,7 +157,7 @@ class BoneMap:
         slab: 0.044, 0.056, 0.065 MPa at the end on meshes 1.6, 1.2, 0.8 / 8, against
         0.0348, 0.0352, 0.0353 under the dot; benchmarks/results/convergence3d.md)."""
         keep = []
-        for v, end_free in ((self.z, z_end_free), (self.s, True)):
+        for v, end_free in ((self.z, z_end_free), (self.s, s_end_free)):
             ok = v <= v[-1] - margin if end_free else np.ones(v.shape, bool)
             if abs(v[0]) > 1e-9:
                 ok &= v >= v[0] + margin
@@ -372,7 +373,8 @@ class Result:
         if self.bone_map is None:
             return {}
         margin = float((self.scene or {}).get("thickness") or 0.0)
-        p, s, z = self.bone_map.interior_peak(margin, skin_says((self.scene or {}), "map_z_end_free"))
+        p, s, z = self.bone_map.interior_peak(margin, skin_says(self.scene or {}, "map_z_end_free"),
+                                              skin_says(self.scene or {}, "profile_ends_free"))
         out = {"peak_map_mpa": p, "peak_map_s_mm": s, "peak_map_z_mm": z}
         pe, se, ze = self.bone_map.peak()
         if pe > p:

@@ -149,6 +149,9 @@ def main(argv: list[str] | None = None) -> int:
         where = f"{e.filename}: " if e.filename else ""
         err.print(f"[bold red]error:[/] {escape(where + str(e.strerror or e))}", highlight=False, soft_wrap=True)
         return 2
+    finally:
+        if threading.current_thread() is threading.main_thread():
+            _signalled.clear()  # read above; a later run (a notebook's, another thread's) starts clean
     return rv if isinstance(rv, int) else 0
 
 

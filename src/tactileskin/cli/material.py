@@ -61,11 +61,13 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     if outp.suffix != ".toml":
         raise ParameterError("--out", out, "a path ending in .toml")
     # before the fit: only a file this command wrote and nobody changed since is replaced (the
-    # folder's record; the MARK line alone is kept by a hand-edited copy). A file with the MARK
-    # line and no entry in the record is an earlier version's (it kept no record): replaced as then
-    if outp.is_file() and not outp.is_symlink() and not fileio.has_record(outp) and _has_mark(outp):
-        fileio.record_file(outp)
-    fileio.claim_file(outp)
+    # folder's record; the MARK line alone is kept by a hand-edited copy). In a folder with no
+    # record at all, a file with the MARK line is an earlier version's (it kept none): replaced
+    # as then
+    earlier = (outp.is_file() and not outp.is_symlink() and not fileio.has_any_record(outp.parent)
+               and _has_mark(outp))
+    if not earlier:
+        fileio.claim_file(outp)
     if test == "indentation":
         from tactileskin.materials.indentation import fit_indentation, read_indentation_csv
 

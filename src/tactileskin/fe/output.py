@@ -403,7 +403,8 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
             from tactileskin.results import skin_says
 
             margin = float((scene or {}).get("thickness", 0.0))
-            plane_z = bmap.interior_peak(margin, skin_says(scene or {}, "map_z_end_free"))[2]
+            plane_z = bmap.interior_peak(margin, skin_says(scene or {}, "map_z_end_free"),
+                                         skin_says(scene or {}, "profile_ends_free"))[2]
             p = bmap.row(plane_z).copy()
             bmap = BoneMap(s, zg, grid, plane_z)
             plane_from_map = True
