@@ -73,7 +73,9 @@ def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
     Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
-    material_nu0, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm), mirrored_x (a
+    material_nu0, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm),
+    profile_plane_from_map / profile_plane_unknown with peak_map_edge_* and profile_plane_z,
+    mirrored_x, mirrored_z (a
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 MARK = "# written by tactileskin material fit"
+EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
 
 def _has_mark(path: Path) -> bool:
@@ -15,7 +16,6 @@ def _has_mark(path: Path) -> bool:
             return fh.read(len(MARK)) == MARK.encode()
     except OSError:
         return False
-EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
 
 @click.group("material")

@@ -261,6 +261,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     iterations) after each converged increment; nothing is printed either way."""
     from tactileskin.geometry.indenters import indenter_symmetry, mirrored_x, require_contact
     from tactileskin.materials import get_material
+    from tactileskin.materials.laws import nu0
 
     law = get_material(scene.material).law  # a bad material (name or file) fails before the mesh is made
     require_contact(scene)
@@ -305,7 +306,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     if getattr(sm, "z_symmetric", False) and not indenter_symmetry(scene)[1]:  # a file's symmetry_z
         res.stats["mirrored_z"] = True
     # tactileskin.quality judges the volume ratio and the element by the law's compressibility
-    res.stats["material_nu0"] = float((3 * law.K0 - 2 * law.mu0) / (2 * (3 * law.K0 + law.mu0)))
+    res.stats["material_nu0"] = float(nu0(law))
     res.stats["order"] = int(scene.order)
     if sized and scene.skin != "file":
         res.stats["mesh_sizes_mm"] = _sizes_against_preview(scene)

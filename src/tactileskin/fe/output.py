@@ -393,11 +393,10 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
             # in tests/test_bone_map.py); take the profile's values so that they agree exactly
             grid[int(np.argmin(np.abs(zg - plane_z)))] = p
         bmap = BoneMap(s, zg, grid, plane_z) if grid is not None else None
-        ind = getattr(model.contact, "indenter", None)
-        no_map = bmap is None
-        if no_map and getattr(ind, "profile_at_map_peak", False):
+        at_map_peak = getattr(getattr(model.contact, "indenter", None), "profile_at_map_peak", False)
+        if at_map_peak and bmap is None:
             plane_from_map = None  # quality: the plane could not follow the load
-        elif getattr(ind, "profile_at_map_peak", False):
+        elif at_map_peak:
             # no plane is known before the solve (a file indenter off z = 0, two bumps, a
             # ring): the profile is the map's row through its peak (>= t from the slab's ends)
             from tactileskin.results import skin_says

@@ -19,7 +19,7 @@ import importlib
 from tactileskin import validate
 from tactileskin.errors import ParameterError
 
-__all__ = ["get_law", "list_laws", "law_from_dict"]
+__all__ = ["get_law", "list_laws", "law_from_dict", "nu0"]
 
 # registry name -> (module, class)
 _MODULES = {
@@ -60,10 +60,11 @@ def law_from_dict(name: str, table, what: str):
     cls = get_law(validate.string(name, f"{what} law", "a law name"))
     law = cls.from_dict(table, f"{what} {name}")
     check_range(f"{what} {name}: small-strain shear modulus mu0", law.mu0, *MU0_RANGE, unit="MPa")
-    check_range(f"{what} {name}: bulk / shear modulus K0 / mu0 (nu0 = {_nu0(law):.6g})", law.K0 / law.mu0,
+    check_range(f"{what} {name}: bulk / shear modulus K0 / mu0 (nu0 = {nu0(law):.6g})", law.K0 / law.mu0,
                 None, MAX_BULK_OVER_SHEAR)
     return law
 
 
-def _nu0(law) -> float:
+def nu0(law) -> float:
+    """A law's small-strain Poisson ratio, from its mu0 and K0."""
     return (3 * law.K0 - 2 * law.mu0) / (2 * (3 * law.K0 + law.mu0))
