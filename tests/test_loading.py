@@ -222,3 +222,18 @@ def test_a_force_beyond_the_laws_lock_up_names_the_force(mesh):
     with pytest.raises(ParameterError, match="force") as e:
         solve(BASE.replace(force=1000.0), mesh=mesh, options=SolverOptions(max_increments=40))
     assert e.value.name == "force" and "stalled at" in str(e.value) and "N/mm" in str(e.value)
+
+
+def test_a_stall_in_a_depth_segment_after_a_force_ramp_is_not_called_a_force_lock_up(mesh):
+    from tactileskin.fe import _force_controlled, solve
+    from tactileskin.fe.solver import SolverOptions
+
+    prog = [Segment("force", 1.0, time=1.0), Segment("hold", time=1.0), Segment("depth", 0.5, time=1.0),
+            Segment("hold", time=1.0)]
+    assert [_force_controlled(prog, i) for i in range(5)] == [True, True, False, False, False]
+    # the depth segment runs out of its increment budget: a solver failure, not "the force"
+    base = BASE.replace(depth=0.2)
+    target = 0.5 * solve(base, mesh=mesh).reaction
+    scene = base.replace(loading=[{"force": target, "time": 0.2}, {"depth": 1.0, "time": 1.0}])
+    with pytest.raises(ConvergenceError, match="increments"):
+        solve(scene, mesh=mesh, options=SolverOptions(max_increments=4))

@@ -168,6 +168,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     multi = len(program) > 1
     peak_of = bone_peak(model) if multi else None
     best = {}
+    done = [0]  # segments finished (the next one is the one running)
     last = {}  # the last converged increment's travel and reaction
     worst = {}  # the material law's extremes over every increment (a creep hold or a second
     # ramp can go beyond the peak-load state's: tactileskin.quality flags them)
@@ -182,6 +183,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         return out
 
     def on_segment(i, seg, ev):
+        done[0] = i + 1
         F = indenter_force(model, ev)
         if seg.kind != "hold" and (not best or F > best["reaction"]):
             best.update(reaction=F, t=model.t, d=model.d, segment=i,
@@ -197,7 +199,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                                       progress=progress, on_segment=on_segment)
     except ConvergenceError as e:
         forced = [g.target for g in program if g.kind == "force"]
-        if not forced or not last or "increments" not in str(e):
+        if not _force_controlled(program, done[0]) or not last or "increments" not in str(e):
             raise
         # a force beyond the law's lock-up: the increments shrink to nothing below the travel
         # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments")
@@ -234,6 +236,16 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                   **({"peak_mpa": last["peak_mpa"]} if "peak_mpa" in last else {})},
     }
     return res, ev, stats
+
+
+def _force_controlled(program, i: int) -> bool:
+    """Whether segment i of a loading program runs under force control: a force ramp, or a
+    hold after one (a hold keeps the control of the segment before it)."""
+    control = None
+    for seg in program[:i + 1]:
+        if seg.kind != "hold":
+            control = seg.kind
+    return i < len(program) and control == "force"
 
 
 def _sizes_against_preview(scene) -> dict:
