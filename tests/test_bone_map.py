@@ -228,3 +228,23 @@ def test_figure_zoom_box_holds_the_loaded_region(tmp_path):
     assert loaded_box(BoneMap(s, z, -P, 0.0)) is None  # no compression: nothing to zoom on
     png = write_bone_map_figure(bm, tmp_path / "m.png", "synthetic")
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_file_skin_without_a_map_warns_once_per_solve(plane_strain, monkeypatch, caplog):
+    # a [[loading]] program makes a result per load segment: the missing map is one warning
+    import tactileskin.fe.output as out
+
+    model, _, _, stats = plane_strain
+
+    def no_graph(*a, **k):
+        raise ParameterError("bone map point (s, z)", (0.0, 0.0), "on the bonded surface")
+
+    monkeypatch.setattr(out, "surface_grid", no_graph)
+    monkeypatch.delattr(model, "_no_map_warned", raising=False)
+    ev = model.evaluate(model.u, model.t, 1.0)
+    scene = {**SCENE.to_dict(), "skin": "file"}
+    with caplog.at_level("WARNING", logger="tactileskin.fe.output"):
+        results = [make_result(model, ev, stats, s_of_point=SCENE.section().s_of_point, scene=scene)
+                   for _ in range(3)]
+    assert all(r.bone_map is None for r in results)
+    assert sum("no bone map" in m for m in caplog.messages) == 1

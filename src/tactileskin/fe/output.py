@@ -386,7 +386,9 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
                 raise
             # a user's bonded surface that is no graph over x (s = x - x_top folds where it
             # curves back: the fingertip written as a file): the result without its map
-            logger.warning("no bone map for this skin file (%s); the profile is on z = %g", e, plane_z)
+            if not getattr(model, "_no_map_warned", False):  # once per solve, not per load segment
+                logger.warning("no bone map for this skin file (%s); the profile is on z = %g", e, plane_z)
+                model._no_map_warned = True
             grid = None
         if grid is not None:
             # the section row is the same interpolant as the profile (equal to rounding: checked
