@@ -201,6 +201,27 @@ def test_a_run_stopped_before_its_first_case_leaves_no_folder(tmp_path):
     assert (out / MARKER).is_file() and (out / "cache" / "key1").is_dir()
 
 
+def test_a_stopped_run_keeps_the_cache_locks_another_sweep_holds(tmp_path):
+    """A second sweep started on the same new folder holds a case lock: removing that file
+    would let a third run compute the same case again; the lock and the folder stay."""
+    fcntl = pytest.importorskip("fcntl")
+    from tactileskin.fileio import claimed
+
+    out = tmp_path / "new"
+    with pytest.raises(KeyboardInterrupt):
+        with claimed(out, "sweep"):
+            (out / "cache").mkdir()
+            for k in ("held", "free"):
+                (out / "cache" / f"{k}.lock").write_text("")
+            fd = os.open(out / "cache" / "held.lock", os.O_RDONLY)  # another open file: another run's lock
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            raise KeyboardInterrupt
+    try:
+        assert sorted(p.name for p in (out / "cache").iterdir()) == ["held.lock"]
+    finally:
+        os.close(fd)
+
+
 def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(tmp_path, monkeypatch):
     """The record is written before the moves with both versions of each replaced file: a run
     killed between two renames (old and new files mixed) does not make the next run refuse

@@ -438,9 +438,8 @@ def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
                 names = {p.name for p in folder.iterdir()}
                 cache = folder / "cache"  # a sweep stopped before its first case: locks only
                 if "cache" in names and cache.is_dir() and not cache.is_symlink() and all(
-                        p.suffix == ".lock" and p.is_file() for p in cache.iterdir()):
-                    for p in cache.iterdir():
-                        p.unlink()
+                        p.suffix == ".lock" and p.is_file() for p in cache.iterdir()) \
+                        and _remove_free_locks(cache):
                     cache.rmdir()
                     names.discard("cache")
                 if MARKER in names and names <= {MARKER, RECORD_LOCK}:
@@ -448,6 +447,31 @@ def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
                         (folder / n).unlink()
                     folder.rmdir()
         raise
+
+
+def _remove_free_locks(folder: Path) -> bool:
+    """Remove the lock files in `folder` that no process holds (each taken before it goes: a
+    sweep started on the same new folder keeps its duplicate-work guard); True if all went."""
+    try:
+        import fcntl
+    except ImportError:  # no flock (Windows): no lock is held by anyone
+        fcntl = None
+    every = True
+    for p in list(folder.iterdir()):
+        try:
+            fd = os.open(p, os.O_RDONLY)
+        except OSError:
+            every = False
+            continue
+        try:
+            if fcntl is not None:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            p.unlink()
+        except OSError:  # held by another run (BlockingIOError) or not ours to remove
+            every = False
+        finally:
+            os.close(fd)
+    return every
 
 
 def adopt_dir(folder, kind: str, names: Iterable[str]) -> None:
