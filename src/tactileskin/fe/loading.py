@@ -33,6 +33,8 @@ log = logging.getLogger(__name__)
 
 FORCE_RTOL = 1e-4   # |F - F*| <= FORCE_RTOL |F*|: the contact tolerance (1e-4 h) moves F by ~3e-5 F
 MAX_TRIALS = 16
+NOISE_FRACTION = 0.1  # of slope x tol_penetration: the accepted reaction error (ForceIncrement._tolerance)
+UNDERSHOOT = 0.05  # of a predicted travel step (about 3 % of it is the predictor's error)
 
 
 def vertical_reaction(model, ev) -> float:
@@ -51,21 +53,44 @@ class ForceIncrement:
     there raises ConvergenceError); d_guess(F): a travel for the first trial when no slope is
     known yet."""
 
-    def __init__(self, target, d_max: float, d_guess, *, f_start: float = 0.0, slope: float | None = None,
+    def __init__(self, target, d_max: float, d_guess, *, f_start: float = 0.0, prior: "ForceIncrement | None" = None,
                  rtol: float = FORCE_RTOL, goal: float | None = None):
         self.target, self.d_max, self.d_guess, self.rtol = target, float(d_max), d_guess, rtol
         self.goal = goal  # the segment's final force, named when the skin cannot carry it
-        self.f_committed, self.slope = float(f_start), slope
-        self.reached = float(f_start)
+        self.f_committed = self.reached = float(f_start)
+        # what predicts the next increment's travel (kept across force-controlled segments):
+        # the local slope dF/dd, the exponent p of F ~ d^p over the last increment's trials, and
+        # the committed state before the last one
+        self.slope, self.p, self.prev = (prior.slope, prior.p, prior.prev) if prior is not None else (None, None, None)
+
+    def _tolerance(self, model, F: float, d: float, reached: float) -> float:
+        """|F - F*| accepted: rtol |F*|, or the reaction's own resolution where that is
+        coarser. The contact is enforced to a penetration tol_penetration (3D: 1e-3 of the
+        facet size), and converged trials scatter about a smooth F(d) by about 5 % of slope x
+        tol_penetration (measured on a 3D sphere: 3-4e-5 N of 0.19 N, 2e-4 of it): 4-7 trials
+        an increment chased that scatter. Twice it is accepted; in 2D rtol stays the finer."""
+        tol_pen = getattr(getattr(model, "contact", None), "tol_penetration", None) or 0.0
+        k = self.slope if self.slope and self.slope > 0 else (reached / d if d > 0 and reached > 0 else 0.0)
+        return max(self.rtol * abs(F), NOISE_FRACTION * k * tol_pen, 1e-12)
 
     def __call__(self, model, u0, t, dt, opts, stats: Stats):
         F = float(self.target(t))
-        tol = max(self.rtol * abs(F), 1e-12)
         d0, f0 = model.d, self.f_committed
-        if self.slope and self.slope > 0:
-            d = d0 + (F - f0) / self.slope
-        else:
-            d = self.d_guess(F) if d0 == 0.0 else d0 * max(F, 1e-300) / max(f0, 1e-300)
+        # first trial: the log-log secant through the last two committed states (it carries the
+        # relaxation between increments: a sphere's first trials within 0.5 % in travel), else
+        # this state and the exponent of the last increment's trials, else the local slope
+        d = _secant((self.prev[0], self.prev[1] - F), (d0, f0 - F), F) if self.prev is not None else None
+        if d is None and self.p and d0 > 0 and f0 > 0 and F > 0:
+            d = d0 * (F / f0) ** (1.0 / self.p)
+        if d is None:
+            if self.slope and self.slope > 0:
+                d = d0 + (F - f0) / self.slope
+            else:
+                d = self.d_guess(F) if d0 == 0.0 else d0 * max(F, 1e-300) / max(f0, 1e-300)
+        elif d > d0:
+            # aim short by UNDERSHOOT of the step: a first trial below the target hands the
+            # second its state (a short step), one above it sends the second back to u0
+            d = d0 + (1.0 - UNDERSHOOT) * (d - d0)
         d = min(max(d, 0.0), self.d_max)
         lo = hi = None            # (d, f) with f < 0 / f > 0
         pts = []                  # converged trials (d, f, u, ev, its)
@@ -95,7 +120,7 @@ class ForceIncrement:
                 f = vertical_reaction(model, ev) - F
                 log.debug("force control: travel %.8g mm, reaction %.8g (target %.8g)", d, f + F, F)
                 pts.append((d, f, u, ev, its))
-                if abs(f) <= tol:
+                if abs(f) <= self._tolerance(model, F, d, f + F):
                     return self._accept(model, d, f + F, d0, u, ev, its, pts)
                 if f < 0:
                     lo = (d, f)
@@ -104,31 +129,31 @@ class ForceIncrement:
                 d = self._next(d, f, lo, hi, pts, F, model)
         finally:
             model.travel_fixed = None
-        raise _Failure(f"force control: reaction not within {tol:.3g} of {F:.6g} after {MAX_TRIALS} trial travels",
+        raise _Failure(f"force control: reaction not within {self.rtol:.3g} x {F:.6g} after {MAX_TRIALS} trial travels",
                        {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts]})
 
     def _next(self, d, f, lo, hi, pts, F, model) -> float:
-        # the secant through the last two trials (near the root F(d) is smooth: superlinear),
-        # kept inside the bracket once there is one (else bisection)
-        k = None
-        if len(pts) >= 2 and pts[-1][0] != pts[-2][0]:
-            k = (pts[-1][1] - pts[-2][1]) / (pts[-1][0] - pts[-2][0])
+        # the secant through the last two trials, in log-log where both reactions are
+        # positive (a contact's F ~ d^p, p 1-2: the linear secant overshot a sphere's first
+        # increment by 24 %), kept inside the bracket once there is one (else bisection)
+        x = _secant(pts[-2][:2], pts[-1][:2], F) if len(pts) >= 2 else None
         if lo is not None and hi is not None:
             w = hi[0] - lo[0]
-            x = d - f / k if k and k > 0 else 0.5 * (lo[0] + hi[0])
+            if x is None:
+                x = 0.5 * (lo[0] + hi[0])
             if not (lo[0] + 0.01 * w <= x <= hi[0] - 0.01 * w):
                 x = 0.5 * (lo[0] + hi[0]) if not math.isfinite(hi[1]) else \
                     lo[0] - lo[1] * w / (hi[1] - lo[1])
                 x = min(max(x, lo[0] + 0.1 * w), hi[0] - 0.1 * w)
             return x
-        # no bracket yet: secant through the last two trials (or the committed slope, or the
-        # chord from first touch), stepping at most 2x the distance already covered
-        if k is not None and k > 0:
-            pass
-        elif self.slope and self.slope > 0:
-            k = self.slope
-        else:
-            k = (f + F) / d if d > 0 and f + F > 0 else 0.0
+        # no bracket yet: that secant, else the power law through this trial with the
+        # committed state's local exponent (or Hertz's 1.5: it undershoots a stiffening layer
+        # rather than overshooting into its lock-up), stepping at most 2x the distance covered
+        if x is None:
+            p = 1.5
+            if self.slope and self.slope > 0 and model.d > 0 and self.f_committed > 0:
+                p = min(max(self.slope * model.d / self.f_committed, 0.5), 4.0)
+            x = d * (F / (f + F)) ** (1.0 / p) if d > 0 and f + F > 0 else (d + self.d_max) / 2 if f < 0 else 0.5 * d
         if f < 0:  # below the target: deeper
             if d >= self.d_max * (1 - 1e-12):
                 goal = F if self.goal is None else self.goal
@@ -137,25 +162,46 @@ class ForceIncrement:
                     f"force {goal:.6g} not reached: the reaction is {f + F:.6g} at the largest travel "
                     f"{self.d_max:.6g} mm (0.6 x thickness){on_way}; the skin cannot carry this force "
                     "within its depth range", {"force": goal, "ramp_force": F, "reached": f + F, "travel_mm": d})
-            step = -f / k if k > 0 else d
-            return min(d + min(step, 2.0 * max(d - model.d, 1e-3 * self.d_max)), self.d_max)
-        step = -f / k if k > 0 else -0.5 * d
-        return max(d + max(step, -0.5 * d), 0.0)
+            x = max(x, d + 1e-6 * self.d_max)
+            return min(x, d + 2.0 * max(d - model.d, 1e-3 * self.d_max), self.d_max)
+        return max(min(x, d), 0.5 * d)
 
     def _accept(self, model, d, Freached, d0, u, ev, its, pts):
-        # the next increment's predictor: the local slope dF/dd of the last two trials (the
-        # chord over the increment under-estimates a stiffening contact and overshoots)
-        near = sorted(pts, key=lambda p: abs(p[0] - d))[:2]
-        if len(near) == 2 and near[0][0] != near[1][0]:
-            self.slope = (near[0][1] - near[1][1]) / (near[0][0] - near[1][0])
-        elif d != d0:
+        # the next increment's predictor: the exponent p of F ~ d^p between the accepted trial
+        # and the one farthest from it (trials a few um apart differ by the contact's noise),
+        # its slope p F / d, and the state this increment started from
+        F = Freached - pts[-1][1]
+        far = max(pts, key=lambda q: abs(q[0] - d))
+        if abs(far[0] - d) > 0.01 * d and far[1] + F > 0 and Freached > 0 and far[0] > 0:
+            p = math.log(Freached / (far[1] + F)) / math.log(d / far[0])
+            self.p = p if 0 < p < 10 else self.p
+        if self.p and d > 0 and Freached > 0:
+            self.slope = self.p * Freached / d
+        elif d != d0 and Freached != self.f_committed:
             self.slope = (Freached - self.f_committed) / (d - d0)
         if self.slope is not None and self.slope <= 0:
             self.slope = None
+        self.prev = (d0, self.f_committed) if d0 > 0 and self.f_committed > 0 and d != d0 else None
         self.f_committed = self.reached = Freached
         self.travel = d
         model.travel_path = (lambda t, d=d: d)  # run() commits this travel (travel_fixed is cleared)
         return u, ev, its
+
+
+def _secant(a, b, F: float) -> float | None:
+    """The travel at which the line through trials a, b = (d, F - F*) reaches F*: in log-log
+    where both travels and reactions are positive and the exponent is, else linear; None if
+    the reaction does not grow with the travel between them."""
+    (da, fa), (db, fb) = a, b
+    Fa, Fb = fa + F, fb + F
+    if da == db or fa == fb:
+        return None
+    if min(da, db, Fa, Fb) > 0 and F > 0:
+        p = math.log(Fb / Fa) / math.log(db / da)
+        if p > 0:
+            return da * (F / Fa) ** (1.0 / p)
+    k = (fb - fa) / (db - da)
+    return da - fa / k if k > 0 else None
 
 
 def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None, progress=None,
@@ -188,7 +234,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
             T = t0 + seg.duration(F0)
             force_inc = ForceIncrement(lambda t, F0=F0, F1=F1, t0=t0, T=T: F0 + (F1 - F0) * min(1.0, (t - t0) / (T - t0)),
                                        d_max, d_guess, f_start=f_now, goal=F1,
-                                       slope=force_inc.slope if force_inc is not None else None)
+                                       prior=force_inc if control == "force" else None)
             increment, control = force_inc, "force"
         else:  # hold
             T = t0 + seg.time
@@ -197,7 +243,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
             else:
                 Fh = f_now
                 force_inc = ForceIncrement(lambda t, Fh=Fh: Fh, d_max, d_guess, f_start=f_now,
-                                           slope=force_inc.slope if force_inc is not None else None)
+                                           prior=force_inc if control == "force" else None)
                 increment = force_inc
         # the rate of S0 jumps at a segment boundary (ramp -> hold): the parabola through the
         # last three states would carry the ramp into the hold (measured: the reaction fell
