@@ -237,3 +237,17 @@ def test_a_stall_in_a_depth_segment_after_a_force_ramp_is_not_called_a_force_loc
     scene = base.replace(loading=[{"force": target, "time": 0.2}, {"depth": 1.0, "time": 1.0}])
     with pytest.raises(ConvergenceError, match="increments"):
         solve(scene, mesh=mesh, options=SolverOptions(max_increments=4))
+
+
+def test_the_force_secant_is_exact_on_a_power_law_and_linear_otherwise():
+    from tactileskin.fe.loading import _secant
+
+    # F = c d^p (a contact: Hertz p = 1.5): two trials give the root exactly in log-log
+    for p in (1.0, 1.5, 2.3):
+        F = lambda d: 0.7 * d ** p  # noqa: E731
+        target = F(0.31)
+        x = _secant((0.2, F(0.2) - target), (0.25, F(0.25) - target), target)
+        assert x == pytest.approx(0.31, rel=1e-12)
+    # a reaction that falls with the travel gives no root; a non-positive one the linear secant
+    assert _secant((0.2, 0.1), (0.25, 0.05), 1.0) is None
+    assert _secant((0.1, -1.5), (0.2, -0.5), 1.0) == pytest.approx(0.25)
