@@ -86,3 +86,23 @@ def test_a_failed_increment_length_is_not_tried_again():
         assert max(capped[k + 1:]) <= 0.7 * capped[k] + 1e-12
     sawtooth = tried_lengths(0.0)
     assert sum(dt > 0.1 for dt in sawtooth) > 4          # without it the growth fails again and again
+
+
+def test_a_late_first_touch_starts_the_ramp_just_before_it():
+    # 'ab' has no dot on the centre line: its dots touch the fingertip after 0.476 mm of the
+    # 0.55 mm travel. The free travel is skipped (no load, no relaxation there), so the
+    # contact gets the increments; the peak equals a 100-increment solve's to its time error.
+    from tactileskin.geometry.indenters import first_contact_travel
+
+    scene = with_quality(Scene(thickness=1.0, indenter="braille", braille_text="ab", depth=0.55), "preview")
+    touch = first_contact_travel(scene)
+    assert 0.45 < touch < 0.5
+    mesh = build_mesh(scene)
+    travels = []
+    r = fe.solve(scene, mesh, progress=lambda info: travels.append(info.travel))
+    # increments over the contact, not the free travel (before: travels 0.078, 0.195,
+    # 0.333, 0.47, 0.55 mm, the whole contact in the last)
+    assert travels[0] > 0.9 * touch and sum(d > touch for d in travels) >= 3
+    ref = fe.solve(scene, mesh, options=SolverOptions(dt0_fraction=0.01, dt_max_fraction=0.01))
+    assert r.peak == pytest.approx(ref.peak, rel=5e-4)  # measured 1.5e-4
+    assert r.status == "ok"
