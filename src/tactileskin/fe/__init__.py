@@ -248,8 +248,12 @@ def _start_near_first_touch(scene, model) -> None:
     skin is unloaded until then (zero stress, no relaxation), and increments spent on the free
     travel made the whole contact of a late touch ('ab' touches after 0.48 of 0.55 mm) come
     in one increment."""
-    from tactileskin.geometry.indenters import first_contact_travel
+    from tactileskin.geometry.indenters import BrailleIndenter, first_contact_travel
 
+    # a Braille text's touch is exact (its dots' own planes on a built-in skin's contour); a
+    # file's is sought on its tips' planes only, and a start past it would miss load
+    if scene.skin == "file" or not isinstance(getattr(model.contact, "indenter", None), BrailleIndenter):
+        return
     touch = first_contact_travel(scene)
     if model.contact is None or touch <= 1e-3 or touch >= scene.indentation:
         return
