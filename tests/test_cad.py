@@ -161,10 +161,62 @@ def test_mold_cavity_is_the_skin(builds, t):
     # also catches the sprue/vents where they pierce the contour's ridge (< 0.3 mm^3, 0.05 %
     # of the 1 mm skin) and the tessellations differ by < 0.1 %: 0.5 % is the requirement.
     cavity = _box([-a, -b, -L / 2], [a, b, L / 2]) - lower - upper - base
-    assert cavity.volume() == pytest.approx(skin.volume(), rel=5e-3)
+    # ... is the skin plus the designed clearance around the printed core (molds.core_seat:
+    # its seat below the nail edges; the end slots lie beyond the box), each to 0.5 % of the skin
+    gap = _core_gap(build) - skin
+    assert gap.volume() > 0.0
+    cast = skin + gap
+    assert cavity.volume() == pytest.approx(skin.volume() + gap.volume(), abs=5e-3 * skin.volume())
     # the same shape, not just the same volume: the symmetric difference is tiny too
-    xor = (cavity - skin).volume() + (skin - cavity).volume()
+    xor = (cavity - cast).volume() + (cast - cavity).volume()
     assert xor < 5e-3 * skin.volume()
+
+
+def _core_gap(build) -> manifold3d.Manifold:
+    """The seat's clearance gap inside the sample's box: the room the mold leaves for the core
+    there (molds.core_seat, tessellated like the parts) minus the core."""
+    a, b, L = FT.half_width, FT.height, FT.sample_length
+    c = molds.MoldParams.from_params().core_clearance
+    seat = solids._single(molds.core_seat(build.sec, c).intersect(solids.box(-a - 1, a + 1, -b - 1, b + 1, -L / 2, L / 2)))
+    path = build.folder.parent / f"seat{build.t:g}.stl"
+    export.write_stl(seat, path)
+    return _solid(trimesh.load(str(path), force="mesh")) - _solid(build.mesh("rigid_base"))
+
+
+@pytest.mark.parametrize("t", [1.0, 5.0])
+def test_a_printed_core_fits_its_seat_with_clearance(builds, t):
+    """Printers do not make exact fits: the core must go in although printed a little
+    oversize, and still rest where it makes the skin t thick (molds.toml [core] clearance)."""
+    build = builds(t)
+    mesh = build.mesh("rigid_base")
+    lower, upper = _solid(build.mesh("mold_lower")), _solid(build.mesh("mold_upper"))
+    c = molds.MoldParams.from_params().core_clearance
+    assert c > 0.0
+    assert build.manifest["parts"][2]["parameters"]["core_clearance"] == c
+
+    def overlap(m: trimesh.Trimesh) -> float:
+        core = _solid(m)
+        return (core ^ lower).volume() + (core ^ upper).volume()
+
+    sliver = 0.1  # mm^3: the facets of the core and of its seat cross (0.008 mm^3; 0.06 for an exact fit)
+    assert overlap(mesh) < sliver
+    # 1 % oversize (0.1 mm on each end, 0.05 mm normal to the seat at the nail edges),
+    # resting on the seat's bottom, the point (0, -b) on the section
+    big = mesh.copy()
+    big.apply_transform(trimesh.transformations.scale_matrix(1.01, origin=[0.0, -FT.height, 0.0]))
+    assert overlap(big) < sliver
+    # it may slide along the finger by most of the clearance: it is not held between the ends
+    for dz in (-0.9 * c, 0.9 * c):
+        assert overlap(mesh.copy().apply_translation([0.0, 0.0, dz])) < sliver
+    # but it rests on the seat's bottom: 0.02 mm lower it cuts into the lower half
+    assert (_solid(mesh.copy().apply_translation([0.0, -0.02, 0.0])) ^ lower).volume() > 1.0
+
+
+def test_core_clearance_is_checked():
+    sec = FT.section(1.0)
+    with pytest.raises(ParameterError, match=r"molds\.core\.clearance=-0\.1 .*valid: \[0, 2\] mm"):
+        molds.MoldParams.from_params(core_clearance=-0.1).check(sec)
+    molds.MoldParams.from_params(core_clearance=0.0).check(sec)
 
 
 @pytest.mark.parametrize("t", THICKNESSES)

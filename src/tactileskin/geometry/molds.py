@@ -3,9 +3,19 @@
 Layout (dimensions in data/geometry/molds.toml, frame as in solids.py):
 - The cavity is the full-width outer contour (the ellipse) extruded over the sample length,
   z in [-L/2, L/2]; the end walls close it.
-- The rigid base sits in the lower half: below the nail edges it fills the contour exactly,
-  so the contour locates it in x and y and the end walls in z. What is left of the cavity is
-  exactly the skin (tests/test_cad.py checks the volumes agree within 0.5 %).
+- The rigid base (the printed core) sits in the lower half, in a seat below the nail edges,
+  with `core_clearance` (molds.toml [core] clearance) around it where mold faces would hold it
+  from opposite sides: a printer cannot make an exact fit (a core printed a little oversize
+  would jam between the end walls and ride on the seat's rim, lifting it and thinning the
+  skin). The seat is the contour offset outwards by the clearance and raised by it, so it
+  touches the contour at the bottom, where the core rests under gravity and keeps the
+  position that makes the skin t thick, and leaves a normal gap c (1 + n_y) elsewhere (about
+  0.54 c at the nail edges, and it reaches c past them for the core's corners): a core
+  printed up to c oversize all round still rests on the bottom. The end walls have a slot as
+  deep as the clearance: the core's section offset by it.
+  What is left of the cavity is exactly the skin plus that gap (tests/test_cad.py checks both
+  within 0.5 % of the skin); silicone that runs into the gap is a thin flash along the nail
+  edges and over the core's ends, trimmed after demolding. 0 gives the exact, unprintable fit.
 - Split plane y = 0, the contour's widest section: neither half has an undercut, and the
   lower half releases the cast skin together with its base.
 - Four alignment pins on the lower half's split face, in clearance holes in the upper half.
@@ -16,14 +26,16 @@ Layout (dimensions in data/geometry/molds.toml, frame as in solids.py):
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 
 import build123d as bd
+import numpy as np
 
 from tactileskin import params
 from tactileskin.errors import ParameterError
 from tactileskin.geometry.fingertip import Section
-from tactileskin.geometry.solids import box, check_solid, contour_solid, occ_guard
+from tactileskin.geometry.solids import _single, base_face, box, check_solid, contour_solid, occ_guard
 
 log = logging.getLogger(__name__)
 
@@ -39,6 +51,7 @@ class MoldParams:
     pour_diameter: float
     vent_diameter: float
     vent_inset: float
+    core_clearance: float
 
     @classmethod
     def from_params(cls, **overrides) -> "MoldParams":
@@ -47,6 +60,11 @@ class MoldParams:
                   pin_clearance=p["pins"]["clearance"], pin_depth_clearance=p["pins"]["depth_clearance"],
                   pin_flange=p["pins"]["flange"], pour_diameter=p["pour"]["pour_diameter"],
                   vent_diameter=p["pour"]["vent_diameter"], vent_inset=p["pour"]["vent_inset"])
+        core = p.get("core", {})
+        if "clearance" not in core and "core_clearance" not in overrides:
+            raise ParameterError("molds.core.clearance", None, ">= 0 mm in molds.toml",
+                                 "add `[core] clearance = 0.2` (the gap around the printed core)")
+        kw["core_clearance"] = core.get("clearance")
         kw.update(overrides)
         return cls(**{k: float(v) for k, v in kw.items()})
 
@@ -59,6 +77,9 @@ class MoldParams:
         for name in ("pin_clearance", "pin_depth_clearance"):
             if not getattr(self, name) >= 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), ">= 0 mm")
+        if not 0.0 <= self.core_clearance <= 0.5 * self.wall:
+            raise ParameterError("molds.core.clearance", self.core_clearance,
+                                 f"[0, {0.5 * self.wall:g}] mm (at most half the {self.wall:g} mm wall)")
         roof = ft.height + self.wall
         if self.pin_height + self.pin_depth_clearance >= roof:
             raise ParameterError("molds.pins.height", self.pin_height,
@@ -97,6 +118,35 @@ def vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: 
                                   plane=bd.Plane((x, y_from, z), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
 
 
+def core_seat(sec: Section, clearance: float) -> bd.Solid:
+    """The room the mold leaves for the printed core (the rigid base) with `clearance` c (mm):
+    over the sample length, the core's section widened below the nail rays, and an arc c
+    beyond them for the core's corners there, to the seat (the contour offset outwards by c
+    and raised by c: it touches the contour only at the bottom, x = 0, y = -b, and leaves a
+    normal gap c (1 + n_y) elsewhere, so a core printed up to c oversize all round still rests
+    on the bottom); beyond each end, a slot c deep in the end wall: the core's section offset
+    by c all round."""
+    ft = sec.fingertip
+    c, L = clearance, ft.sample_length
+    z0 = -0.5 * L
+    with occ_guard("building the core seat", thickness=sec.thickness, core_clearance=c):
+        contour = bd.Wire([bd.Edge.make_ellipse(ft.half_width, ft.height, plane=bd.Plane.XY.offset(z0))])
+        grown = bd.Face(contour.offset_2d(c, kind=bd.Kind.ARC)).translate((0.0, c, 0.0))
+        # below both nail rays (polar angle from +y beyond the nail angle): the core's side,
+        # and c further along the contour, so that the core's corners at the nail edges fit too
+        s = 4.0 * (ft.half_width + ft.height)
+        angle = ft.nail_angle - c / float(np.hypot(*sec.outer_end))
+        dx, dy = math.sin(angle), math.cos(angle)
+        wedge = bd.Face(bd.Wire.make_polygon([(0.0, 0.0, z0), (s * dx, s * dy, z0), (s * dx, -s, z0),
+                                              (-s * dx, -s, z0), (-s * dx, s * dy, z0)], close=True))
+        seat = _single(bd.Solid.extrude(grown, (0.0, 0.0, L)).intersect(bd.Solid.extrude(wedge, (0.0, 0.0, L))))
+        section = base_face(sec, full=True, z=z0)
+        core = bd.Solid.extrude(section, (0.0, 0.0, L))
+        slot = bd.Face(section.outer_wire().offset_2d(c, kind=bd.Kind.ARC))
+        ends = [bd.Solid.extrude(slot.translate((0.0, 0.0, z)), (0.0, 0.0, c)) for z in (-c, L)]
+        return _single(core.fuse(seat, *ends).clean())
+
+
 def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.Solid]:
     """(lower half, upper half) of the skin's casting mold, in the fingertip's frame."""
     mp = mp or MoldParams.from_params()
@@ -105,9 +155,11 @@ def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.
     ft = sec.fingertip
     A, Z = lay.half_width, lay.half_length
     p = dict(thickness=sec.thickness, wall=mp.wall, pin_diameter=mp.pin_diameter,
-             pour_diameter=mp.pour_diameter, vent_diameter=mp.vent_diameter)
+             pour_diameter=mp.pour_diameter, vent_diameter=mp.vent_diameter, core_clearance=mp.core_clearance)
     with occ_guard("building the casting mold", **p):
         cavity = contour_solid(sec)
+        if mp.core_clearance > 0.0:
+            cavity = _single(cavity.fuse(core_seat(sec, mp.core_clearance)).clean())
         pins = [vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
         lower = box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
         # the upper half: pin holes, a sprue at the ridge's middle and a vent near each end;

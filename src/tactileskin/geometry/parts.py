@@ -105,7 +105,8 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
         parts.append(Part("rigid_base", "rigid bone/nail base (mold core)", base, fp))
     if molds:
         lower, upper = _molds.skin_mold(sec, mold_params)
-        mp = dict(fp, **{k: getattr(mold_params, k) for k in ("wall", "pin_diameter", "pour_diameter", "vent_diameter")})
+        mp = dict(fp, **{k: getattr(mold_params, k) for k in ("wall", "pin_diameter", "pour_diameter", "vent_diameter",
+                                                          "core_clearance")})
         parts.append(Part("mold_lower", "casting mold, lower half (holds the base, pins)", lower, mp))
         parts.append(Part("mold_upper", "casting mold, upper half (sprue, vents)", upper, mp))
     log.info("fingertip parts in %.2f s", time.perf_counter() - t0)
