@@ -225,3 +225,15 @@ def test_a_pad_builds_indenters_for_the_pad_as_its_solver_sees_them(tmp_path):
         assert p["bbox_max"][2] - p["bbox_min"][2] == pytest.approx(40.0, abs=1e-6)          # the pad's length
         if kind != "curved":
             assert p["bbox_max"][0] - p["bbox_min"][0] >= 40.0 - 1e-6                       # the pad's width
+
+
+def test_a_pad_too_small_for_the_mold_names_its_size_and_no_molds():
+    """`build --skin pad --pad-width 1`: the message named molds.pour.pour_diameter, a file
+    entry the user never set; it names the pad's size, its minimum and --no-molds."""
+    from tactileskin.geometry.pad_parts import build_pad_parts
+
+    with pytest.raises(ParameterError, match=r"pad_width=3\.0 is invalid; valid: > 4 mm .*--no-molds"):
+        build_pad_parts(2.0, 3.0, 20.0)
+    with pytest.raises(ParameterError, match=r"pad_length=2\.0 is invalid; valid: > 4 mm .*--no-molds"):
+        build_pad_parts(2.0, 20.0, 2.0)
+    assert [p.name for p in build_pad_parts(2.0, 3.0, 2.0, molds=False)] == ["skin"]

@@ -29,9 +29,17 @@ def pad_mold(width: float, length: float, thickness: float, mp: MoldParams | Non
     """(lower part with the pocket and pins, lid with sprue and vents)."""
     mp = mp or MoldParams.from_params()
     w, z = 0.5 * width, 0.5 * length
-    if mp.pour_diameter >= width or mp.pour_diameter >= length:
-        raise ParameterError("molds.pour.pour_diameter", mp.pour_diameter, f"< {min(width, length):g} mm (the pad)")
+    # the sizes the user chose are what stops the mold: name them (and the way out), not the
+    # molds.toml entries they collide with
+    no_molds = "or build without molds (--no-molds)"
+    for name, size in (("pad_width", width), ("pad_length", length)):
+        if mp.pour_diameter >= size:
+            raise ParameterError(name, size, f"> {mp.pour_diameter:g} mm for the mold's sprue "
+                                 "(molds.toml [pour] pour_diameter)", no_molds)
     if not 0.5 * mp.vent_diameter <= mp.vent_inset <= z:
+        if mp.vent_inset > z:
+            raise ParameterError("pad_length", length, f">= {2 * mp.vent_inset:g} mm for the mold's vents "
+                                 "(molds.toml [pour] vent_inset)", no_molds)
         raise ParameterError("molds.pour.vent_inset", mp.vent_inset, f"[{0.5 * mp.vent_diameter:g}, {z:g}] mm")
     hole = mp.pin_diameter + mp.pin_clearance
     xp = w + mp.wall + 0.5 * hole
