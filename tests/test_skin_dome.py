@@ -50,7 +50,7 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
     mp = MoldParams.from_params()
     hole = mp.pin_diameter + mp.pin_clearance
     A_, B_ = A + dome_parts.MOLD_WALL + hole + mp.pin_flange, B + dome_parts.MOLD_WALL
-    half_block = 2 * A_ * B_ * (L + dome_parts.BONE_STEM + c + dome_parts.MOLD_WALL)
+    half_block = 2 * A_ * B_ * (L + dome_parts.BONE_STEM + c + 2 * dome_parts.MOLD_WALL)
     body = dome_parts.body(A, B, c, L).volume + math.pi * (A - t) * (B - t) * dome_parts.BONE_STEM
     pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
     holes = 4 * math.pi * (0.5 * hole) ** 2 * (mp.pin_height + mp.pin_depth_clearance)
@@ -70,6 +70,19 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
     assert not any(column(zs)) and not any(column(zv)) and all(column(0.5 * (zv + zs)))
     with pytest.raises(ParameterError, match="dome_length.*sprue and two vents"):
         dome_parts.mold(A, B, 4.0, 2.0, 1.0)
+
+
+def test_mold_closes_behind_the_core_stem():
+    """The bone core is cantilevered from its stem: an end wall behind the stem's seat stops it
+    along the finger (where it sits sets the skin's thickness at the tip) and closes the cavity;
+    the seat used to run out through the block's end face (no stop, and a leak path)."""
+    t, c, L = 1.0, 8.0, 10.0
+    lower, upper = dome_parts.mold(A, B, c, L, t)
+    z_end = -L - dome_parts.BONE_STEM  # the stem's end face
+    y = 0.5 * (B - t)
+    assert not lower.is_inside((0.0, -y, z_end + 0.1)) and not upper.is_inside((0.0, y, z_end + 0.1))  # the seat
+    assert lower.is_inside((0.0, -y, z_end - 0.1)) and upper.is_inside((0.0, y, z_end - 0.1))  # the stop
+    assert lower.bounding_box().min.Z == pytest.approx(z_end - dome_parts.MOLD_WALL, abs=1e-6)
 
 
 def test_mesh_named_surfaces_and_volume():
@@ -120,7 +133,7 @@ def test_build_cli_exports_watertight_dome_parts(tmp_path):
     mp = MoldParams.from_params()
     hole = mp.pin_diameter + mp.pin_clearance
     half_block = 2 * (A + dome_parts.MOLD_WALL + hole + mp.pin_flange) * (B + dome_parts.MOLD_WALL) * (
-        L + dome_parts.BONE_STEM + c + dome_parts.MOLD_WALL)
+        L + dome_parts.BONE_STEM + c + 2 * dome_parts.MOLD_WALL)
     pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
     exact = {"skin": dome_parts.skin_volume(A, B, c, L, t),
              "bone_core": math.pi * ai * bi * L + stem + 2.0 / 3.0 * math.pi * ai * bi * (c - t),
