@@ -119,3 +119,23 @@ def test_footprint():
     xmin, xmax, zmin, zmax = braille.footprint("c", sa)        # dots 1 and 4
     assert (xmin, xmax) == pytest.approx((-sa.dot_pitch / 2 - r, sa.dot_pitch / 2 + r))
     assert (zmin, zmax) == pytest.approx((-r, r))
+
+
+def test_the_cell_cap_message_reads_the_pitch_and_width_from_their_files(monkeypatch):
+    """One source of truth: the message quoted a literal 6.2 mm pitch and a 16 mm fingertip."""
+    from tactileskin import params
+
+    real = params.load
+
+    def load(name):
+        p = real(name)
+        if name == "braille":
+            p = {**p, "standard_american": {**p["standard_american"], "cell_pitch": 7.0}}
+        if name == "fingertip":
+            p = {**p, "section": {**p["section"], "half_width": 9.0}}
+        return p
+
+    monkeypatch.setattr(params, "load", load)
+    with pytest.raises(ParameterError, match=r"40 cells already span 280 mm at the American pitch, "
+                                             r"the fingertip is 18 mm wide"):
+        braille.check_text("a" * (braille.MAX_CELLS + 1))

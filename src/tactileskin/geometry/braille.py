@@ -190,11 +190,15 @@ def check_text(text: str) -> list[list[int]]:
 
 def _check_cells(text: str, n: int) -> None:
     if n > MAX_CELLS:
+        # the pitch and the width from their files (braille.toml, fingertip.toml), not copies
+        pitch = get_standard("standard_american").cell_pitch
+        width = 2.0 * float(params.load("fingertip")["section"]["half_width"])
         raise ParameterError("braille_text", _short(text),
                              f"at most {MAX_CELLS} braille cells (characters plus capital, number "
                              "and letter signs)",
                              f"the text needs at least {n} cells; {MAX_CELLS} cells already span "
-                             f"{MAX_CELLS * 6.2:.0f} mm at the American pitch, the fingertip is 16 mm wide")
+                             f"{MAX_CELLS * pitch:.0f} mm at the American pitch, the fingertip is "
+                             f"{width:g} mm wide")
 
 
 def _short(text: str, n: int = 48) -> str:
