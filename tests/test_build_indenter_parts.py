@@ -17,17 +17,24 @@ from tactileskin.geometry.fingertip import Fingertip
 from tactileskin.geometry.indenters import make_indenter
 
 
-def _stem_volume(ind, room=None) -> float:
+def _stem_volume(ind) -> float:
     """Stem cylinder plus the fillet ring at its root (Pappus: the corner region between the
-    square rf x rf and the fillet's quarter circle, revolved about the stem axis); the fillet
-    at most half the `room` the back face leaves around the stem."""
+    square rf x rf and the fillet's quarter circle, revolved about the stem axis)."""
     rf = float(params.load("indenters")["stem"]["fillet"])
     r = 0.5 * ind.stem_diameter
-    if room is not None:
-        rf = min(rf, 0.5 * room)
     area = rf * rf * (1.0 - math.pi / 4.0)
     xbar = rf * (5.0 / 6.0 - math.pi / 4.0) / (1.0 - math.pi / 4.0)  # centroid off the stem wall
     return math.pi * r * r * ind.stem_length + 2.0 * math.pi * (r + xbar) * area
+
+
+def _mount_volume(ind, half_x: float, half_z: float) -> float:
+    """The block under the stem where the back face (half-widths half_x, half_z) leaves less
+    than the fillet's room twice around the stem: (stem + 2 x 2 fillets)^2 x mount thickness."""
+    q = params.load("indenters")["stem"]
+    r, rf = 0.5 * ind.stem_diameter, float(q["fillet"])
+    if min(half_x, half_z) - r >= 2.0 * rf:
+        return 0.0
+    return (2.0 * (r + 2.0 * rf)) ** 2 * float(q["mount_thickness"])
 
 
 def _sphere_volume(ind) -> float:
@@ -35,8 +42,8 @@ def _sphere_volume(ind) -> float:
     height h = 0.95 R under it: pi h^2 (3R - h) / 3."""
     R = ind.radius
     h = 0.95 * R
-    return (2.4 * R) ** 2 * 1.25 * R + math.pi * h * h * (3 * R - h) / 3.0 + _stem_volume(
-        ind, room=1.2 * R - 0.5 * ind.stem_diameter)
+    return ((2.4 * R) ** 2 * 1.25 * R + math.pi * h * h * (3 * R - h) / 3.0
+            + _mount_volume(ind, 1.2 * R, 1.2 * R) + _stem_volume(ind))
 
 
 def _cylinder_volume(ind) -> float:
@@ -45,18 +52,19 @@ def _cylinder_volume(ind) -> float:
     theta = 2.0 * math.asin(w / (2.0 * R))
     segment = 0.5 * R * R * (theta - math.sin(theta))
     along = ind.length if ind.axis == "z" else ind.width
-    return (w * ind.back_thickness + segment) * along + _stem_volume(ind)
+    return (w * ind.back_thickness + segment) * along + _mount_volume(ind, 0.5 * w, 0.5 * along) + _stem_volume(ind)
 
 
 @pytest.mark.parametrize("argv, kind, opts", [
     (["--indenter", "sphere", "--indenter-radius", "5"], "sphere", dict(indenter_radius=5.0)),
-    # small balls: the stem (1.6 R) leaves 0.4 R of plate around it, less than the 1 mm fillet
-    # (R = 2.5, the README's example, failed in the kernel before the fillet was kept within it)
+    # small balls: the plate (half-width 1.2 R) is narrower than the stem and its fillet; the
+    # stem stands on a mount block (R = 2.5, the README's example, once failed in the kernel)
     (["--indenter", "sphere", "--indenter-radius", "2.5"], "sphere", dict(indenter_radius=2.5)),
     (["--indenter", "sphere", "--indenter-radius", "0.5"], "sphere", dict(indenter_radius=0.5)),
     (["--indenter", "cylinder", "--indenter-radius", "8", "--indenter-axis", "x"], "cylinder",
      dict(indenter_radius=8.0, indenter_axis="x")),
     (["--indenter", "cylinder", "--indenter-radius", "20"], "cylinder", dict(indenter_radius=20.0)),
+    (["--indenter", "cylinder", "--indenter-radius", "1"], "cylinder", dict(indenter_radius=1.0)),
 ])
 def test_sphere_and_cylinder_parts_are_closed_with_the_closed_form_volume(tmp_path, argv, kind, opts):
     """Chordal bound: vertices on the exact CAD surfaces, no facet more than STL_TOLERANCE off
@@ -96,3 +104,22 @@ def test_bad_indenter_options_are_one_line_errors(tmp_path, capsys, argv, words)
     assert all(w in err for w in words), err
     assert "Traceback" not in cap.err + cap.out
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("kind, opts", [("sphere", dict(indenter_radius=0.3)), ("sphere", dict(indenter_radius=2.5)),
+                                        ("cylinder", dict(indenter_radius=1.0))])
+def test_every_printed_indenter_carries_the_standard_stem(kind, opts):
+    """The stem mounts the indenter on the load cell's adapter (indenters.toml [stem]): the
+    same for every kind. It shrank with small bodies instead: 0.48 mm across and 20 mm long
+    for a ball of R = 0.3 (unprintable), 4 mm for the README's R = 2.5."""
+    import build123d as bd
+
+    q = params.load("indenters")["stem"]
+    ind = make_indenter(kind, y0=7.0, dim=3, sample_length=20.0, **opts)
+    assert ind.stem_diameter == float(q["diameter"])
+    solid = ind.solid()
+    top = solid.bounding_box().max.Y
+    rims = [e for e in solid.edges() if e.geom_type == bd.GeomType.CIRCLE and abs(e.center().Y - top) < 1e-6]
+    assert len(rims) == 1 and rims[0].radius == pytest.approx(0.5 * float(q["diameter"]), abs=1e-6)
+    # the working face is still the model's: the lowest point at y0, the ball / arc under the mount
+    assert solid.bounding_box().min.Y == pytest.approx(7.0, abs=1e-6)

@@ -173,15 +173,22 @@ def box(x0, x1, y0, y1, z0, z1) -> bd.Solid:
 
 def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) -> bd.Solid:
     """Fuse the mounting stem (axis y, from the back face y_back upwards) and fillet its root."""
-    fillet = float(params.load("indenters")["stem"]["fillet"])
+    q = params.load("indenters")["stem"]
+    fillet, mount = float(q["fillet"]), float(q["mount_thickness"])
     r, h = 0.5 * ind.stem_diameter, ind.stem_length
-    # the fillet takes at most half the back face left around the stem: a small ball's plate
-    # (half-width 1.2 R around a 0.8 R stem) has 0.4 R, and a 1 mm fillet failed below R = 2.5
+    # a back face too small for the stem and its whole fillet (a small ball's plate, half-width
+    # 1.2 R; a small cylinder's chord) gets a mount block, the stem's width plus the fillet's
+    # room each side: the stem is the same for every indenter (the load cell's adapter); it
+    # used to shrink with the body instead, to 0.48 mm across and 20 mm long for R = 0.3
     bb = body.bounding_box()
     room = min(-bb.min.X, bb.max.X, -bb.min.Z, bb.max.Z) - r
-    fillet = min(fillet, 0.5 * room) if room > 0 else 0.0
     with occ_guard(f"adding the stem to the {what}", stem_diameter=ind.stem_diameter,
                    stem_length=h, stem_fillet=fillet, **p):
+        if room < 2.0 * fillet:
+            m = r + 2.0 * fillet
+            body = _single(body.fuse(box(-m, m, y_back, y_back + mount, -m, m)).clean())
+            y_back += mount
+            room = 2.0 * fillet
         stem = bd.Solid.make_cylinder(r, h, plane=bd.Plane((0.0, y_back, 0.0), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
         solid = body.fuse(stem).clean()
         if fillet > 0.0:

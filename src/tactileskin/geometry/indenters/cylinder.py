@@ -61,8 +61,7 @@ class CylinderIndenter(Indenter):
         width, length = (chord, length) if axis == "z" else (float(q["flat"]["width"]), min(length, 1.8 * R))
         sagitta = R - math.sqrt(R * R - 0.25 * chord * chord)
         back = min(float(q["curved"]["back_thickness"]), 0.5 * (R - sagitta))
-        stem = stem_params()
-        stem["stem_diameter"] = min(stem["stem_diameter"], 0.8 * chord)  # the stem fits the back
+        stem = stem_params()  # standard; a back narrower than it gets a mount block (solids._add_stem)
         return cls(kind=cls.name, y0=y0, dim=dim, width=width, length=length, radius=R, axis=axis,
                    back_thickness=back, **stem)
 

@@ -43,9 +43,8 @@ class SphereIndenter(Indenter):
     @classmethod
     def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None, **_):
         R = check_radius(indenter_radius, cls.name)
-        stem = stem_params()
-        stem["stem_diameter"] = min(stem["stem_diameter"], 1.6 * R)  # the stem fits the ball
-        return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem)
+        # the standard stem: a ball narrower than it gets a mount block (solids._add_stem)
+        return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem_params())
 
     @property
     def tip_radius(self) -> float:
