@@ -68,3 +68,13 @@ def test_out_folder_with_other_files_is_refused(tmp_path, capsys):
     assert main(["build", "--out", str(tmp_path), "--indenter", "none", "--no-molds"]) == 2
     assert "out=" in " ".join(capsys.readouterr().err.split())
     assert [p.name for p in tmp_path.iterdir()] == ["notes.txt"]
+
+
+def test_a_symlinked_out_folder_is_refused_as_a_link(tmp_path, capsys):
+    """A link to a folder was refused as "it exists and is not a folder", which it is."""
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    assert main(["build", "--out", str(tmp_path / "link"), "--indenter", "none", "--no-molds"]) == 2
+    err = capsys.readouterr().err
+    assert "not a symbolic link" in err and "is not a folder" not in err
+    assert list((tmp_path / "real").iterdir()) == []

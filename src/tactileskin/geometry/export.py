@@ -153,7 +153,10 @@ def _previous_build_files(out: Path) -> set[str] | None:
 def check_target(out: Path) -> None:
     """Only a new or empty folder, or a previous parts build (our marker, or the manifest of a
     build from before the marker with nothing added), may be written into."""
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
+    if out.is_symlink():
+        raise ParameterError("out", str(out), "a folder path, not a symbolic link",
+                             "write to the folder it points to, or to a new folder")
+    if out.exists() and not out.is_dir():
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
     kind = fileio.marker_kind(out)
     if not out.is_dir() or kind == FOLDER_KIND:
