@@ -11,6 +11,10 @@ Conversion rule (``Calibration.pressure``), in words:
 - lighter than the lightest press the function is continued along its tangent, down to
   zero (unactivated film reads zero);
 - the result is clipped to the activation range ``p_range`` (the film's stated range).
+``film.scan.analyze_scan`` flags a profile read on either continuation (summary.json
+``beyond_calibration`` and ``warnings``): pixels held at the darkest press below the
+activation range's top (a lower bound), and a span whose 10 % level lies below the lightest
+press (read on the tangent).
 
 Units. A calibration fitted from presses yields MPa (Eq. 7). The paper's own Eq. 8 is
 stated in "MPa/mm" ("pressure per unit length"; Sec. IV-B says it divided Eq. 7 by the

@@ -165,6 +165,7 @@ class FilmProfile:
     region: dict = field(default_factory=dict)   # how box_px was chosen
     image_note: str = ""                           # pixel scale applied when reading
     warnings: list = field(default_factory=list)   # what makes the profile suspect
+    coverage: dict = field(default_factory=dict)   # pixels beyond the calibrated grayscale range
 
     def summary(self) -> dict:
         cal = self.calibration
@@ -180,6 +181,7 @@ class FilmProfile:
             "n_columns": int(self.s_mm.size), "width_px": int(self.pressure_map.shape[0]),
             "saturated_fraction": self.saturated_fraction,
             "inactive_fraction": self.inactive_fraction,
+            "beyond_calibration": self.coverage,
             "metrics_two_sided": self.metrics,
             "metrics_folded": self.folded["metrics"],
             "asymmetry": self.folded["asymmetry"],
@@ -228,6 +230,29 @@ def _scan_array(scan) -> tuple[str, np.ndarray, str]:
         raise ParameterError("scan", f"array [{gray.min():g}, {gray.max():g}]",
                              "grayscale values in [0, 255]")
     return "<array>", gray, "array: read as 0-255"
+
+
+SPAN_LEVEL = 0.1  # the span's threshold as a fraction of the peak (tactileskin.results.span)
+
+
+def calibration_coverage(cal: Calibration, gray: np.ndarray, pmap: np.ndarray) -> dict:
+    """Pixels of a region outside the calibration's grayscale range (the presses' range):
+    held_fraction, beyond the highest-pressure press and read as its pressure although the
+    activation range goes higher (a silent clip, unlike saturation at the activation range's
+    top); extrapolated_fraction, activated pixels beyond the lowest-pressure press, read on the
+    fit's tangent; and the two ends' grayscale and pressure."""
+    g_hi, g_lo = cal._ends()          # (the high-pressure end, the low-pressure end)
+    lo, hi = cal.p_range
+    p_hi = float(np.clip(cal._f(g_hi), lo, hi))
+    p_lo = float(np.clip(cal._f(g_lo), lo, hi))
+    gs0, gs1 = cal.gs_range
+    past_hi = (gray < gs0) if g_hi == gs0 else (gray > gs1)
+    past_lo = (gray > gs1) if g_lo == gs1 else (gray < gs0)
+    return {"gs_range": [float(gs0), float(gs1)],
+            "high_end_gs": float(g_hi), "high_end_pressure": p_hi,
+            "low_end_gs": float(g_lo), "low_end_pressure": p_lo,
+            "held_fraction": float(np.mean(past_hi & (pmap < hi))),
+            "extrapolated_fraction": float(np.mean(past_lo & (pmap > lo)))}
 
 
 def _variation(pmap: np.ndarray) -> float:
@@ -312,6 +337,13 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     warnings = []
     if sat > 0:
         warnings.append(f"{100 * sat:.1f} % of the region is at the film's saturation ({hi:g} {cal.unit})")
+    coverage = calibration_coverage(cal, region, pmap)
+    if coverage["held_fraction"] > 0:
+        g_end, p_end = coverage["high_end_gs"], coverage["high_end_pressure"]
+        warnings.append(f"{100 * coverage['held_fraction']:.1f} % of the region is beyond the calibration's "
+                        f"highest-pressure press (GS {g_end:.4g}): read as {p_end:.4g} {cal.unit}, the calibrated "
+                        f"maximum, below the activation range's top ({hi:g} {cal.unit}); the pressure there "
+                        "is a lower bound (calibrate to higher pressures)")
     across = _variation(pmap)
     if across_other is not None and across > AXIS_CV and across > AXIS_RATIO * across_other:
         other = "y" if axis == "x" else "x"
@@ -331,6 +363,14 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         origin = centre
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
+    level = SPAN_LEVEL * float(np.max(prof))
+    if coverage["extrapolated_fraction"] > 0 and level < coverage["low_end_pressure"]:
+        warnings.append(f"the span's 10 % level ({level:.4g} {cal.unit}) is below the calibration's lowest "
+                        f"press ({coverage['low_end_pressure']:.4g} {cal.unit}, GS {coverage['low_end_gs']:.4g}): "
+                        "the span ends where the pressure is extrapolated on the fit's tangent "
+                        f"({100 * coverage['extrapolated_fraction']:.1f} % of the region's pixels lie beyond that "
+                        "press; calibrate to lower pressures)")
+        log.warning("%s", warnings[-1])
     fp = FilmProfile(
         s_mm=s, pressure=prof, pressure_sd=sd,
         band_lo=band[0] if band else None, band_hi=band[1] if band else None,
@@ -340,7 +380,8 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         saturated_fraction=sat, inactive_fraction=inactive, source=source,
         metrics=profile_metrics(s, prof),
         folded={"s_mm": sh, "pressure": ph, "asymmetry": asym,
-                "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note, warnings=warnings)
+                "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note, warnings=warnings,
+        coverage=coverage)
     for k, v in fp.metrics.items():
         if not math.isfinite(v):  # pragma: no cover - inputs are checked finite above
             raise ParameterError(f"metric {k}", v, "finite")

@@ -1,0 +1,47 @@
+"""A scan read outside its calibration's grayscale range says so (summary warnings)."""
+
+import numpy as np
+import pytest
+
+from tactileskin.film import analyze_scan
+from tactileskin.film.calibration import Calibration, fit_calibration
+from tactileskin.film.synthetic import gaussian_profile, render_scan
+
+TRUE = Calibration(name="true", model="linear", params=(-0.0015, 0.345), gs_range=(0.0, 255.0),
+                   p_range=(0.0, 0.345))
+PRESSES = np.array([0.05, 0.08, 0.11, 0.14, 0.17, 0.2])  # MPa: the scan's peak 0.3 is beyond them
+
+
+def _scan():
+    return render_scan(gaussian_profile(0.3, 1.2), TRUE, background_gs=245)
+
+
+def test_pixels_held_at_the_darkest_press_below_the_activation_top_are_flagged():
+    # the film's stated range reaches 1 MPa, the presses only 0.2: the darker pixels read
+    # 0.2, a lower bound, not the film's saturation, so before they passed unflagged
+    cal = fit_calibration(TRUE.grayscale(PRESSES), PRESSES, activation_range=(0.0, 1.0))
+    fp = analyze_scan(_scan(), cal)
+    assert fp.metrics["peak"] == pytest.approx(0.2)
+    assert fp.saturated_fraction == 0.0
+    assert fp.coverage["held_fraction"] > 0.1
+    assert any("lower bound" in w for w in fp.warnings)
+    assert fp.summary()["beyond_calibration"]["held_fraction"] == fp.coverage["held_fraction"]
+
+
+def test_a_span_read_on_the_extrapolated_tangent_is_flagged():
+    cal = fit_calibration(TRUE.grayscale(PRESSES), PRESSES)
+    fp = analyze_scan(_scan(), cal)
+    assert fp.coverage["extrapolated_fraction"] > 0
+    assert any("span's 10 % level" in w and "extrapolated" in w for w in fp.warnings)
+    # presses down to 0.01 MPa cover the span's 10 % level (0.03 MPa at most): no warning
+    wide = np.linspace(0.01, 0.35, 8)
+    cal2 = fit_calibration(TRUE.grayscale(wide), wide)
+    fp2 = analyze_scan(_scan(), cal2)
+    assert fp2.coverage["held_fraction"] == 0.0
+    assert not any("span's 10 % level" in w or "lower bound" in w for w in fp2.warnings)
+
+
+def test_the_paper_calibration_covers_every_gray_level():
+    fp = analyze_scan(render_scan(gaussian_profile(0.4, 1.2), background_gs=245))
+    assert fp.coverage["held_fraction"] == fp.coverage["extrapolated_fraction"] == 0.0
+    assert fp.warnings == []
