@@ -7,6 +7,8 @@ import click
 from tactileskin.cli._common import claimed_output
 from tactileskin.film import models
 
+EXIT_SUSPECT = 3  # written, but suspect (as `solve`, `sweep`, `array`, `material fit`)
+
 
 @click.group("film")
 def command() -> None:
@@ -80,7 +82,11 @@ def calibrate(cal_csv, out, model, activation_range, plot):
 @click.option("--out", "-o", type=click.Path(file_okay=False), required=True,
               help="Output directory: profile.csv, summary.json, pressure_map.png.")
 def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, out):
-    """Convert a scanned film to pressure and its profile along the strip."""
+    """Convert a scanned film to pressure and its profile along the strip.
+
+    Exit status 3 when the profile was written but is suspect (saturated film, pixels
+    beyond the calibrated range, a strip along the other axis): summary.json `warnings`.
+    """
     from tactileskin.film import analyze_scan, load_calibration
     from tactileskin.film.plots import _check_cmap
 
@@ -106,6 +112,9 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
                f"asymmetry {fp.folded['asymmetry']:.3f}; saturated "
                f"{100 * fp.saturated_fraction:.1f} % of pixels")
     click.echo(f"wrote {out}")
+    for w in fp.warnings:
+        click.echo(f"warning: suspect profile (exit status 3): {w}", err=True)
+    return EXIT_SUSPECT if fp.warnings else 0
 
 
 @command.command()
@@ -114,7 +123,11 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
 @click.option("--out", "-o", type=click.Path(file_okay=False), default=None,
               help="Where to write comparison.json and overlay.png (default FILM_DIR).")
 def compare(film_dir, sim_dir, out):
-    """Compare a `film analyze` result with a simulated profile (percent differences)."""
+    """Compare a `film analyze` result with a simulated profile (percent differences).
+
+    A comparison resting on a suspect film profile or simulated result says so on stderr and
+    in comparison.json (`status`, `warnings`).
+    """
     from tactileskin.film import compare as do_compare
 
     comp = do_compare(film_dir, sim_dir)
@@ -125,6 +138,8 @@ def compare(film_dir, sim_dir, out):
         click.echo(f"{k:<8} {comp.film_metrics[k]:>10.4g} {comp.sim_metrics[k]:>10.4g} "
                    f"{comp.percent_diff[k]:>+8.1f}")
     status = str(comp.sim_meta.get("status", "ok"))
-    if status != "ok":  # comparison.json carries it too (sim_meta)
+    if status != "ok":  # comparison.json carries it too (sim_meta, status, warnings)
         click.echo(f"warning: the simulated result is {status}", err=True)
+    for w in comp.film_warnings:  # the film's own (summary.json): the comparison inherits them
+        click.echo(f"warning: the film profile is suspect: {w}", err=True)
     click.echo(f"wrote {out or film_dir}")

@@ -113,9 +113,23 @@ class Comparison:
     film_unit: str
     asymmetry: float
     sim_meta: dict
+    warnings: list = None   # what makes the comparison suspect: the film's and the simulation's
+
+    def __post_init__(self):
+        if self.warnings is None:
+            self.warnings = []
+
+    @property
+    def film_warnings(self) -> list:
+        return [w[len("film: "):] for w in self.warnings if w.startswith("film: ")]
+
+    @property
+    def status(self) -> str:
+        return "suspect" if self.warnings else "ok"
 
     def to_dict(self) -> dict:
         return {
+            "status": self.status, "warnings": list(self.warnings),
             "film_metrics_folded": self.film_metrics, "sim_metrics": self.sim_metrics,
             "percent_diff": self.percent_diff,
             "percent_diff_definition": "100 * (sim - film) / film, film folded onto s >= 0",
@@ -167,9 +181,13 @@ def compare(film, sim) -> Comparison:
     """film: FilmProfile or a `film analyze` directory; sim: directory or (s, p) arrays."""
     if isinstance(film, FilmProfile):
         fs, fpr, unit = film.s_mm, film.pressure, film.unit
+        film_warnings = list(film.warnings)
     else:
         fs, fpr, meta = load_film(film)
         unit = meta.get("unit", "MPa")
+        film_warnings = meta.get("warnings") or []
+        if not isinstance(film_warnings, list):
+            film_warnings = [str(film_warnings)]
     if isinstance(sim, (str, Path)):
         ss, sp, smeta = load_simulation(sim)
     else:
@@ -189,4 +207,8 @@ def compare(film, sim) -> Comparison:
                                  "to the film)")
         diff[k] = 100.0 * (sm[k] - fm[k]) / fm[k]
     log.info("film vs sim: %s", diff)
-    return Comparison(fs, fpr, hs, hp, ss, sp, fm, sm, diff, unit, asym, smeta)
+    warnings = [f"film: {w}" for w in film_warnings]
+    status = str(smeta.get("status", "ok"))
+    if status != "ok":
+        warnings.append(f"simulation: {status}")
+    return Comparison(fs, fpr, hs, hp, ss, sp, fm, sm, diff, unit, asym, smeta, warnings)

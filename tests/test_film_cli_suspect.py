@@ -1,0 +1,50 @@
+"""`film analyze` marks a suspect profile (exit 3 and the reasons); `film compare` carries the
+film's warnings and the simulation's status into comparison.json and stderr."""
+
+import json
+
+import numpy as np
+
+from tactileskin.cli import main
+from tactileskin.film import paper_eq8
+from tactileskin.film.synthetic import gaussian_profile, mirrored, render_scan, save_scan
+
+S = np.linspace(0, 6, 121)
+
+
+def _sim_dir(path, status="ok"):
+    path.mkdir(parents=True)
+    np.savetxt(path / "profile.csv", np.column_stack([S, gaussian_profile(1.2, 1.0)(S)]), delimiter=",",
+               header="s_mm,pressure_mpa", comments="", fmt="%.10g")
+    (path / "summary.json").write_text(json.dumps({"status": status}))
+    return path
+
+
+def test_a_saturated_film_exits_3_and_its_comparison_says_why(tmp_path, capsys):
+    # 1.2 MPa/mm at the peak: past Eq. 8's top (0.978), a third of the strip saturates
+    scan = save_scan(render_scan(mirrored(S, gaussian_profile(1.2, 1.0)(S)), paper_eq8(), length_mm=14,
+                                 background_gs=245), tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
+    err = capsys.readouterr().err
+    assert "suspect" in err and "saturation" in err
+    _sim_dir(tmp_path / "sim")
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
+                 str(tmp_path / "cmp")]) == 0  # exit 0 with a warning, as for a suspect simulation
+    assert "the film profile is suspect" in capsys.readouterr().err
+    doc = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
+    assert doc["status"] == "suspect" and any("saturation" in w for w in doc["warnings"])
+
+
+def test_a_clean_film_against_a_suspect_simulation_is_a_suspect_comparison(tmp_path, capsys):
+    scan = save_scan(render_scan(mirrored(S, gaussian_profile(0.4, 1.0)(S)), paper_eq8(), length_mm=14,
+                                 background_gs=245), tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 0
+    _sim_dir(tmp_path / "sim", status="suspect: no contact")
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
+                 str(tmp_path / "cmp")]) == 0
+    doc = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
+    assert doc["status"] == "suspect" and doc["warnings"] == ["simulation: suspect: no contact"]
+    _sim_dir(tmp_path / "sim_ok")
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim_ok"), "-o",
+                 str(tmp_path / "cmp2")]) == 0
+    assert json.loads((tmp_path / "cmp2" / "comparison.json").read_text())["status"] == "ok"
