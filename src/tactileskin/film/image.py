@@ -9,7 +9,13 @@ say which range its values use):
   (logged), else refused.
 - float (F): within [0, 1] -> x255; within [0, 255] -> as is; else refused. (A float scan
   in 0-255 whose values are all <= 1 would be a black image; it is read as a 0-1 image.)
-Colour is BT.601 luma (Y = 0.299 R + 0.587 G + 0.114 B, float, alpha ignored).
+Colour is BT.601 luma (Y = 0.299 R + 0.587 G + 0.114 B, float). An alpha channel must be
+opaque: a transparent pixel's colour is undefined (often black, which the film would read as
+its highest pressure), so an image with any alpha < full is refused (flatten it first).
+
+Scale: `file_px_per_mm` gives the pixels per mm the file records (PNG pHYs in metres, TIFF
+resolution in inches or cm; None when the file records none or no absolute unit), which
+`film.scan.analyze_scan` checks against the scale it is given.
 
 Size: the header's width x height is checked against MAX_PIXELS before any pixel is
 decoded; a compressed image can claim far more pixels than its file size suggests.
@@ -28,7 +34,7 @@ from tactileskin.errors import ParameterError
 log = logging.getLogger(__name__)
 
 LUMA_BT601 = (0.299, 0.587, 0.114)
-LUMINANCE_NOTE = "ITU-R BT.601 luma Y = 0.299 R + 0.587 G + 0.114 B (float, alpha ignored)"
+LUMINANCE_NOTE = "ITU-R BT.601 luma Y = 0.299 R + 0.587 G + 0.114 B (float; alpha must be opaque)"
 # 40 megapixels: a film strip of 300 x 300 mm at the paper's 8 px/mm is 5.8 Mpx, and a
 # whole A4 flatbed scan at 600 dpi (23.6 px/mm) is 34.8 Mpx. The analysis holds a few
 # float64 copies of the image (grayscale, pressure, masks): about 1.5 GB at the cap.
@@ -99,6 +105,7 @@ def read_scan(path) -> tuple[np.ndarray, str]:
                 if getattr(im, "n_frames", 1) > 1:
                     log.warning("%s has %d frames; using the first", path, im.n_frames)
                 mode = im.mode
+                _check_opaque(path, im)
                 if mode in ("L", "F", "I") or mode.startswith("I;16"):
                     arr, note = _to_0_255(path, mode, np.asarray(im))
                 elif mode in ("LA", "La"):
@@ -123,6 +130,41 @@ def read_scan(path) -> tuple[np.ndarray, str]:
         raise ParameterError("scan", str(path), VALID,
                              hint=f"values must be finite on 0-255, got [{arr.min()}, {arr.max()}]")
     return arr, note
+
+
+def _check_opaque(path, im) -> None:
+    """Refuse an image with transparent pixels (their colour is not the film's)."""
+    if im.mode in ("RGBA", "LA", "La", "RGBa", "PA") or (im.mode == "P" and "transparency" in im.info):
+        alpha = np.asarray(im.convert("RGBA").getchannel("A") if im.mode in ("P", "PA")
+                           else im.getchannel("A"))
+        clear = float(np.mean(alpha < 255))
+        if clear > 0:
+            raise ParameterError("scan", str(path), "an opaque image (no transparent pixels)",
+                                 hint=f"{100 * clear:.3g} % of its pixels are (partly) transparent, whose colour is "
+                                      "not the film's (often black: the highest pressure); flatten the image "
+                                      "onto white or crop to the film")
+
+
+def file_px_per_mm(path) -> float | None:
+    """Pixels per mm recorded in an image file's header (PNG pHYs, TIFF resolution), or None
+    when it records none or no absolute unit (a TIFF's default 1 x 1 without a unit)."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(path) as im:
+                info = dict(im.info)
+    except (OSError, UnidentifiedImageError, ValueError, SyntaxError, EOFError):
+        return None
+    dpi = info.get("dpi")
+    if not dpi or "resolution" in info:  # Pillow sets "resolution" too when the unit is unknown
+        return None
+    try:
+        x = float(dpi[0])
+    except (TypeError, ValueError, IndexError):
+        return None
+    return x / 25.4 if x > 1.0 else None
 
 
 def load_grayscale(path) -> np.ndarray:

@@ -24,7 +24,7 @@ from tactileskin import fileio
 from tactileskin.errors import ParameterError
 from tactileskin.film import region as strip_region
 from tactileskin.film.calibration import Calibration, paper_eq8
-from tactileskin.film.image import LUMINANCE_NOTE, load_grayscale, luminance, read_scan  # noqa: F401
+from tactileskin.film.image import LUMINANCE_NOTE, file_px_per_mm, load_grayscale, luminance, read_scan  # noqa: F401
 from tactileskin.film.inputs import finite
 from tactileskin.results import auc, fold_profile, peak, span  # noqa: F401  (fold_profile: film's API)
 
@@ -34,6 +34,7 @@ PX_PER_MM = 8.0          # the paper's scans (Sec. IV-B: 160 x 80 px for 20 x 10
 # 0.01 px/mm (a pixel per 10 cm) to 10^4 px/mm (0.1 um pixels) spans every scanner and
 # microscope by far; outside it a typo is likelier than a scale.
 PX_PER_MM_RANGE = (0.01, 1e4)
+SCALE_TOL = 0.01         # the scale given and the file's may differ by 1 % (dpi rounding in PNG's pHYs)
 PEAK_WINDOW = 0.8        # parabola fitted to the samples >= 80 % of the maximum around it
 # the profile averages across the strip, so the pressure must be nearly uniform across it: an
 # automatically found strip whose variation across (pressure-weighted mean of sd / mean over its
@@ -166,6 +167,7 @@ class FilmProfile:
     image_note: str = ""                           # pixel scale applied when reading
     warnings: list = field(default_factory=list)   # what makes the profile suspect
     coverage: dict = field(default_factory=dict)   # pixels beyond the calibrated grayscale range
+    file_px_per_mm: float | None = None            # the scale the image file records, if any
 
     def summary(self) -> dict:
         cal = self.calibration
@@ -173,6 +175,7 @@ class FilmProfile:
             "warnings": list(self.warnings),
             "source": self.source, "unit": self.unit, "px_per_mm": self.px_per_mm,
             "box_px": list(self.box_px), "region": self.region, "axis": self.axis,
+            "file_px_per_mm": self.file_px_per_mm,
             "centre": self.centre, "origin_mm": self.origin_mm, "luminance": LUMINANCE_NOTE,
             "pixel_scale": self.image_note,
             "calibration": {"name": cal.name, "model": cal.model, "params": list(cal.params),
@@ -288,6 +291,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     else:
         centre = finite("centre", centre, unit="mm")
     source, gray, note = _scan_array(scan)
+    file_ppm = file_px_per_mm(scan) if isinstance(scan, (str, Path)) else None
     length_mm = gray.shape[1 if axis == "x" else 0] / px_per_mm
     if not isinstance(centre, str) and not 0 <= centre <= length_mm:
         raise ParameterError("centre", centre, f"[0, {length_mm:g}] mm (inside the image, "
@@ -335,6 +339,10 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                              f"(calibration {cal.name})",
                              hint=f"region grayscale {region.min():.1f}-{region.max():.1f}")
     warnings = []
+    if file_ppm is not None and abs(px_per_mm / file_ppm - 1.0) > SCALE_TOL:
+        warnings.append(f"the image file records {25.4 * file_ppm:.4g} dpi = {file_ppm:.4g} px/mm but was read at "
+                        f"{px_per_mm:g} px/mm: every length (s, span, area, a box in mm) is off by a factor "
+                        f"{file_ppm / px_per_mm:.3g}; pass --px-per-mm {file_ppm:.4g} if the file is right")
     if sat > 0:
         warnings.append(f"{100 * sat:.1f} % of the region is at the film's saturation ({hi:g} {cal.unit})")
     coverage = calibration_coverage(cal, region, pmap)
@@ -381,7 +389,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         metrics=profile_metrics(s, prof),
         folded={"s_mm": sh, "pressure": ph, "asymmetry": asym,
                 "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note, warnings=warnings,
-        coverage=coverage)
+        coverage=coverage, file_px_per_mm=file_ppm)
     for k, v in fp.metrics.items():
         if not math.isfinite(v):  # pragma: no cover - inputs are checked finite above
             raise ParameterError(f"metric {k}", v, "finite")
