@@ -1,0 +1,29 @@
+"""The paper's claims checked on a chart say at which depth: the depth cap is not the paper's 20 %."""
+
+from tactileskin.array.chart import Chart, ChartConfig, verdicts
+
+
+def _chart(max_depth):
+    cfg = ChartConfig(thicknesses=(1.0, 5.0), pitches=(0.75, 2.0), noise_fs=(0.01,), sets=("paper", "letters"),
+                      max_depth=max_depth)
+    ch = Chart(cfg)
+    for t in cfg.thicknesses:
+        for set_ in ("paper", "letters"):
+            for p in cfg.pitches:
+                ch.rows.append(dict(material="silicone", thickness_mm=t, set=set_, pitch_mm=p, noise_fs=0.01,
+                                    method="template", accuracy=1.0))
+    return ch
+
+
+def test_a_capped_5_mm_verdict_names_its_depth():
+    v = {x["claim"][:4]: x for x in verdicts(_chart(0.4))}
+    five = v["5 mm"]
+    assert five["verdict"].startswith("not supported")
+    assert "capped depth 0.4 mm, not the paper's 1 mm" in five["verdict"]
+    assert "0.4 mm" in five["evidence"]
+    assert v["0.75"]["verdict"] == "supported"  # t = 1 at 20 % = 0.2 mm, under the cap
+
+
+def test_uncapped_verdicts_are_plain():
+    v = verdicts(_chart(None))
+    assert [x["verdict"] for x in v] == ["supported", "not supported"]
