@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tactileskin.errors import ParameterError
 from tactileskin.results import fold_profile
 
 THRESHOLD = 0.2
@@ -44,6 +45,12 @@ def profile_distance(s1, p1, s2, p2, n: int = 2001) -> float:
     the centre (a whole model's, s < 0 too) against one from the symmetry line (a halved
     model's) is folded onto s >= 0 first: the halved model's missing side is no difference."""
     s1, p1, s2, p2 = (np.asarray(v, float) for v in (s1, p1, s2, p2))
+    for name, v in (("s", s1), ("P", p1), ("s", s2), ("P", p2)):
+        if v.size == 0 or not np.all(np.isfinite(v)):
+            # a NaN distance compared below the threshold: "not distinguishable", silently
+            raise ParameterError(f"profile {name}", "empty or non-finite", "finite samples")
+    if s1.shape != p1.shape or s2.shape != p2.shape:
+        raise ParameterError("profile", f"{s1.shape}/{p1.shape}, {s2.shape}/{p2.shape}", "s and P of one length")
     tol = 1e-9 * max(np.abs(s1).max(), np.abs(s2).max(), 1.0)
     two1, two2 = s1.min() < -tol, s2.min() < -tol
     if two1 and not two2:
