@@ -73,7 +73,8 @@ def main(argv=None) -> int:
             data["cases"].append(case)
         new = [{"thickness_mm": r["thickness_mm"], "depth_mm": round(r["depth_mm"], 9), "text": r["text"],
                 "model": r["model"], "taxel_max_error": round(r["max_abs_over_peak_taxel"], 4),
-                "extent_mm": r["extent_mm"], "reference_mesh": r["reference_mesh"], "source": source}
+                "extent_mm": r["extent_mm"], "reference_mesh": r["reference_mesh"],
+                "taxel_mm": r["taxel_mm"], "source": source}
                for r in rs if r["model"] in MODELS]
 
         def key(r):

@@ -440,7 +440,7 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
 
     dot = dot_scene(t, material, cfg)
     return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
-                    model=model, extent=cfg.read_extent)
+                    model=model, extent=cfg.read_extent, taxel=cfg.min_taxel)
 
 
 def letters_judgment(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
@@ -714,6 +714,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 err = surrogate.validate(k, refs[x], x, sec, cfg.standard, taxel=cfg.min_taxel,
                                          extent=cfg.read_extent, **kw)
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
+                             "taxel_mm": float(cfg.min_taxel),
                              "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
                              **err})
     return rows
