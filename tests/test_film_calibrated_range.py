@@ -45,3 +45,12 @@ def test_the_paper_calibration_covers_every_gray_level():
     fp = analyze_scan(render_scan(gaussian_profile(0.4, 1.2), background_gs=245))
     assert fp.coverage["held_fraction"] == fp.coverage["extrapolated_fraction"] == 0.0
     assert fp.warnings == []
+
+
+def test_a_region_that_cuts_the_profile_says_the_span_is_a_lower_bound():
+    img = render_scan(gaussian_profile(0.3, 1.5), TRUE, background_gs=245)
+    cut = analyze_scan(img, TRUE, box_mm=(8, 2, 12, 7))  # 4 mm of a profile 7 mm wide at 10 %
+    assert any("cut there" in w and "lower bounds" in w for w in cut.warnings)
+    whole = analyze_scan(img, TRUE)
+    assert whole.warnings == []
+    assert cut.folded["metrics"]["span_mm"] < 0.7 * whole.folded["metrics"]["span_mm"]

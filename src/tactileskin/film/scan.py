@@ -168,6 +168,7 @@ class FilmProfile:
     warnings: list = field(default_factory=list)   # what makes the profile suspect
     coverage: dict = field(default_factory=dict)   # pixels beyond the calibrated grayscale range
     file_px_per_mm: float | None = None            # the scale the image file records, if any
+    cut_ends: list = field(default_factory=list)   # region ends where P is still >= 10 % of its peak
 
     def summary(self) -> dict:
         cal = self.calibration
@@ -185,6 +186,7 @@ class FilmProfile:
             "saturated_fraction": self.saturated_fraction,
             "inactive_fraction": self.inactive_fraction,
             "beyond_calibration": self.coverage,
+            "cut_ends": list(self.cut_ends),
             "metrics_two_sided": self.metrics,
             "metrics_folded": self.folded["metrics"],
             "asymmetry": self.folded["asymmetry"],
@@ -236,6 +238,7 @@ def _scan_array(scan) -> tuple[str, np.ndarray, str]:
 
 
 SPAN_LEVEL = 0.1  # the span's threshold as a fraction of the peak (tactileskin.results.span)
+PLATEAU = 0.9     # a given region whose every column reads >= this x the peak lies inside the press
 
 
 def calibration_coverage(cal: Calibration, gray: np.ndarray, pmap: np.ndarray) -> dict:
@@ -372,6 +375,16 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
     level = SPAN_LEVEL * float(np.max(prof))
+    ends = [name for name, v in (("start", prof[0]), ("end", prof[-1])) if level > 0 and v >= level]
+    # a region the user put inside the pressed area (every column within 10 % of the peak) is read
+    # as given: it has no profile to cut (the span is the region, plainly); summary.json cut_ends
+    plateau = region_info["method"] != "auto" and float(np.min(prof)) >= PLATEAU * float(np.max(prof))
+    if ends and not plateau:
+        warnings.append(f"the profile is still at {max(prof[0], prof[-1]) / np.max(prof):.0%} of its peak at the "
+                        f"region's {' and '.join(ends)} ({'x' if axis == 'x' else 'y'} "
+                        f"{x_mm[0] - 0.5 / px_per_mm:.4g}-{x_mm[-1] + 0.5 / px_per_mm:.4g} mm): the span and area "
+                        "are cut there (lower bounds); widen the region")
+        log.warning("%s", warnings[-1])
     if coverage["extrapolated_fraction"] > 0 and level < coverage["low_end_pressure"]:
         warnings.append(f"the span's 10 % level ({level:.4g} {cal.unit}) is below the calibration's lowest "
                         f"press ({coverage['low_end_pressure']:.4g} {cal.unit}, GS {coverage['low_end_gs']:.4g}): "
@@ -389,7 +402,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         metrics=profile_metrics(s, prof),
         folded={"s_mm": sh, "pressure": ph, "asymmetry": asym,
                 "metrics": profile_metrics(sh, ph)}, region=region_info, image_note=note, warnings=warnings,
-        coverage=coverage, file_px_per_mm=file_ppm)
+        coverage=coverage, file_px_per_mm=file_ppm, cut_ends=ends)
     for k, v in fp.metrics.items():
         if not math.isfinite(v):  # pragma: no cover - inputs are checked finite above
             raise ParameterError(f"metric {k}", v, "finite")
