@@ -545,8 +545,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             for sc, kernel in kernels.items():
                 if sc == dot:  # the filter of a dot is what it adds to the plate
                     kernel = letter_kernel
-                row = kernel.pressure[int(np.argmin(np.abs(kernel.z - kernel.section_z)))]
-                kc = _cutoff(kernel.s, row, halfspace)
+                kc = map_cutoff(kernel)
                 chart.cutoffs.append({"material": material, "thickness_mm": t, "skin": sc.skin,
                                       "depth_mm": float(sc.indentation),
                                       "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
@@ -594,8 +593,19 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     return chart
 
 
-def _cutoff(s, row, halfspace) -> float:
-    """Measured cut-off of the single dot's section row, resampled on an even grid."""
+def map_cutoff(m: BoneMap) -> float:
+    """Measured cut-off (rad/mm) of a map along s: the 1D spectrum of its projection onto s
+    (the integral over z), which is the map's 2D spectrum along k_s (projection-slice
+    theorem), the one an array sampling along s aliases. The spectrum of the section row (a
+    slice) is not: for a point load on a half-space it reads 4.46 / d against the 2D 3.89 / d
+    (halfspace.cutoff), a 13 % smaller Nyquist pitch."""
+    return _cutoff(m.s, np.trapezoid(m.pressure, m.z, axis=0))
+
+
+def _cutoff(s, row) -> float:
+    """Measured cut-off of a response along s, resampled on an even grid."""
+    from tactileskin.array import halfspace
+
     grid = np.arange(s[0], s[-1], 0.02)
     try:
         kc, _, _ = halfspace.measured_cutoff(grid, np.interp(grid, s, row))

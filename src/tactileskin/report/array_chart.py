@@ -94,8 +94,8 @@ def markdown(chart, validation=None, method: str = "template") -> str:
         lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('depth_mm', float('nan')):.3g} | {c.get('skin', 'fingertip')} | "
                      f"{c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
                      f"{c['nyquist_pitch_mm']:.2f} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
-    lines += ["", "Cut-off where the spectrum of the single dot's section row (or of the half-space "
-              "kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
+    lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
+              "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
               "Depth: 20 % of t" + (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: below the dot "
                                     "height, so the Braille plate never touches)" if cfg.max_depth else "") + ".", ""]
     for set_ in cfg.sets:
