@@ -27,3 +27,20 @@ def test_a_capped_5_mm_verdict_names_its_depth():
 def test_uncapped_verdicts_are_plain():
     v = verdicts(_chart(None))
     assert [x["verdict"] for x in v] == ["supported", "not supported"]
+
+
+def test_a_verdict_within_sampling_noise_of_the_threshold_says_borderline():
+    from tactileskin.array.chart import wilson
+
+    ch = _chart(None)
+    for r in ch.rows:  # 16 test reads of 3 stimuli: 48 readings; 46 right is 0.958
+        r.update(n_test=16, chance=1 / 3)
+        if r["set"] == "paper" and r["thickness_mm"] == 5.0:
+            r["accuracy"] = 46 / 48
+        if r["set"] == "letters":
+            r.update(chance=1 / 36)  # 576 readings at 1.00: no doubt
+    v = {x["claim"][:4]: x for x in verdicts(ch)}
+    assert v["5 mm"]["verdict"].startswith("not supported (borderline: 0.96 on 48 readings")
+    assert v["0.75"]["verdict"] == "supported"
+    lo, hi = wilson(46 / 48, 48)
+    assert lo < 0.95 < hi and 0.85 < lo

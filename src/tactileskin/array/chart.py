@@ -627,6 +627,35 @@ def _off_paper_depth(cfg: ChartConfig, t: float) -> str:
     return f" (at the capped depth {d:g} mm, not the paper's {Scene.depth_fraction * t:g} mm)"
 
 
+def _readings(chart: Chart, material, t, set_, pitch, noise, method) -> int | None:
+    """The number of test readings behind one accuracy (n_test per stimulus x stimuli)."""
+    for r in chart.rows:
+        if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r["noise_fs"], r["method"]) == \
+                (material, t, set_, pitch, noise, method):
+            if r.get("n_test") and r.get("chance"):
+                return int(round(r["n_test"] / r["chance"]))
+    return None
+
+
+def wilson(acc: float, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of an accuracy measured on n readings."""
+    den = 1.0 + z * z / n
+    mid = (acc + z * z / (2 * n)) / den
+    half = z * np.sqrt(acc * (1 - acc) / n + z * z / (4 * n * n)) / den
+    return float(max(0.0, mid - half)), float(min(1.0, mid + half))
+
+
+def _borderline(acc: float, n: int | None) -> str:
+    """'' unless the accuracy's 95 % interval spans GOOD: then the verdict could go either way
+    with another draw of offsets and noise."""
+    if n is None or not np.isfinite(acc):
+        return ""
+    lo, hi = wilson(acc, n)
+    if lo < GOOD <= hi:
+        return f" (borderline: {acc:.2f} on {n} readings, 95 % interval {lo:.2f}-{hi:.2f} spans {GOOD:g})"
+    return ""
+
+
 def verdicts(chart: Chart, method: str = "template") -> list[dict]:
     """The paper's two design claims checked on the chart, per material, at the lowest noise.
     A claim checked at a thickness the depth cap indents less than the paper's 20 % of t says
@@ -641,6 +670,7 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             worst = {p: chart.accuracy(material, 1.0, "letters", p, noise, method) for p in coarser}
             ok = a >= GOOD
             off = _off_paper_depth(cfg, 1.0)
+            off += _borderline(a, _readings(chart, material, 1.0, "letters", PAPER_PITCH, noise, method))
             out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
                         "verdict": ("supported" if ok else "not supported") + off,
                         "evidence": f"letters at 0.75 mm: {a:.2f}; " + ", ".join(f"{p:g} mm: {v:.2f}" for p, v in worst.items())})
@@ -651,8 +681,10 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             acc5 = [chart.accuracy(material, 5.0, "paper", p, noise, method) for p in cfg.pitches]
             best = max(acc5)
             off = _off_paper_depth(cfg, 5.0)
+            pb = cfg.pitches[int(np.argmax(acc5))]
+            line = _borderline(best, _readings(chart, material, 5.0, "paper", pb, noise, method))
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
-                        "verdict": ("supported" if best < GOOD else "not supported") + off,
+                        "verdict": ("supported" if best < GOOD else "not supported") + off + line,
                         "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}" + off})
         else:
             thick = [t for t in cfg.thicknesses if "paper" in cfg.sets]
