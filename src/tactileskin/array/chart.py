@@ -298,6 +298,19 @@ def solve_cached(scenes, cache, on_event=None, workers: int | None = None) -> di
     return out
 
 
+def suspect_solves(recs: dict) -> list[str]:
+    """A note per solve of the chart whose result tactileskin.quality flags (its summary's
+    status is not "ok": no contact, the law out of its range, a peak at the skin's edge, ...):
+    the maps built on it are as suspect as it is."""
+    out = []
+    for sc, rec in recs.items():
+        status = str((getattr(rec, "summary", None) or {}).get("status", "ok"))
+        if status != "ok":
+            out.append(f"the solve {sc.label()} ({sc.indenter_label()}, t = {sc.thickness:g} mm, {sc.material}) "
+                       f"is {status}: the chart's maps built on it are suspect")
+    return out
+
+
 def bone_map_of(record) -> BoneMap:
     return mirrored(read_bone_map(record.path / "bone_map.csv"))
 
@@ -526,6 +539,9 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     say(f"solving {len(set(wanted))} cases (cached cases are read)")
     recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
+    for note in suspect_solves(recs):
+        log.warning(note)
+        chart.notes.append(note)
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot, pdot, blank, sec2, sphere = cases[(material, t)]
