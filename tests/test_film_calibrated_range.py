@@ -54,3 +54,15 @@ def test_a_region_that_cuts_the_profile_says_the_span_is_a_lower_bound():
     whole = analyze_scan(img, TRUE)
     assert whole.warnings == []
     assert cut.folded["metrics"]["span_mm"] < 0.7 * whole.folded["metrics"]["span_mm"]
+
+
+def test_a_fold_about_an_off_centre_origin_is_flagged():
+    # two peaks at +-1.5 mm: the default origin (the largest pixel) sits on one of them and the
+    # fold averaged unlike sides (asymmetry 1.0, span 4.5 mm for 3.0) without a word
+    twin = lambda s: 0.3 * np.exp(-0.5 * ((np.abs(s) - 1.5) / 0.7) ** 2)  # noqa: E731
+    img = render_scan(twin, TRUE, background_gs=245, noise_gs=1, seed=3)
+    off = analyze_scan(img, TRUE)
+    assert off.folded["asymmetry"] > 0.5
+    assert any("not symmetric" in w and "--centre midspan" in w for w in off.warnings)
+    mid = analyze_scan(img, TRUE, centre="midspan")
+    assert mid.folded["asymmetry"] < 0.1 and mid.warnings == []

@@ -238,6 +238,10 @@ def _scan_array(scan) -> tuple[str, np.ndarray, str]:
 
 
 SPAN_LEVEL = 0.1  # the span's threshold as a fraction of the peak (tactileskin.results.span)
+# folded asymmetry (fold_profile: max |P(+s) - P(-s)| / peak) above which the fold is flagged: twice
+# the film's +-10 % accuracy, as the discrimination threshold (a twin-peaked press centred on one
+# peak by --centre peak read 1.0, with a span 50 % long; noise and blur read below 0.05)
+ASYMMETRY = 0.2
 PLATEAU = 0.9     # a given region whose every column reads >= this x the peak lies inside the press
 
 
@@ -374,6 +378,17 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         origin = centre
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
+    wrong_axis = any("try --axis" in w for w in warnings)  # the root cause, said already
+    if asym > ASYMMETRY and not wrong_axis:
+        hint = ""
+        if centre != "midspan":
+            other = fold_profile(x_mm - _midspan_position(x_mm, prof), prof)[2]
+            if other < 0.5 * asym:
+                hint = f" (about the middle of its half-maximum extent it is {other:.2f}: --centre midspan)"
+        warnings.append(f"the profile is not symmetric about its origin at {origin:.3f} mm: |P(+s) - P(-s)| reaches "
+                        f"{asym:.2f} of the peak (> {ASYMMETRY:g}), so the folded profile (and a comparison with a "
+                        f"half model) averages unlike sides{hint}")
+        log.warning("%s", warnings[-1])
     level = SPAN_LEVEL * float(np.max(prof))
     ends = [name for name, v in (("start", prof[0]), ("end", prof[-1])) if level > 0 and v >= level]
     # a region the user put inside the pressed area (every column within 10 % of the peak) is read
