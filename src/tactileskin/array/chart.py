@@ -394,6 +394,7 @@ class Chart:
     letters_models: dict = field(default_factory=dict)  # (material, t) -> the letters' model used
     fallbacks: dict = field(default_factory=dict)  # (material, t) -> the surrogate's measured error that
     #                                                sent its letters to full solves (validity.measured)
+    suspect: dict = field(default_factory=dict)    # (material, t) -> why its solves are suspect
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
@@ -412,7 +413,8 @@ class Chart:
         lines = [",".join(cols + ["status"])]
         for r in self.rows:
             why = (indicative or {}).get((r["material"], r["thickness_mm"])) if r["set"] == "letters" else None
-            status = f'"indicative: {why}"' if why else "ok"
+            bad = self.suspect.get((r["material"], r["thickness_mm"]))
+            status = ('"suspect: ' + bad.replace('"', "'") + '"' if bad else f'"indicative: {why}"' if why else "ok")
             lines.append(",".join([*(f"{r[c]:.6g}" if isinstance(r[c], float) else str(r[c]) for c in cols), status]))
         return "\n".join(lines) + "\n"
 
@@ -539,9 +541,15 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     say(f"solving {len(set(wanted))} cases (cached cases are read)")
     recs = solve_cached(wanted, cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
-    for note in suspect_solves(recs):
-        log.warning(note)
-        chart.notes.append(note)
+    for (m, t), c in cases.items():
+        mine = [x for x in (c[0], c[1], c[2], *c[3].values(), c[4], *full[(m, t)].values(), shallow.get((m, t)))
+                if x is not None]
+        notes = suspect_solves({x: recs[x] for x in mine})
+        for note in notes:
+            log.warning(note)
+            chart.notes.append(note)
+        if notes:
+            chart.suspect[(m, t)] = "; ".join(notes)
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot, pdot, blank, sec2, sphere = cases[(material, t)]
