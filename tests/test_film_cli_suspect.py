@@ -48,3 +48,15 @@ def test_a_clean_film_against_a_suspect_simulation_is_a_suspect_comparison(tmp_p
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim_ok"), "-o",
                  str(tmp_path / "cmp2")]) == 0
     assert json.loads((tmp_path / "cmp2" / "comparison.json").read_text())["status"] == "ok"
+
+
+def test_every_number_printed_has_its_unit(tmp_path, capsys):
+    scan = save_scan(render_scan(mirrored(S, gaussian_profile(0.4, 1.0)(S)), paper_eq8(), length_mm=14,
+                                 background_gs=245), tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("MPa/mm mm") == 2  # the two areas (before: "area 0.87" with no unit)
+    _sim_dir(tmp_path / "sim")
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "c")]) == 0
+    rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.split()[:1] in (["peak"], ["span_mm"], ["auc"])]
+    assert len(rows) == 3 and rows[2].endswith("MPa/mm mm / MPa mm")

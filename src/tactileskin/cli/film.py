@@ -107,8 +107,8 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
     click.echo(f"region x {x0}-{x1}, y {y0}-{y1} px {how}")
     m, f = fp.metrics, fp.folded["metrics"]
     click.echo(f"origin {fp.origin_mm:.3f} mm; two-sided: peak {m['peak']:.4g} {fp.unit}, "
-               f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g}; folded: peak "
-               f"{f['peak']:.4g}, span {f['span_mm']:.3f} mm, area {f['auc']:.4g}; "
+               f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g} {fp.unit} mm; folded: peak "
+               f"{f['peak']:.4g} {fp.unit}, span {f['span_mm']:.3f} mm, area {f['auc']:.4g} {fp.unit} mm; "
                f"asymmetry {fp.folded['asymmetry']:.3f}; saturated "
                f"{100 * fp.saturated_fraction:.1f} % of pixels")
     click.echo(f"wrote {out}")
@@ -134,9 +134,10 @@ def compare(film_dir, sim_dir, out):
     comp.write(out or film_dir)
     click.echo(f"{'metric':<8} {'film':>10} {'sim':>10} {'diff %':>8}   (film {comp.film_unit}, "
                "sim MPa; diff = 100 (sim - film)/film)")
+    units = {"peak": f"{comp.film_unit} / MPa", "span_mm": "mm", "auc": f"{comp.film_unit} mm / MPa mm"}
     for k in ("peak", "span_mm", "auc"):
         click.echo(f"{k:<8} {comp.film_metrics[k]:>10.4g} {comp.sim_metrics[k]:>10.4g} "
-                   f"{comp.percent_diff[k]:>+8.1f}")
+                   f"{comp.percent_diff[k]:>+8.1f}   {units[k]}")
     status = str(comp.sim_meta.get("status", "ok"))
     if status != "ok":  # comparison.json carries it too (sim_meta, status, warnings)
         click.echo(f"warning: the simulated result is {status}", err=True)
