@@ -13,8 +13,14 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
 `taxel` (mm; 0 = a point sensor) is area-averaged: Gauss-Legendre `taxel_points` per direction
-(default one per 0.25 mm of the side, 3 to 16; taxel_points in 2D, taxel_points**2 in 3D) over the square in (s, z) on the sensor's depth
-surface, weighted by the surface's area element (exact mean of a field linear over a flat taxel).
+(default one per 0.25 mm of the side, 3 to 16; taxel_points in 2D, taxel_points**2 in 3D) over the square of that
+side on the sensor's depth surface: the side is arc length on that surface (the chip's own size),
+not the bone's arc length s, which at depth d of a convex section is shorter by the area element
+(1 - d k) / (1 - t k) (1.6-3.2 at mid-depth of the t = 5 mm fingertip); z is straight (exact mean
+of a field linear in arc length). Positions s and a line's pitch stay in the bone's s.
+
+For a depth-ramp the stresses are the final state's; under force control or a loading history
+the peak-load state's, the same state as the bone profile (fe._run_history).
 
 Readings, per sensor, from the Cauchy stress sigma of the final state (sampled by interpolation
 inside the elements, fe.probe): P = -tr(sigma)/3 (the paper's mean pressure, compression
@@ -382,8 +388,12 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         s, z = lay.positions()
         h = 0.5 * lay.taxel
         lim = coords.s_limit(d) if hasattr(coords, "s_limit") else smax
-        _check_range(where, "s" + (" +- taxel/2" if h else ""), np.concatenate([s - h, s + h]), -lim, lim,
+        _check_range(where, "s", s, -lim, lim,
                      note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
+        if h:  # the taxel's edges: taxel/2 of arc length on the depth surface each side
+            edges = taxel_s(coords, s, d, np.array([-1.0, 1.0]), lay.taxel).ravel()
+            _check_range(where, "s +- taxel/2", edges, -lim, lim,
+                         note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
         if dim == 3 and z_range is not None:
             _check_range(where, "z" + (" +- taxel/2" if h else ""), np.concatenate([z - h, z + h]), *z_range)
         n0 = len(ids)
@@ -407,22 +417,54 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         if not lay.taxel:
             continue
         g, w = np.polynomial.legendre.leggauss(lay.taxel_points)
-        a = 0.5 * lay.taxel * g
+        # Gauss points equally weighted in arc length on the depth surface (the taxel's own
+        # plane), so the side is the chip's: in s (the bone's arc length) a side at depth d of
+        # a convex section is shorter by the area element (1 - d k) / (1 - t k); along z straight
         if dim == 2:
-            ds, dz, wq = a, np.zeros_like(a), w
+            gs, gz, wq = g, np.zeros_like(g), w
         else:
-            ds, dz = (m.ravel() for m in np.meshgrid(a, a))
+            gs, gz = (m.ravel() for m in np.meshgrid(g, g))
             wq = np.outer(w, w).ravel()
-        k = len(ds)
+        k = len(gs)
         rows = slice(i0, i0 + cnt)
-        ss = (s[rows, None] + ds[None, :]).ravel()
-        pq, _, _, jac = coords.frame(ss, np.repeat(depth[rows], k))
-        zz = (z[rows, None] + dz[None, :]).ravel() if dim == 3 else np.zeros(len(ss))
+        ss = taxel_s(coords, s[rows], float(depth[i0]), gs, lay.taxel).ravel()
+        pq, _, _, _ = coords.frame(ss, np.repeat(depth[rows], k))
+        zz = (z[rows, None] + 0.5 * lay.taxel * gz[None, :]).ravel() if dim == 3 else np.zeros(len(ss))
         samples[rows, :k] = np.column_stack([pq, zz]).reshape(cnt, k, 3)
-        ww = wq[None, :] * jac.reshape(cnt, k)
-        weights[rows, :k] = ww / ww.sum(axis=1, keepdims=True)
+        weights[rows, :k] = np.broadcast_to(wq / wq.sum(), (cnt, k))
         weights[rows, k:] = 0.0
     return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim)
+
+
+def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 65) -> np.ndarray:
+    """(len(s_centre), len(g)) values of s at the points g * side / 2 of arc length (g in
+    [-1, 1]) from each centre along the depth surface: the inverse of the arc length
+    int jac ds, jac = |d point / ds| (coords.frame's area element; 1 on a flat layer). Each
+    side of a centre has its own table, so a taxel centred on the symmetry line is mirrored
+    exactly."""
+    sc = np.atleast_1d(np.asarray(s_centre, float))
+    g = np.asarray(g, float)
+    half = 0.5 * float(side)
+    _, _, _, j0 = coords.frame(sc, np.full(sc.shape, depth))
+    out = np.empty((sc.size, g.size))
+    u = np.linspace(0.0, 1.0, n)
+    for sign, pick in ((1.0, g >= 0), (-1.0, g < 0)):
+        if not pick.any():
+            continue
+        reach = 1.5 * half / np.maximum(j0, 1e-6)  # covers the half side where jac varies slowly
+        for _ in range(8):  # widen where it falls off faster than that
+            S = sc[:, None] + sign * reach[:, None] * u[None, :]
+            _, _, _, jac = coords.frame(S.ravel(), np.full(S.size, depth))
+            jac = jac.reshape(S.shape)
+            arc = np.concatenate([np.zeros((sc.size, 1)), np.cumsum(
+                0.5 * (jac[:, 1:] + jac[:, :-1]) * np.abs(np.diff(S, axis=1)), axis=1)], axis=1)
+            short = arc[:, -1] < half
+            if not short.any():
+                break
+            reach = np.where(short, 2.0 * reach, reach)
+        for i in range(sc.size):
+            out[i, pick] = np.interp(np.abs(g[pick]) * half, arc[i], S[i])
+    return out
 
 
 def sites_for(scene, z_range=None) -> Sites:
