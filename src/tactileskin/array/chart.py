@@ -181,9 +181,12 @@ class ChartConfig:
                 raise ParameterError(name, v, f"an integer >= {lo}")
         if not isinstance(self.letters, str):
             raise ParameterError("letters", self.letters, "a string of characters a-z, 0-9, e.g. 'abc1'")
+        # "a,b,l" or "a b l" as the other list options are written: the separators are no characters
+        set_("letters", "".join(c for c in self.letters if c not in ", "))
         bad = [c for c in self.letters if c not in CHARACTERS]
         if bad or len(set(self.letters)) < 2:
-            raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9")
+            raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9",
+                                 hint=f"not characters of the set: {''.join(dict.fromkeys(bad))}" if bad else "")
 
     def mesh_for(self, thickness: float) -> tuple[float, float]:
         """(mesh_size, refinement) of the chart's 3D single dots at a thickness: the user's
