@@ -436,7 +436,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
     return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim)
 
 
-def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 65) -> np.ndarray:
+def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 17) -> np.ndarray:
     """(len(s_centre), len(g)) values of s at the points g * side / 2 of arc length (g in
     [-1, 1]) from each centre along the depth surface: the inverse of the arc length
     int jac ds, jac = |d point / ds| (coords.frame's area element; 1 on a flat layer). Each
@@ -445,6 +445,8 @@ def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 65) -> np.n
     sc = np.atleast_1d(np.asarray(s_centre, float))
     g = np.asarray(g, float)
     half = 0.5 * float(side)
+    if isinstance(coords, FlatCoordinates):  # s is arc length on every depth surface
+        return sc[:, None] + half * g[None, :]
     _, _, _, j0 = coords.frame(sc, np.full(sc.shape, depth))
     out = np.empty((sc.size, g.size))
     u = np.linspace(0.0, 1.0, n)
@@ -462,8 +464,14 @@ def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 65) -> np.n
             if not short.any():
                 break
             reach = np.where(short, 2.0 * reach, reach)
-        for i in range(sc.size):
-            out[i, pick] = np.interp(np.abs(g[pick]) * half, arc[i], S[i])
+        # invert every row's arc length table at once (arc increases along each row)
+        uniq, inv = np.unique(np.abs(g[pick]), return_inverse=True)
+        T = uniq * half
+        idx = np.clip((arc[:, :, None] < T[None, None, :]).sum(axis=1), 1, n - 1)
+        a0, a1 = np.take_along_axis(arc, idx - 1, 1), np.take_along_axis(arc, idx, 1)
+        s0, s1 = np.take_along_axis(S, idx - 1, 1), np.take_along_axis(S, idx, 1)
+        frac = np.clip((T[None, :] - a0) / np.where(a1 > a0, a1 - a0, 1.0), 0.0, 1.0)
+        out[:, pick] = (s0 + frac * (s1 - s0))[:, inv.ravel()]
     return out
 
 
