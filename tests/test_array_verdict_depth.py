@@ -40,7 +40,8 @@ def test_a_verdict_within_sampling_noise_of_the_threshold_says_borderline():
         if r["set"] == "letters":
             r.update(chance=1 / 36)  # 576 readings at 1.00: no doubt
     v = {x["claim"][:4]: x for x in verdicts(ch)}
-    assert v["5 mm"]["verdict"].startswith("not supported (borderline: 0.96 on 48 readings")
-    assert v["0.75"]["verdict"] == "supported"
+    assert v["5 mm"]["verdict"] == "not supported"
+    assert "(borderline: 0.96 on 48 readings, 95 % interval 0.86-0.99 spans 0.95)" in v["5 mm"]["evidence"]
+    assert v["0.75"]["verdict"] == "supported" and "borderline" not in v["0.75"]["evidence"]
     lo, hi = wilson(46 / 48, 48)
     assert lo < 0.95 < hi and 0.85 < lo

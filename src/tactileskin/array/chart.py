@@ -674,7 +674,7 @@ def wilson(acc: float, n: int, z: float = 1.96) -> tuple[float, float]:
 
 def _borderline(acc: float, n: int | None) -> str:
     """'' unless the accuracy's 95 % interval spans GOOD: then the verdict could go either way
-    with another draw of offsets and noise."""
+    with another draw of offsets and noise (said in the verdict's evidence)."""
     if n is None or not np.isfinite(acc):
         return ""
     lo, hi = wilson(acc, n)
@@ -697,10 +697,11 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             worst = {p: chart.accuracy(material, 1.0, "letters", p, noise, method) for p in coarser}
             ok = a >= GOOD
             off = _off_paper_depth(cfg, 1.0)
-            off += _borderline(a, _readings(chart, material, 1.0, "letters", PAPER_PITCH, noise, method))
+            line = _borderline(a, _readings(chart, material, 1.0, "letters", PAPER_PITCH, noise, method))
             out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
                         "verdict": ("supported" if ok else "not supported") + off,
-                        "evidence": f"letters at 0.75 mm: {a:.2f}; " + ", ".join(f"{p:g} mm: {v:.2f}" for p, v in worst.items())})
+                        "evidence": f"letters at 0.75 mm: {a:.2f}{line}; "
+                                    + ", ".join(f"{p:g} mm: {v:.2f}" for p, v in worst.items())})
         else:
             out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
                         "verdict": "not evaluated", "evidence": "needs t = 1, pitch 0.75 and the letters set"})
@@ -711,8 +712,8 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             pb = cfg.pitches[int(np.argmax(acc5))]
             line = _borderline(best, _readings(chart, material, 5.0, "paper", pb, noise, method))
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
-                        "verdict": ("supported" if best < GOOD else "not supported") + off + line,
-                        "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}" + off})
+                        "verdict": ("supported" if best < GOOD else "not supported") + off,
+                        "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}" + line + off})
         else:
             thick = [t for t in cfg.thicknesses if "paper" in cfg.sets]
             ev = ", ".join(f"t = {t:g}: {max(chart.accuracy(material, t, 'paper', p, noise, method) for p in cfg.pitches):.2f}"
