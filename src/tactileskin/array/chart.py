@@ -61,6 +61,7 @@ LETTERS_MODELS = ("interaction", "sum", "full")
 # the letters' surrogate is 5.5 % (t = 1, silicone, f) and 5.2 % (t = 0.5) off full solves on
 # finer meshes; on 0.8 / 8 it reads 3.5 and 3.6 % (data/surrogate_validation.json)
 CHART_MESH = (1.2, 8.0)
+MAX_TAXELS = 200  # taxels a side of the sampler's lattice (array.sampler.ArraySpec)
 
 
 def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:
@@ -153,6 +154,12 @@ class ChartConfig:
         set_("taxel_fraction", check_range("taxel_fraction (--taxel)", self.taxel_fraction, 0.0, 1.0,
                                            unit="of the pitch"))
         set_("window", check_range("window", self.window, 0.0, unit="mm (array side)"))
+        # the sampler's lattice has at most MAX_TAXELS a side: a finer pitch over this window would
+        # be cut to a smaller array than the window the report states (it was, silently)
+        fine = [p for p in self.pitches if int(np.floor(self.window / p + 1e-9)) + 1 > MAX_TAXELS]
+        if fine:
+            raise ParameterError("window", self.window, f"at most {(MAX_TAXELS - 1) * min(self.pitches):g} mm at the "
+                                 f"pitch {min(self.pitches):g} mm ({MAX_TAXELS} taxels a side)")
         if not isinstance(self.fallback, bool):
             raise ParameterError("fallback", self.fallback, "true or false")
         for name, choices in (("letters_model", LETTERS_MODELS), ("sphere_quality", QUALITIES), ("skin", SKINS)):
@@ -224,7 +231,7 @@ class ChartConfig:
 
     def spec(self, pitch: float) -> ArraySpec:
         n = int(np.floor(self.window / pitch + 1e-9)) + 1
-        return ArraySpec(pitch=pitch, taxel=self.taxel_fraction * pitch, n=min(n, 200))
+        return ArraySpec(pitch=pitch, taxel=self.taxel_fraction * pitch, n=n)
 
 
 # --- map sources ----------------------------------------------------------------------------
