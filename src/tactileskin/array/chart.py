@@ -583,7 +583,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                 chart.cutoffs.append({"material": material, "thickness_mm": t, "skin": sc.skin,
                                       "depth_mm": float(sc.indentation),
                                       "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
-                                      "nyquist_pitch_mm": float(np.pi / kc) if kc > 0 else float("nan"),
+                                      "nyquist_pitch_mm": float(np.pi / kc) if 0 < kc < np.inf else float("nan"),
                                       "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
             letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None

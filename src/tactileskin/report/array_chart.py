@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 import numpy as np
@@ -91,9 +93,13 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
              "|---|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
+        kc, ny = c["kc_rad_per_mm"], c["nyquist_pitch_mm"]
+        # not measurable: a spectrum that never falls to 10 % (inf) or a response without a mean (nan)
+        kc_s = f"{kc:.2f}" if math.isfinite(kc) else ("n/a (spectrum stays above 10 %)" if kc == math.inf
+                                                      else "n/a (not measurable)")
+        ny_s = f"{ny:.2f}" if math.isfinite(ny) else "n/a"
         lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('depth_mm', float('nan')):.3g} | {c.get('skin', 'fingertip')} | "
-                     f"{c['peak_mpa']:.4f} | {c['kc_rad_per_mm']:.2f} | "
-                     f"{c['nyquist_pitch_mm']:.2f} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
+                     f"{c['peak_mpa']:.4f} | {kc_s} | {ny_s} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
               "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
               "Depth: 20 % of t" + (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: below the dot "

@@ -1,0 +1,19 @@
+"""A cut-off the spectrum never reaches reads n/a, not a Nyquist pitch of 0.00 mm."""
+
+from tactileskin.array.chart import Chart, ChartConfig
+from tactileskin.report.array_chart import markdown
+
+
+def test_an_unmeasurable_cutoff_is_not_a_zero_pitch():
+    cfg = ChartConfig(thicknesses=(1.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",))
+    ch = Chart(cfg)
+    ch.rows.append(dict(material="silicone", thickness_mm=1.0, set="paper", pitch_mm=0.75, taxel_mm=0.6,
+                        noise_fs=0.01, noise_mpa=0.001, full_scale_mpa=0.3, bits=12, method="template",
+                        accuracy=1.0, chance=1 / 3, n_test=16))
+    ch.labels["paper"] = ["flat", "curved", "braille"]
+    ch.cutoffs.append({"material": "silicone", "thickness_mm": 1.0, "skin": "fingertip", "depth_mm": 0.2,
+                       "peak_mpa": 0.04, "kc_rad_per_mm": float("inf"), "nyquist_pitch_mm": float("nan"),
+                       "halfspace_nyquist_pitch_mm": 0.81})
+    md = markdown(ch)
+    row = next(ln for ln in md.splitlines() if ln.startswith("| silicone | 1 | 0.2 |"))
+    assert "n/a (spectrum stays above 10 %) | n/a |" in row and "0.00" not in row and "nan" not in row
