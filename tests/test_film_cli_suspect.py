@@ -26,7 +26,9 @@ def test_a_saturated_film_exits_3_and_its_comparison_says_why(tmp_path, capsys):
                                  background_gs=245), tmp_path / "scan.png")
     assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
     err = capsys.readouterr().err
-    assert "suspect" in err and "saturation" in err
+    assert "suspect profile (exit status 3): 1 reason(s)" in err and "summary.json" in err
+    summary = json.loads((tmp_path / "film" / "summary.json").read_text())
+    assert any("saturation" in w for w in summary["warnings"])
     _sim_dir(tmp_path / "sim")
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
                  str(tmp_path / "cmp")]) == 0  # exit 0 with a warning, as for a suspect simulation

@@ -112,8 +112,9 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
                f"asymmetry {fp.folded['asymmetry']:.3f}; saturated "
                f"{100 * fp.saturated_fraction:.1f} % of pixels")
     click.echo(f"wrote {out}")
-    for w in fp.warnings:
-        click.echo(f"warning: suspect profile (exit status 3): {w}", err=True)
+    if fp.warnings:  # each reason is logged as it is found (stderr); one line says what it means
+        click.echo(f"warning: suspect profile (exit status 3): {len(fp.warnings)} reason(s) above, also in "
+                   f"{out}/summary.json `warnings`", err=True)
     return EXIT_SUSPECT if fp.warnings else 0
 
 
