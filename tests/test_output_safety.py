@@ -62,7 +62,7 @@ def _temporaries(folder: Path) -> list[str]:
 
 def _as_written_by_us(path: Path) -> None:
     """Record `path` in its folder's record as a file tactileskin wrote (an earlier run's)."""
-    rec = fileio._owned(path.parent)
+    rec = fileio.read_record(path.parent)
     rec[path.name] = fileio.file_sha256(path)
     (path.parent / fileio.OWNED_FILES).write_text(__import__("json").dumps(rec))
 
@@ -413,7 +413,7 @@ def test_a_build_folder_from_before_the_marker_is_adopted(tmp_path, capsys):
     for n in (fileio.MARKER, fileio.OWNED_FILES, fileio.RECORD_LOCK):
         (out / n).unlink()  # as an earlier version left it: the manifest's files only
     assert main(argv) == 0
-    assert (out / fileio.MARKER).is_file() and "skin.stl" in fileio._owned(out)
+    assert (out / fileio.MARKER).is_file() and "skin.stl" in fileio.read_record(out)
 
 
 def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monkeypatch):

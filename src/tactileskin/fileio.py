@@ -114,7 +114,7 @@ def os_errors(path, *, own_name: bool = True) -> Iterator[None]:
     except OutputError:
         raise
     except OSError as e:
-        named = e.filename if own_name and e.filename and not _TMP_RE.match(Path(str(e.filename)).name) else path
+        named = e.filename if own_name and e.filename and not is_temporary(Path(str(e.filename)).name) else path
         raise OutputError(named, _cause(e)) from e
 
 
@@ -253,7 +253,7 @@ def file_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _owned(folder: Path) -> dict:
+def read_record(folder: Path) -> dict:
     try:
         rec = json.loads((folder / OWNED_FILES).read_text())
         return rec if isinstance(rec, dict) else {}
@@ -261,12 +261,12 @@ def _owned(folder: Path) -> dict:
         return {}
 
 
-def _entries(entry) -> list:
+def entry_digests(entry) -> list:
     """The digests of a record entry (a digest, a list of them, or none)."""
     return list(entry) if isinstance(entry, list) else [entry] if isinstance(entry, str) else []
 
 
-def _recorded(entry, digest: str) -> bool:
+def is_recorded(entry, digest: str) -> bool:
     """Whether a record entry (a digest, or [old, new] while a result is being moved in) has
     `digest`."""
     return digest == entry or (isinstance(entry, list) and digest in entry)
@@ -281,7 +281,7 @@ def claim_file(path, what: str = "--out") -> Path:
     if path.exists() or path.is_symlink():
         try:
             ours = (not path.is_symlink() and path.is_file()
-                    and _recorded(_owned(path.parent).get(path.name), file_sha256(path)))
+                    and is_recorded(read_record(path.parent).get(path.name), file_sha256(path)))
         except OSError:
             ours = False
         if not ours:
@@ -300,8 +300,8 @@ def record_file(path) -> None:
     path = Path(path)
     with os_errors(path):
         digest = file_sha256(path)
-    with _record_lock(path.parent):  # two writers into one folder must not lose an entry
-        rec = {k: v for k, v in _owned(path.parent).items() if (path.parent / k).is_file()}
+    with record_lock(path.parent):  # two writers into one folder must not lose an entry
+        rec = {k: v for k, v in read_record(path.parent).items() if (path.parent / k).is_file()}
         rec[path.name] = digest
         atomic_write_json(path.parent / OWNED_FILES, rec)
 
@@ -312,7 +312,7 @@ RECORD_LOCK = ".tactileskin-files.lock"
 
 
 @contextlib.contextmanager
-def _record_lock(folder: Path) -> Iterator[None]:
+def record_lock(folder: Path) -> Iterator[None]:
     """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
     OWNED_FILES (waits for another writer into the same folder). Without flock (no fcntl, a
     file system without locks) there is no lock, as in the cache."""
@@ -389,7 +389,7 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
         raise OutputError(folder, f"{what} must be a folder, and this is a file")
     if folder.is_dir():
         with os_errors(folder):
-            entries = [p for p in folder.iterdir() if not _TMP_RE.match(p.name)
+            entries = [p for p in folder.iterdir() if not is_temporary(p.name)
                        and p.name not in (OWNED_FILES, RECORD_LOCK)]  # our bookkeeping of single files
         if entries and not _is_ours(folder, kind):
             other = marker_kind(folder)
@@ -403,17 +403,17 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     make_dirs(folder)
     clean_stale(folder)
     if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, _marker(kind))
+        atomic_write_json(folder / MARKER, marker_doc(kind))
     return folder
 
 
-def _marker(kind: str) -> dict:
+def marker_doc(kind: str) -> dict:
     # "record": its results are in OWNED_FILES (a marker without it is an earlier version's)
     return {"kind": kind, "record": 1, "note": "written by tactileskin; its commands may replace their "
                                                 "own files here"}
 
 
-def _legacy(folder: Path) -> bool:
+def is_legacy(folder: Path) -> bool:
     """Whether our marker in `folder` is from a version before the record of written files:
     then the folder's pattern-matching files are its earlier result, as that version took them."""
     try:
@@ -483,7 +483,7 @@ def adopt_dir(folder, kind: str, names: Iterable[str]) -> None:
         if (folder / n).is_file() and not (folder / n).is_symlink():
             record_file(folder / n)
     if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, _marker(kind))
+        atomic_write_json(folder / MARKER, marker_doc(kind))
 
 
 @contextlib.contextmanager
@@ -532,9 +532,9 @@ def _files(root: Path, subfolders=None) -> list[str]:
     out = []
     for dirpath, dirnames, filenames in os.walk(root):
         rel = Path(dirpath).relative_to(root)
-        dirnames[:] = [d for d in dirnames if not _TMP_RE.match(d)
+        dirnames[:] = [d for d in dirnames if not is_temporary(d)
                        and (subfolders is None or rel != Path(".") or d in subfolders)]
-        out += [(rel / f).as_posix() for f in filenames if not _TMP_RE.match(f)]
+        out += [(rel / f).as_posix() for f in filenames if not is_temporary(f)]
     return out
 
 
@@ -547,7 +547,7 @@ def _check_owned(folder: Path, old: list[str], new: list[str], rec: dict) -> lis
     for rel in old:
         p = folder / rel
         try:
-            same = rel in rec and not p.is_symlink() and _recorded(rec[rel], file_sha256(p))
+            same = rel in rec and not p.is_symlink() and is_recorded(rec[rel], file_sha256(p))
         except OSError:
             same = False
         if same:
@@ -598,7 +598,7 @@ def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iter
         marked = (folder / MARKER).is_file()
         with os_errors(folder):  # the digests the record will hold, before anything moves
             digests = {rel: file_sha256(tmp / rel) for rel in new} if marked else {}
-        with _record_lock(folder) if marked else contextlib.nullcontext():
+        with record_lock(folder) if marked else contextlib.nullcontext():
             _replace_files(folder, tmp, own, new, last, digests if marked else None)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -612,13 +612,13 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     tops = {p.split("/")[0] for p in own if "/" in p}
     old = [f for f in _files(folder, tops) if any(fnmatch.fnmatchcase(f, p) for p in own)]
     rec = None
-    legacy = digests is not None and _legacy(folder)
+    legacy = digests is not None and is_legacy(folder)
     if legacy:
         # marked by a version before the record of results (2026-11-26): its pattern-matching
         # files are the earlier result, as that version took them; the record starts here
-        rec = _owned(folder)  # single files (mesh -o, export -o) that version did record
+        rec = read_record(folder)  # single files (mesh -o, export -o) that version did record
     elif digests is not None:
-        rec = _owned(folder)
+        rec = read_record(folder)
         old = _check_owned(folder, old, new, rec)
     for rel in new:  # a linked subfolder would take our files into a folder we do not own
         for parent in list(Path(rel).parents)[:-1]:
@@ -631,7 +631,7 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
     try:
         with os_errors(folder):
             if rec is not None:  # a kill during the moves leaves either version of each file: both ours
-                atomic_write_json(folder / OWNED_FILES, {**rec, **{k: _entries(rec.get(k)) + [v]
+                atomic_write_json(folder / OWNED_FILES, {**rec, **{k: entry_digests(rec.get(k)) + [v]
                                                                    for k, v in digests.items()}})
             order = sorted(set(new) | set(old), key=lambda f: f == last)
             if last in old:
@@ -658,7 +658,7 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
                 if legacy:
                     with contextlib.suppress(OSError, ValueError, AttributeError):
                         kind = json.loads((folder / MARKER).read_text()).get("kind")
-                        atomic_write_json(folder / MARKER, _marker(kind))
+                        atomic_write_json(folder / MARKER, marker_doc(kind))
     except BaseException:
         for src, dst in reversed(moved_in):  # the earlier result back as it was
             with contextlib.suppress(OSError):
