@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from tactileskin import fileio
+from tactileskin import fileio, staging
 from tactileskin.fileio import OutputError
 
 
@@ -22,7 +22,7 @@ def test_files_and_folders_follow_the_umask(tmp_path):
         f = fileio.atomic_write_text(tmp_path / "a" / "b.txt", "x")
         assert _mode(f) == 0o640
         assert _mode(tmp_path / "a") == 0o750
-        with fileio.staged_dir(tmp_path / "case") as d:
+        with staging.staged_dir(tmp_path / "case") as d:
             (d / "f").write_text("y")
         assert _mode(tmp_path / "case") == 0o750
     finally:

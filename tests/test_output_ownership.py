@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import tactileskin.fe
-from tactileskin import fileio
+from tactileskin import fileio, staging
 from tactileskin.cli import main
 
 from test_output_safety import CHEAP, _err, _temporaries, fake_result
@@ -68,23 +68,23 @@ def test_an_edited_report_is_not_overwritten(tmp_path, capsys, fake_solve):
 def test_staged_files_in_a_marked_folder_replace_only_recorded_files(tmp_path):
     d = fileio.claim_dir(tmp_path / "d", "test")
     own = ("a.csv", "fig9_*.png", "sub/x_*.csv")
-    with fileio.staged_files(d, own) as tmp:
+    with staging.staged_files(d, own) as tmp:
         (tmp / "a.csv").write_text("1")
         (tmp / "fig9_case.png").write_text("1")
     (d / "fig9_my_notes.png").write_text("mine")
     (d / "sub").mkdir()
     (d / "sub" / "x_mine.csv").write_text("mine")
-    with fileio.staged_files(d, own) as tmp:
+    with staging.staged_files(d, own) as tmp:
         (tmp / "a.csv").write_text("2")  # no figure this time: the recorded one goes
     assert not (d / "fig9_case.png").exists() and (d / "a.csv").read_text() == "2"
     assert (d / "fig9_my_notes.png").read_text() == "mine" and (d / "sub" / "x_mine.csv").read_text() == "mine"
     assert set(_record(d)) == {"a.csv"}
     # an edited file of ours that the new result does not write is the user's now: it stays
-    with fileio.staged_files(d, own) as tmp:
+    with staging.staged_files(d, own) as tmp:
         (tmp / "a.csv").write_text("3")
         (tmp / "fig9_case.png").write_text("3")
     (d / "fig9_case.png").write_text("edited")
-    with fileio.staged_files(d, own) as tmp:
+    with staging.staged_files(d, own) as tmp:
         (tmp / "a.csv").write_text("4")
     assert (d / "fig9_case.png").read_text() == "edited"  # its entry stays: a rewrite says "changed since"
 
@@ -231,7 +231,7 @@ def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(t
     d = tmp_path / "o"
     fileio.claim_dir(d, "solve")
     for text in ("1", "2"):
-        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+        with staging.staged_files(d, ("a.csv", "b.csv")) as tmp:
             (tmp / "a.csv").write_text("a" + text)
             (tmp / "b.csv").write_text("b" + text)
     real, calls = os.replace, []
@@ -242,20 +242,20 @@ def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(t
             raise SystemExit(137)
         return real(src, dst)
 
-    monkeypatch.setattr(fileio.os, "replace", dying)
-    monkeypatch.setattr(fileio.contextlib, "suppress", lambda *e: (_ for _ in ()).throw(SystemExit(137)))
+    monkeypatch.setattr(staging.os, "replace", dying)
+    monkeypatch.setattr(staging.contextlib, "suppress", lambda *e: (_ for _ in ()).throw(SystemExit(137)))
     for text in ("3", "3b"):  # twice: the second run's record keeps the first's digests
         calls.clear()
         with pytest.raises(SystemExit):
-            with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+            with staging.staged_files(d, ("a.csv", "b.csv")) as tmp:
                 (tmp / "a.csv").write_text("a" + text)
                 (tmp / "b.csv").write_text("b" + text)
     monkeypatch.undo()
     with pytest.raises(KeyboardInterrupt):  # and a run undone cleanly puts the record back too
-        with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:
+        with staging.staged_files(d, ("a.csv", "b.csv")) as tmp:
             (tmp / "a.csv").write_text("a5")
             raise KeyboardInterrupt
-    with fileio.staged_files(d, ("a.csv", "b.csv")) as tmp:  # accepted, whatever mix is there
+    with staging.staged_files(d, ("a.csv", "b.csv")) as tmp:  # accepted, whatever mix is there
         (tmp / "a.csv").write_text("a4")
         (tmp / "b.csv").write_text("b4")
     assert (d / "a.csv").read_text() == "a4" and (d / "b.csv").read_text() == "b4"
@@ -293,9 +293,9 @@ def test_a_legacy_folder_upgraded_by_one_command_keeps_the_others_files(tmp_path
     (d / fileio.MARKER).write_text(json.dumps(marker))
     (d / "profile.csv").write_text("old analyze")
     (d / "comparison.json").write_text("old compare")
-    with fileio.staged_files(d, ("comparison.json",)) as tmp:
+    with staging.staged_files(d, ("comparison.json",)) as tmp:
         (tmp / "comparison.json").write_text("new compare")
-    with fileio.staged_files(d, ("profile.csv", "comparison.json")) as tmp:
+    with staging.staged_files(d, ("profile.csv", "comparison.json")) as tmp:
         (tmp / "profile.csv").write_text("new analyze")
         (tmp / "comparison.json").write_text("newer compare")
     assert (d / "profile.csv").read_text() == "new analyze"

@@ -21,7 +21,7 @@ import pytest
 import tactileskin
 import tactileskin.fe
 import tactileskin.sweep as sw
-from tactileskin import fileio, params
+from tactileskin import fileio, params, staging
 from tactileskin.cli import main
 from tactileskin.results import Result
 
@@ -124,7 +124,7 @@ def test_staged_files_undo_a_move_that_fails_halfway(tmp_path, monkeypatch):
 
     d = tmp_path / "d"
     own = ("a.csv", "b.csv", "c.csv", "summary.json")
-    with fileio.staged_files(d, own, last="summary.json") as tmp:
+    with staging.staged_files(d, own, last="summary.json") as tmp:
         for name in own:
             (tmp / name).write_text("old")
     before = {p.name: p.read_text() for p in d.iterdir()}
@@ -137,7 +137,7 @@ def test_staged_files_undo_a_move_that_fails_halfway(tmp_path, monkeypatch):
         return real(src, dst)
 
     monkeypatch.setattr(os, "replace", flaky)
-    with pytest.raises(fileio.OutputError), fileio.staged_files(d, own, last="summary.json") as tmp:
+    with pytest.raises(fileio.OutputError), staging.staged_files(d, own, last="summary.json") as tmp:
         for name in own:
             (tmp / name).write_text("new")
     monkeypatch.setattr(os, "replace", real)
@@ -175,23 +175,23 @@ def test_a_failed_2d_comparison_keeps_the_3d_result(tmp_path, capsys, monkeypatc
 
 def test_staged_files_replace_one_result_with_the_next(tmp_path):
     d = tmp_path / "d"
-    with fileio.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
+    with staging.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
         for name in ("a.csv", "map.csv", "summary.json"):
             (tmp / name).write_text("1")
         (tmp / "steps").mkdir()
         (tmp / "steps" / "s_0.vtu").write_text("1")
     (d / "steps" / "mine.txt").write_text("mine")
-    with fileio.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
+    with staging.staged_files(d, ("a.csv", "map.csv", "steps/s_*.vtu", "summary.json"), last="summary.json") as tmp:
         (tmp / "a.csv").write_text("2")  # no map, no steps this time
         (tmp / "summary.json").write_text("2")
     assert sorted(f.relative_to(d).as_posix() for f in d.rglob("*")) == ["a.csv", "steps", "steps/mine.txt",
                                                                        "summary.json"]
     assert (d / "a.csv").read_text() == "2" and (d / "summary.json").read_text() == "2"
-    with pytest.raises(RuntimeError), fileio.staged_files(d, ("a.csv", "summary.json")) as tmp:
+    with pytest.raises(RuntimeError), staging.staged_files(d, ("a.csv", "summary.json")) as tmp:
         (tmp / "a.csv").write_text("3")
         raise RuntimeError("the body failed")
     assert (d / "a.csv").read_text() == "2" and _temporaries(d) == []
-    with pytest.raises(ValueError, match="other.txt"), fileio.staged_files(d, ("a.csv",)) as tmp:
+    with pytest.raises(ValueError, match="other.txt"), staging.staged_files(d, ("a.csv",)) as tmp:
         (tmp / "other.txt").write_text("x")  # only owned names are moved in
     assert not (d / "other.txt").exists()
     # a link where a subfolder of ours goes: refused, nothing written through it
@@ -200,7 +200,7 @@ def test_staged_files_replace_one_result_with_the_next(tmp_path):
     (d / "steps").rmdir()
     (d / "steps").symlink_to(tmp_path / "users")
     with pytest.raises(fileio.OutputError, match="link"), \
-            fileio.staged_files(d, ("a.csv", "steps/s_*.vtu")) as tmp:
+            staging.staged_files(d, ("a.csv", "steps/s_*.vtu")) as tmp:
         (tmp / "a.csv").write_text("4")
         (tmp / "steps").mkdir()
         (tmp / "steps" / "s_0.vtu").write_text("4")
@@ -420,7 +420,7 @@ def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monk
     import errno
 
     final = tmp_path / "entry"
-    with fileio.staged_dir(final) as tmp:
+    with staging.staged_dir(final) as tmp:
         (tmp / "a").write_text("1")
     real = os.replace
 
@@ -430,7 +430,7 @@ def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monk
         return real(src, dst)
 
     monkeypatch.setattr(os, "replace", busy)
-    with pytest.raises(fileio.OutputError), fileio.staged_dir(final) as tmp:
+    with pytest.raises(fileio.OutputError), staging.staged_dir(final) as tmp:
         (tmp / "a").write_text("2")
     assert [p.name for p in tmp_path.iterdir()] == ["entry"] and (final / "a").read_text() == "1"
 

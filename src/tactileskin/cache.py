@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import __version__, fileio, params
+from tactileskin import __version__, fileio, params, staging
 from tactileskin.errors import TactileSkinError
 from tactileskin.scene import SCHEMA_VERSION, Scene
 
@@ -296,7 +296,7 @@ class ResultCache:
         """Write `result` (has .write_owned(dir)) under the scene's key, atomically."""
         key = key or self.key(scene)
         final = self.root / key
-        with fileio.os_errors(final), fileio.staged_dir(final) as tmp:
+        with fileio.os_errors(final), staging.staged_dir(final) as tmp:
             result.write_owned(tmp)
             scene.to_toml(tmp / "scene.toml")
             files = {f.name: fileio.file_sha256(f) for f in sorted(tmp.iterdir()) if f.is_file()}

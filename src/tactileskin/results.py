@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, validate
+from tactileskin import fileio, staging, validate
 from tactileskin.errors import ConvergenceError, ParameterError
 
 
@@ -432,7 +432,7 @@ class Result:
         CLI solve's figures, 2D section and comparison included (SOLVE_FILES)."""
         validate.path(directory, "directory", "a folder path (str or os.PathLike)")
         directory = fileio.claim_dir(directory, "solve", what="directory")
-        with fileio.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
+        with staging.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
             self._write_files(tmp)
         return directory
 
@@ -442,12 +442,12 @@ class Result:
         with a history, result.pvd over result_steps/; with sensors, sensors.csv; 3D: also
         bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
         where it occurs) into `directory`, creating it. All of them are staged and moved in
-        together (fileio.staged_files): a failed write leaves the folder as it was, and files of
+        together (staging.staged_files): a failed write leaves the folder as it was, and files of
         an earlier result that this one has not (a map, a field file) are removed; other files
         are not touched. For folders the caller owns (a cache entry, a staging folder): `write`
         claims a user's folder first."""
         directory = fileio.make_dirs(directory)
-        with fileio.staged_files(directory, OWN_FILES, last="summary.json") as tmp:
+        with staging.staged_files(directory, OWN_FILES, last="summary.json") as tmp:
             self._write_files(tmp)
         return directory
 

@@ -44,7 +44,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     from rich.table import Table
     from rich.text import Text
 
-    from tactileskin import fileio
+    from tactileskin import fileio, staging
     from tactileskin.cli._console import new_console
     from tactileskin.errors import TactileSkinError
     from tactileskin.fe import solve
@@ -75,7 +75,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                 r2_error = e
         # one result in the folder: staged, then moved in together (summary.json last); files
         # of an earlier result this one has not (a map, a 2D section) are removed
-        with fileio.staged_files(out, OWN_FILES, last="summary.json") as tmp:
+        with staging.staged_files(out, OWN_FILES, last="summary.json") as tmp:
             res.write_owned(tmp)
             _write_map_figure(res, tmp, scene.label())
             _write_sensors_figure(res, tmp, scene.label())

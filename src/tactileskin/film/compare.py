@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio
+from tactileskin import fileio, staging
 from tactileskin.errors import ParameterError
 from tactileskin.film.inputs import read_text
 from tactileskin.film.scan import (COMPARE_NAMES, FilmProfile, fold_profile,
@@ -153,7 +153,7 @@ class Comparison:
         else:
             fileio.claim_dir(out, "film-compare")
         doc = json.loads(json.dumps(self.to_dict(), default=str))
-        with fileio.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
+        with staging.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
             fileio.atomic_write_json(tmp / "comparison.json", _finite_or_none(doc))
             plots.overlay(self, tmp / "overlay.png")
         return {"comparison": out / "comparison.json", "overlay": out / "overlay.png"}

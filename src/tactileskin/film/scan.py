@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio
+from tactileskin import fileio, staging
 from tactileskin.errors import ParameterError
 from tactileskin.film import region as strip_region
 from tactileskin.film.calibration import Calibration, paper_eq8
@@ -200,7 +200,7 @@ class FilmProfile:
         """Write profile.csv, summary.json and pressure_map.png into ``out``.
 
         ``out`` must be new, empty or a `film analyze` folder (fileio.claim_dir). The files
-        are staged and moved in together (fileio.staged_files): a failed write leaves the
+        are staged and moved in together (staging.staged_files): a failed write leaves the
         folder as it was. A comparison left there by an earlier `film compare` is removed: it
         describes the previous profile.
         """
@@ -215,7 +215,7 @@ class FilmProfile:
             hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
             lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},"
                          f"{self.pressure_sd[k]:.6g},{lo},{hi}")
-        with fileio.staged_files(out, ANALYZE_NAMES + COMPARE_NAMES, last=names["summary"]) as tmp:
+        with staging.staged_files(out, ANALYZE_NAMES + COMPARE_NAMES, last=names["summary"]) as tmp:
             fileio.atomic_write_text(tmp / names["profile"], "\n".join(lines) + "\n")
             fileio.atomic_write_json(tmp / names["summary"], self.summary())
             plots.pressure_map(self, tmp / names["map"], cmap=cmap)

@@ -1,6 +1,6 @@
 """Write parts as binary STL + STEP, check every STL is a valid volume, write manifest.json.
 
-All output goes into a staging folder inside the target (fileio.staged_files) and is moved
+All output goes into a staging folder inside the target (staging.staged_files) and is moved
 into place only once every file is written and checked: a failed build leaves nothing behind
 (an existing previous build in the target stays untouched until the new one is complete).
 The target is a new or empty folder or a previous build's; the folder itself (its mode,
@@ -20,7 +20,7 @@ import build123d as bd
 import numpy as np
 import trimesh
 
-from tactileskin import fileio
+from tactileskin import fileio, staging
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import format_params, occ_guard
@@ -185,7 +185,7 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
     legacy = None if (out / fileio.MARKER).is_file() else _previous_build_files(out)
     if legacy is not None:  # a build from before the marker: its listed files become recorded ones
         fileio.adopt_dir(out, FOLDER_KIND, legacy)
-    with fileio.claimed(out, FOLDER_KIND), fileio.staged_files(out, BUILD_FILES, last=MANIFEST) as tmp:
+    with fileio.claimed(out, FOLDER_KIND), staging.staged_files(out, BUILD_FILES, last=MANIFEST) as tmp:
         t0 = time.perf_counter()
         entries = []
         for part in parts:

@@ -248,7 +248,7 @@ def write_outputs(chart, out: Path, validation=None, method: str = "template") -
     """accuracies.csv, array_chart.md and the figures into `out` (claimed by the caller),
     staged and moved in together (the report last): a failed write leaves the earlier chart,
     and figures of an earlier chart this one has not are removed."""
-    from tactileskin.fileio import staged_files
+    from tactileskin.staging import staged_files
 
     trust = letters_trust(chart, validation) if "letters" in chart.config.sets else {}
     indicative = {k: ("the letters' surrogate is " + ("not validated" if m["error"] is None

@@ -10,7 +10,8 @@ import re
 from pathlib import Path
 
 from tactileskin import quality
-from tactileskin.fileio import atomic_write_text, make_dirs, staged_files
+from tactileskin.fileio import atomic_write_text, make_dirs
+from tactileskin.staging import staged_files
 
 log = logging.getLogger(__name__)
 
