@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from tactileskin import fileio, staging
+from tactileskin import fileio, outdir, staging
 from tactileskin.fileio import OutputError
 
 
@@ -56,36 +56,36 @@ def test_claim_refuses_a_folder_of_user_files_and_keeps_them(tmp_path):
     d.mkdir()
     (d / "notes.txt").write_text("mine")
     with pytest.raises(OutputError, match="notes.txt"):
-        fileio.claim_dir(d, "solve")
+        outdir.claim_dir(d, "solve")
     assert (d / "notes.txt").read_text() == "mine"
-    assert not (d / fileio.MARKER).exists()
+    assert not (d / outdir.MARKER).exists()
 
 
 def test_claim_accepts_new_empty_and_own_folders_only(tmp_path):
-    fileio.claim_dir(tmp_path / "new", "solve")
-    assert (tmp_path / "new" / fileio.MARKER).is_file()
+    outdir.claim_dir(tmp_path / "new", "solve")
+    assert (tmp_path / "new" / outdir.MARKER).is_file()
     (tmp_path / "empty").mkdir()
-    fileio.claim_dir(tmp_path / "empty", "solve")
+    outdir.claim_dir(tmp_path / "empty", "solve")
     (tmp_path / "new" / "user.txt").write_text("later")  # our folder stays ours
-    fileio.claim_dir(tmp_path / "new", "solve")
+    outdir.claim_dir(tmp_path / "new", "solve")
     with pytest.raises(OutputError):  # but not for another command's kind
-        fileio.claim_dir(tmp_path / "new", "sweep")
+        outdir.claim_dir(tmp_path / "new", "sweep")
     # no marker: a user's summary.json is not ours, however much it looks like a solve output
     user = tmp_path / "user"
     user.mkdir()
     (user / "summary.json").write_text("MY DATA")
     with pytest.raises(OutputError, match="summary.json"):
-        fileio.claim_dir(user, "solve")
-    assert (user / "summary.json").read_text() == "MY DATA" and not (user / fileio.MARKER).exists()
+        outdir.claim_dir(user, "solve")
+    assert (user / "summary.json").read_text() == "MY DATA" and not (user / outdir.MARKER).exists()
 
 
 def test_claim_refuses_a_file_and_a_path_under_a_file(tmp_path):
     f = tmp_path / "f"
     f.write_text("x")
     with pytest.raises(OutputError, match="is a file"):
-        fileio.claim_dir(f, "solve")
+        outdir.claim_dir(f, "solve")
     with pytest.raises(OutputError, match=str(f)):
-        fileio.claim_dir(f / "sub", "solve")
+        outdir.claim_dir(f / "sub", "solve")
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root ignores folder permissions")

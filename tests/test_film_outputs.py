@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from tactileskin import fileio
+from tactileskin import fileio, outdir
 from tactileskin.cli import main
 from tactileskin.film.synthetic import gaussian_profile, render_scan, save_scan
 
@@ -68,13 +68,13 @@ def test_compare_into_a_foreign_folder_is_refused(tmp_path, capsys, scan, sim):
     # a new folder becomes a compare folder, and can be written again
     for _ in range(2):
         assert main(["film", "compare", str(film), str(sim), "--out", str(tmp_path / "cmp")]) == 0
-    assert json.loads((tmp_path / "cmp" / fileio.MARKER).read_text())["kind"] == "film-compare"
+    assert json.loads((tmp_path / "cmp" / outdir.MARKER).read_text())["kind"] == "film-compare"
 
 
 def test_compare_refuses_a_folder_without_our_marker(tmp_path, scan, sim):
     film = tmp_path / "film"
     assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
-    (film / fileio.MARKER).unlink()  # e.g. a user's copy of the profile and summary
+    (film / outdir.MARKER).unlink()  # e.g. a user's copy of the profile and summary
     before = {p.name: p.read_bytes() for p in film.iterdir()}
     assert main(["film", "compare", str(film), str(sim)]) == 2
     assert {p.name: p.read_bytes() for p in film.iterdir()} == before

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import tactileskin.fe
-from tactileskin import fileio, staging
+from tactileskin import fileio, outdir, staging
 from tactileskin.cli import main
 
 from test_output_safety import CHEAP, _err, _temporaries, fake_result
@@ -66,7 +66,7 @@ def test_an_edited_report_is_not_overwritten(tmp_path, capsys, fake_solve):
 
 
 def test_staged_files_in_a_marked_folder_replace_only_recorded_files(tmp_path):
-    d = fileio.claim_dir(tmp_path / "d", "test")
+    d = outdir.claim_dir(tmp_path / "d", "test")
     own = ("a.csv", "fig9_*.png", "sub/x_*.csv")
     with staging.staged_files(d, own) as tmp:
         (tmp / "a.csv").write_text("1")
@@ -173,7 +173,7 @@ def test_a_write_failing_inside_staging_names_the_destination(tmp_path, capsys, 
 
 
 def test_another_commands_folder_is_refused_naming_that_command(tmp_path, capsys, fake_solve):
-    d = fileio.claim_dir(tmp_path / "sw", "sweep")
+    d = outdir.claim_dir(tmp_path / "sw", "sweep")
     (d / "cache").mkdir()
     assert main(["solve", *CHEAP, "--out", str(d)]) == 2
     err = " ".join(_err(capsys).split())
@@ -183,7 +183,7 @@ def test_another_commands_folder_is_refused_naming_that_command(tmp_path, capsys
 def test_a_run_stopped_before_its_first_case_leaves_no_folder(tmp_path):
     """A sweep interrupted before any case finished left its new folder holding the marker and
     cache/*.lock alone; a folder that held anything else, or existed before, is kept."""
-    from tactileskin.fileio import MARKER, claimed
+    from tactileskin.outdir import MARKER, claimed
 
     out = tmp_path / "new"
     with pytest.raises(KeyboardInterrupt):
@@ -205,7 +205,7 @@ def test_a_stopped_run_keeps_the_cache_locks_another_sweep_holds(tmp_path):
     """A second sweep started on the same new folder holds a case lock: removing that file
     would let a third run compute the same case again; the lock and the folder stay."""
     fcntl = pytest.importorskip("fcntl")
-    from tactileskin.fileio import claimed
+    from tactileskin.outdir import claimed
 
     out = tmp_path / "new"
     with pytest.raises(KeyboardInterrupt):
@@ -226,10 +226,8 @@ def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(t
     """The record is written before the moves with both versions of each replaced file: a run
     killed between two renames (old and new files mixed) does not make the next run refuse
     its own files as 'changed since'."""
-    from tactileskin import fileio
-
     d = tmp_path / "o"
-    fileio.claim_dir(d, "solve")
+    outdir.claim_dir(d, "solve")
     for text in ("1", "2"):
         with staging.staged_files(d, ("a.csv", "b.csv")) as tmp:
             (tmp / "a.csv").write_text("a" + text)
@@ -284,13 +282,11 @@ def test_the_record_lock_opens_read_only_where_it_cannot_be_written(tmp_path, mo
 def test_a_legacy_folder_upgraded_by_one_command_keeps_the_others_files(tmp_path):
     """A film folder of an earlier version: `film compare` (its own files only) upgraded the
     marker, and the next `film analyze` refused the earlier analyze files as not ours."""
-    from tactileskin import fileio
-
     d = tmp_path / "f"
-    fileio.claim_dir(d, "film-analyze")
-    marker = json.loads((d / fileio.MARKER).read_text())
+    outdir.claim_dir(d, "film-analyze")
+    marker = json.loads((d / outdir.MARKER).read_text())
     del marker["record"]
-    (d / fileio.MARKER).write_text(json.dumps(marker))
+    (d / outdir.MARKER).write_text(json.dumps(marker))
     (d / "profile.csv").write_text("old analyze")
     (d / "comparison.json").write_text("old compare")
     with staging.staged_files(d, ("comparison.json",)) as tmp:
@@ -309,4 +305,4 @@ def test_a_folder_of_our_bookkeeping_alone_is_empty(tmp_path):
     (d / "deck.msh").write_text("x")
     fileio.record_file(d / "deck.msh")
     (d / "deck.msh").unlink()
-    fileio.claim_dir(d, "solve")  # was refused: "holds files tactileskin did not write (.tactileskin-files.json, ...)"
+    outdir.claim_dir(d, "solve")  # was refused: "holds files tactileskin did not write (.tactileskin-files.json, ...)"

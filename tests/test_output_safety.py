@@ -21,7 +21,7 @@ import pytest
 import tactileskin
 import tactileskin.fe
 import tactileskin.sweep as sw
-from tactileskin import fileio, params, staging
+from tactileskin import fileio, outdir, params, staging
 from tactileskin.cli import main
 from tactileskin.results import Result
 
@@ -366,7 +366,7 @@ def test_sweep_refuses_an_unmarked_folder_of_lookalike_names(tmp_path, capsys, c
     assert main(argv) == 2
     assert "did not write" in capsys.readouterr().err and counted_cases == []  # refused before solving
     assert all((out / n).read_text() == "mine" for n in ("results.csv", "report.md", "fig11_peak.svg"))
-    assert not (out / fileio.MARKER).exists()
+    assert not (out / outdir.MARKER).exists()
 
 
 # --- build --------------------------------------------------------------------------------
@@ -380,7 +380,7 @@ def test_build_output_has_umask_permissions_and_writes_into_its_folder(tmp_path,
         os.umask(old)
     assert stat.S_IMODE(out.stat().st_mode) == 0o755
     modes = {p.name: stat.S_IMODE(p.stat().st_mode) for p in out.iterdir()}
-    assert "manifest.json" in modes and "skin.stl" in modes and fileio.MARKER in modes
+    assert "manifest.json" in modes and "skin.stl" in modes and outdir.MARKER in modes
     assert modes == {n: 0o644 for n in modes}
     assert [p.name for p in tmp_path.iterdir()] == ["parts"]
     capsys.readouterr()
@@ -410,10 +410,10 @@ def test_a_build_folder_from_before_the_marker_is_adopted(tmp_path, capsys):
     out = tmp_path / "parts"
     argv = ["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]
     assert main(argv) == 0
-    for n in (fileio.MARKER, fileio.OWNED_FILES, fileio.RECORD_LOCK):
+    for n in (outdir.MARKER, fileio.OWNED_FILES, fileio.RECORD_LOCK):
         (out / n).unlink()  # as an earlier version left it: the manifest's files only
     assert main(argv) == 0
-    assert (out / fileio.MARKER).is_file() and "skin.stl" in fileio.read_record(out)
+    assert (out / outdir.MARKER).is_file() and "skin.stl" in fileio.read_record(out)
 
 
 def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monkeypatch):

@@ -163,7 +163,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         cache = Path(out) / "cache" if out is not None else default_cache_dir()
     rc = ResultCache(cache)
     if out is not None:
-        from tactileskin.fileio import claim_dir
+        from tactileskin.outdir import claim_dir
 
         claim_dir(Path(out), "sweep", what="out")
     t0 = time.perf_counter()

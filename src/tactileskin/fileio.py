@@ -9,7 +9,7 @@ Rules (issue #12, "never destroy user data"):
   run can remove the leftovers of a killed one (`clean_stale`) without touching the files
   of a writer that is still alive.
 - An output folder is written into only if it is new, empty, or marked as the toolkit's
-  (`claim_dir` writes the marker `.tactileskin`); a folder holding files we did not write
+  (`outdir.claim_dir` writes the marker `.tactileskin`); a folder holding files we did not write
   is refused, never emptied.
 - A single output file of the CLI replaces an existing file only if the toolkit wrote it and
   nobody changed it since (`claim_file`, `record_file`: the folder's `.tactileskin-files.json`).
@@ -32,13 +32,12 @@ import shutil
 import tempfile
 import time
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Iterator
 
 from tactileskin.errors import TactileSkinError
 
 log = logging.getLogger(__name__)
 
-MARKER = ".tactileskin"
 # `.NAME.tskPID[hHOST]-XXXX[.suffix]`: HOST names the writer's host and PID namespace (`_host`)
 _TMP_RE = re.compile(r"^\..+\.tsk(\d+)(?:h([0-9a-f]{8}))?-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
 _TMP_NAME_RE = re.compile(r"^\.(.+)\.tsk\d+(?:h[0-9a-f]{8})?-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # group 1: the target
@@ -342,151 +341,6 @@ def record_lock(folder: Path) -> Iterator[None]:
         yield
     finally:
         os.close(fd)  # releases the lock
-
-
-# --- output folders -------------------------------------------------------------------
-
-def _is_ours(folder: Path, kind: str | None) -> bool:
-    """Whether `folder` carries our marker (of `kind`, if given). A folder without it is not
-    ours, whatever its file names: a user's summary.json or report.md looks like ours."""
-    marker = folder / MARKER
-    if not marker.is_file():
-        return False
-    if kind is None:
-        return True
-    try:
-        return json.loads(marker.read_text()).get("kind") in (kind, None)
-    except (OSError, ValueError, AttributeError):
-        return False
-
-
-def marker_kind(folder) -> str | None:
-    """The kind our marker in `folder` names ("solve", "film-analyze", ...): "" for a marker
-    without a readable one, None without a marker."""
-    folder = Path(folder)
-    if not (folder / MARKER).is_file():
-        return None
-    try:
-        kind = json.loads((folder / MARKER).read_text()).get("kind")
-    except (OSError, ValueError, AttributeError):
-        kind = None
-    return kind if isinstance(kind, str) else ""
-
-
-def written_by(kind: str) -> str:
-    """`kind` as the message of a refused folder names it: the command (`film analyze`)."""
-    return f"`{kind.replace('-', ' ')}`" if kind else "of an unknown kind"
-
-
-def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
-    """Make `folder` the toolkit's output folder of `kind`, or refuse it.
-
-    Accepted: a missing or empty folder, or a folder with our marker of the same kind.
-    Anything else raises OutputError and nothing is written. Stale temporaries of killed runs
-    are removed.
-    """
-    folder = Path(folder)
-    if folder.is_symlink() and not folder.is_dir():
-        raise OutputError(folder, "it is a broken symbolic link")
-    if folder.exists() and not folder.is_dir():
-        raise OutputError(folder, f"{what} must be a folder, and this is a file")
-    if folder.is_dir():
-        with os_errors(folder):
-            entries = [p for p in folder.iterdir() if not is_temporary(p.name)
-                       and p.name not in (OWNED_FILES, RECORD_LOCK)]  # our bookkeeping of single files
-        if entries and not _is_ours(folder, kind):
-            other = marker_kind(folder)
-            if other is not None:  # ours, but another command's: say so, not "did not write"
-                raise OutputError(folder, f"the folder was written by another tactileskin command "
-                                          f"({written_by(other)}); "
-                                          f"refusing to write into it: give {what} a new or empty folder")
-            shown = ", ".join(sorted(p.name for p in entries)[:3]) + (", ..." if len(entries) > 3 else "")
-            raise OutputError(folder, f"the folder holds files tactileskin did not write ({shown}); "
-                                      f"refusing to write into it: give {what} a new or empty folder")
-    make_dirs(folder)
-    clean_stale(folder)
-    if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, marker_doc(kind))
-    return folder
-
-
-def marker_doc(kind: str) -> dict:
-    # "record": its results are in OWNED_FILES (a marker without it is an earlier version's)
-    return {"kind": kind, "record": 1, "note": "written by tactileskin; its commands may replace their "
-                                                "own files here"}
-
-
-def is_legacy(folder: Path) -> bool:
-    """Whether our marker in `folder` is from a version before the record of written files:
-    then the folder's pattern-matching files are its earlier result, as that version took them."""
-    try:
-        return json.loads((folder / MARKER).read_text()).get("record") != 1
-    except (OSError, ValueError, AttributeError):
-        return True
-
-
-@contextlib.contextmanager
-def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
-    """claim_dir `folder` for the body; if the body fails and the folder was created here and
-    holds nothing but our marker (and record lock), remove it again: a refused or failed run
-    leaves no empty folder behind."""
-    folder = Path(folder)
-    existed = folder.exists() or folder.is_symlink()
-    claim_dir(folder, kind, what=what)
-    try:
-        yield folder
-    except BaseException:
-        if not existed:
-            with contextlib.suppress(OSError):
-                names = {p.name for p in folder.iterdir()}
-                cache = folder / "cache"  # a sweep stopped before its first case: locks only
-                if "cache" in names and cache.is_dir() and not cache.is_symlink() and all(
-                        p.suffix == ".lock" and p.is_file() for p in cache.iterdir()) \
-                        and _remove_free_locks(cache):
-                    cache.rmdir()
-                    names.discard("cache")
-                if MARKER in names and names <= {MARKER, RECORD_LOCK}:
-                    for n in names:
-                        (folder / n).unlink()
-                    folder.rmdir()
-        raise
-
-
-def _remove_free_locks(folder: Path) -> bool:
-    """Remove the lock files in `folder` that no process holds (each taken before it goes: a
-    sweep started on the same new folder keeps its duplicate-work guard); True if all went."""
-    try:
-        import fcntl
-    except ImportError:  # no flock (Windows): no lock is held by anyone
-        fcntl = None
-    every = True
-    for p in list(folder.iterdir()):
-        try:
-            fd = os.open(p, os.O_RDONLY)
-        except OSError:
-            every = False
-            continue
-        try:
-            if fcntl is not None:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            p.unlink()
-        except OSError:  # held by another run (BlockingIOError) or not ours to remove
-            every = False
-        finally:
-            os.close(fd)
-    return every
-
-
-def adopt_dir(folder, kind: str, names: Iterable[str]) -> None:
-    """Mark `folder` as ours of `kind`, recording `names` in it as files we wrote, as they are
-    now: for a folder an earlier version wrote without the marker and record (the caller has
-    made sure those files are the toolkit's, e.g. listed in its manifest)."""
-    folder = Path(folder)
-    for n in names:
-        if (folder / n).is_file() and not (folder / n).is_symlink():
-            record_file(folder / n)
-    if not (folder / MARKER).is_file():
-        atomic_write_json(folder / MARKER, marker_doc(kind))
 
 
 def fix_tree_modes(root) -> None:

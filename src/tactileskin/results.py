@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, staging, validate
+from tactileskin import fileio, outdir, staging, validate
 from tactileskin.errors import ConvergenceError, ParameterError
 
 
@@ -427,11 +427,11 @@ class Result:
 
     def write(self, directory) -> Path:
         """Write the result into `directory`: a new or empty folder, or one tactileskin marked
-        as a solve's (fileio.claim_dir; a folder of other files is refused, OutputError, and
+        as a solve's (outdir.claim_dir; a folder of other files is refused, OutputError, and
         left as it is). See write_owned for the files; the earlier result there goes whole, a
         CLI solve's figures, 2D section and comparison included (SOLVE_FILES)."""
         validate.path(directory, "directory", "a folder path (str or os.PathLike)")
-        directory = fileio.claim_dir(directory, "solve", what="directory")
+        directory = outdir.claim_dir(directory, "solve", what="directory")
         with staging.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
             self._write_files(tmp)
         return directory

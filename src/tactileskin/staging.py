@@ -23,7 +23,6 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from tactileskin.fileio import (
-    MARKER,
     OWNED_FILES,
     RECORD_LOCK,
     STAGING,
@@ -33,16 +32,15 @@ from tactileskin.fileio import (
     dir_mode,
     entry_digests,
     file_sha256,
-    is_legacy,
     is_recorded,
     is_temporary,
     make_dirs,
-    marker_doc,
     os_errors,
     read_record,
     record_lock,
     tmp_prefix,
 )
+from tactileskin.outdir import MARKER, is_legacy, marker_doc
 
 
 @contextlib.contextmanager

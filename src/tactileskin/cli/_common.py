@@ -256,8 +256,8 @@ def scene_from_options(scene_opts: dict, command: str = "solve"):
 
 
 def claimed_output(out, kind: str, what: str = "--out"):
-    """Claim the output folder `out` for the body (fileio.claimed: a folder created here and
+    """Claim the output folder `out` for the body (outdir.claimed: a folder created here and
     left holding only our marker by a failed body is removed again)."""
-    from tactileskin import fileio
+    from tactileskin import outdir
 
-    return fileio.claimed(out, kind, what=what)
+    return outdir.claimed(out, kind, what=what)

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, staging
+from tactileskin import fileio, outdir, staging
 from tactileskin.errors import ParameterError
 from tactileskin.film.inputs import read_text
 from tactileskin.film.scan import (COMPARE_NAMES, FilmProfile, fold_profile,
@@ -142,16 +142,16 @@ class Comparison:
     def write(self, out) -> dict[str, Path]:
         """comparison.json and overlay.png into ``out``, each atomically.
 
-        ``out`` is claimed with fileio.claim_dir: a new or empty folder, a `film compare`
+        ``out`` is claimed with outdir.claim_dir: a new or empty folder, a `film compare`
         folder, or a `film analyze` folder (the default of the CLI: the film's own folder).
         """
         from tactileskin.film import plots
 
         out = Path(out)
         if _is_analyze_folder(out):
-            fileio.claim_dir(out, "film-analyze")
+            outdir.claim_dir(out, "film-analyze")
         else:
-            fileio.claim_dir(out, "film-compare")
+            outdir.claim_dir(out, "film-compare")
         doc = json.loads(json.dumps(self.to_dict(), default=str))
         with staging.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
             fileio.atomic_write_json(tmp / "comparison.json", _finite_or_none(doc))
@@ -162,7 +162,7 @@ class Comparison:
 def _is_analyze_folder(out: Path) -> bool:
     """A folder `film analyze` wrote: its marker says so."""
     try:
-        return json.loads((out / fileio.MARKER).read_text()).get("kind") == "film-analyze"
+        return json.loads((out / outdir.MARKER).read_text()).get("kind") == "film-analyze"
     except (OSError, ValueError, AttributeError):
         return False
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, staging
+from tactileskin import fileio, outdir, staging
 from tactileskin.errors import ParameterError
 from tactileskin.film import region as strip_region
 from tactileskin.film.calibration import Calibration, paper_eq8
@@ -199,7 +199,7 @@ class FilmProfile:
     def write(self, out, *, cmap: str = "viridis") -> dict[str, Path]:
         """Write profile.csv, summary.json and pressure_map.png into ``out``.
 
-        ``out`` must be new, empty or a `film analyze` folder (fileio.claim_dir). The files
+        ``out`` must be new, empty or a `film analyze` folder (outdir.claim_dir). The files
         are staged and moved in together (staging.staged_files): a failed write leaves the
         folder as it was. A comparison left there by an earlier `film compare` is removed: it
         describes the previous profile.
@@ -207,7 +207,7 @@ class FilmProfile:
         from tactileskin.film import plots
 
         plots._check_cmap(cmap)
-        out = fileio.claim_dir(out, "film-analyze")
+        out = outdir.claim_dir(out, "film-analyze")
         names = {"profile": "profile.csv", "summary": "summary.json", "map": "pressure_map.png"}
         lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
         for k in range(self.s_mm.size):

@@ -20,7 +20,7 @@ import build123d as bd
 import numpy as np
 import trimesh
 
-from tactileskin import fileio, staging
+from tactileskin import fileio, outdir, staging
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import format_params, occ_guard
@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 MANIFEST = "manifest.json"
 MANIFEST_KIND = "tactileskin.parts"  # marks a folder this module wrote (and may replace)
-FOLDER_KIND = "build"  # the folder's marker (fileio.claim_dir)
+FOLDER_KIND = "build"  # the folder's marker (outdir.claim_dir)
 BUILD_FILES = (MANIFEST, "*.stl", "*.step")  # staged_files patterns: what a build may replace
 
 # Tessellation (absolute, unlike build123d.export_stl whose deflection is relative to each
@@ -158,7 +158,7 @@ def check_target(out: Path) -> None:
                              "write to the folder it points to, or to a new folder")
     if out.exists() and not out.is_dir():
         raise ParameterError("out", str(out), "a folder path (it exists and is not a folder)")
-    kind = fileio.marker_kind(out)
+    kind = outdir.marker_kind(out)
     if not out.is_dir() or kind == FOLDER_KIND:
         return
     with fileio.os_errors(out):
@@ -166,7 +166,7 @@ def check_target(out: Path) -> None:
     valid = "a new or empty folder, or the folder of a previous `tactileskin build`"
     if kind is not None:
         raise ParameterError("out", str(out), valid,
-                             hint=f"the folder was written by another tactileskin command ({fileio.written_by(kind)})")
+                             hint=f"the folder was written by another tactileskin command ({outdir.written_by(kind)})")
     ours = _previous_build_files(out)
     others = sorted(n for n in entries if ours is None or n not in ours)
     if others:
@@ -182,10 +182,10 @@ def export_parts(parts: list[Part], out_dir, *, tolerance: float = STL_TOLERANCE
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ParameterError("parts", names, "unique part names")
-    legacy = None if (out / fileio.MARKER).is_file() else _previous_build_files(out)
+    legacy = None if (out / outdir.MARKER).is_file() else _previous_build_files(out)
     if legacy is not None:  # a build from before the marker: its listed files become recorded ones
-        fileio.adopt_dir(out, FOLDER_KIND, legacy)
-    with fileio.claimed(out, FOLDER_KIND), staging.staged_files(out, BUILD_FILES, last=MANIFEST) as tmp:
+        outdir.adopt_dir(out, FOLDER_KIND, legacy)
+    with outdir.claimed(out, FOLDER_KIND), staging.staged_files(out, BUILD_FILES, last=MANIFEST) as tmp:
         t0 = time.perf_counter()
         entries = []
         for part in parts:
