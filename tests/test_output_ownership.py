@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import tactileskin.fe
-from tactileskin import fileio, outdir, staging
+from tactileskin import fileio, outdir, ownership, staging
 from tactileskin.cli import main
 
 from test_output_safety import CHEAP, _err, _temporaries, fake_result
@@ -23,7 +23,7 @@ def fake_solve(monkeypatch):
 
 
 def _record(folder: Path) -> dict:
-    return json.loads((folder / fileio.OWNED_FILES).read_text())
+    return json.loads((folder / ownership.OWNED_FILES).read_text())
 
 
 def test_users_files_with_our_names_stay_in_a_solve_folder(tmp_path, capsys, fake_solve):
@@ -45,7 +45,7 @@ def test_a_users_file_the_new_result_would_replace_is_refused(tmp_path, capsys, 
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     rec = _record(d)
     del rec["contact.csv"]  # as if the user had put it there
-    (d / fileio.OWNED_FILES).write_text(json.dumps(rec))
+    (d / ownership.OWNED_FILES).write_text(json.dumps(rec))
     (d / "contact.csv").write_text("mine\n")
     before = {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()}
     assert main(["solve", *CHEAP, "--out", str(d)]) == 2
@@ -121,7 +121,7 @@ def test_an_api_result_written_into_a_cli_solve_folder_replaces_its_whole_result
 
 def _write_and_record(path: str) -> None:
     fileio.atomic_write_text(path, "deck\n")
-    fileio.record_file(path)
+    ownership.record_file(path)
 
 
 def test_parallel_single_file_writes_into_one_folder_keep_every_record(tmp_path):
@@ -132,7 +132,7 @@ def test_parallel_single_file_writes_into_one_folder_keep_every_record(tmp_path)
         pool.map(_write_and_record, names)
     assert set(_record(tmp_path)) == {Path(n).name for n in names}  # none lost to a race
     for n in names:
-        fileio.claim_file(n)  # each may be rewritten
+        ownership.claim_file(n)  # each may be rewritten
 
 
 def test_an_unreachable_scheduler_is_refused_before_the_folder_is_claimed(tmp_path, capsys):
@@ -262,21 +262,19 @@ def test_a_write_stopped_during_its_moves_leaves_a_folder_the_next_run_accepts(t
 def test_the_record_lock_opens_read_only_where_it_cannot_be_written(tmp_path, monkeypatch):
     # a group-shared folder's lock file is 0644 under umask 022: another user cannot open it for
     # writing ("permission denied" refused every rerun); flock needs no write access
-    from tactileskin import fileio
-
     real, flags = os.open, []
 
     def opener(p, f, *a):
         flags.append(f)
-        if str(p).endswith(fileio.RECORD_LOCK) and f & os.O_RDWR:
+        if str(p).endswith(ownership.RECORD_LOCK) and f & os.O_RDWR:
             raise PermissionError(13, "Permission denied")
         return real(p, f, *a)
 
-    monkeypatch.setattr(fileio.os, "open", opener)
+    monkeypatch.setattr(ownership.os, "open", opener)
     (tmp_path / "x.inp").write_text("x")
-    fileio.record_file(tmp_path / "x.inp")
+    ownership.record_file(tmp_path / "x.inp")
     assert any(f & (os.O_WRONLY | os.O_RDWR) == 0 for f in flags)
-    assert "x.inp" in json.loads((tmp_path / fileio.OWNED_FILES).read_text())
+    assert "x.inp" in json.loads((tmp_path / ownership.OWNED_FILES).read_text())
 
 
 def test_a_legacy_folder_upgraded_by_one_command_keeps_the_others_files(tmp_path):
@@ -298,11 +296,9 @@ def test_a_legacy_folder_upgraded_by_one_command_keeps_the_others_files(tmp_path
 
 
 def test_a_folder_of_our_bookkeeping_alone_is_empty(tmp_path):
-    from tactileskin import fileio
-
     d = tmp_path / "d"
     d.mkdir()
     (d / "deck.msh").write_text("x")
-    fileio.record_file(d / "deck.msh")
+    ownership.record_file(d / "deck.msh")
     (d / "deck.msh").unlink()
     outdir.claim_dir(d, "solve")  # was refused: "holds files tactileskin did not write (.tactileskin-files.json, ...)"

@@ -21,7 +21,7 @@ import pytest
 import tactileskin
 import tactileskin.fe
 import tactileskin.sweep as sw
-from tactileskin import fileio, outdir, params, staging
+from tactileskin import fileio, outdir, ownership, params, staging
 from tactileskin.cli import main
 from tactileskin.results import Result
 
@@ -62,9 +62,9 @@ def _temporaries(folder: Path) -> list[str]:
 
 def _as_written_by_us(path: Path) -> None:
     """Record `path` in its folder's record as a file tactileskin wrote (an earlier run's)."""
-    rec = fileio.read_record(path.parent)
+    rec = ownership.read_record(path.parent)
     rec[path.name] = fileio.file_sha256(path)
-    (path.parent / fileio.OWNED_FILES).write_text(__import__("json").dumps(rec))
+    (path.parent / ownership.OWNED_FILES).write_text(__import__("json").dumps(rec))
 
 
 # --- solve --out ------------------------------------------------------------------------
@@ -84,7 +84,7 @@ def test_solve_rewrites_its_own_folder_and_refuses_unmarked_lookalikes(tmp_path,
     d = tmp_path / "d"
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # marked as ours: rewritten
-    assert sorted(p.name for p in d.iterdir()) == [".tactileskin", fileio.OWNED_FILES, fileio.RECORD_LOCK,
+    assert sorted(p.name for p in d.iterdir()) == [".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK,
                                                   "contact.csv", "profile.csv", "result.vtu", "summary.json"]
     # without our marker, files with solve's names are the user's: refused, left as they are
     user = tmp_path / "user"
@@ -410,10 +410,10 @@ def test_a_build_folder_from_before_the_marker_is_adopted(tmp_path, capsys):
     out = tmp_path / "parts"
     argv = ["build", "-t", "2", "--indenter", "none", "--no-molds", "--out", str(out)]
     assert main(argv) == 0
-    for n in (outdir.MARKER, fileio.OWNED_FILES, fileio.RECORD_LOCK):
+    for n in (outdir.MARKER, ownership.OWNED_FILES, ownership.RECORD_LOCK):
         (out / n).unlink()  # as an earlier version left it: the manifest's files only
     assert main(argv) == 0
-    assert (out / outdir.MARKER).is_file() and "skin.stl" in fileio.read_record(out)
+    assert (out / outdir.MARKER).is_file() and "skin.stl" in ownership.read_record(out)
 
 
 def test_staged_dir_leaves_no_temporary_when_the_first_move_fails(tmp_path, monkeypatch):

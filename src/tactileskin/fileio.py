@@ -8,15 +8,11 @@ Rules (issue #12, "never destroy user data"):
 - A temporary name carries the writer's pid (`.NAME.tsk<pid>-XXXX.tmp`), so that the next
   run can remove the leftovers of a killed one (`clean_stale`) without touching the files
   of a writer that is still alive.
-- An output folder is written into only if it is new, empty, or marked as the toolkit's
-  (`outdir.claim_dir` writes the marker `.tactileskin`); a folder holding files we did not write
-  is refused, never emptied.
-- A single output file of the CLI replaces an existing file only if the toolkit wrote it and
-  nobody changed it since (`claim_file`, `record_file`: the folder's `.tactileskin-files.json`).
-  The same record lists the files of a result in a marked output folder (`staging.staged_files`): a
-  rerun replaces or removes only those, so a user's file stays whatever its name, and a file
-  of ours the user edited is refused, not overwritten.
 - An OSError becomes an `OutputError` that names the path and the cause in one line.
+
+Which existing files a write may replace is decided beside this module, which writes
+wherever it is told: the output folder's marker (outdir), the record of the files the
+toolkit wrote (ownership), and the moves of a whole result into place (staging).
 """
 
 from __future__ import annotations
@@ -25,7 +21,6 @@ import contextlib
 import errno
 import functools
 import json
-import logging
 import os
 import re
 import shutil
@@ -35,8 +30,6 @@ from pathlib import Path
 from typing import Iterator
 
 from tactileskin.errors import TactileSkinError
-
-log = logging.getLogger(__name__)
 
 # `.NAME.tskPID[hHOST]-XXXX[.suffix]`: HOST names the writer's host and PID namespace (`_host`)
 _TMP_RE = re.compile(r"^\..+\.tsk(\d+)(?:h([0-9a-f]{8}))?-[A-Za-z0-9_]+(\.[A-Za-z0-9]+)?$")  # any suffix
@@ -236,16 +229,9 @@ def atomic_write_json(path, obj) -> Path:
     return atomic_write_text(path, text + "\n")
 
 
-# --- single output files ------------------------------------------------------------------
-
-# Beside single files the CLI writes (a deck, a mesh, a calibration, a plot), the folder's
-# record of them: name -> sha256 of the contents written. An existing file is replaced only
-# if the record lists it with its current contents, i.e. the toolkit wrote it and nobody has
-# changed it since; a user's file of the same name (or the command's own input) is refused.
-OWNED_FILES = ".tactileskin-files.json"
-
-
 def file_sha256(path: Path) -> str:
+    """The hex SHA-256 of a file's bytes: the digests of the record of written files
+    (ownership) and of the cache's entries."""
     import hashlib
 
     h = hashlib.sha256()
@@ -253,94 +239,6 @@ def file_sha256(path: Path) -> str:
         for block in iter(lambda: fh.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
-
-
-def read_record(folder: Path) -> dict:
-    try:
-        rec = json.loads((folder / OWNED_FILES).read_text())
-        return rec if isinstance(rec, dict) else {}
-    except (OSError, ValueError):
-        return {}
-
-
-def entry_digests(entry) -> list:
-    """The digests of a record entry (a digest, a list of them, or none)."""
-    return list(entry) if isinstance(entry, list) else [entry] if isinstance(entry, str) else []
-
-
-def is_recorded(entry, digest: str) -> bool:
-    """Whether a record entry (a digest, or [old, new] while a result is being moved in) has
-    `digest`."""
-    return digest == entry or (isinstance(entry, list) and digest in entry)
-
-
-def claim_file(path, what: str = "--out") -> Path:
-    """Refuse `path` as an output file unless it is new or a file the toolkit wrote there and
-    nobody changed since (OWNED_FILES); call before the work, `record_file` after writing."""
-    path = Path(path)
-    if path.is_dir():
-        raise OutputError(path, f"{what} must be a file name, and this is a folder")
-    if path.exists() or path.is_symlink():
-        try:
-            ours = (not path.is_symlink() and path.is_file()
-                    and is_recorded(read_record(path.parent).get(path.name), file_sha256(path)))
-        except OSError:
-            ours = False
-        if not ours:
-            raise OutputError(path, "the file exists and tactileskin did not write it (or it was changed since); "
-                                    f"refusing to overwrite it: give {what} a new file name")
-    return path
-
-
-def has_any_record(folder) -> bool:
-    """Whether `folder` has an OWNED_FILES record (this version's writes leave one)."""
-    return (Path(folder) / OWNED_FILES).exists()
-
-
-def record_file(path) -> None:
-    """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
-    path = Path(path)
-    with os_errors(path):
-        digest = file_sha256(path)
-    with record_lock(path.parent):  # two writers into one folder must not lose an entry
-        rec = {k: v for k, v in read_record(path.parent).items() if (path.parent / k).is_file()}
-        rec[path.name] = digest
-        atomic_write_json(path.parent / OWNED_FILES, rec)
-
-
-# The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,
-# left in place (removing it would race with the next writer's open).
-RECORD_LOCK = ".tactileskin-files.lock"
-
-
-@contextlib.contextmanager
-def record_lock(folder: Path) -> Iterator[None]:
-    """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
-    OWNED_FILES (waits for another writer into the same folder). Without flock (no fcntl, a
-    file system without locks) there is no lock, as in the cache."""
-    try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not POSIX
-        yield
-        return
-    # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
-    # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
-    with os_errors(folder / OWNED_FILES, own_name=False):
-        try:
-            fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
-        except PermissionError:
-            fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX)
-        except OSError as e:
-            if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.EBADF):
-                with os_errors(folder / OWNED_FILES, own_name=False):
-                    raise
-            log.warning("no file locks in %s (%s): its record is written without one", folder, e.strerror)
-        yield
-    finally:
-        os.close(fd)  # releases the lock
 
 
 def fix_tree_modes(root) -> None:

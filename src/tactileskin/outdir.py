@@ -16,17 +16,8 @@ import os
 from pathlib import Path
 from typing import Iterable, Iterator
 
-from tactileskin.fileio import (
-    OWNED_FILES,
-    RECORD_LOCK,
-    OutputError,
-    atomic_write_json,
-    clean_stale,
-    is_temporary,
-    make_dirs,
-    os_errors,
-    record_file,
-)
+from tactileskin.fileio import OutputError, atomic_write_json, clean_stale, is_temporary, make_dirs, os_errors
+from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, record_file
 
 MARKER = ".tactileskin"
 

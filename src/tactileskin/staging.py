@@ -23,24 +23,19 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from tactileskin.fileio import (
-    OWNED_FILES,
-    RECORD_LOCK,
     STAGING,
     OutputError,
     atomic_write_json,
     clean_stale,
     dir_mode,
-    entry_digests,
     file_sha256,
-    is_recorded,
     is_temporary,
     make_dirs,
     os_errors,
-    read_record,
-    record_lock,
     tmp_prefix,
 )
 from tactileskin.outdir import MARKER, is_legacy, marker_doc
+from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, entry_digests, is_recorded, read_record, record_lock
 
 
 @contextlib.contextmanager

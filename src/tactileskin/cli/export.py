@@ -18,7 +18,7 @@ def command(out, dialect, scene_opts):
     as an input deck for Abaqus/Standard or CalculiX (units mm, s, N, MPa; per mm of depth)."""
     from rich.markup import escape
 
-    from tactileskin import fileio
+    from tactileskin import ownership
     from tactileskin.cli._console import new_console
     from tactileskin.errors import ParameterError
     from tactileskin.mesh.deck import write_deck
@@ -26,8 +26,8 @@ def command(out, dialect, scene_opts):
     if not out.lower().endswith(".inp"):
         raise ParameterError("--out", out, "a file name ending in .inp")
     scene = scene_from_options(scene_opts, "export")  # --elastic: leave out the Prony series
-    fileio.claim_file(out)  # before meshing: a user's file of that name is refused
+    ownership.claim_file(out)  # before meshing: a user's file of that name is refused
     deck = write_deck(scene, out, dialect=dialect)
-    fileio.record_file(out)
+    ownership.record_file(out)
     new_console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes, "
                     f"{'viscoelastic' if deck.info['viscoelastic'] else 'elastic'} {dialect} deck")

@@ -33,7 +33,7 @@ def calibrate(cal_csv, out, model, activation_range, plot):
     """
     from pathlib import Path
 
-    from tactileskin import fileio
+    from tactileskin import ownership
     from tactileskin.errors import ParameterError
     from tactileskin.film import calibrate_csv
 
@@ -41,15 +41,15 @@ def calibrate(cal_csv, out, model, activation_range, plot):
         raise ParameterError("--plot", plot, "a file other than --out")
     for path, what in ((out, "--out"), (plot, "--plot")):
         if path:  # before the fit: a user's file (the input CSV too) is refused, not overwritten
-            fileio.claim_file(path, what)
+            ownership.claim_file(path, what)
     cal = calibrate_csv(cal_csv, model=model, activation_range=activation_range)
     if plot:
         from tactileskin.film import plots
 
         plots.calibration_plot(cal, plot)
-        fileio.record_file(plot)
+        ownership.record_file(plot)
     cal.save(out)
-    fileio.record_file(out)
+    ownership.record_file(out)
     r = cal.report
     lin = r["linear"]
     (a_lo, a_hi), (b_lo, b_hi) = lin["param_ci90"]

@@ -53,7 +53,7 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
 
     Prints the parameters and the fit quality (R^2, RMSE, max relative error) and writes a
     material file usable as --material OUT or Scene(material="OUT")."""
-    from tactileskin import fileio
+    from tactileskin import fileio, ownership
     from tactileskin.errors import ParameterError
     from tactileskin.materials.fit import fit as fit_law, read_uniaxial_csv
 
@@ -64,10 +64,10 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     # folder's record; the MARK line alone is kept by a hand-edited copy). In a folder with no
     # record at all, a file with the MARK line is an earlier version's (it kept none): replaced
     # as then
-    earlier = (outp.is_file() and not outp.is_symlink() and not fileio.has_any_record(outp.parent)
+    earlier = (outp.is_file() and not outp.is_symlink() and not ownership.has_any_record(outp.parent)
                and _has_mark(outp))
     if not earlier:
-        fileio.claim_file(outp)
+        ownership.claim_file(outp)
     if test == "indentation":
         from tactileskin.materials.indentation import fit_indentation, read_indentation_csv
 
@@ -84,7 +84,7 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
                   f"chi <= {q['chi_max']:.3g}): E = {f.E:.5g} MPa, R^2 = {q['r2']:.5f}, RMSE = {q['rmse_n']:.3g} N, "
                   f"max relative error {100 * q['max_rel_err']:.2f} %")
         fileio.atomic_write_text(outp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
-        fileio.record_file(outp)
+        ownership.record_file(outp)
         click.echo(f.describe())
         click.echo(f"wrote {out}")
         return
@@ -100,7 +100,7 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
               f"{100 * q['max_rel_err']:.2f} %" + "".join(f"; SUSPECT: {w}" for w in f.warnings))
     mat = f.material(name or Path(data).stem, source)
     fileio.atomic_write_text(outp, MARK + "\n" + mat.to_toml())
-    fileio.record_file(outp)
+    ownership.record_file(outp)
     click.echo(f.describe())
     click.echo(f"wrote {out}" + (" (a suspect fit: exit status 3)" if f.warnings else ""))
     return EXIT_SUSPECT if f.warnings else 0

@@ -19,7 +19,7 @@ def command(out, cell, scene_opts):
     from rich.markup import escape
     from rich.table import Table
 
-    from tactileskin import fileio
+    from tactileskin import ownership
     from tactileskin.cli._console import new_console
     from tactileskin.mesh import FORMATS, build_mesh
     from tactileskin.errors import ParameterError
@@ -27,7 +27,7 @@ def command(out, cell, scene_opts):
     if out is not None and not any(out.lower().endswith(s) for s in FORMATS):
         raise ParameterError("--out", out, "a file name ending in " + ", ".join(FORMATS))
     if out is not None:
-        fileio.claim_file(out)  # before meshing: a user's file of that name is refused
+        ownership.claim_file(out)  # before meshing: a user's file of that name is refused
     scene = scene_from_options(scene_opts, "mesh")
     sm = build_mesh(scene, cell=cell)
     q, sec = sm.quality, sm.section
@@ -62,5 +62,5 @@ def command(out, cell, scene_opts):
     console.print(table)
     if out is not None:
         path = sm.write(out)
-        fileio.record_file(path)
+        ownership.record_file(path)
         console.print(f"wrote {escape(str(path))}")

@@ -1,0 +1,116 @@
+"""The record of the files the toolkit wrote into a folder (`.tactileskin-files.json`), kept
+so that a rerun replaces its own files and never a user's.
+
+A single output file of the CLI replaces an existing file only if the record lists it with
+its current contents (`claim_file` before the work, `record_file` after it); staging keeps
+the record of a result's files in a marked output folder (outdir). Every read-modify-write
+of the record holds an flock on `.tactileskin-files.lock` beside it (`record_lock`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import logging
+import os
+from pathlib import Path
+from typing import Iterator
+
+from tactileskin.fileio import OutputError, atomic_write_json, file_sha256, os_errors
+
+log = logging.getLogger(__name__)
+
+# Beside single files the CLI writes (a deck, a mesh, a calibration, a plot), the folder's
+# record of them: name -> sha256 of the contents written. An existing file is replaced only
+# if the record lists it with its current contents, i.e. the toolkit wrote it and nobody has
+# changed it since; a user's file of the same name (or the command's own input) is refused.
+OWNED_FILES = ".tactileskin-files.json"
+
+
+def read_record(folder: Path) -> dict:
+    try:
+        rec = json.loads((folder / OWNED_FILES).read_text())
+        return rec if isinstance(rec, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def entry_digests(entry) -> list:
+    """The digests of a record entry (a digest, a list of them, or none)."""
+    return list(entry) if isinstance(entry, list) else [entry] if isinstance(entry, str) else []
+
+
+def is_recorded(entry, digest: str) -> bool:
+    """Whether a record entry (a digest, or [old, new] while a result is being moved in) has
+    `digest`."""
+    return digest == entry or (isinstance(entry, list) and digest in entry)
+
+
+def claim_file(path, what: str = "--out") -> Path:
+    """Refuse `path` as an output file unless it is new or a file the toolkit wrote there and
+    nobody changed since (OWNED_FILES); call before the work, `record_file` after writing."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError(path, f"{what} must be a file name, and this is a folder")
+    if path.exists() or path.is_symlink():
+        try:
+            ours = (not path.is_symlink() and path.is_file()
+                    and is_recorded(read_record(path.parent).get(path.name), file_sha256(path)))
+        except OSError:
+            ours = False
+        if not ours:
+            raise OutputError(path, "the file exists and tactileskin did not write it (or it was changed since); "
+                                    f"refusing to overwrite it: give {what} a new file name")
+    return path
+
+
+def has_any_record(folder) -> bool:
+    """Whether `folder` has an OWNED_FILES record (this version's writes leave one)."""
+    return (Path(folder) / OWNED_FILES).exists()
+
+
+def record_file(path) -> None:
+    """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
+    path = Path(path)
+    with os_errors(path):
+        digest = file_sha256(path)
+    with record_lock(path.parent):  # two writers into one folder must not lose an entry
+        rec = {k: v for k, v in read_record(path.parent).items() if (path.parent / k).is_file()}
+        rec[path.name] = digest
+        atomic_write_json(path.parent / OWNED_FILES, rec)
+
+
+# The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,
+# left in place (removing it would race with the next writer's open).
+RECORD_LOCK = ".tactileskin-files.lock"
+
+
+@contextlib.contextmanager
+def record_lock(folder: Path) -> Iterator[None]:
+    """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
+    OWNED_FILES (waits for another writer into the same folder). Without flock (no fcntl, a
+    file system without locks) there is no lock, as in the cache."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
+    # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
+    with os_errors(folder / OWNED_FILES, own_name=False):
+        try:
+            fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+        except PermissionError:
+            fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        except OSError as e:
+            if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.EBADF):
+                with os_errors(folder / OWNED_FILES, own_name=False):
+                    raise
+            log.warning("no file locks in %s (%s): its record is written without one", folder, e.strerror)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
