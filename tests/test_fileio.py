@@ -1,4 +1,4 @@
-"""fileio: atomic writes under the umask, owned output folders, stale temporaries."""
+"""fileio, outdir, staging: atomic writes under the umask, owned output folders, stale temporaries."""
 
 import os
 import stat

@@ -1,6 +1,6 @@
 """Film inputs checked with one-line errors (no traceback, nothing written): non-finite or
 out-of-range options, malformed calibration JSON and CSV, degenerate presses, inverted
-ranges; strict JSON out; output folders claimed with fileio."""
+ranges; strict JSON out; output folders claimed with outdir."""
 
 import json
 

@@ -29,6 +29,7 @@ OWNED_FILES = ".tactileskin-files.json"
 
 
 def read_record(folder: Path) -> dict:
+    """The folder's OWNED_FILES (name -> entry); {} without one or for an unreadable one."""
     try:
         rec = json.loads((folder / OWNED_FILES).read_text())
         return rec if isinstance(rec, dict) else {}
