@@ -250,3 +250,21 @@ def test_a_file_indenters_long_triangles_are_split_and_the_gap_is_the_same(tmp_p
     brute = np.array([np.min(np.linalg.norm(closest_point(tri, np.repeat(x[None], len(tri), 0)) - x, axis=1))
                       for x in q])
     np.testing.assert_allclose(np.abs(g), brute, atol=1e-9)
+
+
+def test_a_sphere_is_pressed_within_its_printed_cap():
+    # the printed ball is a cap 0.95 R high on a plate (geometry.solids.sphere_indenter): a
+    # deeper press would push the plate into the skin (and wrap the model's skin round the ball)
+    from tactileskin.array.chart import ChartConfig
+    from tactileskin.geometry.indenters.sphere import CAP
+
+    assert CAP == 0.95
+    with pytest.raises(ParameterError, match=r"depth=1\.0 .*<= 0\.95 x indenter_radius = 0\.475 mm"):
+        Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=2.0, depth=1.0)
+    with pytest.raises(ParameterError, match="depth"):  # the default 20 % of t = 1 mm
+        Scene(dim=3, indenter="sphere", indenter_radius=1.0, thickness=5.0)
+    Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=2.0, depth=0.47)
+    Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=2.0, force=0.1)  # the travel is found
+    with pytest.raises(ParameterError, match=r"sphere_radius=0\.5 .*>= 1\.05 mm"):
+        ChartConfig(thicknesses=(5.0,), sets=("shapes",), sphere_radius=0.5)
+    ChartConfig(thicknesses=(5.0,), sets=("shapes",), sphere_radius=0.5, max_depth=0.4)

@@ -27,6 +27,7 @@ import numpy as np
 from tactileskin import params
 from tactileskin.errors import CadError, TactileSkinError
 from tactileskin.geometry.fingertip import Section
+from tactileskin.geometry.indenters.sphere import CAP
 from tactileskin.geometry.indenters import (BrailleIndenter, CylinderIndenter, FlatIndenter, Indenter,
                                             SphereIndenter)
 
@@ -239,11 +240,11 @@ def cylinder_indenter(ind: CylinderIndenter) -> bd.Solid:
 
 def sphere_indenter(ind: SphereIndenter) -> bd.Solid:
     """The ball fused into a plate whose underside is 0.05 R below the ball's equator: the
-    working face is the spherical cap of height 0.95 R (the model's ball, for any depth
-    below that), and the sphere's poles (axis along z, on the equator) lie inside the plate,
+    working face is the spherical cap of height CAP R = 0.95 R (the model's ball, for any
+    depth a scene may ask), and the sphere's poles (axis along z, on the equator) lie inside the plate,
     where OCC's degenerate pole facets cannot break the STL (as for the Braille dots)."""
     R, y0 = ind.radius, ind.y0
-    yc, yb = y0 + R, y0 + 0.95 * R
+    yc, yb = y0 + R, y0 + CAP * R
     half, y_back = 1.2 * R, y0 + 2.2 * R
     p = dict(kind="sphere", radius=R)
     with occ_guard("building the sphere indenter", **p):

@@ -15,6 +15,11 @@ from tactileskin.geometry.indenters.base import Indenter, check_radius, hertz_ha
 from tactileskin.geometry.indenters.registry import register
 
 
+# the printed ball's working face: a cap this fraction of R high (solids.sphere_indenter fuses
+# it into a plate there); deeper presses are refused
+CAP = 0.95
+
+
 @register
 @dataclass(frozen=True, eq=False)
 class SphereIndenter(Indenter):
@@ -34,6 +39,15 @@ class SphereIndenter(Indenter):
                                  "a sphere is not uniform along the finger; its plane-strain section "
                                  "is a cylinder: use indenter = 'cylinder' (indenter_axis = 'z') for "
                                  "that 2D model")
+        if scene.force is None and not scene.loading:
+            # past its cap the ball would sink to its mount (and in the model, wrap the skin
+            # round its equator): the printed part presses with its plate there
+            depth = scene.depth if scene.depth is not None else scene.depth_fraction * scene.thickness
+            if depth > CAP * radius:
+                raise ParameterError("depth", depth, f"<= {CAP:g} x indenter_radius = {CAP * radius:.3g} mm "
+                                     "for the sphere indenter",
+                                     f"the ball's working face is a cap {CAP:g} R high; its mount plate starts "
+                                     "there: use a larger indenter_radius or a smaller depth")
         return {"indenter_radius": radius}
 
     @classmethod
