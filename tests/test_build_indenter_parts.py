@@ -123,3 +123,23 @@ def test_every_printed_indenter_carries_the_standard_stem(kind, opts):
     assert len(rims) == 1 and rims[0].radius == pytest.approx(0.5 * float(q["diameter"]), abs=1e-6)
     # the working face is still the model's: the lowest point at y0, the ball / arc under the mount
     assert solid.bounding_box().min.Y == pytest.approx(7.0, abs=1e-6)
+
+
+def test_a_geometry_folder_without_the_mount_thickness_is_a_one_line_error(tmp_path, monkeypatch, capsys):
+    """A TACTILESKIN_GEOMETRY folder copied before the mount block has no [stem]
+    mount_thickness: an indenter that needs the block names the entry (it was a KeyError
+    traceback, for every indenter, the flat plate too); one that does not builds as before."""
+    import shutil
+
+    geo = tmp_path / "geometry"
+    shutil.copytree(params.geometry_dir(), geo)
+    text = (geo / "indenters.toml").read_text()
+    kept = [ln for ln in text.splitlines() if not ln.startswith("mount_thickness")]
+    assert len(kept) == len(text.splitlines()) - 1
+    (geo / "indenters.toml").write_text("\n".join(kept) + "\n")
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(geo))
+    make_indenter("flat", y0=7.0, dim=3, sample_length=20.0).solid()  # no block: not read
+    out = tmp_path / "out"
+    assert main(["build", "--out", str(out), "--no-molds", "--indenter", "sphere", "--indenter-radius", "0.5"]) == 2
+    cap = capsys.readouterr()
+    assert "indenters.stem.mount_thickness" in cap.err and "Traceback" not in cap.err + cap.out

@@ -25,7 +25,7 @@ import build123d as bd
 import numpy as np
 
 from tactileskin import params
-from tactileskin.errors import CadError, TactileSkinError
+from tactileskin.errors import CadError, ParameterError, TactileSkinError, check_range
 from tactileskin.geometry.fingertip import Section
 from tactileskin.geometry.indenters.sphere import CAP
 from tactileskin.geometry.indenters import (BrailleIndenter, CylinderIndenter, FlatIndenter, Indenter,
@@ -175,7 +175,7 @@ def box(x0, x1, y0, y1, z0, z1) -> bd.Solid:
 def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) -> bd.Solid:
     """Fuse the mounting stem (axis y, from the back face y_back upwards) and fillet its root."""
     q = params.load("indenters")["stem"]
-    fillet, mount = float(q["fillet"]), float(q["mount_thickness"])
+    fillet = float(q["fillet"])
     r, h = 0.5 * ind.stem_diameter, ind.stem_length
     # a back face too small for the stem and its whole fillet (a small ball's plate, half-width
     # 1.2 R; a small cylinder's chord) gets a mount block, the stem's width plus the fillet's
@@ -186,6 +186,7 @@ def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) 
     with occ_guard(f"adding the stem to the {what}", stem_diameter=ind.stem_diameter,
                    stem_length=h, stem_fillet=fillet, **p):
         if room < 2.0 * fillet:
+            mount = _mount_thickness(q)
             m = r + 2.0 * fillet
             body = _single(body.fuse(box(-m, m, y_back, y_back + mount, -m, m)).clean())
             y_back += mount
@@ -200,6 +201,17 @@ def _add_stem(body: bd.Solid, ind: Indenter, y_back: float, what: str, p: dict) 
                 raise CadError(f"{what}: found {len(root)} stem root edges, expected 1 for {format_params(p)}")
             solid = solid.fillet(fillet, root)
     return check_solid(solid, what, **p)
+
+
+def _mount_thickness(stem: dict) -> float:
+    """indenters.toml [stem] mount_thickness, checked: a geometry folder written before the
+    mount block (TACTILESKIN_GEOMETRY) lacks it, and only the indenters that need a block read it."""
+    name = "indenters.stem.mount_thickness"
+    if "mount_thickness" not in stem:
+        raise ParameterError(name, None, "> 0 mm in indenters.toml",
+                             "add `mount_thickness = 3.0` under [stem] (the block under the stem of a "
+                             "ball or cylinder narrower than the stem)")
+    return check_range(name, stem["mount_thickness"], 0.0, None, lo_open=True, unit="mm")
 
 
 def indenter_solid(ind: Indenter) -> bd.Solid:
