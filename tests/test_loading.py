@@ -251,3 +251,18 @@ def test_the_force_secant_is_exact_on_a_power_law_and_linear_otherwise():
     # a reaction that falls with the travel gives no root; a non-positive one the linear secant
     assert _secant((0.2, 0.1), (0.25, 0.05), 1.0) is None
     assert _secant((0.1, -1.5), (0.2, -0.5), 1.0) == pytest.approx(0.25)
+
+
+def test_a_force_ramp_after_a_force_hold_starts_from_a_sane_trial(mesh):
+    """After a creep hold the last two committed states carry the same force (to the
+    tolerance): the log-log secant through them has an exponent of ~0.01 and sent the next
+    ramp's first trials to zero travel (an unload) or to d_max (a reload); silicone, hold then
+    unload to half, took 3 cutbacks and 4x the Newton iterations."""
+    from tactileskin.fe import solve
+
+    sc = BASE.replace(material="silicone", viscoelastic=True, force=0.01, load_time=0.05,
+                      loading=[{"hold": 1.0}, {"force": 0.005, "time": 0.05}])
+    r = solve(sc, mesh=mesh)
+    assert r.stats["cutbacks"] == 0
+    assert r.stats["force_trials"] <= 4 * r.stats["increments"]
+    assert r.loading["final"]["reaction"] == pytest.approx(0.005, rel=5e-4)

@@ -35,6 +35,7 @@ FORCE_RTOL = 1e-4   # |F - F*| <= FORCE_RTOL |F*|: the contact tolerance (1e-4 h
 MAX_TRIALS = 16
 NOISE_FRACTION = 0.1  # of slope x tol_penetration: the accepted reaction error (ForceIncrement._tolerance)
 UNDERSHOOT = 0.05  # of a predicted travel step (about 3 % of it is the predictor's error)
+SECANT_BASE = 0.1  # the committed states' force difference, as a fraction of the step it predicts
 
 
 def vertical_reaction(model, ev) -> float:
@@ -73,13 +74,24 @@ class ForceIncrement:
         k = self.slope if self.slope and self.slope > 0 else (reached / d if d > 0 and reached > 0 else 0.0)
         return max(self.rtol * abs(F), NOISE_FRACTION * k * tol_pen, 1e-12)
 
+    def _prev_spans(self, model, F: float, d0: float, f0: float) -> bool:
+        """Whether the secant through the last two committed states may predict this step: their
+        forces must differ by more than the reaction's resolution and by SECANT_BASE of the step.
+        After a force hold they are equal to within the tolerance, and the line through them
+        (an exponent of ~0.01) sent the next ramp's first trials to zero travel or to d_max
+        (silicone, hold then unload to half: 3 cutbacks, 4x the Newton iterations)."""
+        if self.prev is None:
+            return False
+        base = abs(f0 - self.prev[1])
+        return base > 10.0 * self._tolerance(model, F, d0, f0) and base >= SECANT_BASE * abs(F - f0)
+
     def __call__(self, model, u0, t, dt, opts, stats: Stats):
         F = float(self.target(t))
         d0, f0 = model.d, self.f_committed
         # first trial: the log-log secant through the last two committed states (it carries the
         # relaxation between increments: a sphere's first trials within 0.5 % in travel), else
         # this state and the exponent of the last increment's trials, else the local slope
-        d = _secant((self.prev[0], self.prev[1] - F), (d0, f0 - F), F) if self.prev is not None else None
+        d = _secant((self.prev[0], self.prev[1] - F), (d0, f0 - F), F) if self._prev_spans(model, F, d0, f0) else None
         if d is None and self.p and d0 > 0 and f0 > 0 and F > 0:
             d = d0 * (F / f0) ** (1.0 / self.p)
         if d is None:
