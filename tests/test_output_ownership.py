@@ -302,3 +302,14 @@ def test_a_folder_of_our_bookkeeping_alone_is_empty(tmp_path):
     ownership.record_file(d / "deck.msh")
     (d / "deck.msh").unlink()
     outdir.claim_dir(d, "solve")  # was refused: "holds files tactileskin did not write (.tactileskin-files.json, ...)"
+
+
+def test_removing_free_locks_removes_nothing_but_lock_files(tmp_path):
+    """claimed()'s clean-up checks that a new folder's cache holds only locks, then removes
+    them: a file another run wrote in between is not one of them (it was unlinked too)."""
+    from tactileskin.outdir import _remove_free_locks
+
+    (tmp_path / "a.lock").write_text("")
+    (tmp_path / "case.json").write_text("another run's")
+    assert _remove_free_locks(tmp_path) is False
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.json"]

@@ -137,6 +137,10 @@ def _remove_free_locks(folder: Path) -> bool:
         fcntl = None
     every = True
     for p in list(folder.iterdir()):
+        if p.suffix != ".lock" or p.is_symlink() or not p.is_file():
+            # the caller saw only locks, but a run sharing the folder may have written since
+            every = False
+            continue
         try:
             fd = os.open(p, os.O_RDONLY)
         except OSError:
