@@ -278,3 +278,20 @@ def test_a_shallow_2d_force_ramp_reaches_its_force_to_rtol(mesh):
     target = solve(base, mesh=mesh).reaction
     r = solve(BASE.replace(force=target, depth=None, load_time=base.duration), mesh=mesh)
     assert abs(r.loading["reached_force"] - target) <= 1.01 * FORCE_RTOL * target
+
+
+def test_the_3d_reaction_allowance_is_bounded_and_2d_keeps_rtol():
+    from types import SimpleNamespace
+
+    from tactileskin.fe.loading import FORCE_RTOL, NOISE_CAP, ForceIncrement
+
+    inc = ForceIncrement(lambda t: 1.0, 1.0, lambda F: 0.1)
+    contact = SimpleNamespace(tol_penetration=5e-4)
+    m3, m2 = SimpleNamespace(m=3, contact=contact), SimpleNamespace(m=2, contact=contact)
+    # F ~ d^1.5 at d = 0.3 mm: slope 1.5 F / d; the allowance 0.1 x slope x 5e-4 = 2.5e-4 F
+    inc.slope = 1.5 / 0.3
+    assert inc._tolerance(m3, 1.0, 0.3, 1.0) == pytest.approx(2.5e-4)
+    assert inc._tolerance(m2, 1.0, 0.3, 1.0) == pytest.approx(FORCE_RTOL)
+    # a shallow press (2 um): slope x tolerance grows as 1/travel; the allowance stops at the cap
+    inc.slope = 1.5 / 0.002
+    assert inc._tolerance(m3, 1.0, 0.002, 1.0) == pytest.approx(NOISE_CAP)

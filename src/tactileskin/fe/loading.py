@@ -34,6 +34,7 @@ log = logging.getLogger(__name__)
 FORCE_RTOL = 1e-4   # |F - F*| <= FORCE_RTOL |F*|: the contact tolerance (1e-4 h) moves F by ~3e-5 F
 MAX_TRIALS = 16
 NOISE_FRACTION = 0.1  # of slope x tol_penetration: the accepted reaction error (ForceIncrement._tolerance)
+NOISE_CAP = 1e-3      # ... but never more than this fraction of the force (3D sphere at 0.3 mm: 3e-4)
 UNDERSHOOT = 0.05  # of a predicted travel step (about 3 % of it is the predictor's error)
 SECANT_BASE = 0.1  # the committed states' force difference, as a fraction of the step it predicts
 
@@ -76,7 +77,8 @@ class ForceIncrement:
         if getattr(model, "m", 3) != 3:
             tol_pen = 0.0
         k = self.slope if self.slope and self.slope > 0 else (reached / d if d > 0 and reached > 0 else 0.0)
-        return max(self.rtol * abs(F), NOISE_FRACTION * k * tol_pen, 1e-12)
+        # at most NOISE_CAP |F|: slope x tol_penetration grows as 1/travel on a shallow press
+        return max(self.rtol * abs(F), min(NOISE_FRACTION * k * tol_pen, NOISE_CAP * abs(F)), 1e-12)
 
     def _prev_spans(self, model, F: float, d0: float, f0: float) -> bool:
         """Whether the secant through the last two committed states may predict this step: their
@@ -145,7 +147,9 @@ class ForceIncrement:
                 d = self._next(d, f, lo, hi, pts, F, model)
         finally:
             model.travel_fixed = None
-        raise _Failure(f"force control: reaction not within {self.rtol:.3g} x {F:.6g} after {MAX_TRIALS} trial travels",
+        last = pts[-1] if pts else (model.d, 0.0)
+        raise _Failure(f"force control: reaction not within {self._tolerance(model, F, last[0], last[1] + F):.3g} "
+                       f"of {F:.6g} after {MAX_TRIALS} trial travels",
                        {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts]})
 
     def _next(self, d, f, lo, hi, pts, F, model) -> float:
