@@ -11,7 +11,8 @@ Layout (dimensions in data/geometry/molds.toml, frame as in solids.py):
   touches the contour at the bottom, where the core rests under gravity and keeps the
   position that makes the skin t thick, and leaves a normal gap c (1 + n_y) elsewhere (about
   0.54 c at the nail edges, and it reaches c past them for the core's corners): a core
-  printed up to c oversize all round still rests on the bottom. The end walls have a slot as
+  printed up to c oversize all round still rests on the bottom (its top then stands about
+  twice its oversize higher: the skin over the pulp is that much thinner). The end walls have a slot as
   deep as the clearance: the core's section offset by it.
   What is left of the cavity is exactly the skin plus that gap (tests/test_cad.py checks both
   within 0.5 % of the skin); silicone that runs into the gap is a thin flash along the nail
