@@ -33,9 +33,12 @@ def test_files_without_an_absolute_scale_are_not_checked(tmp_path):
     Image.fromarray(img).save(tmp_path / "a.png")        # no pHYs
     Image.fromarray(img).save(tmp_path / "a.tif")        # Pillow's 1 x 1 without a unit
     Image.fromarray(img).save(tmp_path / "b.tif", dpi=(203.2, 203.2))  # 8 px/mm exactly
-    assert file_px_per_mm(tmp_path / "a.png") is None and file_px_per_mm(tmp_path / "a.tif") is None
+    # the screen defaults editors stamp on any image (it advised --px-per-mm 2.835 for them)
+    Image.fromarray(img).save(tmp_path / "c.png", dpi=(72, 72))
+    Image.fromarray(img).save(tmp_path / "d.tif", dpi=(96, 96))
+    assert all(file_px_per_mm(tmp_path / n) is None for n in ("a.png", "a.tif", "c.png", "d.tif"))
     assert file_px_per_mm(tmp_path / "b.tif") == pytest.approx(8.0)
-    for name in ("a.png", "a.tif", "b.tif"):
+    for name in ("a.png", "a.tif", "b.tif", "c.png", "d.tif"):
         assert analyze_scan(tmp_path / name).warnings == []
 
 

@@ -145,9 +145,13 @@ def _check_opaque(path, im) -> None:
                                       "onto white or crop to the film")
 
 
+SCREEN_DPI = (72.0, 96.0)  # written by default, not measured: no scale
+
+
 def file_px_per_mm(path) -> float | None:
     """Pixels per mm recorded in an image file's header (PNG pHYs, TIFF resolution), or None
-    when it records none or no absolute unit (a TIFF's default 1 x 1 without a unit)."""
+    when it records none, no absolute unit (a TIFF's default 1 x 1 without a unit) or a
+    screen default (SCREEN_DPI)."""
     from PIL import Image, UnidentifiedImageError
 
     try:
@@ -164,7 +168,10 @@ def file_px_per_mm(path) -> float | None:
         x = float(dpi[0])
     except (TypeError, ValueError, IndexError):
         return None
-    return x / 25.4 if x > 1.0 else None
+    # 72 and 96 dpi are the screen defaults editors and screenshot tools stamp on any image;
+    # read as a scale they flagged every such file and advised a wrong --px-per-mm
+    # (PNG's pHYs keeps whole pixels per metre: 72 dpi reads back as 72.009)
+    return x / 25.4 if x > 1.0 and all(abs(x - s) > 0.05 for s in SCREEN_DPI) else None
 
 
 def load_grayscale(path) -> np.ndarray:
