@@ -35,7 +35,7 @@ import numpy as np
 
 from tactileskin.array import classify, surrogate
 from tactileskin.array.maps import mirrored
-from tactileskin.array.sampler import ArraySpec, Readout
+from tactileskin.array.sampler import MAX_TAXELS, ArraySpec, Readout
 from tactileskin.errors import ParameterError, TactileSkinError, check_range, range_text
 from tactileskin.geometry.braille import DIGITS as BRAILLE_DIGITS
 from tactileskin.geometry.braille import LETTERS as BRAILLE_LETTERS
@@ -61,7 +61,6 @@ LETTERS_MODELS = ("interaction", "sum", "full")
 # the letters' surrogate is 5.5 % (t = 1, silicone, f) and 5.2 % (t = 0.5) off full solves on
 # finer meshes; on 0.8 / 8 it reads 3.5 and 3.6 % (data/surrogate_validation.json)
 CHART_MESH = (1.2, 8.0)
-MAX_TAXELS = 200  # taxels a side of the sampler's lattice (array.sampler.ArraySpec)
 
 
 def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:

@@ -22,9 +22,10 @@ import numpy as np
 from tactileskin.array.maps import interpolator
 from tactileskin.errors import ParameterError
 from tactileskin.results import BoneMap
+from tactileskin.sensors import TAXEL_SPACING  # mm between Gauss points of the default rule
 
-TAXEL_SPACING = 0.25   # mm between Gauss points of the default rule (tactileskin.sensors.TAXEL_SPACING)
 MIN_QUAD, MAX_QUAD = 4, 64
+MAX_TAXELS = 200  # taxels a side of an array's lattice
 
 
 def default_quad(taxel: float) -> int:
@@ -59,8 +60,8 @@ class ArraySpec:
             object.__setattr__(self, "quad", default_quad(self.taxel))
         if self.taxel > self.pitch:
             raise ParameterError("taxel", self.taxel, f"<= pitch = {self.pitch:g} mm (taxels must not overlap)")
-        if not (isinstance(self.n, (int, np.integer)) and 1 <= self.n <= 200):
-            raise ParameterError("n", self.n, "an integer in [1, 200] taxels per side")
+        if not (isinstance(self.n, (int, np.integer)) and 1 <= self.n <= MAX_TAXELS):
+            raise ParameterError("n", self.n, f"an integer in [1, {MAX_TAXELS}] taxels per side")
         if not (isinstance(self.quad, (int, np.integer)) and 1 <= self.quad <= MAX_QUAD):
             raise ParameterError("quad", self.quad, f"an integer in [1, {MAX_QUAD}]")
         if not np.isfinite(self.rotation_deg):
