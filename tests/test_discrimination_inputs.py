@@ -13,7 +13,7 @@ P = np.exp(-S**2)
 def test_non_finite_profiles_are_refused():
     q = P.copy()
     q[3] = np.nan
-    with pytest.raises(ParameterError, match="non-finite"):
+    with pytest.raises(ParameterError, match="profile 'b' P=.*non-finite"):  # names the record
         discriminate({"a": (S, P), "b": (S, q)})
     with pytest.raises(ParameterError):
         profile_distance(S, P, S[:-1], P)

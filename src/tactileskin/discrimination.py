@@ -45,10 +45,10 @@ def profile_distance(s1, p1, s2, p2, n: int = 2001) -> float:
     the centre (a whole model's, s < 0 too) against one from the symmetry line (a halved
     model's) is folded onto s >= 0 first: the halved model's missing side is no difference."""
     s1, p1, s2, p2 = (np.asarray(v, float) for v in (s1, p1, s2, p2))
-    for name, v in (("s", s1), ("P", p1), ("s", s2), ("P", p2)):
+    for which, name, v in ((1, "s", s1), (1, "P", p1), (2, "s", s2), (2, "P", p2)):
         if v.size == 0 or not np.all(np.isfinite(v)):
             # a NaN distance compared below the threshold: "not distinguishable", silently
-            raise ParameterError(f"profile {name}", "empty or non-finite", "finite samples")
+            raise ParameterError(f"profile {which} {name}", "empty or non-finite", "finite samples")
     if s1.shape != p1.shape or s2.shape != p2.shape:
         raise ParameterError("profile", f"{s1.shape}/{p1.shape}, {s2.shape}/{p2.shape}", "s and P of one length")
     tol = 1e-9 * max(np.abs(s1).max(), np.abs(s2).max(), 1.0)
@@ -81,6 +81,10 @@ def discriminate(profiles: dict[str, tuple[np.ndarray, np.ndarray]],
         return Verdict({}, float("nan"), False)
     dist = {}
     for (na, (sa, pa)), (nb, (sb, pb)) in itertools.combinations(sorted(profiles.items()), 2):
-        dist[(na, nb)] = profile_distance(sa, pa, sb, pb)
+        try:
+            dist[(na, nb)] = profile_distance(sa, pa, sb, pb)
+        except ParameterError as e:  # name the record, not "profile 2"
+            which = na if e.name.startswith("profile 1") else nb
+            raise ParameterError(f"profile {which!r} {e.name.split()[-1]}", e.value, e.valid) from None
     dmin = min(dist.values())
     return Verdict(dist, dmin, dmin >= threshold)
