@@ -211,9 +211,20 @@ def _rows(fh, values, per_line: int = 16, fmt=str) -> None:
         fh.write(", ".join(fmt(v) for v in values[i:i + per_line]) + "\n")
 
 
+FIELD_WIDTH = 20  # CalculiX reads at most 20 characters per field ("*ERROR reading *NODE" beyond)
+
+
 def _num(v: float) -> str:
-    """Shortest text that reads back as the same double (coordinates round-trip exactly)."""
-    return repr(float(v))
+    """Shortest text that reads back as the same double (coordinates round-trip exactly),
+    unless that is wider than a CalculiX field: then the most significant digits that fit
+    (-1.0000245733392007e-14, 22 characters, came out of a 3D mesh; 13 digits still leave a
+    relative error below 1e-12)."""
+    s = repr(float(v))
+    for p in range(16, 0, -1):
+        if len(s) <= FIELD_WIDTH:
+            return s
+        s = f"{float(v):.{p}g}"
+    return s  # pragma: no cover - '%.1g' of a double is at most 8 characters
 
 
 def material_lines(material, *, viscoelastic: bool, dialect: str) -> str:
@@ -255,16 +266,18 @@ class Deck:
     info: dict = field(default_factory=dict)
 
 
-def _check_dim(dim: int) -> None:
-    if dim != 2:
-        raise ParameterError("dim", dim, "2 (the deck is the plane-strain half section)",
-                             "a 3D deck needs a meshed 3D indenter; `tactileskin mesh --dim 3 -o x.inp` "
-                             "writes the 3D mesh with its sets")
+def _check_dim(dim: int, dialect: str) -> None:
+    if dim == 3 and dialect != "calculix":
+        raise ParameterError("dialect", dialect, "calculix for a 3D deck (mesh.deck3d)",
+                             "a 3D Abaqus deck would need R3D3 elements on a *RIGID BODY, not written yet")
+    if dim not in (2, 3):  # pragma: no cover - scenes are 2D or 3D
+        raise ParameterError("dim", dim, "2 or 3")
 
 
 def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | None = None,
               penalty: float | None = None, increments: int = 20) -> Deck:
-    """The input deck of a 2D scene on its mesh. viscoelastic: default the scene's;
+    """The input deck of a scene on its mesh (3D: CalculiX only, mesh.deck3d). viscoelastic:
+    default the scene's;
     penalty (CalculiX contact slope, MPa/mm): default 10 K0 / h_fine (100 K0 / h made ccx 2.20
     diverge on the t = 3 polyurethane flat case); increments: the first
     time increment is T / increments (both solvers adapt it)."""
@@ -273,7 +286,9 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
 
     if dialect not in DIALECTS:
         raise ParameterError("dialect", dialect, "one of " + ", ".join(DIALECTS))
-    _check_dim(scene.dim if scene.dim != 2 else skinmesh.dim)
+    if skinmesh.dim != scene.dim:
+        raise ParameterError("mesh", f"{skinmesh.dim}D", f"a {scene.dim}D mesh for the {scene.dim}D scene")
+    _check_dim(scene.dim, dialect)
     if not (isinstance(increments, int) and 1 <= increments <= 10000):
         raise ParameterError("increments", increments, "an integer in [1, 10000]")
     program = scene.program()
@@ -282,6 +297,10 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
                              "a depth ramp (the deck has one displacement step)",
                              "force control and [[loading]] histories are not written to decks yet; export "
                              "the scene with its depth")
+    if scene.dim == 3:
+        from tactileskin.mesh.deck3d import deck_text_3d
+
+        return deck_text_3d(scene, skinmesh, penalty=penalty, increments=increments, viscoelastic=viscoelastic)
     mat = get_material(scene.material)
     visco = scene.viscoelastic if viscoelastic is None else bool(viscoelastic)
     ind = indenter_for_scene(scene)
@@ -405,7 +424,7 @@ def write_deck(scene, path, skinmesh=None, dialect: str = "abaqus", **kw) -> Dec
     from tactileskin import fileio
 
     if skinmesh is None:
-        _check_dim(scene.dim)  # before meshing
+        _check_dim(scene.dim, dialect)  # before meshing
         from tactileskin.mesh import build_mesh
 
         skinmesh = build_mesh(scene)

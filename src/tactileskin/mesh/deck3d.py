@@ -1,0 +1,144 @@
+"""A 3D scene as a CalculiX input deck: C3D10 skin, meshed rigid indenter, penalty contact.
+
+`deck_text_3d(scene, skinmesh, ...)` writes what the 3D solver solves (fe.model_for_scene):
+- the skin's P2 tetrahedra as C3D10 (scikit-fem's edge order (0,1) (1,2) (0,2) (0,3) (1,3)
+  (2,3) is C3D10's mid-node order 5-10; gmsh's tetra10 swaps the last two, which
+  mesh._gmsh undoes on import; cells with node 4 on the negative side of face 1-2-3 are
+  flipped, deck.abaqus_cells), one *NSET and one element-face *SURFACE per named boundary;
+- the material as *HYPERFOAM (instantaneous; ccx has no Prony series);
+- supports: the skin's bonded boundaries fixed in x, y, z (fingertip: bone_interface and
+  nail_edge), u_x = 0 on the symmetry plane x = 0 of a half model, u_z = 0 on end_back when
+  the mesh is z-symmetric (the plane z = 0); end_front (and a non-symmetric end_back) free;
+- the indenter: its working face triangulated on the kind's exact surface
+  (mesh.indenter3d), thickened into C3D6 wedges whose nodes are all moved by the travel
+  (a rigid translation without *RIGID BODY, as the 2D CalculiX deck does); the face
+  extends 1 mm past the skin on every side, like the solver's unbounded analytic indenter;
+- frictionless surface-to-surface contact, skin outer surface slave, indenter face master,
+  linear penalty `penalty` MPa/mm (default 10 K0 / h_fine, as in 2D);
+- one NLGEOM *STATIC step from zero to the full travel over the scene's ramp time.
+
+Forces in the .dat totals are those of the modelled part (a quarter for a flat plate or a
+symmetric Braille cell): `info["force_factor"]` gives the whole indenter's, as
+Result.reaction reports it. Only the CalculiX dialect: an Abaqus 3D deck would need
+R3D3 elements on a *RIGID BODY, which nothing here can run to check.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+
+import numpy as np
+
+from tactileskin.errors import ParameterError
+
+log = logging.getLogger(__name__)
+
+WEDGE_HEIGHT = 0.5  # mm: thickness of the indenter's wedge layer (its nodes are all prescribed)
+
+
+def footprint(skinmesh, margin: float = 1.0) -> tuple[float, float, float, float]:
+    """(xmin, xmax, zmin, zmax) of the indenter face: the skin's extent plus `margin` mm."""
+    X = np.asarray(skinmesh.mesh.doflocs, float)
+    return (float(X[0].min()) - margin, float(X[0].max()) + margin,
+            float(X[2].min()) - margin, float(X[2].max()) + margin)
+
+
+def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: int = 20,
+                 face_size: float | None = None, viscoelastic: bool | None = None):
+    """The CalculiX deck of a 3D scene on its mesh (a deck.Deck). face_size: indenter facet
+    size away from the Braille caps (default the skin's coarse size: a plane is exact at any
+    size); penalty, increments: as deck.deck_text."""
+    from tactileskin.geometry.indenters import indenter_for_scene
+    from tactileskin.materials import get_material
+    from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, boundary_faces, material_lines
+    from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
+    from tactileskin.mesh.skinmesh import facet_nodes
+
+    if skinmesh.dim != 3:
+        raise ParameterError("mesh", f"{skinmesh.dim}D", "a 3D skin mesh for a 3D deck")
+    mat = get_material(scene.material)
+    visco = scene.viscoelastic if viscoelastic is None else bool(viscoelastic)
+    ind = indenter_for_scene(scene)
+    etype, pts, cells = abaqus_cells(skinmesh)
+    n_nodes, n_cells = len(pts), len(cells)
+    T, depth = scene.duration, scene.indentation
+    h_fine = float(skinmesh.sizes.get("fine", scene.mesh_size / scene.refinement))
+    h_face = float(face_size if face_size is not None else skinmesh.sizes.get("coarse", scene.mesh_size))
+    hf = mat.hyperfoam
+    if penalty is None:
+        penalty = 10.0 * max(hf.K0, hf.mu0) / h_fine
+    if not (isinstance(penalty, (int, float)) and np.isfinite(penalty) and penalty > 0):
+        raise ParameterError("penalty", penalty, "a positive contact stiffness (MPa/mm)")
+    face = indenter_face(ind, footprint(skinmesh), h_face)
+    ipts, icells = wedge_cells(face, WEDGE_HEIGHT)
+    halved, zsym = bool(skinmesh.halved), bool(getattr(skinmesh, "z_symmetric", False))
+
+    fh = io.StringIO()
+    w = fh.write
+    w("*HEADING\n")
+    w(f"tactileskin {scene.label()}: 3D, units mm s N MPa (calculix)\n")
+    w("**\n** Skin: C3D10; then the indenter's wedge nodes\n*NODE\n")
+    for i, p in enumerate(np.concatenate([pts, ipts])):
+        w(f"{i + 1}, {_num(p[0])}, {_num(p[1])}, {_num(p[2])}\n")
+    w(f"*ELEMENT, TYPE={etype}, ELSET=skin\n")
+    for i, c in enumerate(cells):
+        w(f"{i + 1}, " + ", ".join(str(int(v) + 1) for v in c) + "\n")
+    for name, facets in skinmesh.boundaries.items():
+        nodes = np.unique(facet_nodes(skinmesh.mesh, facets, 3, skinmesh.order))
+        w(f"*NSET, NSET={name}\n")
+        _rows(fh, nodes + 1)
+        w(f"*SURFACE, TYPE=ELEMENT, NAME={name}_faces\n")
+        for e, f in boundary_faces(skinmesh, cells, etype, facets):
+            w(f"{e + 1}, S{f}\n")
+    w(material_lines(mat, viscoelastic=False, dialect="calculix"))
+    w(f"*SOLID SECTION, ELSET=skin, MATERIAL={_name(mat.name)}\n")
+
+    ref, n_ind = n_nodes + 1, len(ipts)
+    w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, moves by -"
+      + _num(depth) + " mm over " + _num(T) + " s; C3D6 wedges, face S1 on the working face,\n"
+      "** all nodes prescribed (a rigid translation)\n")
+    w("*NSET, NSET=indenter_nodes, GENERATE\n")
+    w(f"{ref}, {ref + n_ind - 1}, 1\n")
+    w("*ELEMENT, TYPE=C3D6, ELSET=indenter\n")
+    for i, c in enumerate(icells):
+        w(f"{n_cells + 1 + i}, " + ", ".join(str(ref + int(v)) for v in c) + "\n")
+    w("*SURFACE, TYPE=ELEMENT, NAME=indenter_face\n")
+    _rows(fh, [f"{n_cells + 1 + i}, S1" for i in range(len(icells))], 1)
+    w("*MATERIAL, NAME=indenter_rigid\n*ELASTIC\n1e6, 0.3\n")
+    w("*SOLID SECTION, ELSET=indenter, MATERIAL=indenter_rigid\n")
+
+    w("**\n** Contact: frictionless (no *FRICTION), linear penalty\n")
+    w("*SURFACE INTERACTION, NAME=frictionless\n")
+    w(f"*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n{_num(penalty)}\n")
+    w("*CONTACT PAIR, INTERACTION=frictionless, TYPE=SURFACE TO SURFACE\n")
+    w("outer_surface_faces, indenter_face\n")
+    w(f"*AMPLITUDE, NAME=travel\n0., 0., {_num(T)}, 1.\n")
+
+    fixed = [b for b in scene.skin_kind.fixed_boundaries if b in skinmesh.boundaries]
+    w("**\n** Supports: " + ", ".join(fixed) + " fixed" + ("; symmetry plane x = 0" if halved else "")
+      + ("; end_back is the symmetry plane z = 0" if zsym else "") + "\n")
+    w("*BOUNDARY\n" + "".join(f"{b}, 1, 3\n" for b in fixed))
+    if halved:
+        w("symmetry, 1, 1\n")
+    if zsym:
+        w("end_back, 3, 3\n")
+    w("indenter_nodes, 1, 1\nindenter_nodes, 3, 3\n")
+
+    dt0 = T / increments
+    w(f"**\n** indentation {_num(depth)} mm at {_num(scene.rate)} mm/s\n")
+    w("*STEP, NLGEOM, INC=10000\n")
+    w(f"*STATIC\n{_num(dt0)}, {_num(T)}, {_num(T * 1e-6)}, {_num(T / 10)}\n")
+    w("*BOUNDARY, AMPLITUDE=travel\n")
+    w(f"indenter_nodes, 2, 2, {_num(-depth)}\n")
+    w("*NODE FILE\nU, RF\n*EL FILE\nS, E\n*CONTACT FILE\nCDIS, CSTR\n")
+    w("*NODE PRINT, NSET=bone_interface, TOTALS=ONLY\nRF\n")
+    w("*NODE PRINT, NSET=indenter_nodes, TOTALS=ONLY\nRF\n")
+    w("*END STEP\n")
+    if visco and mat.prony.n_terms:
+        log.warning("CalculiX has no Prony viscoelasticity: the deck uses the instantaneous hyperfoam alone")
+    info = {"indenter_nodes": n_ind, "indenter_cells": len(icells), "penalty_mpa_per_mm": float(penalty),
+            "viscoelastic": False, "time_s": T, "depth_mm": depth,
+            "force_factor": (2.0 if halved else 1.0) * (2.0 if zsym else 1.0),
+            "face_size_mm": h_face, "face_chord_error_mm": max_chord_error(face, ind)}
+    return Deck(fh.getvalue(), "calculix", n_nodes, n_cells, etype, info)
