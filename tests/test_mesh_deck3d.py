@@ -1,0 +1,180 @@
+"""The 3D CalculiX deck (mesh.deck3d) and the meshed indenter face (mesh.indenter3d): element
+counts, node order (positive isoparametric volumes that add up to the mesh's), sets, surfaces,
+supports as the 3D solver applies them, and the indenter face on the kind's exact surface.
+No CalculiX needed (benchmarks/calculix_compare3d.py runs ccx)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.indenters import indenter_for_scene
+from tactileskin.mesh import build_mesh
+from tactileskin.mesh.deck import FACES, _num, deck_text, parse_deck, undefined_names
+from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
+from tactileskin.scene import Scene
+
+
+@pytest.fixture(scope="module")
+def braille():
+    sc = Scene(thickness=1.0, material="polyurethane", indenter="braille", dim=3, viscoelastic=False,
+               mesh_size=1.6, refinement=8.0)
+    sm = build_mesh(sc)
+    return sc, sm, deck_text(sc, sm, "calculix")
+
+
+def _tet10_grad(x):
+    """dN/dxi of C3D10 (corners 1-4, mid-edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4), from the
+    element's definition (independent of scikit-fem)."""
+    L = (1.0 - x.sum(), *x)
+    dl = np.array([[-1.0, -1.0, -1.0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    rows = [(4 * L[i] - 1) * dl[i] for i in range(4)]
+    for i, j in ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)):
+        rows.append(4 * (L[i] * dl[j] + L[j] * dl[i]))
+    return np.array(rows)
+
+
+def _elements(p, etype):
+    ids = sorted(k for k, (t, _) in p["elements"].items() if t == etype)
+    X = np.array([[p["nodes"][n] for n in p["elements"][k][1]] for k in ids])
+    return ids, X
+
+
+def test_c3d10_cells_have_positive_volumes_adding_up_to_the_mesh(braille):
+    from skfem.quadrature import get_quadrature
+    from skfem.refdom import RefTet
+
+    sc, sm, deck = braille
+    p = parse_deck(deck.text)
+    ids, X = _elements(p, "C3D10")
+    assert len(ids) == deck.n_skin_cells == sm.mesh.nelements
+    pts, w = get_quadrature(RefTet, 4)  # det J of a P2 tet is cubic: integrated exactly
+    dets = np.stack([np.linalg.det(np.einsum("kd,ckD->cDd", _tet10_grad(pts[:, q]), X))
+                     for q in range(len(w))], 1)
+    assert np.all(dets > 0.0)  # at every point of every element, curved boundary cells too
+    assert (dets @ w).sum() == pytest.approx(sm.measure(), rel=1e-10)
+
+
+def test_wedges_are_positive_and_their_face_s1_is_the_working_face(braille):
+    sc, sm, deck = braille
+    p = parse_deck(deck.text)
+    ids, X = _elements(p, "C3D6")
+    assert len(ids) == deck.info["indenter_cells"] > 0
+    # C3D6 (Abaqus / ccx): corners 1-2-3 counter-clockwise seen from 4-5-6 = positive volume
+    bot, top = X[:, :3], X[:, 3:]
+    n = np.cross(bot[:, 1] - bot[:, 0], bot[:, 2] - bot[:, 0])
+    assert np.all(np.einsum("ij,ij->i", n, top.mean(1) - bot.mean(1)) > 0.0)
+    assert np.all(n[:, 1] > 0.0)  # S1's outward normal (-n) points down, to the skin
+    ind = indenter_for_scene(sc)
+    x0, x1, z0, z1 = ind.face_box()
+    b = bot.reshape(-1, 3)
+    inside = (b[:, 0] >= x0) & (b[:, 0] <= x1) & (b[:, 2] >= z0) & (b[:, 2] <= z1)
+    assert np.allclose(b[inside, 1], ind.surface_y(b[inside, 0], b[inside, 2]), atol=1e-12, rtol=0)
+    faces = p["surfaces"]["indenter_face"][1]
+    assert {r[1] for r in faces} == {"S1"} and len(faces) == len(ids)
+
+
+def test_sets_surfaces_and_supports_are_the_solvers(braille):
+    sc, sm, deck = braille
+    p = parse_deck(deck.text)
+    assert undefined_names(p) == []
+    assert len(p["nodes"]) == deck.n_skin_nodes + deck.info["indenter_nodes"]
+    for name, facets in sm.boundaries.items():
+        faces = p["surfaces"][f"{name}_faces"][1]
+        assert len(faces) == len(facets)
+        nset = set(p["nsets"][name])
+        # all six nodes of each listed face (corners and C3D10 mid-nodes) are the boundary's:
+        # a wrong mid-node order would name a node off the face
+        mids = {(0, 1, 2): (4, 5, 6), (0, 3, 1): (7, 8, 4), (1, 3, 2): (8, 9, 5), (2, 3, 0): (9, 7, 6)}
+        for e, f in faces:
+            nodes = p["elements"][int(e)][1]
+            loc = FACES["C3D10"][int(f[1:]) - 1]
+            assert {nodes[i] for i in loc + mids[loc]} <= nset
+    # the quarter model: bonded bone and nail fixed, x = 0 and z = 0 symmetry planes, z = 10 free
+    bc = [b for b in p["blocks"] if b[0] == "BOUNDARY" and "AMPLITUDE" not in b[1]]
+    rows = {tuple(r) for b in bc for r in b[2]}
+    assert rows == {("bone_interface", "1", "3"), ("nail_edge", "1", "3"), ("symmetry", "1", "1"),
+                    ("end_back", "3", "3"), ("indenter_nodes", "1", "1"), ("indenter_nodes", "3", "3")}
+    assert sm.z_symmetric and sm.halved and deck.info["force_factor"] == 4.0
+    X = np.array([p["nodes"][n] for n in p["nsets"]["end_back"]])
+    assert np.all(X[:, 2] == 0.0)
+    moved = next(b for b in p["blocks"] if b[0] == "BOUNDARY" and b[1].get("AMPLITUDE") == "travel")
+    assert moved[2] == [["indenter_nodes", "2", "2", _num(-sc.indentation)]]
+    pair = next(b for b in p["blocks"] if b[0] == "CONTACT PAIR")
+    assert pair[1]["TYPE"] == "SURFACE TO SURFACE" and pair[2] == [["outer_surface_faces", "indenter_face"]]
+    mat = p["materials"]["polyurethane"]
+    assert [kw for kw, _, _ in mat] == ["HYPERFOAM"]  # elastic: ccx has no Prony series
+    # every number fits CalculiX's 20-character fields
+    assert all(len(v) <= 20 for kw, _, rows in p["blocks"] if kw != "HEADING" for r in rows for v in r)
+
+
+def test_a_flat_plate_deck_has_no_z_symmetry_only_where_the_mesh_has_none():
+    sc = Scene(thickness=1.0, material="polyurethane", indenter="flat", dim=3, mesh_size=1.6, refinement=2.0)
+    sm = build_mesh(sc, mesh_size=2.5, refinement=2.0)
+    deck = deck_text(sc, sm, "calculix")
+    p = parse_deck(deck.text)
+    assert undefined_names(p) == []
+    ids, X = _elements(p, "C3D6")
+    assert np.all(X[:, :3, 1] == indenter_for_scene(sc).y0)  # the plane y = y0 at zero travel
+    assert deck.info["face_chord_error_mm"] < 1e-12
+    # the face covers the skin with 1 mm to spare on every side
+    Xs = sm.mesh.doflocs
+    assert X[:, :, 0].min() == pytest.approx(Xs[0].min() - 1.0) and X[:, :, 2].max() == pytest.approx(Xs[2].max() + 1.0)
+    from tactileskin.mesh.slab3d import build_slab_mesh
+
+    whole = build_slab_mesh(sc, mesh_size=2.5, refinement=2.0, use_z_symmetry=False)
+    d2 = deck_text(sc, whole, "calculix")
+    assert "end_back, 3, 3" not in d2.text and d2.info["force_factor"] == 2.0
+    assert "end_back, 3, 3" in deck.text
+
+
+def test_braille_face_follows_the_caps_within_microns():
+    sc = Scene(thickness=1.0, indenter="braille", dim=3)
+    ind = indenter_for_scene(sc)
+    face = indenter_face(ind, (-1.0, 8.0, -1.0, 11.0), 1.6)
+    err = max_chord_error(face, ind)
+    assert 0.0 < err < 5e-3  # mm, measured vertically (the rim is steep: slope 2.4)
+    a = 0.5 * ind.standard.base_diameter
+    r = np.hypot(face.points[:, 0], face.points[:, 2])
+    assert np.sum(np.isclose(r, a, atol=1e-9)) >= 24  # the base circle is a line of nodes (the kink)
+    # no facet straddles the rim: each lies on the cap or on the plate
+    rt = r[face.tris]
+    assert not np.any((rt.min(1) < a - 1e-9) & (rt.max(1) > a + 1e-9))
+    n = np.cross(*(face.points[face.tris[:, k]] - face.points[face.tris[:, 0]] for k in (1, 2)))
+    assert np.all(n[:, 1] < 0.0)
+    pts, cells = wedge_cells(face, 0.5)
+    assert cells.shape == (len(face.tris), 6) and np.allclose(pts[len(face.points):, 1] - face.points[:, 1], 0.5)
+
+
+def test_bad_requests_raise_typed_errors(braille):
+    sc, sm, _ = braille
+    with pytest.raises(ParameterError, match="dialect"):
+        deck_text(sc, sm, "abaqus")
+    with pytest.raises(ParameterError, match="penalty"):
+        deck_text(sc, sm, "calculix", penalty=-1.0)
+    ind = indenter_for_scene(Scene(indenter="sphere", indenter_radius=2.0, dim=3))
+    with pytest.raises(ParameterError, match="indenter"):
+        indenter_face(ind, (0, 1, 0, 1), 0.5)
+    with pytest.raises(ParameterError, match="box"):
+        indenter_face(indenter_for_scene(sc), (1, 0, 0, 1), 0.5)
+
+
+def test_numbers_fit_calculix_fields():
+    for v in (-1.0000245733392007e-14, 1.2345678901234567e-4, -3.5790351206165774, 7.0, 0.0, -1.5e-300):
+        s = _num(v)
+        assert len(s) <= 20 and float(s) == pytest.approx(v, rel=1e-12, abs=0)
+    assert _num(-3.5790351206165774) == repr(-3.5790351206165774)  # exact where it fits
+
+
+def test_cli_exports_a_3d_calculix_deck(tmp_path, capsys):
+    from tactileskin.cli import main
+
+    out = tmp_path / "slab.inp"
+    args = ["export", "--dim", "3", "-t", "1", "-m", "polyurethane", "-i", "braille", "--mesh-size", "1.6",
+            "--refinement", "8", "--elastic", "-o", str(out)]
+    assert main(args) == 0  # the dialect defaults to calculix in 3D
+    said = capsys.readouterr().out
+    assert "C3D10" in said and "C3D6" in said and "calculix" in said
+    p = parse_deck(out.read_text())
+    assert undefined_names(p) == [] and "indenter_face" in p["surfaces"]
