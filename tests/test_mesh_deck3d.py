@@ -178,3 +178,38 @@ def test_cli_exports_a_3d_calculix_deck(tmp_path, capsys):
     assert "C3D10" in said and "C3D6" in said and "calculix" in said
     p = parse_deck(out.read_text())
     assert undefined_names(p) == [] and "indenter_face" in p["surfaces"]
+
+
+def _benchmark():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "calculix_compare3d.py"
+    spec = importlib.util.spec_from_file_location("calculix_compare3d", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_benchmark_without_ccx_says_so_and_writes_nothing(tmp_path, monkeypatch, capsys):
+    bench = _benchmark()
+    monkeypatch.setattr(bench.shutil, "which", lambda name: None)
+    out = tmp_path / "cmp.md"
+    assert bench.main(["--case", "braille:1", "--out", str(out)]) == 2
+    assert "calculix-ccx" in capsys.readouterr().err
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_benchmark_reads_the_last_integration_point_block(tmp_path):
+    dat = tmp_path / "job.dat"
+    dat.write_text(
+        "\n stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set SKIN and time  0.1\n\n"
+        "         1   1  1.0 2.0 3.0 0.0 0.0 0.0\n         1   2  9.0 9.0 9.0 0.0 0.0 0.0\n"
+        "\n stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set SKIN and time  0.2\n\n"
+        "         1   1 -1.0E-01 -2.0E-01 -3.0E-01 0.0 0.0 0.0\n"
+        "         1   2 -4.0E-01 -5.0E-01 -6.0E-01 0.0 0.0 0.0\n"
+        "         2   1  1.5 2.5 3.5 0.0 0.0 0.0\n"
+        "\n total force (fx,fy,fz) for set INDENTER_NODES and time  0.2\n\n  1.0 2.0 3.0\n")
+    ip = _benchmark().read_dat_elstress(dat)
+    assert sorted(ip) == [1, 2] and ip[1].shape == (2, 6)
+    assert np.allclose(ip[1][:, :3], [[-0.1, -0.2, -0.3], [-0.4, -0.5, -0.6]]) and np.allclose(ip[2][0, :3], [1.5, 2.5, 3.5])
