@@ -44,7 +44,7 @@ from tactileskin import fileio  # noqa: E402
 from tactileskin.fe.recovery import PointFit  # noqa: E402
 from tactileskin.materials import get_material  # noqa: E402
 from tactileskin.mesh import build_mesh  # noqa: E402
-from tactileskin.mesh.deck import deck_text  # noqa: E402
+from tactileskin.mesh.deck3d import deck_text_3d  # noqa: E402
 from tactileskin.mesh.skinmesh import facet_nodes  # noqa: E402
 from tactileskin.planner import with_quality  # noqa: E402
 from tactileskin.scene import Scene  # noqa: E402
@@ -150,12 +150,14 @@ def reference(scene, fresh: bool) -> dict:
     return row
 
 
-def compare(scene, penalty_factors: list[float], fresh: bool, timeout: float, cached: bool = False) -> list[dict]:
+def compare(scene, penalty_factors: list[float], fresh: bool, timeout: float, cached: bool = False,
+            cap_size: float | None = None) -> list[dict]:
+    raw = lambda f: _raw(scene, f, cap_size)  # noqa: E731
     if cached:
-        return [json.loads(_raw(scene, f).read_text()) for f in penalty_factors if _raw(scene, f).exists()]
-    todo = [f for f in penalty_factors if fresh or not _raw(scene, f).exists()]
+        return [json.loads(raw(f).read_text()) for f in penalty_factors if raw(f).exists()]
+    todo = [f for f in penalty_factors if fresh or not raw(f).exists()]
     if not todo:
-        return [json.loads(_raw(scene, f).read_text()) for f in penalty_factors]
+        return [json.loads(raw(f).read_text()) for f in penalty_factors]
     sm = build_mesh(scene)
     hf = get_material(scene.material).hyperfoam
     h = float(sm.sizes["fine"])
@@ -171,7 +173,7 @@ def compare(scene, penalty_factors: list[float], fresh: bool, timeout: float, ca
 
     ts, rows = {}, []
     for f in todo:
-        deck = deck_text(scene, sm, "calculix", penalty=f * max(hf.K0, hf.mu0) / h)
+        deck = deck_text_3d(scene, sm, penalty=f * max(hf.K0, hf.mu0) / h, cap_size=cap_size)
         text = deck.text.replace("*END STEP\n", "*EL PRINT, ELSET=skin\nS\n*END STEP\n")
         work = Path(tempfile.mkdtemp(prefix="tsk_ccx3d_"))
         proc = None
@@ -182,20 +184,22 @@ def compare(scene, penalty_factors: list[float], fresh: bool, timeout: float, ca
                     ts[form] = ts_solve(scene.replace(formulation=form), sm)
             ccx = finish_ccx(proc, t0, work, timeout)
             row = _row(scene, sm, deck, work, ccx, f, ts, plane, s_nodes, bone_cells)
+            row["cap_size_mm"] = cap_size
         finally:
             if proc is not None and proc.poll() is None:
                 proc.kill()
                 proc.wait()
             shutil.rmtree(work, ignore_errors=True)
         RAW.mkdir(parents=True, exist_ok=True)
-        fileio.atomic_write_text(_raw(scene, f), json.dumps(row, indent=1))
+        fileio.atomic_write_text(raw(f), json.dumps(row, indent=1))
         rows.append(row)
     done = {r["penalty_factor"]: r for r in rows}
-    return [done[f] if f in done else json.loads(_raw(scene, f).read_text()) for f in penalty_factors]
+    return [done[f] if f in done else json.loads(raw(f).read_text()) for f in penalty_factors]
 
 
-def _raw(scene, factor: float) -> Path:
-    return RAW / f"{scene.label()}_{scene.mesh_size:g}-{scene.refinement:g}_p{factor:g}.json"
+def _raw(scene, factor: float, cap_size: float | None = None) -> Path:
+    cap = f"_cap{cap_size:g}" if cap_size else ""
+    return RAW / f"{scene.label()}_{scene.mesh_size:g}-{scene.refinement:g}_p{factor:g}{cap}.json"
 
 
 def _row(scene, sm, deck, work, ccx, factor, ts, plane, s_nodes, bone_cells) -> dict:
@@ -286,7 +290,8 @@ def markdown(rows: list[dict], cmd: str, refs: list[dict] = ()) -> str:
          "|---|---|---|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         c = r["ccx"]
-        L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells, {r['dofs']} dofs | CalculiX, penalty "
+        cap = f", cap facets {r['cap_size_mm']:g} mm" if r.get("cap_size_mm") else ""
+        L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells, {r['dofs']} dofs | CalculiX{cap}, penalty "
                  f"{r['penalty']:.0f} MPa/mm ({r['penalty_factor']:g} K0/h), penetration "
                  f"{c['penetration_mm'] * 1e3:.2f} um = {100 * c['penetration_mm'] / r['depth']:.2f} % of the travel "
                  f"| {c['peak']:.4f} at s = {c['peak_s']:.2f} | {c['force']:.4f} | - | "
@@ -361,6 +366,8 @@ def main(argv=None) -> int:
                     help="finer meshes solved by tactileskin alone (mixed): the converged peak and force")
     ap.add_argument("--penalty-factor", type=float, nargs="+", default=[10.0],
                     help="CalculiX contact slope in units of K0 / h_fine")
+    ap.add_argument("--cap-size", type=float, default=None,
+                    help="facet size (mm) on the Braille caps of the ccx indenter (default mesh.indenter3d's)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per ccx run")
     ap.add_argument("--fresh", action="store_true", help="solve again what raw_calculix3d/ holds")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -374,7 +381,7 @@ def main(argv=None) -> int:
         parts = case.split(":")
         kind, t, mesh = parts[0], (parts[1:2] or ["1"])[0], (parts[2:3] or [""])[0]
         rows += compare(make_scene(kind, float(t), a.quality, mesh or a.mesh), a.penalty_factor, a.fresh,
-                        a.timeout, a.cached)
+                        a.timeout, a.cached, a.cap_size)
         for m in a.reference:  # KIND:SIZE/REF for one indenter, SIZE/REF for every case
             k, _, m = m.rpartition(":")
             if k in ("", kind) and not any(r["scene"] == make_scene(kind, float(t), a.quality, m).label()

@@ -45,10 +45,11 @@ def footprint(skinmesh, margin: float = 1.0) -> tuple[float, float, float, float
 
 
 def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: int = 20,
-                 face_size: float | None = None, viscoelastic: bool | None = None):
+                 face_size: float | None = None, cap_size: float | None = None,
+                 viscoelastic: bool | None = None):
     """The CalculiX deck of a 3D scene on its mesh (a deck.Deck). face_size: indenter facet
     size away from the Braille caps (default the skin's coarse size: a plane is exact at any
-    size); penalty, increments: as deck.deck_text."""
+    size); cap_size: on the caps (default indenter3d's); penalty, increments: as deck.deck_text."""
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.materials import get_material
     from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, boundary_faces, material_lines
@@ -70,7 +71,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
         penalty = 10.0 * max(hf.K0, hf.mu0) / h_fine
     if not (isinstance(penalty, (int, float)) and np.isfinite(penalty) and penalty > 0):
         raise ParameterError("penalty", penalty, "a positive contact stiffness (MPa/mm)")
-    face = indenter_face(ind, footprint(skinmesh), h_face)
+    face = indenter_face(ind, footprint(skinmesh), h_face, cap_size)
     ipts, icells = wedge_cells(face, WEDGE_HEIGHT)
     halved, zsym = bool(skinmesh.halved), bool(getattr(skinmesh, "z_symmetric", False))
 
