@@ -213,3 +213,14 @@ def test_benchmark_reads_the_last_integration_point_block(tmp_path):
     ip = _benchmark().read_dat_elstress(dat)
     assert sorted(ip) == [1, 2] and ip[1].shape == (2, 6)
     assert np.allclose(ip[1][:, :3], [[-0.1, -0.2, -0.3], [-0.4, -0.5, -0.6]]) and np.allclose(ip[2][0, :3], [1.5, 2.5, 3.5])
+
+
+def test_a_dot_cut_by_the_footprint_stays_inside_it():
+    """A footprint box that cuts a dot's base circle (a slab narrower than the text) keeps
+    the face inside the box, the cut cap included."""
+    sc = Scene(thickness=1.0, indenter="braille", dim=3)
+    ind = indenter_for_scene(sc)
+    face = indenter_face(ind, (0.3, 3.0, -2.0, 2.0), 0.5)  # the dot at x = 0 is cut at x = 0.3
+    assert face.points[:, 0].min() == pytest.approx(0.3) and face.points[:, 0].max() == pytest.approx(3.0)
+    on_cap = np.hypot(face.points[:, 0], face.points[:, 2]) < 0.5 * ind.standard.base_diameter - 1e-9
+    assert on_cap.any() and max_chord_error(face, ind) < 5e-3

@@ -77,6 +77,11 @@ def indenter_face(indenter, box: tuple[float, float, float, float], h: float,
         disks = [occ.addDisk(cx, cz, 0.0, a, a) for cx, cz, a in dots]
         if disks:  # the base circles become edges of the face's triangulation (the kink)
             occ.fragment([(2, rect)], [(2, d) for d in disks])
+            # a disk crossing the box edge leaves a piece outside it: not part of the face
+            outside = [(2, t) for _, t in occ.getEntities(2)
+                       if not (x0 <= occ.getCenterOfMass(2, t)[0] <= x1 and z0 <= occ.getCenterOfMass(2, t)[1] <= z1)]
+            if outside:
+                occ.remove(outside, recursive=True)
         occ.synchronize()
         fields = []
         fld = gmsh.model.mesh.field
