@@ -153,8 +153,10 @@ def reference(scene, fresh: bool) -> dict:
 def compare(scene, penalty_factors: list[float], fresh: bool, timeout: float, cached: bool = False,
             cap_size: float | None = None) -> list[dict]:
     raw = lambda f: _raw(scene, f, cap_size)  # noqa: E731
-    if cached:
-        return [json.loads(raw(f).read_text()) for f in penalty_factors if raw(f).exists()]
+    if cached:  # every cap size held for each penalty
+        stem = lambda f: _raw(scene, f).stem  # noqa: E731
+        return [json.loads(q.read_text()) for f in penalty_factors
+                for q in sorted(RAW.glob(stem(f) + "*.json")) if q.stem == stem(f) or q.stem.startswith(stem(f) + "_cap")]
     todo = [f for f in penalty_factors if fresh or not raw(f).exists()]
     if not todo:
         return [json.loads(raw(f).read_text()) for f in penalty_factors]
@@ -290,7 +292,8 @@ def markdown(rows: list[dict], cmd: str, refs: list[dict] = ()) -> str:
          "|---|---|---|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         c = r["ccx"]
-        cap = f", cap facets {r['cap_size_mm']:g} mm" if r.get("cap_size_mm") else ""
+        cap = (f" (cap facets {r['cap_size_mm']:g} mm, " if r.get("cap_size_mm") else " (") + \
+            f"face <= {r['face_chord_um']:.1f} um off the dot)" if "braille" in r["scene"] else ""
         L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells, {r['dofs']} dofs | CalculiX{cap}, penalty "
                  f"{r['penalty']:.0f} MPa/mm ({r['penalty_factor']:g} K0/h), penetration "
                  f"{c['penetration_mm'] * 1e3:.2f} um = {100 * c['penetration_mm'] / r['depth']:.2f} % of the travel "
