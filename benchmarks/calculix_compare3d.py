@@ -277,7 +277,7 @@ def _pct(a: float, b: float) -> str:
 def markdown(rows: list[dict], cmd: str, refs: list[dict] = ()) -> str:
     L = ["# tactileskin 3D vs CalculiX (ccx 2.20) on the same tetrahedral mesh", "",
          f"Command: `{cmd}` (CPU seconds of each process; ccx with OMP_NUM_THREADS=1, spooles; "
-         "tactileskin one thread).", "",
+         "tactileskin with its default threads, all counted).", "",
          "Polyurethane, 20 % nominal strain at 1 mm/s, elastic (instantaneous hyperfoam; ccx has no "
          "Prony series), quarter model (x >= 0, z >= 0; end z = 10 mm free). Same P2 tetrahedra: "
          "tactileskin solves them as is, ccx as C3D10 (4 integration points, displacement "

@@ -226,3 +226,15 @@ def test_a_dot_cut_by_the_footprint_stays_inside_it():
     assert face.points[:, 0].min() == pytest.approx(0.3) and face.points[:, 0].max() == pytest.approx(3.0)
     on_cap = np.hypot(face.points[:, 0], face.points[:, 2]) < 0.5 * ind.standard.base_diameter - 1e-9
     assert on_cap.any() and max_chord_error(face, ind) < 5e-3
+
+
+def test_default_penalty_is_forty_k0_over_h(braille):
+    """At 10 K0/h (the 2D default) ccx let the t = 1 plate penetrate 3.5 % of the travel."""
+    from tactileskin.materials import get_material
+
+    sc, sm, deck = braille
+    hf = get_material(sc.material).hyperfoam
+    assert deck.info["penalty_mpa_per_mm"] == pytest.approx(40.0 * max(hf.K0, hf.mu0) / sm.sizes["fine"])
+    p = parse_deck(deck.text)
+    slope = next(rows for kw, _, rows in p["blocks"] if kw == "SURFACE BEHAVIOR")
+    assert float(slope[0][0]) == pytest.approx(deck.info["penalty_mpa_per_mm"])

@@ -14,7 +14,9 @@
   (a rigid translation without *RIGID BODY, as the 2D CalculiX deck does); the face
   extends 1 mm past the skin on every side, like the solver's unbounded analytic indenter;
 - frictionless surface-to-surface contact, skin outer surface slave, indenter face master,
-  linear penalty `penalty` MPa/mm (default 10 K0 / h_fine, as in 2D);
+  linear penalty `penalty` MPa/mm (default 40 K0 / h_fine: at 2D's 10 K0 / h ccx let the t = 1 mm
+  plate penetrate 3.5 % of the travel and read 5.6 % low in bone pressure; 40 and 160 converged
+  on every 3D case run, benchmarks/results/calculix_compare3d.md);
 - one NLGEOM *STATIC step from zero to the full travel over the scene's ramp time.
 
 Forces in the .dat totals are those of the modelled part (a quarter for a flat plate or a
@@ -35,6 +37,7 @@ from tactileskin.errors import ParameterError
 log = logging.getLogger(__name__)
 
 WEDGE_HEIGHT = 0.5  # mm: thickness of the indenter's wedge layer (its nodes are all prescribed)
+PENALTY_FACTOR = 40.0  # default contact slope in K0 / h_fine (module docstring)
 
 
 def footprint(skinmesh, margin: float = 1.0) -> tuple[float, float, float, float]:
@@ -49,7 +52,8 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
                  viscoelastic: bool | None = None):
     """The CalculiX deck of a 3D scene on its mesh (a deck.Deck). face_size: indenter facet
     size away from the Braille caps (default the skin's coarse size: a plane is exact at any
-    size); cap_size: on the caps (default indenter3d's); penalty, increments: as deck.deck_text."""
+    size); cap_size: on the caps (default indenter3d's); penalty (MPa/mm): default
+    PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.materials import get_material
     from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, boundary_faces, material_lines
@@ -68,7 +72,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     h_face = float(face_size if face_size is not None else skinmesh.sizes.get("coarse", scene.mesh_size))
     hf = mat.hyperfoam
     if penalty is None:
-        penalty = 10.0 * max(hf.K0, hf.mu0) / h_fine
+        penalty = PENALTY_FACTOR * max(hf.K0, hf.mu0) / h_fine
     if not (isinstance(penalty, (int, float)) and np.isfinite(penalty) and penalty > 0):
         raise ParameterError("penalty", penalty, "a positive contact stiffness (MPa/mm)")
     face = indenter_face(ind, footprint(skinmesh), h_face, cap_size)
