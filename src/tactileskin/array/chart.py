@@ -165,6 +165,13 @@ class ChartConfig:
             if not isinstance(getattr(self, name), str) or getattr(self, name) not in choices:
                 raise ParameterError(name, getattr(self, name), " or ".join(choices))
         check_range("sphere_radius", self.sphere_radius, 0.1, 1000.0, lo_open=True, unit="mm")  # the sphere kind's range
+        if self.max_depth is not None:
+            set_("max_depth", check_range("max_depth", self.max_depth, 0.0, lo_open=True,
+                                          unit="mm (or none: 20 % of t)"))
+        for name, rng, unit in (("mesh_size", MESH_SIZE, "mm"), ("refinement", REFINEMENT, "")):
+            if getattr(self, name) is not None:  # the Scene's ranges, named by the chart's key
+                set_(name, check_range(name, getattr(self, name), *rng, unit=unit))
+        validate.string(self.standard, "standard", "a Braille standard name")
         if "shapes" in self.sets:  # the ball presses within its cap (indenters.sphere.CAP), at every thickness
             from tactileskin.geometry.indenters.sphere import CAP
             from tactileskin.scene import Scene
@@ -174,13 +181,6 @@ class ChartConfig:
                 raise ParameterError("sphere_radius", self.sphere_radius,
                                      f">= {deepest / CAP:.3g} mm for the chart's deepest press ({deepest:g} mm; "
                                      f"the ball's working cap is {CAP:g} R high)", "or a smaller --max-depth")
-        if self.max_depth is not None:
-            set_("max_depth", check_range("max_depth", self.max_depth, 0.0, lo_open=True,
-                                          unit="mm (or none: 20 % of t)"))
-        for name, rng, unit in (("mesh_size", MESH_SIZE, "mm"), ("refinement", REFINEMENT, "")):
-            if getattr(self, name) is not None:  # the Scene's ranges, named by the chart's key
-                set_(name, check_range(name, getattr(self, name), *rng, unit=unit))
-        validate.string(self.standard, "standard", "a Braille standard name")
         try:
             get_standard(self.standard)
         except ParameterError as e:
