@@ -255,7 +255,7 @@ def _start_near_first_touch(scene, model) -> None:
     if scene.skin == "file" or not isinstance(getattr(model.contact, "indenter", None), BrailleIndenter):
         return
     touch = first_contact_travel(scene)
-    if model.contact is None or touch <= 1e-3 or touch >= scene.indentation:
+    if touch <= 1e-3 or touch >= scene.indentation:
         return
     model.t = START_BEFORE_TOUCH * touch / model.contact.rate
     model.d = model.travel(model.t)

@@ -15,8 +15,9 @@ around the unchanged displacement-controlled increment solve. Why not the border
 bordered Newton the force equation inherits the active-set and multiplier kinks of the
 contact (its derivative jumps as points enter contact) and a diverging iterate would need
 the safeguards redone for d. F(d) is monotone for a stable skin, so a bracketed scalar
-root is safe, and the secant slope of the last increment predicts the next travel: on the
-2D coarse meshes 2-4 trial solves per increment (stats force_trials).
+root is safe; the secant is taken in log-log (a contact's F ~ d^p) and the committed states
+predict the next travel: 3-4 trial solves per increment at `preview`, 2D and 3D (stats
+force_trials; benchmarks/results/force_control.md).
 """
 
 from __future__ import annotations
