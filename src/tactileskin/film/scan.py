@@ -360,7 +360,8 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                         f"maximum, below the activation range's top ({hi:g} {cal.unit}); the pressure there "
                         "is a lower bound (calibrate to higher pressures)")
     across = _variation(pmap)
-    if across_other is not None and across > AXIS_CV and across > AXIS_RATIO * across_other:
+    wrong_axis = across_other is not None and across > AXIS_CV and across > AXIS_RATIO * across_other
+    if wrong_axis:
         other = "y" if axis == "x" else "x"
         warnings.append(f"the pressure varies across the strip by {across:.0%} of its mean, across a strip along "
                         f"{other} by {across_other:.0%}: the strip seems to run along {other}; try --axis {other}")
@@ -378,8 +379,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         origin = centre
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
-    wrong_axis = any("try --axis" in w for w in warnings)  # the root cause, said already
-    if asym > ASYMMETRY and not wrong_axis:
+    if asym > ASYMMETRY and not wrong_axis:  # a wrong axis is the root cause, said already
         hint = ""
         if centre != "midspan":
             other = fold_profile(x_mm - _midspan_position(x_mm, prof), prof)[2]
