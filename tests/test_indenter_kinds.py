@@ -268,3 +268,17 @@ def test_a_sphere_is_pressed_within_its_printed_cap():
     with pytest.raises(ParameterError, match=r"sphere_radius=0\.5 .*>= 1\.05 mm"):
         ChartConfig(thicknesses=(5.0,), sets=("shapes",), sphere_radius=0.5)
     ChartConfig(thicknesses=(5.0,), sets=("shapes",), sphere_radius=0.5, max_depth=0.4)
+
+
+def test_a_force_past_the_spheres_cap_is_flagged():
+    # force control finds the travel only in the solve (measured: R 0.5 on 1 mm silicone at 6x
+    # the 0.25 mm reaction went to 0.521 mm, past the 0.475 mm cap, and read "ok")
+    from tactileskin import quality
+
+    ball = indenter_for_scene(Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=1.0, depth=0.1))
+    assert ball.working_depth == pytest.approx(0.475)
+    assert indenter_for_scene(Scene(indenter="flat")).working_depth == float("inf")
+    normal = {"peak_mpa": 0.1, "reaction_n": 0.3, "contact_points": 10}
+    assert quality.flags(normal) == []
+    found = quality.flags({**normal, "indenter_cap": {"travel_mm": 0.521, "cap_mm": 0.475}})
+    assert [f.code for f in found] == ["indenter_cap"] and "0.521 mm" in found[0].reason

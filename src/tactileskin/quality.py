@@ -44,7 +44,7 @@ COARSE_GLOBAL = 2.0
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "mirrored_x" | "mirrored_z" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "mirrored_x" | "mirrored_z" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -75,7 +75,7 @@ def flags(summary: dict) -> list[Flag]:
     Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
     material_nu0, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm),
     profile_plane_from_map / profile_plane_unknown with peak_map_edge_* and profile_plane_z,
-    mirrored_x, mirrored_z (a
+    indenter_cap, mirrored_x, mirrored_z (a
     key that is missing is not checked; a non-finite value is flagged).
     """
     out = []
@@ -133,6 +133,12 @@ def flags(summary: dict) -> list[Flag]:
                         "within one skin thickness of where the bonded skin ends: a corner singularity that "
                         f"grows with mesh refinement; the interior peak is {pi:.4g} MPa at s = "
                         f"{_num(summary, 'peak_interior_s_mm'):g} mm"))
+    cap = summary.get("indenter_cap")
+    if isinstance(cap, dict):
+        out.append(Flag("indenter_cap", f"the indenter travelled {_num(cap, 'travel_mm') or math.nan:.3g} mm, past its printed "
+                        f"working face ({_num(cap, 'cap_mm') or math.nan:.3g} mm: a sphere's cap is 0.95 R high, its mount "
+                        "plate starts there): the printed part would press with its mount, and the model's skin "
+                        "wraps round the ball; use a larger radius or a smaller force"))
     if summary.get("mirrored_x"):
         out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
                         "half x >= 0: the result is that of the indenter and its mirror image together "

@@ -32,6 +32,7 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
 from __future__ import annotations
 
 import contextlib
+import math
 import logging
 import os
 import time
@@ -169,12 +170,14 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     peak_of = bone_peak(model) if multi else None
     best = {}
     done = [0]  # segments finished (the next one is the one running)
+    deepest = [0.0]  # the largest travel of any increment (a creep hold sinks past the peak load's)
     last = {}  # the last converged increment's travel and reaction
     worst = {}  # the material law's extremes over every increment (a creep hold or a second
     # ramp can go beyond the peak-load state's: tactileskin.quality flags them)
 
     def record(model, ev):
         last.update(d=float(model.d), reaction=float(indenter_force(model, ev)))
+        deepest[0] = max(deepest[0], float(model.d))
         for k, v in law_state(ev, model.stress(ev)).items():
             worst[k] = v if k not in worst else (min if k == "min_J" else max)(worst[k], v)
         out = {"peak_mpa": peak_of(ev)} if peak_of is not None else {}
@@ -217,6 +220,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         res.stats[k] = getattr(stats, k)
     for k, v in worst.items():
         res.stats[k] = min(res.stats[k], v) if k == "min_J" else max(res.stats[k], v)
+    res.stats["max_travel_mm"] = deepest[0]
     if history and res.fields is not None:
         res.fields["steps"] = [(float(h["t"]), np.asarray(h["displacement"], float)) for h in hist
                                if "displacement" in h and "t" in h]
@@ -338,6 +342,10 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
     if getattr(model, "_linsolve", None) is not None:
         res.stats["linear_solver"] = model._linsolve.describe()
+    cap = getattr(getattr(model.contact, "indenter", None), "working_depth", math.inf)
+    travel = res.stats.get("max_travel_mm", float(model.d))
+    if travel > cap:  # a force or a creep took the indenter past its printed working face
+        res.stats["indenter_cap"] = {"travel_mm": travel, "cap_mm": float(cap)}
     if sm.halved and mirrored_x(scene):
         res.stats["mirrored_x"] = True
     if getattr(sm, "z_symmetric", False) and not indenter_symmetry(scene)[1]:  # a file's symmetry_z

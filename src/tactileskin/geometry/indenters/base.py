@@ -169,6 +169,12 @@ class Indenter:
         Braille base plate past the dot height); 0: none does."""
         return 0.0
 
+    @property
+    def working_depth(self) -> float:
+        """Travel (mm) beyond which the printed part would press with more than the modelled
+        face (its mount); inf where the model is the whole part."""
+        return float("inf")
+
     def contact_planes(self) -> np.ndarray:
         """z planes on which the first touch is sought in 3D (the slab is uniform along z)."""
         return np.zeros(1)

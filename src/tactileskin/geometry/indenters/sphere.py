@@ -64,6 +64,10 @@ class SphereIndenter(Indenter):
     def tip_radius(self) -> float:
         return float(self.radius)
 
+    @property
+    def working_depth(self) -> float:
+        return CAP * float(self.radius)
+
     def centre(self, d: float = 0.0) -> np.ndarray:
         return np.array([0.0, self.y0 + self.radius - d, 0.0])
 
