@@ -205,6 +205,26 @@ def indenter_strip(indenter, x_lo: float, x_hi: float, h: float, height: float =
 
 # --- the deck -----------------------------------------------------------------------------
 
+def skin_mesh_lines(fh, skinmesh, points: np.ndarray, cells: np.ndarray, etype: str, dim: int) -> None:
+    """The node lines (after a *NODE keyword: every point, numbered from 1), the skin's
+    *ELEMENT block, and an *NSET and a face *SURFACE for each named boundary."""
+    from tactileskin.mesh.skinmesh import facet_nodes
+
+    w = fh.write
+    for i, p in enumerate(points):
+        w(f"{i + 1}, " + ", ".join(_num(v) for v in p[:dim]) + "\n")
+    w(f"*ELEMENT, TYPE={etype}, ELSET=skin\n")
+    for i, c in enumerate(cells):
+        w(f"{i + 1}, " + ", ".join(str(int(v) + 1) for v in c) + "\n")
+    for name, facets in skinmesh.boundaries.items():
+        nodes = np.unique(facet_nodes(skinmesh.mesh, facets, dim, skinmesh.order))
+        w(f"*NSET, NSET={name}\n")
+        _rows(fh, nodes + 1)
+        w(f"*SURFACE, TYPE=ELEMENT, NAME={name}_faces\n")
+        for e, f in boundary_faces(skinmesh, cells, etype, facets):
+            w(f"{e + 1}, S{f}\n")
+
+
 def _rows(fh, values, per_line: int = 16, fmt=str) -> None:
     values = list(values)
     for i in range(0, len(values), per_line):
@@ -327,20 +347,7 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     else:
         ipts, icells = indenter_strip(ind, x_lo, x_hi, h_fine)
     w("*NODE\n")
-    for i, p in enumerate(np.concatenate([pts, ipts])):
-        w(f"{i + 1}, {_num(p[0])}, {_num(p[1])}\n")
-    w(f"*ELEMENT, TYPE={etype}, ELSET=skin\n")
-    for i, c in enumerate(cells):
-        w(f"{i + 1}, " + ", ".join(str(int(v) + 1) for v in c) + "\n")
-    from tactileskin.mesh.skinmesh import facet_nodes
-
-    for name, facets in skinmesh.boundaries.items():
-        nodes = np.unique(facet_nodes(skinmesh.mesh, facets, 2, skinmesh.order))
-        w(f"*NSET, NSET={name}\n")
-        _rows(fh, nodes + 1)
-        w(f"*SURFACE, TYPE=ELEMENT, NAME={name}_faces\n")
-        for e, f in boundary_faces(skinmesh, cells, etype, facets):
-            w(f"{e + 1}, S{f}\n")
+    skin_mesh_lines(fh, skinmesh, np.concatenate([pts, ipts]), cells, etype, 2)
     mname = _name(mat.name)
     w(material_lines(mat, viscoelastic=visco, dialect=dialect))
     w(f"*SOLID SECTION, ELSET=skin, MATERIAL={mname}\n1.\n")

@@ -56,9 +56,8 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.materials import get_material
-    from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, boundary_faces, material_lines
+    from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, material_lines, skin_mesh_lines
     from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
-    from tactileskin.mesh.skinmesh import facet_nodes
 
     if skinmesh.dim != 3:
         raise ParameterError("mesh", f"{skinmesh.dim}D", "a 3D skin mesh for a 3D deck")
@@ -84,18 +83,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     w("*HEADING\n")
     w(f"tactileskin {scene.label()}: 3D, units mm s N MPa (calculix)\n")
     w("**\n** Skin: C3D10; then the indenter's wedge nodes\n*NODE\n")
-    for i, p in enumerate(np.concatenate([pts, ipts])):
-        w(f"{i + 1}, {_num(p[0])}, {_num(p[1])}, {_num(p[2])}\n")
-    w(f"*ELEMENT, TYPE={etype}, ELSET=skin\n")
-    for i, c in enumerate(cells):
-        w(f"{i + 1}, " + ", ".join(str(int(v) + 1) for v in c) + "\n")
-    for name, facets in skinmesh.boundaries.items():
-        nodes = np.unique(facet_nodes(skinmesh.mesh, facets, 3, skinmesh.order))
-        w(f"*NSET, NSET={name}\n")
-        _rows(fh, nodes + 1)
-        w(f"*SURFACE, TYPE=ELEMENT, NAME={name}_faces\n")
-        for e, f in boundary_faces(skinmesh, cells, etype, facets):
-            w(f"{e + 1}, S{f}\n")
+    skin_mesh_lines(fh, skinmesh, np.concatenate([pts, ipts]), cells, etype, 3)
     w(material_lines(mat, viscoelastic=False, dialect="calculix"))
     w(f"*SOLID SECTION, ELSET=skin, MATERIAL={_name(mat.name)}\n")
 
