@@ -17,6 +17,7 @@ from tactileskin.mesh.deck import (FACES, _FLIP, abaqus_cells, analytic_segments
                                    segment_points, undefined_names)
 from tactileskin.mesh.skinmesh import SkinMesh
 from tactileskin.scene import Scene
+from mesh_probe import c3d10_grad
 
 
 @pytest.fixture(scope="module")
@@ -38,16 +39,6 @@ def _p2_tri_grad(xi, eta):
     return np.array(rows)
 
 
-def _p2_tet_grad(x):
-    """dN/dxi of C3D10 (corners 1-4, mid-edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4), shape (10, 3)."""
-    L = (1.0 - x.sum(), *x)
-    dl = np.array([[-1.0, -1.0, -1.0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
-    rows = [(4 * L[i] - 1) * dl[i] for i in range(4)]
-    for i, j in ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)):
-        rows.append(4 * (L[i] * dl[j] + L[j] * dl[i]))
-    return np.array(rows)
-
-
 def _signed_measures(X: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
     """(integral of det J, min det J at the points) per cell, X (cells, nodes, dim); degree-4
     rules (det J of a P2 cell is degree 2 in 2D, 3 in 3D: integrated exactly)."""
@@ -55,7 +46,7 @@ def _signed_measures(X: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
     from skfem.refdom import RefTet, RefTri
 
     pts, w = get_quadrature(RefTri if dim == 2 else RefTet, 4)
-    grad = _p2_tri_grad if dim == 2 else (lambda *a: _p2_tet_grad(np.array(a)))
+    grad = _p2_tri_grad if dim == 2 else (lambda *a: c3d10_grad(np.array(a)))
     dets = np.stack([np.linalg.det(np.einsum("kd,ckD->cDd", grad(*pts[:, q]), X)) for q in range(len(w))], 1)
     return dets @ w, dets.min(axis=1)
 

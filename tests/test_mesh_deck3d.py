@@ -14,6 +14,7 @@ from tactileskin.mesh import build_mesh
 from tactileskin.mesh.deck import FACES, _num, deck_text, parse_deck, undefined_names
 from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
 from tactileskin.scene import Scene
+from mesh_probe import c3d10_grad
 
 
 @pytest.fixture(scope="module")
@@ -22,17 +23,6 @@ def braille():
                mesh_size=1.6, refinement=8.0)
     sm = build_mesh(sc)
     return sc, sm, deck_text(sc, sm, "calculix")
-
-
-def _tet10_grad(x):
-    """dN/dxi of C3D10 (corners 1-4, mid-edges 1-2, 2-3, 3-1, 1-4, 2-4, 3-4), from the
-    element's definition (independent of scikit-fem)."""
-    L = (1.0 - x.sum(), *x)
-    dl = np.array([[-1.0, -1.0, -1.0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
-    rows = [(4 * L[i] - 1) * dl[i] for i in range(4)]
-    for i, j in ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)):
-        rows.append(4 * (L[i] * dl[j] + L[j] * dl[i]))
-    return np.array(rows)
 
 
 def _elements(p, etype):
@@ -50,7 +40,7 @@ def test_c3d10_cells_have_positive_volumes_adding_up_to_the_mesh(braille):
     ids, X = _elements(p, "C3D10")
     assert len(ids) == deck.n_skin_cells == sm.mesh.nelements
     pts, w = get_quadrature(RefTet, 4)  # det J of a P2 tet is cubic: integrated exactly
-    dets = np.stack([np.linalg.det(np.einsum("kd,ckD->cDd", _tet10_grad(pts[:, q]), X))
+    dets = np.stack([np.linalg.det(np.einsum("kd,ckD->cDd", c3d10_grad(pts[:, q]), X))
                      for q in range(len(w))], 1)
     assert np.all(dets > 0.0)  # at every point of every element, curved boundary cells too
     assert (dets @ w).sum() == pytest.approx(sm.measure(), rel=1e-10)
