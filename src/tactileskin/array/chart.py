@@ -679,12 +679,12 @@ def _readings(chart: Chart, material, t, set_, pitch, noise, method) -> int | No
     return None
 
 
-def wilson(acc: float, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % Wilson score interval of an accuracy measured on n readings."""
-    den = 1.0 + z * z / n
-    mid = (acc + z * z / (2 * n)) / den
-    half = z * np.sqrt(acc * (1 - acc) / n + z * z / (4 * n * n)) / den
-    return float(max(0.0, mid - half)), float(min(1.0, mid + half))
+def wilson(acc: float, n: int) -> tuple[float, float]:
+    """95 % Wilson score interval of an accuracy measured on n readings (scipy's binomtest)."""
+    from scipy.stats import binomtest
+
+    ci = binomtest(int(round(acc * n)), int(n)).proportion_ci(0.95, method="wilson")
+    return float(ci.low), float(ci.high)
 
 
 def _borderline(acc: float, n: int | None) -> str:
