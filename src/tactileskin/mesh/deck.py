@@ -225,6 +225,19 @@ def skin_mesh_lines(fh, skinmesh, points: np.ndarray, cells: np.ndarray, etype: 
             w(f"{e + 1}, S{f}\n")
 
 
+def indenter_mesh_lines(fh, ref: int, n_nodes: int, cells: np.ndarray, n_skin_cells: int, etype: str) -> None:
+    """A meshed rigid indenter's node set (its nodes numbered from `ref`), its *ELEMENT block
+    (numbered after the skin's cells) and its working face, face S1 of every cell."""
+    w = fh.write
+    w("*NSET, NSET=indenter_nodes, GENERATE\n")
+    w(f"{ref}, {ref + n_nodes - 1}, 1\n")
+    w(f"*ELEMENT, TYPE={etype}, ELSET=indenter\n")
+    for i, c in enumerate(cells):
+        w(f"{n_skin_cells + 1 + i}, " + ", ".join(str(ref + int(v)) for v in c) + "\n")
+    w("*SURFACE, TYPE=ELEMENT, NAME=indenter_face\n")
+    _rows(fh, [f"{n_skin_cells + 1 + i}, S1" for i in range(len(cells))], 1)
+
+
 def _rows(fh, values, per_line: int = 16, fmt=str) -> None:
     values = list(values)
     for i in range(0, len(values), per_line):
@@ -364,13 +377,7 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
         moved, n_ind = "indenter_ref", 0
     else:
         n_ind = len(ipts)
-        w("*NSET, NSET=indenter_nodes, GENERATE\n")
-        w(f"{ref}, {ref + n_ind - 1}, 1\n")
-        w("*ELEMENT, TYPE=CPE4, ELSET=indenter\n")
-        for i, c in enumerate(icells):
-            w(f"{n_cells + 1 + i}, " + ", ".join(str(ref + int(v)) for v in c) + "\n")
-        w("*SURFACE, TYPE=ELEMENT, NAME=indenter_face\n")
-        _rows(fh, [f"{n_cells + 1 + i}, S1" for i in range(len(icells))], 1)
+        indenter_mesh_lines(fh, ref, n_ind, icells, n_cells, "CPE4")
         w("** the strip only carries the contact surface: all its nodes are prescribed\n")
         w("*MATERIAL, NAME=indenter_rigid\n*ELASTIC\n1e6, 0.3\n")
         w("*SOLID SECTION, ELSET=indenter, MATERIAL=indenter_rigid\n1.\n")

@@ -56,7 +56,8 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
     from tactileskin.geometry.indenters import indenter_for_scene
     from tactileskin.materials import get_material
-    from tactileskin.mesh.deck import Deck, _name, _num, _rows, abaqus_cells, material_lines, skin_mesh_lines
+    from tactileskin.mesh.deck import (Deck, _name, _num, abaqus_cells, indenter_mesh_lines, material_lines,
+                                        skin_mesh_lines)
     from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
 
     if skinmesh.dim != 3:
@@ -91,13 +92,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, moves by -"
       + _num(depth) + " mm over " + _num(T) + " s; C3D6 wedges, face S1 on the working face,\n"
       "** all nodes prescribed (a rigid translation)\n")
-    w("*NSET, NSET=indenter_nodes, GENERATE\n")
-    w(f"{ref}, {ref + n_ind - 1}, 1\n")
-    w("*ELEMENT, TYPE=C3D6, ELSET=indenter\n")
-    for i, c in enumerate(icells):
-        w(f"{n_cells + 1 + i}, " + ", ".join(str(ref + int(v)) for v in c) + "\n")
-    w("*SURFACE, TYPE=ELEMENT, NAME=indenter_face\n")
-    _rows(fh, [f"{n_cells + 1 + i}, S1" for i in range(len(icells))], 1)
+    indenter_mesh_lines(fh, ref, n_ind, icells, n_cells, "C3D6")
     w("*MATERIAL, NAME=indenter_rigid\n*ELASTIC\n1e6, 0.3\n")
     w("*SOLID SECTION, ELSET=indenter, MATERIAL=indenter_rigid\n")
 
