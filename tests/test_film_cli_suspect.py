@@ -1,5 +1,5 @@
 """`film analyze` marks a suspect profile (exit 3 and the reasons); `film compare` carries the
-film's warnings and the simulation's status into comparison.json and stderr."""
+film's warnings and the simulation's status into comparison.json and stderr, and exits 3."""
 
 import json
 
@@ -31,7 +31,7 @@ def test_a_saturated_film_exits_3_and_its_comparison_says_why(tmp_path, capsys):
     assert any("saturation" in w for w in summary["warnings"])
     _sim_dir(tmp_path / "sim")
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
-                 str(tmp_path / "cmp")]) == 0  # exit 0 with a warning, as for a suspect simulation
+                 str(tmp_path / "cmp")]) == 3  # written, suspect: as `analyze`, `solve`, `sweep`
     assert "the film profile is suspect" in capsys.readouterr().err
     doc = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
     assert doc["status"] == "suspect" and any("saturation" in w for w in doc["warnings"])
@@ -43,7 +43,7 @@ def test_a_clean_film_against_a_suspect_simulation_is_a_suspect_comparison(tmp_p
     assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 0
     _sim_dir(tmp_path / "sim", status="suspect: no contact")
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
-                 str(tmp_path / "cmp")]) == 0
+                 str(tmp_path / "cmp")]) == 3
     doc = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
     assert doc["status"] == "suspect" and doc["warnings"] == ["simulation: suspect: no contact"]
     _sim_dir(tmp_path / "sim_ok")

@@ -101,7 +101,7 @@ def test_compare_refuses_a_result_without_contact_and_warns_of_a_suspect_one(tmp
     np.savetxt(sim / "profile.csv", np.column_stack([S, gaussian_profile(0.4, 1.0)(S)]), delimiter=",",
                header="s_mm,pressure_mpa", comments="", fmt="%.10g")
     (sim / "summary.json").write_text(json.dumps({"status": "suspect: volume ratio J = 0.8"}))
-    assert main(["film", "compare", str(film), str(sim)]) == 0
+    assert main(["film", "compare", str(film), str(sim)]) == 3  # written, and suspect
     assert "warning: the simulated result is suspect" in capsys.readouterr().err
 
 

@@ -127,7 +127,7 @@ def compare(film_dir, sim_dir, out):
     """Compare a `film analyze` result with a simulated profile (percent differences).
 
     A comparison resting on a suspect film profile or simulated result says so on stderr and
-    in comparison.json (`status`, `warnings`).
+    in comparison.json (`status`, `warnings`), and exits 3.
     """
     from tactileskin.film import compare as do_compare
 
@@ -145,3 +145,4 @@ def compare(film_dir, sim_dir, out):
     for w in comp.film_warnings:  # the film's own (summary.json): the comparison inherits them
         click.echo(f"warning: the film profile is suspect: {w}", err=True)
     click.echo(f"wrote {out or film_dir}")
+    return EXIT_SUSPECT if comp.status != "ok" else 0
