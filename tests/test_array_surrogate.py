@@ -451,10 +451,23 @@ def test_letters_trust_from_the_measurement_file_and_from_this_runs_validation()
     fine = [dict(rows[0], text="⠿", max_abs_over_peak_taxel=0.031, reference_mesh=[0.8, 8.0]),
             dict(rows[0], text="l", max_abs_over_peak_taxel=0.029, reference_mesh=[0.8, 8.0]),
             dict(rows[0], text="⠿", max_abs_over_peak_taxel=0.068, reference_mesh=[1.2, 8.0])]
-    got = validity.measured("polyurethane", "pad", mesh, 1.0, 0.2, fine)
+    got = validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, fine)
     assert got["status"] == "within" and got["error"] == 0.031 and got["texts"] == ["⠿", "l"]
     worse = [dict(fine[0], max_abs_over_peak_taxel=0.09), fine[2]]
-    assert validity.measured("polyurethane", "pad", mesh, 1.0, 0.2, worse)["error"] == 0.09
+    assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, worse)["error"] == 0.09
+    # each character at its own finest reference: a coarser row of another character still counts
+    other = [fine[0], dict(rows[0], text="k", max_abs_over_peak_taxel=0.06)]
+    got = validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, other)
+    assert got["error"] == 0.06 and got["reference_mesh"] == mesh and not validity.finer_reference(got, mesh)
+    # this run's rows join the project's measurements, never hide them: the file puts the sum
+    # 8.5 % off at t = 1 on the silicone pad (f); a run that validated only the full cell within
+    # 3 % (against the same 0.8 / 8 solves) leaves it at 8.5 %, a worse run row raises it
+    mine = [dict(rows[0], material="silicone", text="⠿", reference_mesh=[0.8, 8.0])]
+    got = validity.measured("silicone", "pad", mesh, 1.0, 0.2, mine)
+    assert got["status"] == "exceeds" and got["error"] == pytest.approx(t1["error"]) and "⠿" in got["texts"]
+    assert got["source"].startswith("this run's validation; ")
+    got = validity.measured("silicone", "pad", mesh, 1.0, 0.2, [dict(mine[0], max_abs_over_peak_taxel=0.12)])
+    assert got["error"] == 0.12
     # a row measured inside a smaller square than the chart reads does not answer for it
     rows[0]["extent_mm"] = 4.5
     assert validity.measured("polyurethane", "fingertip", mesh, 1.0, 0.2, rows, extent=4.5)["status"] == "within"
@@ -500,17 +513,19 @@ def test_chart_report_marks_letters_whose_surrogate_is_not_within_tolerance(monk
             "(8.5%), t = 2 mm (14.6%)") in md
     assert ("| silicone | 0.75 mm pitch reads Braille at t = 1 mm | supported (indicative: the letters' surrogate "
             "is off by 8.5% at t = 1 mm) |") in md
-    # this run's validation within 5 % at t = 1 takes precedence: that row unmarked, the verdict plain
+    # this run's validation within 5 % at t = 1 does not hide the file's 8.5 % (f): still marked
     rows = [{"material": "silicone", "thickness_mm": 1.0, "depth_mm": 0.2, "text": "⠿", "model": "sum",
              "rel_l2": 0.02, "max_abs_over_peak": 0.04, "peak_rel": -0.01, "within_tolerance": True,
              "max_abs_over_peak_taxel": 0.03, "peak_rel_taxel": -0.01, "within_tolerance_taxel": True,
              "extent_mm": cfg.read_extent}]
     md = markdown(ch, rows)
-    assert "| 1 | 0.01 |" in md and "| 2 † | 0.01 |" in md
-    assert "| silicone | 0.75 mm pitch reads Braille at t = 1 mm | supported |" in md
-    # ... unless it was measured in a smaller square than this chart reads: the file's row again
+    assert "| 1 † | 0.01 |" in md and "| 2 † | 0.01 |" in md and "| silicone | 1 | sum | 8.5% |" in md
+    # a run row worse than the file's, of a character the file has not, raises it
+    rows[0].update(text="k", max_abs_over_peak_taxel=0.11)
+    assert "| silicone | 1 | sum | 11.0% |" in markdown(ch, rows)
+    # ... unless it was measured in a smaller square than this chart reads: the file's rows alone
     rows[0]["extent_mm"] = cfg.read_extent - 1.0
-    assert "| 1 † | 0.01 |" in markdown(ch, rows)
+    assert "| silicone | 1 | sum | 8.5% |" in markdown(ch, rows)
     ch = chart.compute(cfg, cache=None)
     # on the fingertip nothing is validated: every letters row marked, the 0.75 mm verdict qualified
     md = markdown(chart.compute(chart.ChartConfig(**{**cfg.__dict__, "skin": "fingertip"}), cache=None))
@@ -632,7 +647,8 @@ def test_no_fallback_where_the_surrogate_exceeds_only_against_a_finer_mesh(monke
     md = markdown(ch, rows)
     assert "| 1 † | 0.01 |" in md and "against full solves on the finer 0.8 / 8 mesh" in md
     assert any("t = 1 mm (7.0%)" in n for n in suspect(ch, rows))
-    own = [row("f", 0.07, [1.2, 8.0])]
+    # a character the project's file has not measured (k), 7 % off full solves on the chart's mesh
+    own = [row("k", 0.07, [1.2, 8.0])]
     ch2 = chart.compute(cfg, cache=None, validation=own)
     assert ch2.fallbacks[("silicone", 1.0)]["error"] == pytest.approx(0.07)
 

@@ -125,8 +125,8 @@ class ChartConfig:
     # the sum's 4.3, 6.4, 14.5, 5.7, 13.7 % at t = 0.5, 1, 2, 3, 5 mm), "full" solves every letter
     # in 3D (one solve per letter and t: where the surrogates are not within 5 %)
     letters_model: str = "interaction"
-    # where the surrogate's measured error (this run's validation rows, else
-    # data/surrogate_validation.json; array.validity) exceeds its tolerance, solve that
+    # where the surrogate's measured error (this run's validation rows and
+    # data/surrogate_validation.json, the worse; array.validity) exceeds its tolerance, solve that
     # thickness's letters in full instead (one 3D solve per letter); False: keep the surrogate,
     # marked indicative
     fallback: bool = True

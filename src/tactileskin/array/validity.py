@@ -1,10 +1,11 @@
 """How far the letters' surrogate is trusted at each thickness: its measured error against
-full 3D solves, from this run's validation rows (`chart.validate_surrogate`) or, failing
-those, from the project's measurements in tactileskin/data/surrogate_validation.json.
+full 3D solves, from this run's validation rows (`chart.validate_surrogate`) and the
+project's measurements in tactileskin/data/surrogate_validation.json, the worse of them.
 
 The error of a (material, skin, mesh, t, depth) is the worst taxel-averaged error over its
 validated characters, inside a square around the cell at least as large as the chart reads,
-against the full solves on the finest mesh measured (a row's reference_mesh, else the chart's), for the model the chart used ("interaction", the plain "sum", or past the dot height "plate + sum"; a row
+against the full solves on the finest mesh measured for that character (a row's reference_mesh,
+else the chart's), for the model the chart used ("interaction", the plain "sum", or past the dot height "plate + sum"; a row
 without a model is the sum); where nothing matches it is not validated. Either way the chart
 says so beside the letters' accuracies.
 """
@@ -22,6 +23,8 @@ DATA = ("data", "surrogate_validation.json")
 # taxel is at least its own: smaller taxels (point sensors) see the sub-taxel ripple the box
 # average hid (pointwise the surrogate was 9-12 % off where 0.4 mm taxels read 2.9-4.9 %)
 DATA_TAXEL = 0.4
+# the source named for this run's validation rows
+RUN_SOURCE = "this run's validation"
 
 
 @lru_cache(maxsize=1)
@@ -68,7 +71,7 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
     (ChartConfig.read_extent), which a row's own extent must cover; `taxel`: the chart's smallest
     taxel side (mm; 0 = point sensors), which must be at least the rows' (DATA_TAXEL where a row
     does not say)."""
-    rows, source = [], ""
+    rows = []
     for r in validation or ():
         rt = float(r.get("taxel_mm", DATA_TAXEL))
         key = "max_abs_over_peak_taxel" if rt > 0 else "max_abs_over_peak"  # taxel 0: pointwise
@@ -76,28 +79,30 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
                 and _match(r.get("depth_mm", depth), depth) and key in r \
                 and _covers(r, extent) and _taxel_ok(rt, taxel):
             rows.append({"text": r["text"], "taxel_max_error": r[key],
-                         "reference_mesh": r.get("reference_mesh")})
-            source = "this run's validation"
-    if not rows:
-        for case in load()["cases"]:
-            if case["material"] != material or case["skin"] != skin or \
-                    not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
-                continue
-            for r in case["rows"]:
-                if r.get("model", "sum") == model and _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth) \
-                        and _covers(r, extent) and _taxel_ok(r.get("taxel_mm", DATA_TAXEL), taxel):
-                    rows.append(r)
-                    source = r["source"]
+                         "reference_mesh": r.get("reference_mesh"), "source": RUN_SOURCE})
+    for case in load()["cases"]:
+        if case["material"] != material or case["skin"] != skin or \
+                not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
+            continue
+        for r in case["rows"]:
+            if r.get("model", "sum") == model and _match(r["thickness_mm"], t) and _match(r["depth_mm"], depth) \
+                    and _covers(r, extent) and _taxel_ok(r.get("taxel_mm", DATA_TAXEL), taxel):
+                rows.append(r)
     if not rows:
         return {"error": None, "texts": [], "source": "", "status": "not validated"}
-    # against the finest reference measured: a full solve on a coarser mesh carries its own
-    # discretisation error (t = 1 mm full cell at 1.2 / 8: -3.3 % in the peak)
-    finest = min(_reference(r, mesh) for r in rows)
-    rows = [r for r in rows if _reference(r, mesh) == finest]
-    source = rows[0].get("source", source)
-    err = max(float(r["taxel_max_error"]) for r in rows)
-    ref = tuple(float(v) for v in (rows[0].get("reference_mesh") or mesh))
-    return {"error": err, "texts": [r["text"] for r in rows], "source": source,
+    # each character against the finest reference measured for it: a full solve on a coarser
+    # mesh carries its own discretisation error (t = 1 mm full cell at 1.2 / 8: -3.3 % in the
+    # peak). This run's rows join the file's, never replace them: a run that validated one
+    # character does not hide a worse one measured before
+    finest = {}
+    for r in rows:
+        finest[r["text"]] = min(finest.get(r["text"], math.inf), _reference(r, mesh))
+    rows = [r for r in rows if _reference(r, mesh) == finest[r["text"]]]
+    worst = max(rows, key=lambda r: float(r["taxel_max_error"]))
+    err = float(worst["taxel_max_error"])
+    sources = list(dict.fromkeys(r["source"] for r in rows))
+    ref = tuple(float(v) for v in (worst.get("reference_mesh") or mesh))
+    return {"error": err, "texts": list(dict.fromkeys(r["text"] for r in rows)), "source": "; ".join(sources),
             "status": "within" if err <= tolerance() else "exceeds", "reference_mesh": ref}
 
 
