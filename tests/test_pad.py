@@ -152,6 +152,37 @@ def test_3d_pad_slice_equals_2d_section():
     assert np.max(np.abs(p3[inner] - r2.pressure[inner])) < 0.03 * np.max(np.abs(r2.pressure))
 
 
+@pytest.mark.slow
+def test_3d_pad_free_ends_cost_a_fixed_force_along_a_z_cylinder():
+    """A cylinder along the pad (z) loads it uniformly along its length, so the 2D section is
+    the long pad's limit but not a finite block's: its free ends z = +-L/2 carry less. Through
+    the solver's own quarter model (fe.solve / model_for_scene: the whole indenter's force),
+    with u_z = 0 on the end too the force per mm is the 2D section's (force factor, symmetry
+    planes and force integration right); with free ends each end costs a fixed force, so F(L)
+    grows by the plane-strain force per mm of added length (benchmarks/results/pad_length.md:
+    t = 2, L = 10..80 mm, an end costs 0.71 t of plane-strain pad on two meshes). ~20 s."""
+    from tactileskin.fe import indenter_force, model_for_scene, solve
+
+    sc2 = _pad(thickness=1.0, pad_width=6.0, pad_length=6.0, indenter="cylinder", indenter_radius=3.0,
+               indenter_axis="z", depth_fraction=0.1, mesh_size=0.6, refinement=2.0)
+    f2 = 2.0 * solve(sc2).reaction  # N/mm of the whole section (2D reports the half x >= 0)
+    sc3 = sc2.replace(dim=3)
+    base, sm = model_for_scene(sc3)
+    assert sm.z_symmetric and sm.halved and base.force_factor == 4.0
+    m = Model(base.mesh, base.boundaries, base.law, list(base.dirichlet) + [Dirichlet("end_front", (2,))],
+              formulation=base.formulation, contact=base.contact, order=sc3.order, stiffness=base.stiffness)
+    m.force_factor = base.force_factor
+    ev, _ = run(m, sc3.duration)
+    f_ps = indenter_force(m, ev) / sc3.pad_length
+    # measured +1.4 % (coarse tetrahedra against triangles, as in the slice test above)
+    assert f_ps == pytest.approx(f2, rel=0.03)
+    F = {L: solve(sc3.replace(pad_length=L)).reaction for L in (6.0, 12.0)}
+    # measured 0.764: the free ends matter (each costs 0.71 mm = 0.71 t of plane-strain pad)
+    assert F[6.0] / (f_ps * 6.0) < 0.85
+    # measured -1.0 % (the ends of the 6 mm pad still see each other a little)
+    assert (F[12.0] - F[6.0]) / 6.0 == pytest.approx(f_ps, rel=0.02)
+
+
 def test_sensors_on_pad_read_depth_along_y_and_the_homogeneous_stress():
     """Sensors at depth d sit at y = t - d with normal +y; in the homogeneous sliding state they
     read the closed-form stress (sigma_nn = sigma_yy, P = -tr/3, no shear) at every depth."""
