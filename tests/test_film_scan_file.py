@@ -56,3 +56,19 @@ def test_transparent_pixels_are_refused_opaque_alpha_is_read(tmp_path):
     Image.fromarray(la, "LA").save(tmp_path / "la.png")
     with pytest.raises(ParameterError, match="transparent"):
         read_scan(tmp_path / "la.png")
+
+
+def test_a_tiff_resolution_without_a_unit_tag_is_dots_per_inch(tmp_path):
+    """TIFF 6.0: ResolutionUnit defaults to inch; a 600 dpi scan whose writer left the tag
+    out read as 'no scale' and was analysed at 8 px/mm unflagged (2.95 x too wide)."""
+    from PIL import TiffImagePlugin
+
+    tags = TiffImagePlugin.ImageFileDirectory_v2()
+    tags[282], tags[283] = 600.0, 600.0  # XResolution, YResolution; no ResolutionUnit (296)
+    Image.fromarray(_scan(DPI600)).save(tmp_path / "nounit.tif", tiffinfo=tags)
+    assert 296 not in Image.open(tmp_path / "nounit.tif").tag_v2
+    assert file_px_per_mm(tmp_path / "nounit.tif") == pytest.approx(DPI600, rel=1e-4)
+    assert any("--px-per-mm 23.62" in w for w in analyze_scan(tmp_path / "nounit.tif").warnings)
+    tags[296] = 1  # an explicit 'no absolute unit': still no scale
+    Image.fromarray(_scan(DPI600)).save(tmp_path / "none.tif", tiffinfo=tags)
+    assert file_px_per_mm(tmp_path / "none.tif") is None

@@ -14,7 +14,8 @@ opaque: a transparent pixel's colour is undefined (often black, which the film w
 its highest pressure), so an image with any alpha < full is refused (flatten it first).
 
 Scale: `file_px_per_mm` gives the pixels per mm the file records (PNG pHYs in metres, TIFF
-resolution in inches or cm; None when the file records none or no absolute unit), which
+resolution in inches (also without a unit tag, the TIFF default) or cm; None when the
+file records none or no absolute unit), which
 `film.scan.analyze_scan` checks against the scale it is given.
 
 Size: the header's width x height is checked against MAX_PIXELS before any pixel is
@@ -150,8 +151,9 @@ SCREEN_DPI = (72.0, 96.0)  # written by default, not measured: no scale
 
 def file_px_per_mm(path) -> float | None:
     """Pixels per mm recorded in an image file's header (PNG pHYs, TIFF resolution), or None
-    when it records none, no absolute unit (a TIFF's default 1 x 1 without a unit) or a
-    screen default (SCREEN_DPI)."""
+    when it records none, no absolute unit (TIFF ResolutionUnit 1; a TIFF without
+    XResolution, which Pillow reports as 1 x 1) or a screen default (SCREEN_DPI). A TIFF
+    XResolution without a ResolutionUnit tag is in inches (the TIFF 6.0 default)."""
     from PIL import Image, UnidentifiedImageError
 
     try:
@@ -159,10 +161,15 @@ def file_px_per_mm(path) -> float | None:
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             with Image.open(path) as im:
                 info = dict(im.info)
+                tags = getattr(im, "tag_v2", None)
+                # TIFF 6.0: ResolutionUnit defaults to 2 (inch), so an XResolution without a
+                # unit tag is dots per inch; without XResolution Pillow reports its 1 x 1
+                tiff_inch = tags is not None and 282 in tags and 296 not in tags
     except (OSError, UnidentifiedImageError, ValueError, SyntaxError, EOFError):
         return None
     dpi = info.get("dpi")
-    if not dpi or "resolution" in info:  # Pillow sets "resolution" too when the unit is unknown
+    # Pillow sets "resolution" too when the unit is 1 (none) or absent (inch by the spec)
+    if not dpi or ("resolution" in info and not tiff_inch):
         return None
     try:
         x = float(dpi[0])
