@@ -147,3 +147,14 @@ def test_an_empty_config_is_refused(tmp_path, capsys, no_solves, text):
     err = capsys.readouterr().err
     assert "config=" in err and "at least one setting" in err and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_repeated_list_values_are_one_axis_value():
+    """-t 1,1 (or a repeated pitch, noise, material, set) wrote every row of accuracies.csv
+    twice; a sweep drops repeated cases, and so does the chart's config."""
+    from tactileskin.array.chart import ChartConfig
+
+    cfg = ChartConfig(thicknesses=(1, 1.0, 3), pitches=(1, 1, 2), noise_fs=(0.01, 0.01), materials=("silicone",) * 2,
+                      sets=("paper", "paper"))
+    assert (cfg.thicknesses, cfg.pitches, cfg.noise_fs) == ((1, 3), (1, 2), (0.01,))
+    assert cfg.materials == ("silicone",) and cfg.sets == ("paper",)
