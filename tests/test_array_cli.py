@@ -158,3 +158,35 @@ def test_repeated_list_values_are_one_axis_value():
                       sets=("paper", "paper"))
     assert (cfg.thicknesses, cfg.pitches, cfg.noise_fs) == ((1, 3), (1, 2), (0.01,))
     assert cfg.materials == ("silicone",) and cfg.sets == ("paper",)
+
+
+@pytest.mark.parametrize("flags, words", [
+    # LDA's covariance of 161 x 161 taxels is 5 GB a copy: a MemoryError traceback after the solves
+    (["--pitch", "0.05,1"], ["pitches (--pitch)=0.05", ">= 0.08", "8 mm window", "covariance"]),
+    # the readings of 1e8 offsets filled the memory after the solves
+    (["--offsets", "100000000"], ["n_train (--offsets)=100000000", "an integer in [2, "]),
+])
+def test_a_chart_too_big_for_memory_is_refused_before_any_solve(tmp_path, capsys, no_solves, flags, words):
+    out = tmp_path / "o"
+    assert main(["array", "--set", "paper", "-t", "1", "-o", str(out), *flags]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert all(w in err for w in words) and "Traceback" not in err, err
+    assert not out.exists()
+
+
+def test_the_memory_rule_keeps_the_default_chart_and_its_finest_allowed_pitch():
+    from tactileskin.array import classify
+    from tactileskin.array.chart import ChartConfig
+    from tactileskin.errors import ParameterError
+
+    ChartConfig()  # the default chart is far within it
+    msg = ""
+    try:
+        ChartConfig(pitches=(0.05,), sets=("letters",))
+    except ParameterError as e:
+        msg = str(e)
+    p = float(msg.split(">= ")[1].split(" mm")[0])
+    cfg = ChartConfig(pitches=(p,), sets=("letters",))  # the pitch the message quotes is accepted
+    assert classify.memory_bytes(36, cfg.spec(p).n ** 2, 16, 16, 4) <= classify.MAX_BYTES
+    with pytest.raises(ParameterError, match="template_grid"):
+        ChartConfig(pitches=(1.0,), template_grid=2000)

@@ -203,6 +203,42 @@ class ChartConfig:
         if bad or len(set(self.letters)) < 2:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9",
                                  hint=f"not characters of the set: {''.join(dict.fromkeys(bad))}" if bad else "")
+        self._check_memory()
+
+    def _check_memory(self) -> None:
+        """Refuse, before any solve, a chart whose classification of one (set, pitch) would
+        not fit in classify.MAX_BYTES: pitch 0.05 mm over the 8 mm window (LDA's covariance
+        of 161^2 taxels, 5 GB a copy) or --offsets 100000000 ran out of memory after the
+        solves, with a traceback."""
+        import math
+
+        from tactileskin.array import classify
+
+        ncls = max({"paper": 3, "shapes": 4, "letters": len(set(self.letters))}[s] for s in self.sets)
+        need = lambda k, tr, te, g: classify.memory_bytes(ncls, k * k, tr, te, g)  # noqa: E731
+        top, pitch = classify.MAX_BYTES, min(self.pitches)
+        k = self.spec(pitch).n
+        if need(k, self.n_train, self.n_test, self.template_grid) <= top:
+            return
+        cap = f"the {top / 2**30:g} GiB the classification of one pitch may hold in memory"
+        if need(k, 2, 1, 1) > top:  # LDA's covariance alone: the pitch is too fine for the window
+            # the finest lattice these offsets and templates fit on (else the least they need)
+            fits = [j for j in range(2, k) if need(j, self.n_train, self.n_test, self.template_grid) <= top]
+            kmax = max(fits or [j for j in range(2, k) if need(j, 2, 1, 1) <= top])
+            pmin = self.window / (kmax - 1)
+            e = 10.0 ** (math.floor(math.log10(pmin)) - 2)
+            raise ParameterError("pitches (--pitch)", pitch, f">= {math.ceil(pmin / e) * e:.3g} mm over the "
+                                 f"{self.window:g} mm window (at most {kmax} x {kmax} taxels)",
+                                 hint=f"{k} x {k} taxels: LDA's taxel covariance alone exceeds {cap}")
+        if need(k, 2, 1, self.template_grid) > top:
+            gmax = max(g for g in range(1, self.template_grid) if need(k, 2, 1, g) <= top)
+            raise ParameterError("template_grid", self.template_grid, f"an integer in [1, {gmax}] at the pitch "
+                                 f"{pitch:g} mm ({k} x {k} taxels)", hint=f"its templates would exceed {cap}")
+        fixed = need(k, 0, 0, self.template_grid)
+        nmax = int((top - fixed) // (need(k, 1, 1, self.template_grid) - fixed))
+        raise ParameterError("n_train (--offsets)", max(self.n_train, self.n_test),
+                             f"an integer in [2, {nmax}] at the pitch {pitch:g} mm ({k} x {k} taxels) and "
+                             f"{ncls} stimuli", hint=f"their readings would exceed {cap}")
 
     def mesh_for(self, thickness: float) -> tuple[float, float]:
         """(mesh_size, refinement) of the chart's 3D single dots at a thickness: the user's

@@ -25,6 +25,22 @@ from tactileskin.array.sampler import ArraySpec, Readout, sample
 from tactileskin.errors import ParameterError
 
 METHODS = ("template", "lda")
+# The readings and classifiers of one (set, pitch) are held in memory at once (chart.compute):
+# the clean readings, their noisy copies, the template distances and LDA's taxel covariance,
+# n_taxels^2 floats in a few copies while it is shrunk and solved (1.57 GB peak measured at
+# 81 x 81 taxels, 0.34 GB a copy). A chart that would need more is refused before any solve
+# (ChartConfig): at 161 x 161 taxels the covariance alone is 5 GB a copy.
+MAX_BYTES = 4 * 2**30
+LDA_COPIES = 5
+
+
+def memory_bytes(n_class: int, n_taxels: int, n_train: int, n_test: int, template_grid: int) -> float:
+    """Estimated peak bytes of classifying one (set, pitch): `n_class` stimuli read by
+    `n_taxels` taxels at n_train + n_test random offsets and template_grid^2 template ones."""
+    g2 = float(template_grid) ** 2
+    readings = n_class * (2.0 * (n_train + n_test) + g2) * n_taxels * 8.0  # clean + noisy
+    distances = float(n_class) * n_test * n_class * g2 * 8.0               # nearest template
+    return readings + distances + LDA_COPIES * float(n_taxels) ** 2 * 8.0
 
 
 @dataclass
