@@ -78,3 +78,28 @@ def test_a_symlinked_out_folder_is_refused_as_a_link(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "not a symbolic link" in err and "is not a folder" not in err
     assert list((tmp_path / "real").iterdir()) == []
+
+
+@pytest.mark.parametrize("skin", ["pad", "dome"])
+@pytest.mark.parametrize("edit, words", [
+    # holes 3.5 mm for 4 mm pins: the pad's and the dome's molds were written, exit 0
+    (("clearance = 0.2         # hole", "clearance = -0.5         # hole"), ["molds.pin_clearance=-0.5", ">= 0 mm"]),
+    (("wall = 4.0", 'wall = "abc"'), ["molds.wall='abc'", "a number"]),  # a ValueError traceback
+])
+def test_molds_toml_values_are_checked_for_every_skin(tmp_path, monkeypatch, capsys, skin, edit, words):
+    import shutil
+
+    from tactileskin.cli import main
+    from tactileskin.params import geometry_dir
+
+    geo = tmp_path / "geo"
+    shutil.copytree(geometry_dir(), geo)
+    text = (geo / "molds.toml").read_text()
+    assert edit[0] in text
+    (geo / "molds.toml").write_text(text.replace(edit[0], edit[1], 1))
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(geo))
+    out = tmp_path / "b"
+    assert main(["build", "--skin", skin, "-t", "2", "-i", "none", "-o", str(out)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert all(w in err for w in words) and "Traceback" not in err, err
+    assert not out.exists()

@@ -67,20 +67,37 @@ class MoldParams:
                                  "add `[core] clearance = 0.2` (the gap around the printed core)")
         kw["core_clearance"] = core.get("clearance")
         kw.update(overrides)
+        from tactileskin import validate
+
+        for k, v in kw.items():  # a string in molds.toml was a ValueError traceback
+            if not validate.is_number(v):
+                raise ParameterError(f"molds.{k}", v, "a number (mm) in molds.toml")
         return cls(**{k: float(v) for k, v in kw.items()})
 
-    def check(self, sec: Section) -> None:
-        """Raise ParameterError if the mold cannot be made for this fingertip."""
-        ft = sec.fingertip
+    def __post_init__(self):
+        # every skin's mold (fingertip, pad, dome) is built from these: the pad's and the dome's
+        # molds never ran `check`, and a negative pin clearance (holes narrower than the pins:
+        # a mold that cannot close) was written as a good part
+        import dataclasses
+        import math
+
+        for f in dataclasses.fields(self):
+            if not math.isfinite(getattr(self, f.name)):
+                raise ParameterError(f"molds.{f.name}", getattr(self, f.name), "a finite number (mm)")
         for name in ("wall", "pin_diameter", "pin_height", "pour_diameter", "vent_diameter", "pin_flange"):
             if not getattr(self, name) > 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), "> 0 mm")
-        for name in ("pin_clearance", "pin_depth_clearance"):
+        for name in ("pin_clearance", "pin_depth_clearance", "vent_inset"):
             if not getattr(self, name) >= 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), ">= 0 mm")
         if not 0.0 <= self.core_clearance <= 0.5 * self.wall:
             raise ParameterError("molds.core.clearance", self.core_clearance,
                                  f"[0, {0.5 * self.wall:g}] mm (at most half the {self.wall:g} mm wall)")
+
+    def check(self, sec: Section) -> None:
+        """Raise ParameterError if the mold cannot be made for this fingertip (the values' own
+        ranges are checked when a MoldParams is made)."""
+        ft = sec.fingertip
         roof = ft.height + self.wall
         if self.pin_height + self.pin_depth_clearance >= roof:
             raise ParameterError("molds.pins.height", self.pin_height,
