@@ -190,3 +190,16 @@ def test_the_memory_rule_keeps_the_default_chart_and_its_finest_allowed_pitch():
     assert classify.memory_bytes(36, cfg.spec(p).n ** 2, 16, 16, 4) <= classify.MAX_BYTES
     with pytest.raises(ParameterError, match="template_grid"):
         ChartConfig(pitches=(1.0,), template_grid=2000)
+
+
+def test_the_validate_option_has_the_config_keys_limit(tmp_path, capsys, no_solves):
+    """--validate took any number of texts (each a full 3D solve per thickness); the config's
+    `validate` key is capped at MAX_TEXTS."""
+    from tactileskin.cli.array import MAX_TEXTS
+
+    out = tmp_path / "o"
+    texts = ",".join(["l"] * (MAX_TEXTS + 1))
+    assert main(["array", "--set", "letters", "-t", "1", "--pitch", "4", "-o", str(out), "--validate", texts]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "validate" in err and f"at most {MAX_TEXTS}" in err and "Traceback" not in err, err
+    assert not out.exists()

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin import validate
+from tactileskin import validate as validate_mod  # `validate` is also an option's name
 from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
@@ -38,7 +38,7 @@ def load_config(path) -> dict:
     table = data.get("array", {})
     if not isinstance(table, dict):
         raise ParameterError("config [array]", table, "a table of settings, e.g. [array] then thicknesses = [1, 3]")
-    validate.known_keys(table, KEYS, "config [array]")
+    validate_mod.known_keys(table, KEYS, "config [array]")
     if not table:  # surely a mistake: it would start the whole default chart (36 full 3D solves, hours)
         raise ParameterError("config", str(path), "a TOML file with at least one setting in its [array] table",
                              "it sets nothing; leave out --config for the default chart")
@@ -46,11 +46,11 @@ def load_config(path) -> dict:
     for k, v in table.items():
         if k in NAME_LISTS and isinstance(v, str):
             v = [x.strip() for x in v.split(",") if x.strip()]
-        elif k in NUMBER_LISTS and validate.is_number(v):
+        elif k in NUMBER_LISTS and validate_mod.is_number(v):
             v = [v]
         out[k] = tuple(v) if isinstance(v, list) else v
     if "validate" in out:
-        out["validate"] = validate.string_list(out["validate"], "validate", MAX_TEXTS, min_len=1)
+        out["validate"] = validate_mod.string_list(out["validate"], "validate", MAX_TEXTS, min_len=1)
     return resolve_paths(out, path)
 
 
@@ -127,8 +127,10 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  max_depth=max_depth, letters_model=letters_model, fallback=fallback, sphere_radius=sphere_radius,
                  sphere_quality=sphere_quality)
     kw.update({k: v for k, v in flags.items() if v is not None})
-    if validate is not None:
-        texts = names(validate, "validate")
+    if validate is not None:  # the config key's rule (at most MAX_TEXTS full solves per thickness)
+        texts = validate_mod.string_list(names(validate, "validate"), "validate (--validate)", MAX_TEXTS)
+    if texts:  # a repeated text is one validation (its rows were written twice)
+        texts = tuple(dict.fromkeys(texts))
     try:
         cfg = ChartConfig(**kw)
     except TypeError as e:
