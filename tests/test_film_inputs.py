@@ -140,6 +140,8 @@ ROWS = "30,100,40\n20,100,100\n10,100,160\n2,100,220\n"
     (HEADER + "30,100,40\n", "calibration points=1"),
     (HEADER + "30,100,40\n10,100,160\n", "calibration points=2"),
     ("", "header"),
+    # both: the gray value was used and the image silently ignored
+    ("force_n,area_mm2,gray,image\n30,100,40,p.png\n20,100,100,p.png\n10,100,160,p.png\n", "not both"),
 ])
 def test_bad_calibration_csv(tmp_path, capsys, body, needle):
     from PIL import Image

@@ -467,6 +467,10 @@ def read_calibration_csv(path) -> dict[str, np.ndarray]:
             raise ParameterError(f"force_n ({where})", f_n, "> 0 N")
         if not a > 0:
             raise ParameterError(f"area_mm2 ({where})", a, "> 0 mm^2")
+        if r.get("gray") and r.get("image"):  # the gray value won and the image was never read
+            raise ParameterError(f"calibration CSV ({where})", f"gray {r['gray']} and image {r['image']}",
+                                 "a gray value or an image path, not both",
+                                 "leave one of the two cells empty")
         if r.get("gray"):
             g = _csv_number(f"gray ({where})", r["gray"], "a number in [0, 255]")
             if not 0 <= g <= 255:
