@@ -279,3 +279,21 @@ def test_cli_export_writes_the_deck_and_rejects_bad_requests(tmp_path, capsys):
     assert "--dialect" in err and "calculix" in err and "Traceback" not in err
     assert sorted(q.name for q in tmp_path.iterdir()) == [".tactileskin-files.json", ".tactileskin-files.lock",
                                                           "case.inp"]  # its record of what it wrote, and its lock
+
+
+@pytest.mark.parametrize("dim", ["2", "3"])
+def test_export_refuses_a_law_the_deck_cannot_write_before_meshing(tmp_path, capsys, monkeypatch, dim):
+    """A neo-Hookean material file was refused after meshing with 'valid: hyperfoam (use
+    Material.law)', a Python hint, on the command line."""
+    import tactileskin.mesh as mesh_pkg
+    from tactileskin.cli import main
+
+    si = get_material("silicone")
+    mat = tmp_path / "nh.toml"
+    mat.write_text(f'law = "neo_hookean"\n[neo_hookean]\nmu = {si.law.mu0!r}\nkappa = {si.law.K0!r}\n')
+    monkeypatch.setattr(mesh_pkg, "build_mesh", lambda *a, **k: pytest.fail("meshed before the check"))
+    out = tmp_path / "nh.inp"
+    assert main(["export", "-t", "1", "-i", "flat", "--dim", dim, "-m", str(mat), "-o", str(out)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "neo_hookean" in err and "hyperfoam for a deck" in err and "Material.law" not in err, err
+    assert "Traceback" not in err and not out.exists()

@@ -307,6 +307,25 @@ def _check_dim(dim: int, dialect: str) -> None:
         raise ParameterError("dim", dim, "2 or 3")
 
 
+def _check_scene(scene, dialect: str) -> None:
+    """What a deck cannot hold, checked before meshing: the dimension's dialect, a loading
+    other than one depth ramp, a material law other than hyperfoam."""
+    from tactileskin.materials import get_material
+
+    _check_dim(scene.dim, dialect)
+    program = scene.program()
+    if len(program) != 1 or program[0].kind != "depth":
+        raise ParameterError("loading", "force control" if scene.force is not None else "a loading history",
+                             "a depth ramp (the deck has one displacement step)",
+                             "force control and [[loading]] histories are not written to decks yet; export "
+                             "the scene with its depth")
+    mat = get_material(scene.material)
+    if mat.law_name != "hyperfoam":  # was "valid: hyperfoam (use Material.law)", after meshing
+        raise ParameterError(f"material {mat.name!r} law", mat.law_name,
+                             "hyperfoam for a deck (it writes *HYPERFOAM)",
+                             f"a {mat.law_name} material is not written to decks yet")
+
+
 def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | None = None,
               penalty: float | None = None, increments: int = 20) -> Deck:
     """The input deck of a scene on its mesh (3D: CalculiX only, mesh.deck3d). viscoelastic:
@@ -321,15 +340,9 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
         raise ParameterError("dialect", dialect, "one of " + ", ".join(DIALECTS))
     if skinmesh.dim != scene.dim:
         raise ParameterError("mesh", f"{skinmesh.dim}D", f"a {scene.dim}D mesh for the {scene.dim}D scene")
-    _check_dim(scene.dim, dialect)
+    _check_scene(scene, dialect)
     if not (isinstance(increments, int) and 1 <= increments <= 10000):
         raise ParameterError("increments", increments, "an integer in [1, 10000]")
-    program = scene.program()
-    if len(program) != 1 or program[0].kind != "depth":
-        raise ParameterError("loading", "force control" if scene.force is not None else "a loading history",
-                             "a depth ramp (the deck has one displacement step)",
-                             "force control and [[loading]] histories are not written to decks yet; export "
-                             "the scene with its depth")
     if scene.dim == 3:
         from tactileskin.mesh.deck3d import deck_text_3d
 
@@ -438,7 +451,7 @@ def write_deck(scene, path, skinmesh=None, dialect: str = "abaqus", **kw) -> Dec
     from tactileskin import fileio
 
     if skinmesh is None:
-        _check_dim(scene.dim, dialect)  # before meshing
+        _check_scene(scene, dialect)  # before meshing
         from tactileskin.mesh import build_mesh
 
         skinmesh = build_mesh(scene)
