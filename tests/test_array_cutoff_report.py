@@ -17,3 +17,16 @@ def test_an_unmeasurable_cutoff_is_not_a_zero_pitch():
     md = markdown(ch)
     row = next(ln for ln in md.splitlines() if ln.startswith("| silicone | 1 | 0.2 |"))
     assert "n/a (spectrum stays above 10 %) | n/a |" in row and "0.00" not in row and "nan" not in row
+
+
+def test_the_depth_cap_sentence_says_whether_the_plate_touches():
+    """A cap past the dot height (0.48 mm) read 'below the dot height, so the Braille plate
+    never touches' (while the chart's notes said it touched)."""
+    def md(cap):
+        ch = Chart(ChartConfig(thicknesses=(3.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",), max_depth=cap))
+        ch.labels["paper"] = ["flat", "curved", "braille"]
+        return " ".join(markdown(ch).split())
+
+    assert "capped at 0.4 mm" in md(0.4) and "never touches" in md(0.4)
+    assert "capped at 0.55 mm" in md(0.55) and "never touches" not in md(0.55)
+    assert "the Braille plate touches" in md(0.55)

@@ -73,6 +73,22 @@ def _meshes(cfg) -> str:
     return ", ".join(f"{m[0]:g} / {m[1]:g} at t = {', '.join(f'{t:g}' for t in ts)} mm" for m, ts in by.items())
 
 
+def _cap_text(cfg) -> str:
+    """The depth cap's sentence: it keeps the Braille plate off only below the dot height (a
+    cap of 0.55 mm read 'below the dot height, so the plate never touches' while the notes
+    said the plate touched)."""
+    if not cfg.max_depth:
+        return ""
+    from tactileskin.geometry.braille import get_standard
+
+    h = get_standard(cfg.standard).height
+    if cfg.max_depth <= h:
+        return (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: not past the dot height {h:g} mm, so "
+                "the Braille plate never touches)")
+    return (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: past the dot height {h:g} mm, so the "
+            "Braille plate touches where the depth exceeds it)")
+
+
 def markdown(chart, validation=None, method: str = "template") -> str:
     """The report section: conditions, the skin as a filter, accuracy tables, verdicts, and the
     surrogate's validation."""
@@ -102,8 +118,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                      f"{c['peak_mpa']:.4f} | {kc_s} | {ny_s} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
               "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
-              "Depth: 20 % of t" + (f", capped at {cfg.max_depth:g} mm (ChartConfig.max_depth: below the dot "
-                                    "height, so the Braille plate never touches)" if cfg.max_depth else "") + ".", ""]
+              "Depth: 20 % of t" + _cap_text(cfg) + ".", ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
             lines += [f"### {material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})", "",
