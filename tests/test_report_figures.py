@@ -86,3 +86,19 @@ def test_report_states_version_preset_and_mesh_sizes():
     assert f"tactileskin {__version__}" in text
     assert f"| preview | {pre.mesh_size:g} | {pre.refinement:g} |" in text and "| 2 |" in text
     assert "| custom | 0.77 | 2 | 0.385 |" in text and "rtol = 1e-05" in text
+
+
+def test_a_suspect_profile_is_marked_in_fig10(tmp_path, monkeypatch):
+    """A suspect case's profile (here: no contact) was drawn and labelled as any other."""
+    s = np.linspace(0, 8, 81)
+    ok = {"peak_mpa": 0.3, "contact_points": 5, "reaction_n_per_mm": 0.5, "min_J": 0.95, "max_abs_stress_mpa": 0.4}
+    none = {**ok, "peak_mpa": 0.0, "contact_points": 0, "reaction_n_per_mm": 0.0}
+    recs = [CaseRecord(Scene(thickness=3.0, indenter="flat"), s, 0.3 * np.exp(-s ** 2), ok, Path(".")),
+            CaseRecord(Scene(thickness=3.0, indenter="curved"), s, 0 * s, none, Path("."))]
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.profiles_figure(recs, tmp_path)
+    fig = got["fig10_profiles"]
+    labels = [ln.get_label() for ln in fig.axes[0].lines if not ln.get_label().startswith("_")]
+    assert labels == ["flat", "curved (suspect)"]
+    assert "suspect" in fig._suptitle.get_text() and "curved" in fig._suptitle.get_text()

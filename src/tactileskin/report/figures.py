@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tactileskin import quality
 from tactileskin.fileio import atomic_write_bytes, make_dirs
 
 INDENTER_ORDER = ("flat", "curved", "braille")
@@ -99,6 +100,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
     variants = sorted({getattr(r, "variant", "") for r in records})
     dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
     used = set()
+    suspect = []
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
             ax = axes[i * rows_per_mat + j // cols][j % cols]
@@ -107,8 +109,13 @@ def profiles_figure(records, out: Path) -> list[Path]:
                             key=lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,
                                            getattr(r, "variant", ""), r.scene.dim)):
                 k = variants.index(getattr(r, "variant", "")) + len(variants) * dims.index(r.scene.dim)
+                name = _ind_name(r) + (f" {r.scene.dim}d" if len(dims) > 1 else "")
+                # a suspect case (no contact, the law out of range, ...) was drawn as any other
+                bad = quality.kind(quality.status(getattr(r, "summary", None) or {})) != "ok"
+                if bad:
+                    suspect.append(f"{name} (t = {t:g})" if len(thick) > 1 or len(mats) > 1 else name)
                 ax.plot(r.s, r.pressure, _DASHES[k % len(_DASHES)], color=COLOURS.get(r.scene.indenter.value),
-                        label=_ind_name(r) + (f" {r.scene.dim}d" if len(dims) > 1 else ""))
+                        label=name + (" (suspect)" if bad else ""), alpha=0.45 if bad else 1.0)
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.set_xlim(0, 8)
@@ -123,7 +130,9 @@ def profiles_figure(records, out: Path) -> list[Path]:
     handles, labels = axes[0][0].get_legend_handles_labels()
     if handles:
         fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 4), fontsize=8)
-    fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)", fontsize=10)
+    fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)"
+                 + (f"\nsuspect (pale; report.md): {', '.join(dict.fromkeys(suspect))}" if suspect else ""),
+                 fontsize=10, color="black")
     return _save(fig, out, "fig10_profiles")
 
 
