@@ -338,3 +338,18 @@ def test_a_file_indenter_on_a_skin_file_without_a_map_is_flagged():
     assert [f.code for f in quality.flags({**NORMAL, "bone_map_missing": True, "profile_plane_unknown": True})] \
         == ["no_bone_map"]
     assert quality.flags({**NORMAL, "bone_map_missing": True}) == []  # a built-in indenter's plane is known
+
+
+def test_the_figures_of_a_suspect_solve_say_so(tmp_path, monkeypatch):
+    """sensors.png (and a 3D bone_map.png) of a suspect result were titled as any other."""
+    import tactileskin.report.sensors as rs
+    from tactileskin.cli import main
+
+    titles = []
+    monkeypatch.setattr(rs, "write_sensors_figure", lambda data, png, title="": titles.append(title))
+    (tmp_path / "s.toml").write_text('[[sensors]]\nkind = "points"\ns = [0.0, 1.0]\ndepth = 0.5\n')
+    out = tmp_path / "o"
+    # no contact: the depth is far below the contact tolerance
+    assert main(["solve", "-t", "3", "-i", "curved", "--quality", "preview", "--depth", "1e-6",
+                 "--sensors", str(tmp_path / "s.toml"), "--out", str(out)]) == 3
+    assert len(titles) == 1 and "SUSPECT: no contact" in titles[0], titles

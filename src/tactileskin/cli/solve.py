@@ -168,16 +168,28 @@ def _write_figure(data, png, draw: str, title: str) -> None:
     getattr(importlib.import_module(module), func)(data, png, title=title)
 
 
+def _figure_title(res, text: str) -> str:
+    """A figure's title, with the result's suspect status when it has one (a no-contact map
+    was titled as any other)."""
+    if res.bone_map is None and res.sensors is None:
+        return text
+    status = str(res.summary().get("status", "ok"))
+    if quality.kind(status) == "ok":
+        return text
+    why = status.split(":", 1)[-1].strip()
+    return f"{text}\nSUSPECT: {why[:97] + '...' if len(why) > 100 else why}"
+
+
 def _write_map_figure(res, path, label: str) -> None:
     """bone_map.png of a 3D result."""
     _write_figure(res.bone_map, path / "bone_map.png", "tactileskin.report.bone_map:write_bone_map_figure",
-                  f"bone pressure, {label}")
+                  _figure_title(res, f"bone pressure, {label}"))
 
 
 def _write_sensors_figure(res, path, label: str) -> None:
     """sensors.png of a result with sensors."""
     _write_figure(res.sensors, path / "sensors.png", "tactileskin.report.sensors:write_sensors_figure",
-                  f"sensor readings, {label}")
+                  _figure_title(res, f"sensor readings, {label}"))
 
 
 def _solve_2d(scene):
