@@ -62,3 +62,24 @@ def test_every_number_printed_has_its_unit(tmp_path, capsys):
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "c")]) == 0
     rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.split()[:1] in (["peak"], ["span_mm"], ["auc"])]
     assert len(rows) == 3 and rows[2].endswith("MPa/mm mm / MPa mm")
+
+
+def test_the_figures_of_a_suspect_film_and_comparison_say_so(tmp_path, monkeypatch):
+    """pressure_map.png and overlay.png of a suspect profile / comparison were titled as any other."""
+    from tactileskin.film import plots
+
+    titles = {}
+    real = plots._save
+
+    def save(fig, path):
+        titles[path.name] = " ".join(ax.get_title() for ax in fig.axes)
+        return real(fig, path)
+
+    monkeypatch.setattr(plots, "_save", save)
+    scan = save_scan(render_scan(mirrored(S, gaussian_profile(1.2, 1.0)(S)), paper_eq8(), length_mm=14,
+                                 background_gs=245), tmp_path / "scan.png")  # saturated: suspect
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
+    assert "SUSPECT: 1 warning in summary.json" in titles["pressure_map.png"]
+    _sim_dir(tmp_path / "sim")
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "cmp")]) == 0
+    assert "SUSPECT: 1 warning in comparison.json" in titles["overlay.png"]

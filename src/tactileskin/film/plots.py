@@ -59,7 +59,7 @@ def pressure_map(fp, path, *, cmap: str = DEFAULT_CMAP) -> Path:
                    vmin=fp.calibration.p_range[0], vmax=fp.calibration.p_range[1],
                    interpolation="nearest")
     ax.set_ylabel("across strip (mm)")
-    ax.set_title(f"film pressure ({fp.calibration.name})")
+    ax.set_title(f"film pressure ({fp.calibration.name})" + _suspect_note(fp.warnings, "summary.json"))
     fig.colorbar(im, ax=[ax, ax2], label=f"pressure ({fp.unit})", shrink=0.9)
     ax2.plot(fp.s_mm, fp.pressure, "k-", lw=1.2, label="mean across width")
     if fp.band_lo is not None:
@@ -69,6 +69,12 @@ def pressure_map(fp, path, *, cmap: str = DEFAULT_CMAP) -> Path:
     ax2.set_ylabel(f"P ({fp.unit})")
     ax2.legend(fontsize=8)
     return _save(fig, path)
+
+
+def _suspect_note(warnings, where: str) -> str:
+    """A second title line for a suspect result (its figure was titled as any other)."""
+    n = len(warnings or [])
+    return f"\nSUSPECT: {n} warning{'s' if n > 1 else ''} in {where}" if n else ""
 
 
 def calibration_plot(cal, path) -> Path:
@@ -110,7 +116,7 @@ def overlay(comp, path) -> Path:
     ax.plot(-comp.sim_s, comp.sim_p, "r--", lw=0.8, alpha=0.5)
     d = comp.percent_diff
     ax.set_title(f"peak {d['peak']:+.1f} %, span {d['span_mm']:+.1f} %, area {d['auc']:+.1f} % "
-                 "(sim vs film)", fontsize=10)
+                 "(sim vs film)" + _suspect_note(comp.warnings, "comparison.json"), fontsize=10)
     ax.set_xlabel("s (mm)")
     ax.set_ylabel(f"P (film {comp.film_unit}; simulation MPa)")
     ax.legend(fontsize=8)
