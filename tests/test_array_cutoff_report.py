@@ -30,3 +30,21 @@ def test_the_depth_cap_sentence_says_whether_the_plate_touches():
     assert "capped at 0.4 mm" in md(0.4) and "never touches" in md(0.4)
     assert "capped at 0.55 mm" in md(0.55) and "never touches" not in md(0.55)
     assert "the Braille plate touches" in md(0.55)
+
+
+def test_the_chart_figure_of_a_suspect_chart_says_so(tmp_path, monkeypatch):
+    """The report listed the chart's suspect parts (here a note: the plate touches) while its
+    figures were titled as a clean chart."""
+    from tactileskin.report import array_chart
+
+    cfg = ChartConfig(thicknesses=(3.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",))
+    ch = Chart(cfg)
+    ch.rows.append(dict(material="silicone", thickness_mm=3.0, set="paper", pitch_mm=0.75, taxel_mm=0.6,
+                        noise_fs=0.01, noise_mpa=0.001, full_scale_mpa=0.3, bits=12, method="template",
+                        accuracy=1.0, chance=1 / 3, n_test=16))
+    ch.labels["paper"] = ["flat", "curved", "braille"]
+    ch.notes.append("t = 3 mm: the depth 0.6 mm passes the dot height 0.48 mm: the plate touches")
+    titles = []
+    monkeypatch.setattr(array_chart, "_save", lambda fig, out, stem: titles.append(fig._suptitle.get_text()) or [])
+    array_chart.write_outputs(ch, tmp_path)
+    assert len(titles) == 1 and "SUSPECT parts of the chart: 1 note in array_chart.md" in titles[0], titles

@@ -25,10 +25,14 @@ def set_title(set_: str, cfg) -> str:
     return SET_TITLES[set_].format(r=cfg.sphere_radius, chars=chars)
 
 
-def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
+def write_figures(chart, out: Path, method: str = "template", indicative: dict | None = None,
+                  notes: list | None = None) -> list[Path]:
     """One figure per material and stimulus set: accuracy over thickness (rows) x pitch
     (columns), a panel per noise level; the paper's 0.75 mm pitch dashed, the paper's
-    "5 mm cannot" row hatched; PNG and SVG."""
+    "5 mm cannot" row hatched; PNG and SVG. `indicative` {(material, t): why}: those letters
+    rows are marked † (as in the report's tables); `notes` (report.suspect): the title says
+    the chart has suspect parts (the figures were titled as a clean chart)."""
+    indicative = indicative or {}
     plt = _plt()
     cfg = chart.config
     paths = []
@@ -45,7 +49,8 @@ def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
                         ax.text(j, i, f"{A[i, j]:.2f}", ha="center", va="center", fontsize=7,
                                 color="white" if A[i, j] < 0.6 else "black")
                 ax.set_xticks(range(len(ps)), [f"{p:g}" for p in ps])
-                ax.set_yticks(range(len(ts)), [f"{t:g}" for t in ts])
+                ax.set_yticks(range(len(ts)), [f"{t:g}" + (" †" if set_ == "letters" and (material, t) in indicative
+                                                          else "") for t in ts])
                 ax.set_xlabel("pitch (mm)")
                 ax.set_ylabel("skin thickness t (mm)")
                 ax.set_title(f"noise {noise:g} x full scale", fontsize=9)
@@ -58,7 +63,12 @@ def write_figures(chart, out: Path, method: str = "template") -> list[Path]:
             if axes[0][0].get_legend_handles_labels()[0]:  # the paper's marks, where on the grid
                 axes[0][0].legend(loc="upper right", fontsize=7, framealpha=0.8)
             fig.colorbar(im, ax=axes[0].tolist(), label=f"accuracy ({method})", shrink=0.9)
-            fig.suptitle(f"{material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})", fontsize=10)
+            title = f"{material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})"
+            if set_ == "letters" and any(k[0] == material for k in indicative):
+                title += "\n† indicative: the letters' surrogate not shown within its tolerance (array_chart.md)"
+            if notes:
+                title += f"\nSUSPECT parts of the chart: {len(notes)} note{'s' if len(notes) > 1 else ''} in array_chart.md"
+            fig.suptitle(title, fontsize=10)
             paths += _save(fig, out, f"array_{material}_{set_}")
     return paths
 
@@ -272,6 +282,6 @@ def write_outputs(chart, out: Path, validation=None, method: str = "template") -
     with staged_files(out, ARRAY_FILES, last="array_chart.md") as tmp:
         atomic_write_text(tmp / "accuracies.csv", chart.to_csv(indicative))
         atomic_write_text(tmp / "array_chart.md", markdown(chart, validation, method) + "\n")
-        figures = write_figures(chart, tmp, method)
+        figures = write_figures(chart, tmp, method, indicative, suspect(chart, validation, trust))
     return {"csv": out / "accuracies.csv", "report": out / "array_chart.md",
             "figures": [out / p.name for p in figures]}
