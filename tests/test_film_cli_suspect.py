@@ -81,5 +81,5 @@ def test_the_figures_of_a_suspect_film_and_comparison_say_so(tmp_path, monkeypat
     assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
     assert "SUSPECT: 1 warning in summary.json" in titles["pressure_map.png"]
     _sim_dir(tmp_path / "sim")
-    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "cmp")]) == 0
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "cmp")]) == 3
     assert "SUSPECT: 1 warning in comparison.json" in titles["overlay.png"]
