@@ -168,7 +168,7 @@ def test_help_states_the_valid_ranges_from_the_validation_constants(cmd):
               range_text(*RADIUS, lo_open=True), range_text(*pad.SIZE)]
     if cmd != "mesh":  # the physics options
         wanted += [range_text(*scene.RATE), f"Default {scene.Scene.rate:g}", "--force-rate",
-                   range_text(0, loading.MAX_FORCE, lo_open=True, unit="N"), "mixed (locking-free; default)"]
+                   range_text(loading.MIN_FORCE, loading.MAX_FORCE, unit="N"), "mixed (locking-free; default)"]
     for w in wanted:
         assert w in text, (w, text)
     assert "[0.5, 5.512]" in text  # the fingertip's, as the QA probe's Scene error stated it

@@ -35,6 +35,9 @@ def test_default_scene_keys_unchanged_and_loading_enters_them():
 
 @pytest.mark.parametrize("fields, needle", [
     (dict(force=-1.0), "force"),
+    # below the reaction's resolution: 1e-7 N/mm stalled in its first increment, unnamed
+    (dict(force=1e-5), r"force.*\[0.0001, 10000\]"),
+    (dict(loading=[{"force": 1e-7, "rate": 1.0}]), r"loading\[0\].force"),
     (dict(force=0.2, depth=0.3), "depth"),
     (dict(force_rate=1.0), "force_rate"),
     (dict(force=0.2, force_rate=1.0, load_time=1.0), "force_rate"),

@@ -29,6 +29,11 @@ KINDS = ("depth", "force", "hold")
 MAX_SEGMENTS = 20
 MAX_TIME = 1e6       # s: a segment longer than ~11 days is a units mistake
 MAX_FORCE = 1e4      # N (N/mm): far beyond any soft skin under a fingertip-sized indenter
+# N (N/mm): below it the ramp's first targets are within the reaction's own resolution (1 mm
+# silicone under the flat plate in 2D: 1e-7 N/mm stalled in its first increment, its reaction
+# not within 1e-12 of 4.7e-11 N/mm; 3D preview, an R 2.5 sphere on 2 mm silicone: 1e-5 N
+# stalled, 1e-4 solves, as do the 1 mm dot, an R 0.5 sphere and the 5 mm flat plate)
+MIN_FORCE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -80,7 +85,7 @@ def segment_from(value, where: str, *, max_depth: float, default_rate: float) ->
         target = check_range(f"{where}.depth", d["depth"], 0.0, max_depth, unit="mm")
         unit = "mm/s"
     else:
-        target = check_range(f"{where}.force", d["force"], 0.0, MAX_FORCE, lo_open=True, unit="N (N/mm in 2D)",)
+        target = check_range(f"{where}.force", d["force"], MIN_FORCE, MAX_FORCE, unit="N (N/mm in 2D)")
         unit = "N/s (N/mm/s in 2D)"
         if "rate" not in d and "time" not in d:
             raise ParameterError(f"{where}.rate", None, f"rate = {unit} or time = s for a force segment")

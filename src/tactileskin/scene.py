@@ -256,7 +256,7 @@ class Scene:
             if self.depth is not None:
                 raise ParameterError("depth", self.depth, "not with force (force control finds the travel)",
                                      "give depth or force")
-            set_("force", check_range("force", self.force, 0.0, loading.MAX_FORCE, lo_open=True,
+            set_("force", check_range("force", self.force, loading.MIN_FORCE, loading.MAX_FORCE,
                                       unit="N (N/mm in 2D)"))
         for name in ("force_rate", "load_time"):
             if getattr(self, name) is not None and self.force is None:

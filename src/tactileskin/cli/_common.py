@@ -103,9 +103,9 @@ class _HelpText:
     @staticmethod
     def force() -> str:
         from tactileskin.errors import range_text
-        from tactileskin.loading import MAX_FORCE
+        from tactileskin.loading import MAX_FORCE, MIN_FORCE
 
-        return "in " + range_text(0.0, MAX_FORCE, lo_open=True, unit="N")
+        return "in " + range_text(MIN_FORCE, MAX_FORCE, unit="N")
 
     @staticmethod
     def formulation() -> str:
