@@ -219,9 +219,16 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
 
 
 def all_figures(records, rows, out: Path) -> list[Path]:
+    """Every sweep figure; like the bar and thickness figures (rows of status ok), Fig. 10
+    draws the ok results only: a suspect profile is not a result to compare with (it is in
+    the tables, marked)."""
+    from tactileskin import quality
+
     make_dirs(out)
     paths = thickness_figure(rows, out)
-    paths += profiles_figure(records, out)
+    ok = [r for r in records if quality.status(r.summary) == "ok"]
+    if ok:
+        paths += profiles_figure(ok, out)
     paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
     paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)
     paths += metric_figure(rows, "auc_mpa_mm", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)

@@ -506,6 +506,8 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
     if sus:
         out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]
     out += ["", "## Figures", ""]
+    if bad:
+        out += ["The figures show the ok cases only; the suspect and failed ones are in the tables above.", ""]
     for p in figures:
         if p.suffix == ".png" and p.stem != "metrics_vs_thickness":
             out.append(f"![{p.stem}]({p.name})")
