@@ -106,3 +106,33 @@ def test_profiles_figure_leaves_out_suspect_results_as_the_other_figures_do(tmp_
     lines = [ln for ax in got["fig10_profiles"].axes for ln in ax.lines if ln.get_label() in ("flat", "curved")]
     assert len(lines) == 2
     assert max(float(np.max(ln.get_ydata())) for ln in lines) == pytest.approx(0.3)
+
+
+def _one_thickness_2d_3d():
+    s = np.linspace(0, 8, 81)
+    recs, rows = [], []
+    for ind, dim, pk in (("flat", 2, 0.3), ("curved", 2, 0.2), ("braille", 2, 0.1), ("braille", 3, 0.04)):
+        p = pk * np.exp(-s ** 2)
+        recs.append(CaseRecord(Scene(thickness=1.0, material="silicone", indenter=ind), s, p, {}, Path(".")))
+        rows.append(dict(status="ok", material="silicone", thickness_mm=1.0, indenter=ind, braille_text="",
+                         dim=dim, peak_mpa=pk, span_mm=1.0, auc_mpa_mm=pk))
+    return recs, rows
+
+
+def test_sweep_figures_keep_their_title_and_legend_inside_the_image(tmp_path, monkeypatch):
+    # one thickness and material: a one-panel figure 3.2 in wide clipped its suptitle
+    # ('face mean pressure along the bone (cf. paper') and its legend ('bra' for 'braille 3d')
+    recs, rows = _one_thickness_2d_3d()
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.all_figures(recs, rows, tmp_path)
+    for stem, fig in got.items():
+        fig.canvas.draw()
+        r = fig.canvas.get_renderer()
+        W, H = fig.bbox.width, fig.bbox.height
+        for artist in [fig._suptitle, *fig.legends]:
+            if artist is None:
+                continue
+            bb = artist.get_window_extent(r)
+            assert bb.x0 >= -1 and bb.x1 <= W + 1 and bb.y0 >= -1 and bb.y1 <= H + 1, (stem, bb, W)
+    figures._plt().close("all")
