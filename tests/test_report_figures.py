@@ -119,6 +119,20 @@ def _one_thickness_2d_3d():
     return recs, rows
 
 
+def test_bars_of_the_2d_ridge_and_the_3d_dots_look_different(tmp_path, monkeypatch):
+    # `--braille-dim both`: the 'braille 2d' and 'braille 3d' bars had one colour and no hatch,
+    # so the legend could not tell which bar is which model
+    recs, rows = _one_thickness_2d_3d()
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.all_figures(recs, rows, tmp_path)
+    for stem in ("fig11_peak", "fig12_span", "fig13_auc"):
+        ax = got[stem].axes[0]
+        style = {c.get_label(): (c.patches[0].get_facecolor(), c.patches[0].get_hatch()) for c in ax.containers}
+        assert style["braille 2d"] != style["braille 3d"], stem
+    figures._plt().close("all")
+
+
 def test_sweep_figures_keep_their_title_and_legend_inside_the_image(tmp_path, monkeypatch):
     # one thickness and material: a one-panel figure 3.2 in wide clipped its suptitle
     # ('face mean pressure along the bone (cf. paper') and its legend ('bra' for 'braille 3d')

@@ -152,6 +152,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     series = sorted({key(r) + (r["indenter"],) for r in rows})
     variants = sorted({r.get("variant") or "" for r in rows})
     dims = {r.get("dim", 2) for r in rows}
+    dim_list = sorted(dims)  # the 2D ridge and the 3D dots: one colour, told apart by hatch
     nrows, cols = _grid(len(mats), 2)
     width = float(np.clip(1.2 + 0.22 * len(thick) * max(len(series), 1), 3.6, 7.5))  # per panel
     fig, axes = plt.subplots(nrows, cols, figsize=(width * cols, 3.2 * nrows + 0.5), squeeze=False,
@@ -171,7 +172,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
             ax.bar(np.arange(len(thick)) + (q - (len(series) - 1) / 2) * w, vals, w,
                    label=_series(ind, sk[1], sk[2]) + (f" {sk[3]}d" if len(dims) > 1 else ""),
                    color=COLOURS.get(ind),
-                   hatch=_HATCHES[variants.index(sk[2]) % len(_HATCHES)])
+                   hatch=_HATCHES[(variants.index(sk[2]) + len(variants) * dim_list.index(sk[3])) % len(_HATCHES)])
         ax.set_xticks(np.arange(len(thick)), [f"{t:g}" for t in thick],
                       rotation=45 if len(thick) > 8 else 0)
         ax.set_xlabel("skin thickness t (mm)")
