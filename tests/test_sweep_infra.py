@@ -143,3 +143,26 @@ def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_tracebac
     assert len(made) == 1 and made[0].shutdown_on_close is False  # the exit hook skips it
     assert theirs.shutdown_on_close is True
     SpecCluster._instances.discard(theirs)
+
+
+@pytest.mark.parametrize("spec, name", [
+    ("[sweep]\nthicknesses = [1.0, 3.0, 1.0]\n", "thicknesses"),
+    ("[sweep]\nthicknesses = [1]\nmaterials = [\"silicone\", \"silicone\"]\n", "materials"),
+    ("[sweep]\nthicknesses = [1]\nindenters = [\"flat\", \"flat\"]\n", "indenters"),
+])
+def test_a_value_listed_twice_in_a_sweep_is_refused_not_silently_dropped(tmp_path, capsys, spec, name):
+    # [1, 3, 1] (meant [1, 3, 5]?) ran 2 cases and said "2 cases", the repeat dropped silently
+    from tactileskin.cli import main
+
+    f = tmp_path / "sweep.toml"
+    f.write_text(spec)
+    rc = main(["sweep", "--scene", str(f), "--out", str(tmp_path / "out"), "--serial", "--no-render"])
+    err = capsys.readouterr().err
+    assert rc == 2 and name in err and "listed twice" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_expand_grid_refuses_a_repeated_axis_value():
+    with pytest.raises(ParameterError, match="thicknesses.*listed twice"):
+        expand_grid(thicknesses=[1.0, 3.0, 1.0])
+    assert len(expand_grid(thicknesses=[1.0, 3.0], materials=["silicone"], indenters=["flat"])) == 2

@@ -79,6 +79,9 @@ MAX_CASES = 10_000
 BRAILLE_DIMS = (2, 3)
 
 
+_NONE = object()
+
+
 def expand_grid(
     thicknesses: Sequence[float] = PAPER_THICKNESSES,
     materials: Sequence[str] = PAPER_MATERIALS,
@@ -110,6 +113,11 @@ def expand_grid(
             raise ParameterError(name, axis, "a sequence of values, not a string")
         if axis is not None and len(axis) == 0:  # would be a sweep of no case, silently
             raise ParameterError(name, list(axis), "at least one value")
+        if axis is not None and name != "braille_dims":  # (dims: a set of models, duplicates dropped)
+            repeated = next((v for i, v in enumerate(axis) if v in list(axis)[:i]), _NONE)
+            if repeated is not _NONE:  # [1, 3, 1] for [1, 3, 5]: ran 2 cases, the repeat dropped silently
+                raise ParameterError(name, list(axis), "distinct values",
+                                     f"{repeated!r} is listed twice; each value is a set of cases")
     if any(f is not None for f in forces) and any(d is not None for d in depths):
         raise ParameterError("forces", list(forces), "either forces or depths, not both",
                              "a case is pressed to a depth or to a force")
