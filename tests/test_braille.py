@@ -139,3 +139,19 @@ def test_the_cell_cap_message_reads_the_pitch_and_width_from_their_files(monkeyp
     with pytest.raises(ParameterError, match=r"40 cells already span 280 mm at the American pitch, "
                                              r"the fingertip is 18 mm wide"):
         braille.check_text("a" * (braille.MAX_CELLS + 1))
+
+
+@pytest.mark.parametrize("text", [" ", "⠀", "  \n "])
+def test_a_text_without_a_raised_dot_is_refused_by_the_scene_not_by_the_solve(tmp_path, capsys, text):
+    # a sweep TOML's braille_texts = [" "] passed the scene's checks and failed only in the
+    # solve: the sweep claimed its folder, wrote a report of one failed case and exited 1
+    from tactileskin.cli import main
+    from tactileskin.scene import Scene
+
+    with pytest.raises(ParameterError, match="braille_text.*raised dot"):
+        Scene(indenter="braille", braille_text=text)
+    f = tmp_path / "sweep.toml"
+    f.write_text(f'[sweep]\nthicknesses = [1.0]\nindenters = ["braille"]\nbraille_texts = [{text!r}]\n'.replace("'", '"'))
+    rc = main(["sweep", "--scene", str(f), "--out", str(tmp_path / "out"), "--serial", "--no-render"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "raised dot" in err and not (tmp_path / "out").exists()

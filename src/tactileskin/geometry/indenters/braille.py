@@ -50,9 +50,12 @@ class BrailleIndenter(Indenter):
 
     @classmethod
     def check_scene(cls, scene) -> dict:
-        _braille.get_standard(scene.braille_standard)  # raises ParameterError if unknown
+        std = _braille.get_standard(scene.braille_standard)  # raises ParameterError if unknown
         if scene.braille_text:
             _braille.check_text(scene.braille_text)   # raises on unknown characters, > MAX_CELLS
+            # and on a text with no raised dot (only spaces): refused with the scene, as any bad
+            # field, not by the solve (a sweep reported it as a failed case in a written folder)
+            _braille.dot_centres(scene.braille_text, std)
         return {}
 
     @classmethod
