@@ -150,3 +150,27 @@ def test_sweep_figures_keep_their_title_and_legend_inside_the_image(tmp_path, mo
             bb = artist.get_window_extent(r)
             assert bb.x0 >= -1 and bb.x1 <= W + 1 and bb.y0 >= -1 and bb.y1 <= H + 1, (stem, bb, W)
     figures._plt().close("all")
+
+
+def test_report_states_geometry_files_that_are_not_the_shipped_ones(tmp_path, monkeypatch):
+    # with TACTILESKIN_GEOMETRY naming an edited fingertip.toml the cache keyed the results by
+    # it, but report.md said nothing: the paper checks read as if on the shipped fingertip
+    import shutil
+
+    from tactileskin import params
+    from tactileskin.report.markdown import build_report
+
+    scenes = [Scene(thickness=1.0, material="silicone", indenter="flat")]
+    rows = [dict(case="t1", status="ok", material="silicone", thickness_mm=1.0, indenter="flat", braille_text="",
+                 depth_mm=0.2, peak_mpa=0.3, span_mm=2.0, auc_mpa_mm=0.4, reaction_n_per_mm=0.5)]
+    plain = build_report(rows, [], [], [], [], 1.0, scenes=scenes)
+    assert "TACTILESKIN_GEOMETRY" not in plain
+    geo = tmp_path / "geo"
+    shutil.copytree(params._packaged_dir(), geo)
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(geo))
+    assert "the same bytes as the shipped" in "\n".join(run_settings(scenes))
+    f = geo / "fingertip.toml"
+    f.write_text(f.read_text().replace("half_width = 8.0", "half_width = 8.4"))
+    md = build_report(rows, [], [], [], [], 1.0, scenes=scenes)
+    assert md.count("fingertip.toml differs from the shipped files") == 2  # run settings and the paper section
+    assert str(geo) in md

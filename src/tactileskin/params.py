@@ -98,6 +98,26 @@ def load(name: str) -> dict:
     return hit
 
 
+def geometry_changes() -> list[str] | None:
+    """None when the geometry parameter files are the shipped ones (no TACTILESKIN_GEOMETRY, or
+    it names the shipped folder); else the names of the .toml files whose bytes differ from the
+    shipped ones (missing or added included): what a report must state, since its numbers come
+    from them."""
+    folder, shipped = geometry_dir(), _packaged_dir()
+    with contextlib.suppress(OSError):
+        if folder.resolve() == shipped.resolve():
+            return None
+
+    def files(d: Path) -> dict:
+        try:
+            return {p.name: p.read_bytes() for p in d.iterdir() if p.name.endswith(".toml") and p.is_file()}
+        except OSError:
+            return {}
+
+    a, b = files(folder), files(shipped)
+    return sorted(n for n in set(a) | set(b) if a.get(n) != b.get(n))
+
+
 def geometry_digest() -> str:
     """SHA-256 of every geometry parameter file (names and bytes, sorted by name): part of
     the result cache's key, so that editing a dimension invalidates the cached results."""

@@ -384,6 +384,27 @@ def quality_name(scene) -> str:
     return "custom"
 
 
+def geometry_note() -> str:
+    """'' for the shipped geometry parameter files; else where they came from and which differ
+    from the shipped ones (the cache keys them, so the numbers are theirs: the report says so)."""
+    from tactileskin import params
+
+    changed = params.geometry_changes()
+    if changed is None:
+        return ""
+    return (f"Geometry parameter files from `{params.geometry_dir()}` (TACTILESKIN_GEOMETRY), not the shipped ones: "
+            + (f"{', '.join(changed)} {'differs' if len(changed) == 1 else 'differ'} from the shipped files, so the fingertip, indenters or Braille "
+               "of these cases are not the paper's reconstruction." if changed
+               else "the same bytes as the shipped files."))
+
+
+def params_changed() -> bool:
+    """Whether a geometry parameter file differs from the shipped one."""
+    from tactileskin import params
+
+    return bool(params.geometry_changes())
+
+
 def run_settings(scenes) -> list[str]:
     """The section stating what produced the numbers: version, mesh presets and sizes, model
     and solver settings (the solver's defaults: a sweep does not change them)."""
@@ -406,6 +427,9 @@ def run_settings(scenes) -> list[str]:
             out.append(f"| {dim}D | {ind} | {q} | {h:g} | {ref:g} | {h / ref:.3g} | P{order} | {form} | "
                        f"{'yes' if visco else 'no'} | {rate:g} | {n} |")
         out.append("")
+    note = geometry_note()
+    if note:
+        out += [note, ""]
     opts = ", ".join(f"{f.name} = {getattr(SolverOptions(), f.name)!r}" for f in dataclasses.fields(SolverOptions))
     out += [f"Solver settings (fe.solver.SolverOptions): {opts}.", ""]
     return out
@@ -452,6 +476,8 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
             "Only the cases at the paper's conditions enter these checks (indentation 20 % of the "
             "thickness, the default rate, viscoelastic, the default fingertip and Braille standard); "
             "where several remain for one material, thickness and indenter, the first listed is used.", ""]
+    if params_changed():
+        out += ["**Geometry**: " + geometry_note(), ""]
     checks = paper_checks_by_model(rows, records) if two_models else paper_checks(rows, records)
     if not checks:
         out += [NO_CLAIM, ""]
