@@ -245,3 +245,22 @@ def test_real_sweep_with_both_dims(tmp_path):
     cells = [c.strip() for c in line.strip("|").split("|")]
     assert float(cells[3]) == pytest.approx(p2 / p3, abs=0.006)
     assert p2 / p3 > 1.5
+
+
+def test_a_3d_verdict_without_its_3d_dot_is_not_given():
+    # the 3D dot failed or is suspect: the '3D dots' column judged flat against curved only and
+    # read 'distinguishable' (and could mark a 'change') although no 3D dot took part
+    recs, rows = _sweep([_case(1.0, "flat", 0.5, 4.0), _case(1.0, "curved", 0.4, 2.0),
+                         _case(1.0, "braille", 0.3, 0.8),
+                         _case(1.0, "braille", 0.39, 2.0, dim=3, summary=dict(contact_points=0))])
+    g = {m["group"]: m for m in markdown.discrimination_by_model(recs)}[("silicone", 1.0, "")]
+    assert g["verdict"][2] == "distinguishable"
+    assert g["verdict"][3].startswith("n/a") and not g["changed"]
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    line = next(ln for ln in report.splitlines() if ln.startswith("| silicone | 1 |"))
+    assert "| distinguishable | curved–flat" in line and "| n/a (" in line
+    # and without the 2D ridge's case the 2D column is not judged either
+    recs2 = [r for r in recs if not (r.scene.indenter.value == "braille" and r.scene.dim == 2)]
+    recs2[-1].summary = {}
+    g2 = {m["group"]: m for m in markdown.discrimination_by_model(recs2)}[("silicone", 1.0, "")]
+    assert g2["verdict"][2].startswith("n/a") and not g2["verdict"][3].startswith("n/a") and not g2["changed"]

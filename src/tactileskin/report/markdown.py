@@ -245,13 +245,23 @@ def discrimination_by_model(records) -> list[dict]:
     the Braille cases as the 2D ridge and as the 3D dots: dict(group, distances={dim: ..},
     verdict={dim: ..}, changed)."""
     merged: dict[tuple, dict] = {}
+    braille = defaultdict(dict)  # group -> {dim: its Braille profiles' names}
     for dim in BRAILLE_MODELS:
         for key, profs in _profiles_by_group(records, with_text=True, braille_dim=dim):
             m = merged.setdefault(key, dict(group=key, distances={}, verdict={}))
             m["distances"][dim], m["verdict"][dim] = _discrimination_cells(profs)
+            braille[key][dim] = {n for n in profs if n.startswith("braille")}
+    for key, m in merged.items():
+        # a model whose Braille case is missing (failed, suspect) while the other has it judged
+        # flat against curved only: that is no verdict of that model (it read 'distinguishable')
+        if any(braille[key].get(d) for d in BRAILLE_MODELS):
+            for dim in BRAILLE_MODELS:
+                if dim in m["verdict"] and not braille[key].get(dim):
+                    m["verdict"][dim] = "n/a (its Braille case failed, is suspect or was not run)"
     for m in merged.values():
         v = m["verdict"]
-        m["changed"] = len(v) == len(BRAILLE_MODELS) and len(set(v.values())) > 1
+        m["changed"] = (len(v) == len(BRAILLE_MODELS) and not any(x.startswith("n/a") for x in v.values())
+                        and len(set(v.values())) > 1)
     return [merged[k] for k in sorted(merged)]
 
 
