@@ -264,3 +264,17 @@ def test_a_3d_verdict_without_its_3d_dot_is_not_given():
     recs2[-1].summary = {}
     g2 = {m["group"]: m for m in markdown.discrimination_by_model(recs2)}[("silicone", 1.0, "")]
     assert g2["verdict"][2].startswith("n/a") and not g2["verdict"][3].startswith("n/a") and not g2["changed"]
+
+
+def test_a_failed_3d_dot_is_not_answered_with_run_braille_dim_both():
+    # the sweep ran --braille-dim both and its 3D dot failed: the report told the user to run the
+    # sweep with `--braille-dim both`, which they had
+    from tactileskin import quality
+
+    recs, rows = _sweep([_case(1.0, "flat", 0.5, 4.0), _case(1.0, "curved", 0.4, 2.0),
+                         _case(1.0, "braille", 0.3, 0.8)])
+    rows.append(dict(case="t1-silicone-braille-3d", status=quality.failed_status("did not converge"),
+                     material="silicone", thickness_mm=1.0, indenter="braille", braille_text="", dim=3, paper=True))
+    report = markdown.build_report(rows, recs, [], [], [], 1.0)
+    assert "--braille-dim both" not in report
+    assert "No Braille case has a result in both dimensions" in report

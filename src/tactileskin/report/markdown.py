@@ -319,8 +319,14 @@ def _ratio(a: float, b: float) -> str:
     return f"{a / b:.2f}" if b > 0 else "n/a"
 
 
-def braille_comparison(records) -> list[str]:
-    """The report section comparing, per Braille case, the 2D ridge and the 3D dots."""
+def _both_dims_run(rows) -> bool:
+    """Whether the sweep ran Braille cases in both dimensions (whatever became of them)."""
+    return rows is not None and {r.get("dim", 2) for r in rows if r.get("indenter") == "braille"} >= {2, 3}
+
+
+def braille_comparison(records, rows=None) -> list[str]:
+    """The report section comparing, per Braille case, the 2D ridge and the 3D dots (rows:
+    the sweep's, to tell a pair that failed from one that was not run)."""
     pairs = braille_pairs(records)
     lines = ["## Braille: 2D ridge against 3D dots", "",
              "The paper models a Braille dot row as a ridge in its 2D plane-strain section; the 3D "
@@ -333,7 +339,9 @@ def braille_comparison(records) -> list[str]:
              f"at 1.9-3.1x the peak of a dot (1.9x at t = 5, where the plate presses too) with spans "
              f"within 7 % ({RIDGE_VS_DOTS_SOURCE}).", ""]
     if not pairs:
-        lines.append("No Braille case was solved in both dimensions (run the sweep with "
+        lines.append("No Braille case has a result in both dimensions: those that failed or are "
+                     "suspect are listed above." if _both_dims_run(rows) else
+                     "No Braille case was solved in both dimensions (run the sweep with "
                      "`--braille-dim both`).")
         return lines
     suspect = {id(r) for r in _suspect_records(records)}
@@ -481,7 +489,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
     two_models = has_3d_braille(rows)
     if two_models:
-        out += braille_comparison(records) + [""]
+        out += braille_comparison(records, rows) + [""]
     out += ["## Against the paper", "",
             "Only the cases at the paper's conditions enter these checks (indentation 20 % of the "
             "thickness, the default rate, viscoelastic, the default fingertip and Braille standard); "
@@ -508,7 +516,9 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
         out += ["", ("Verdicts the 3D dots change: " + "; ".join(changed) + ".") if changed
                 else "No verdict changes from the 2D ridge to the 3D dots"
                 + (f" among the {len(checks) - len(one)} checks both models answer; {len(one)} checks have "
-                   "one model only (n/a), so they compare nothing (`--braille-dim both` solves both)." if one
+                   "one model only (n/a), so they compare nothing" + (
+                       " (their other model's cases failed or are suspect)." if _both_dims_run(rows)
+                       else " (`--braille-dim both` solves both).") if one
                    else ".")]
     else:
         out += ["| paper says | ours | verdict |", "|---|---|---|"]
