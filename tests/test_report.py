@@ -127,3 +127,33 @@ def test_renders_of_cases_whose_names_clean_alike_do_not_overwrite_each_other(tm
     assert len(renders) == 2
     report = (out / "report.md").read_text()
     assert all(r in report for r in renders)
+
+
+def test_a_claim_whose_case_failed_or_is_suspect_is_listed_untested_not_dropped():
+    # t = 1 mm silicone, the curved case failed: the peak-order and discrimination claims at
+    # 1 mm (and the span trend of the curved plate) vanished from the table, while the module
+    # promises that a claim the sweep cannot test says so
+    from tactileskin import quality
+    from tactileskin.report.markdown import build_report
+
+    data = {}
+    for t in (1.0, 3.0):
+        for ind, (pk, w) in {"flat": (0.5, 4.0), "curved": (0.4, 2.0), "braille": (0.3, 0.8)}.items():
+            data[("silicone", t, ind)] = (pk / t, w)
+    recs, rows = _records(data)
+    for r, rec in zip(rows, recs):
+        r.update(case=rec.scene.label(), depth_mm=rec.scene.indentation, reaction_n_per_mm=0.1)
+        rec.case = r["case"]
+    i = next(k for k, r in enumerate(rows) if (r["thickness_mm"], r["indenter"]) == (1.0, "curved"))
+    rows[i] = dict(rows[i], status=quality.failed_status("did not converge"))
+    del recs[i]
+    checks = {c["claim"]: c for c in paper_checks(rows, recs)}
+    for claim in ("silicone 1 mm: peak order flat > curved > Braille holds",
+                  "silicone 1 mm: indenters distinguishable",
+                  "silicone, curved: span shrinks as the skin thickens"):
+        assert checks[claim]["verdict"] == "untested", claim
+        assert checks[claim]["ours"] == "t1-silicone-curved-2d: failed", claim
+    assert checks["silicone 3 mm: peak order flat > curved > Braille holds"]["verdict"] == "agrees"
+    assert checks["silicone, flat: span shrinks as the skin thickens"]["verdict"] in ("agrees", "differs")
+    md = build_report(rows, recs, [], [], [], 1.0)
+    assert "| silicone 1 mm: indenters distinguishable | t1-silicone-curved-2d: failed | untested |" in md

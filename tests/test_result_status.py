@@ -167,7 +167,9 @@ def test_report_lists_failed_and_suspect_first_and_keeps_suspect_out_of_checks()
     checks = {c["claim"]: c for c in paper_checks(rows, recs)}
     flat = checks["peak, 1 mm silicone, flat ≈ 0.5 MPa/mm (agrees within ±25%)"]
     assert flat["verdict"] == "untested" and flat["ours"] == "suspect result"
-    assert not any("distinguishable" in c for c in checks)  # 2 trusted profiles only: no verdict
+    # 2 trusted profiles only: no verdict, but the claim is listed as untested, naming the suspect case
+    dist = checks["silicone 1 mm: indenters distinguishable"]
+    assert dist["verdict"] == "untested" and dist["ours"] == "t1-silicone-flat-2d: suspect"
     md = build_report(rows, recs, [], [], [], 1.0)
     top = md[: md.index("## Cases")]
     assert "t3-x: failed: did not converge" in top and "t1-silicone-flat-2d: suspect: stress" in top
