@@ -157,3 +157,15 @@ def test_a_claim_whose_case_failed_or_is_suspect_is_listed_untested_not_dropped(
     assert checks["silicone, flat: span shrinks as the skin thickens"]["verdict"] in ("agrees", "differs")
     md = build_report(rows, recs, [], [], [], 1.0)
     assert "| silicone 1 mm: indenters distinguishable | t1-silicone-curved-2d: failed | untested |" in md
+
+
+def test_no_pairs_because_suspect_is_not_reported_as_one_indenter_per_group():
+    # flat and curved both suspect: the report said "One indenter per material and thickness"
+    from tactileskin.report.markdown import NO_PAIRS, discrimination_table
+
+    s = np.linspace(0, 8, 81)
+    recs = [CaseRecord(Scene(thickness=1.0, material="silicone", indenter=ind), s, pk * np.exp(-s ** 2),
+                       {"max_abs_stress_mpa": 300.0}, Path(".")) for ind, pk in (("flat", 0.3), ("curved", 0.2))]
+    lines = discrimination_table(recs)
+    assert lines != [NO_PAIRS] and "suspect" in lines[0]
+    assert discrimination_table(recs[:1]) == [NO_PAIRS]

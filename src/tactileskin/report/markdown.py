@@ -270,12 +270,18 @@ NO_CLAIM = ("No paper claim applies to this grid: the paper's claims are about s
             "indentation, and this sweep ran none of them at the paper's conditions (its numbers are "
             "in the tables above).")
 NO_PAIRS = "One indenter per material and thickness: no pair of profiles to tell apart."
+NO_TRUSTED_PAIRS = ("No pair of ok profiles to tell apart: the suspect results are left out (listed below), "
+                    "so no verdict.")
 
 
 def discrimination_table(records) -> list[str]:
     groups = [g for g in _profiles_by_group(records, with_text=True) if len(g[1]) >= 2]
     if not groups:
-        return [NO_PAIRS]
+        # pairs there were, among the results before the suspect ones were left out
+        pairs = defaultdict(int)
+        for r in records:
+            pairs[(r.scene.material, r.scene.thickness)] += 1
+        return [NO_TRUSTED_PAIRS if _suspect_records(records) and max(pairs.values(), default=0) >= 2 else NO_PAIRS]
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     for (mat, t, variant), profs in groups:
         d, verdict = _discrimination_cells(profs)
