@@ -3,6 +3,7 @@
 import pytest
 
 from tactileskin.cli import main
+from tactileskin.errors import ParameterError
 
 
 def test_bad_pitch_is_one_line_and_no_output(tmp_path, capsys):
@@ -149,15 +150,20 @@ def test_an_empty_config_is_refused(tmp_path, capsys, no_solves, text):
     assert not (tmp_path / "o").exists()
 
 
-def test_repeated_list_values_are_one_axis_value():
+def test_a_value_listed_twice_is_refused(tmp_path, capsys):
     """-t 1,1 (or a repeated pitch, noise, material, set) wrote every row of accuracies.csv
-    twice; a sweep drops repeated cases, and so does the chart's config."""
+    twice; [1, 3, 1] is likely a typo for [1, 3, 5]: refused, naming the list, as a sweep does."""
     from tactileskin.array.chart import ChartConfig
 
-    cfg = ChartConfig(thicknesses=(1, 1.0, 3), pitches=(1, 1, 2), noise_fs=(0.01, 0.01), materials=("silicone",) * 2,
-                      sets=("paper", "paper"))
-    assert (cfg.thicknesses, cfg.pitches, cfg.noise_fs) == ((1, 3), (1, 2), (0.01,))
-    assert cfg.materials == ("silicone",) and cfg.sets == ("paper",)
+    for kw, name in ((dict(thicknesses=(1, 1.0, 3)), "thicknesses"), (dict(pitches=(1, 2, 1)), "pitches"),
+                     (dict(noise_fs=(0.01, 0.01)), "noise_fs"), (dict(materials=("silicone",) * 2), "materials"),
+                     (dict(sets=("paper", "paper")), "sets")):
+        with pytest.raises(ParameterError, match=f"{name}.*distinct values"):
+            ChartConfig(**kw)
+    out = tmp_path / "o"
+    assert main(["array", "-t", "1,1", "--set", "paper", "-o", str(out)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "listed twice" in err and "Traceback" not in err and not out.exists()
 
 
 @pytest.mark.parametrize("flags, words", [

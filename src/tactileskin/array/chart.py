@@ -64,9 +64,9 @@ CHART_MESH = (1.2, 8.0)
 
 
 def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:
-    """A non-empty list of numbers within [lo, hi] as a tuple, duplicates dropped (as a
-    sweep's repeated cases are: a repeated value wrote every row of accuracies.csv twice); a
-    string is refused (it would iterate per character)."""
+    """A non-empty list of distinct numbers within [lo, hi] as a tuple (a repeated value wrote
+    every row of accuracies.csv twice; [1, 3, 1] is likely a typo for [1, 3, 5], refused as a
+    sweep refuses it); a string is refused (it would iterate per character)."""
     from tactileskin import validate
     from tactileskin.sweep import MAX_AXIS_VALUES
 
@@ -76,11 +76,19 @@ def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool
     items = validate.sequence(v, name, ("numbers in " if rng[0] in "[(" else "numbers ") + rng, MAX_AXIS_VALUES)
     if not items:
         raise ParameterError(name, v, "at least one value")
-    return tuple(dict.fromkeys(check_range(name, x, lo, hi, lo_open=lo_open, unit=unit) for x in items))
+    return _distinct(name, tuple(check_range(name, x, lo, hi, lo_open=lo_open, unit=unit) for x in items))
+
+
+def _distinct(name: str, values: tuple) -> tuple:
+    """values, refused where one is listed twice."""
+    for i, v in enumerate(values):
+        if v in values[:i]:
+            raise ParameterError(name, list(values), "distinct values", f"{v!r} is listed twice")
+    return values
 
 
 def _names(v, name: str, choices: tuple | None) -> tuple:
-    """A non-empty list of strings (of `choices` where given) as a tuple, duplicates dropped."""
+    """A non-empty list of distinct strings (of `choices` where given) as a tuple."""
     from tactileskin import validate
     from tactileskin.sweep import MAX_AXIS_VALUES
 
@@ -91,7 +99,7 @@ def _names(v, name: str, choices: tuple | None) -> tuple:
     for x in items:
         if not isinstance(x, str) or (choices is not None and x not in choices):
             raise ParameterError(name, x, "a string" if choices is None else " or ".join(choices))
-    return tuple(dict.fromkeys(items))
+    return _distinct(name, tuple(items))
 
 
 @dataclass(frozen=True)
