@@ -196,6 +196,10 @@ def test_the_memory_rule_keeps_the_default_chart_and_its_finest_allowed_pitch():
     assert classify.memory_bytes(36, cfg.spec(p).n ** 2, 16, 16, 4) <= classify.MAX_BYTES
     with pytest.raises(ParameterError, match="template_grid"):
         ChartConfig(pitches=(1.0,), template_grid=2000)
+    # templates that fit with one test offset but not with two: template_grid named, not n_train
+    # with the empty range "an integer in [2, 1]"
+    with pytest.raises(ParameterError, match=r"template_grid=500 .*\[1, \d+\]"):
+        ChartConfig(pitches=(4.0,), sets=("letters",), template_grid=500, n_train=2, n_test=2)
 
 
 def test_the_validate_option_has_the_config_keys_limit(tmp_path, capsys, no_solves):

@@ -238,8 +238,10 @@ class ChartConfig:
             raise ParameterError("pitches (--pitch)", pitch, f">= {math.ceil(pmin / e) * e:.3g} mm over the "
                                  f"{self.window:g} mm window (at most {kmax} x {kmax} taxels)",
                                  hint=f"{k} x {k} taxels: LDA's taxel covariance alone exceeds {cap}")
-        if need(k, 2, 1, self.template_grid) > top:
-            gmax = max(g for g in range(1, self.template_grid) if need(k, 2, 1, g) <= top)
+        # the fewest offsets the offsets' rule below can name: 2 each (--offsets sets both); with
+        # (2, 1) here a template_grid that fits only there was blamed on n_train, "in [2, 1]"
+        if need(k, 2, 2, self.template_grid) > top:
+            gmax = max((g for g in range(1, self.template_grid) if need(k, 2, 2, g) <= top), default=1)
             raise ParameterError("template_grid", self.template_grid, f"an integer in [1, {gmax}] at the pitch "
                                  f"{pitch:g} mm ({k} x {k} taxels)", hint=f"its templates would exceed {cap}")
         fixed = need(k, 0, 0, self.template_grid)
