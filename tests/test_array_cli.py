@@ -213,3 +213,18 @@ def test_the_validate_option_has_the_config_keys_limit(tmp_path, capsys, no_solv
     err = " ".join(capsys.readouterr().err.split())
     assert "validate" in err and f"at most {MAX_TEXTS}" in err and "Traceback" not in err, err
     assert not out.exists()
+
+
+def test_the_fallback_help_says_the_run_rows_join_the_projects_measurements():
+    """Since e5616da a run's --validate rows join data/surrogate_validation.json (the worse
+    counts); --help and the README still said 'this run's --validate, else the project's'."""
+    from pathlib import Path
+
+    from click.testing import CliRunner
+
+    from tactileskin.cli import cli
+
+    text = " ".join(CliRunner().invoke(cli, ["array", "--help"]).output.split())
+    assert "else the project's" not in text and "together with the project's measurements" in text
+    readme = Path(__file__).resolve().parents[1] / "README.md"
+    assert "rows first, else the project's" not in " ".join(readme.read_text(encoding="utf-8").split())

@@ -570,8 +570,8 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             workers: int | None = None, validation=None) -> Chart:
     """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`,
     all of them first, in one batch on `workers` processes (solve_cached). `validation`: this
-    run's validate_surrogate rows, which judge the letters' surrogate before the project's
-    measurements do (fallback_reason)."""
+    run's validate_surrogate rows, which judge the letters' surrogate together with the
+    project's measurements (fallback_reason, array.validity.measured)."""
     from tactileskin.array import halfspace
     from tactileskin.array.validity import finer_mesh_reason
 

@@ -91,8 +91,8 @@ def load_config(path) -> dict:
                    "dots (sum): their measured errors are in the report; or a full 3D solve of every letter "
                    "(full: one solve per letter and thickness).")
 @click.option("--fallback/--no-fallback", default=None,
-              help="Where the letters' surrogate is measured past 5 % of full solves (this run's --validate, "
-                   "else the project's measurements), solve that thickness's letters in full (default), or "
+              help="Where the letters' surrogate is measured past 5 % of full solves (this run's --validate "
+                   "rows together with the project's measurements, the worse), solve that thickness's letters in full (default), or "
                    "keep the surrogate and mark those letters indicative.")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
