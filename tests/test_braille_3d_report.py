@@ -278,3 +278,19 @@ def test_a_failed_3d_dot_is_not_answered_with_run_braille_dim_both():
     report = markdown.build_report(rows, recs, [], [], [], 1.0)
     assert "--braille-dim both" not in report
     assert "No Braille case has a result in both dimensions" in report
+
+
+def test_a_3d_verdict_missing_one_of_its_braille_texts_is_not_a_change():
+    # texts a and b in both models, the 3D b suspect: the 3D column judged without b read
+    # 'distinguishable' against the 2D 'not distinguishable' (a and b alike) and was reported as
+    # a verdict the 3D dots change
+    def case(ind, pk, w, dim=2, text="", summary=None):
+        sc = Scene(thickness=1.0, material="silicone", indenter=ind, dim=dim, braille_text=text)
+        return CaseRecord(sc, S, pk * np.exp(-(S / w) ** 2), dict(summary or {}), Path("."))
+
+    recs = [case("flat", 0.5, 4.0), case("curved", 0.4, 2.0), case("braille", 0.30, 0.8, text="a"),
+            case("braille", 0.305, 0.8, text="b"), case("braille", 0.2, 0.6, dim=3, text="a"),
+            case("braille", 0.201, 0.6, dim=3, text="b", summary=dict(contact_points=0))]
+    g = {m["group"]: m for m in markdown.discrimination_by_model(recs)}[("silicone", 1.0, "")]
+    assert g["verdict"][2] == "not distinguishable"
+    assert g["verdict"][3].startswith("n/a") and not g["changed"]

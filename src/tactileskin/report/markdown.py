@@ -301,12 +301,14 @@ def discrimination_by_model(records) -> list[dict]:
             m["distances"][dim], m["verdict"][dim] = _discrimination_cells(profs)
             braille[key][dim] = {n for n in profs if n.startswith("braille")}
     for key, m in merged.items():
-        # a model whose Braille case is missing (failed, suspect) while the other has it judged
-        # flat against curved only: that is no verdict of that model (it read 'distinguishable')
-        if any(braille[key].get(d) for d in BRAILLE_MODELS):
-            for dim in BRAILLE_MODELS:
-                if dim in m["verdict"] and not braille[key].get(dim):
-                    m["verdict"][dim] = "n/a (its Braille case failed, is suspect or was not run)"
+        # a model missing a Braille case (failed, suspect) that the other has judged fewer
+        # profiles: that is no verdict of that model (without its only Braille case it read
+        # 'distinguishable' from flat against curved; without one of two texts it could read a
+        # 'change' that was the missing pair's, not the model's)
+        names = set().union(*braille[key].values())
+        for dim in BRAILLE_MODELS:
+            if dim in m["verdict"] and braille[key].get(dim, set()) != names:
+                m["verdict"][dim] = "n/a (a Braille case of it failed, is suspect or was not run)"
     for m in merged.values():
         v = m["verdict"]
         m["changed"] = (len(v) == len(BRAILLE_MODELS) and not any(x.startswith("n/a") for x in v.values())
