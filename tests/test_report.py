@@ -169,3 +169,17 @@ def test_no_pairs_because_suspect_is_not_reported_as_one_indenter_per_group():
     lines = discrimination_table(recs)
     assert lines != [NO_PAIRS] and "suspect" in lines[0]
     assert discrimination_table(recs[:1]) == [NO_PAIRS]
+
+
+def test_one_indenter_at_two_depths_one_suspect_is_no_pair_left_out():
+    # flat at 0.2 and 0.4 mm (variants d0.2, d0.4), the deeper suspect: they were never a pair
+    # to tell apart, but the table said the suspect results had been left out of one
+    from tactileskin.report.markdown import NO_PAIRS, discrimination_table
+    from tactileskin.sweep import case_variants
+
+    s = np.linspace(0, 8, 81)
+    recs = [CaseRecord(Scene(thickness=1.0, material="silicone", indenter="flat", depth=d), s, 0.3 * np.exp(-s ** 2),
+                       summ, Path(".")) for d, summ in ((0.2, {}), (0.4, {"max_abs_stress_mpa": 300.0}))]
+    for r, v in zip(recs, case_variants([r.scene for r in recs])):
+        r.variant = v
+    assert discrimination_table(recs) == [NO_PAIRS]

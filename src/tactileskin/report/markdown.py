@@ -277,10 +277,11 @@ NO_TRUSTED_PAIRS = ("No pair of ok profiles to tell apart: the suspect results a
 def discrimination_table(records) -> list[str]:
     groups = [g for g in _profiles_by_group(records, with_text=True) if len(g[1]) >= 2]
     if not groups:
-        # pairs there were, among the results before the suspect ones were left out
+        # pairs there were, among the results before the suspect ones were left out (grouped as
+        # the table groups them: two depths of one indenter are no pair)
         pairs = defaultdict(int)
         for r in records:
-            pairs[(r.scene.material, r.scene.thickness)] += 1
+            pairs[(r.scene.material, r.scene.thickness, getattr(r, "variant", ""))] += 1
         return [NO_TRUSTED_PAIRS if _suspect_records(records) and max(pairs.values(), default=0) >= 2 else NO_PAIRS]
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     for (mat, t, variant), profs in groups:
