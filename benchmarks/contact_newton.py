@@ -70,7 +70,8 @@ def configure(model, variant: str) -> SolverOptions:
         kw = {}
         for item in variant[4:].split("/"):
             k, v = item.split("=")
-            kw[k] = type(getattr(SolverOptions(), k))(float(v))
+            default = getattr(SolverOptions(), k)  # None: a by-dimension default (solver.EASY_ITERATIONS)
+            kw[k] = type(default)(float(v)) if default is not None else (int(v) if v.lstrip("-").isdigit() else float(v))
         return SolverOptions(**kw)
     elif variant != "now":
         raise SystemExit(f"unknown variant {variant!r}")

@@ -213,6 +213,12 @@ def test_the_validate_option_has_the_config_keys_limit(tmp_path, capsys, no_solv
     err = " ".join(capsys.readouterr().err.split())
     assert "validate" in err and f"at most {MAX_TEXTS}" in err and "Traceback" not in err, err
     assert not out.exists()
+    # a repeated text (its rows were written twice) and an empty list (silently nothing) are refused
+    for arg, words in (("l,r,l", "listed twice"), ("", "at least 1")):
+        assert main(["array", "--set", "letters", "-t", "1", "--pitch", "4", "-o", str(out), "--validate", arg]) == 2
+        err = " ".join(capsys.readouterr().err.split())
+        assert "validate" in err and words in err and "Traceback" not in err, err
+        assert not out.exists()
 
 
 def test_the_fallback_help_says_the_run_rows_join_the_projects_measurements():

@@ -86,6 +86,7 @@ def test_report_states_version_preset_and_mesh_sizes():
     assert f"tactileskin {__version__}" in text
     assert f"| preview | {pre.mesh_size:g} | {pre.refinement:g} |" in text and "| 2 |" in text
     assert "| custom | 0.77 | 2 | 0.385 |" in text and "rtol = 1e-05" in text
+    assert "easy_iterations {2: 7, 3: 6}" in text  # the values used where the option is None
 
 
 def test_profiles_figure_leaves_out_suspect_results_as_the_other_figures_do(tmp_path, monkeypatch):

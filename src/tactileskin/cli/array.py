@@ -128,9 +128,13 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
                  sphere_quality=sphere_quality)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:  # the config key's rule (at most MAX_TEXTS full solves per thickness)
-        texts = validate_mod.string_list(names(validate, "validate"), "validate (--validate)", MAX_TEXTS)
-    if texts:  # a repeated text is one validation (its rows were written twice)
-        texts = tuple(dict.fromkeys(texts))
+        texts = validate_mod.string_list(names(validate, "validate"), "validate (--validate)", MAX_TEXTS,
+                                         min_len=1)
+    if texts:  # a repeated text wrote its rows twice: refused, as a chart axis's repeats are
+        repeated = next((x for i, x in enumerate(texts) if x in texts[:i]), None)
+        if repeated is not None:
+            raise ParameterError("validate (--validate)", ",".join(texts), "distinct texts",
+                                 f"{repeated!r} is listed twice")
     try:
         cfg = ChartConfig(**kw)
     except TypeError as e:

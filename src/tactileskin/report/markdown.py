@@ -481,7 +481,7 @@ def run_settings(scenes) -> list[str]:
     import dataclasses
     import platform
 
-    from tactileskin.fe.solver import SolverOptions
+    from tactileskin.fe.solver import EASY_ITERATIONS, SHORT_STEP, SolverOptions
 
     scenes = list(scenes)
     out = ["## Run settings", "",
@@ -501,7 +501,8 @@ def run_settings(scenes) -> list[str]:
     if note:
         out += [note, ""]
     opts = ", ".join(f"{f.name} = {getattr(SolverOptions(), f.name)!r}" for f in dataclasses.fields(SolverOptions))
-    out += [f"Solver settings (fe.solver.SolverOptions): {opts}.", ""]
+    out += [f"Solver settings (fe.solver.SolverOptions): {opts}; where None, by model dimension: "
+            f"easy_iterations {EASY_ITERATIONS}, short_step {SHORT_STEP}.", ""]
     return out
 
 
