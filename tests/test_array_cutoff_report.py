@@ -4,13 +4,18 @@ from tactileskin.array.chart import Chart, ChartConfig
 from tactileskin.report.array_chart import markdown
 
 
-def test_an_unmeasurable_cutoff_is_not_a_zero_pitch():
-    cfg = ChartConfig(thicknesses=(1.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",))
-    ch = Chart(cfg)
-    ch.rows.append(dict(material="silicone", thickness_mm=1.0, set="paper", pitch_mm=0.75, taxel_mm=0.6,
+def _one_row_chart(t: float) -> Chart:
+    """A paper-set chart of one accuracy row at t (mm), pitch 0.75 mm."""
+    ch = Chart(ChartConfig(thicknesses=(t,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",)))
+    ch.rows.append(dict(material="silicone", thickness_mm=t, set="paper", pitch_mm=0.75, taxel_mm=0.6,
                         noise_fs=0.01, noise_mpa=0.001, full_scale_mpa=0.3, bits=12, method="template",
                         accuracy=1.0, chance=1 / 3, n_test=16))
     ch.labels["paper"] = ["flat", "curved", "braille"]
+    return ch
+
+
+def test_an_unmeasurable_cutoff_is_not_a_zero_pitch():
+    ch = _one_row_chart(1.0)
     ch.cutoffs.append({"material": "silicone", "thickness_mm": 1.0, "skin": "fingertip", "depth_mm": 0.2,
                        "peak_mpa": 0.04, "kc_rad_per_mm": float("inf"), "nyquist_pitch_mm": float("nan"),
                        "halfspace_nyquist_pitch_mm": 0.81})
@@ -37,12 +42,7 @@ def test_the_chart_figure_of_a_suspect_chart_says_so(tmp_path, monkeypatch):
     figures were titled as a clean chart."""
     from tactileskin.report import array_chart
 
-    cfg = ChartConfig(thicknesses=(3.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",))
-    ch = Chart(cfg)
-    ch.rows.append(dict(material="silicone", thickness_mm=3.0, set="paper", pitch_mm=0.75, taxel_mm=0.6,
-                        noise_fs=0.01, noise_mpa=0.001, full_scale_mpa=0.3, bits=12, method="template",
-                        accuracy=1.0, chance=1 / 3, n_test=16))
-    ch.labels["paper"] = ["flat", "curved", "braille"]
+    ch = _one_row_chart(3.0)
     ch.notes.append("t = 3 mm: the depth 0.6 mm passes the dot height 0.48 mm: the plate touches")
     titles = []
     monkeypatch.setattr(array_chart, "_save", lambda fig, out, stem: titles.append(fig._suptitle.get_text()) or [])
