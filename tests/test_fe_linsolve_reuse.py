@@ -332,3 +332,30 @@ def test_factor_precision_option_is_checked(slab3d):
     model = model_for_scene(sc, build_slab_mesh(sc, length=2.0))[0]
     with pytest.raises(ParameterError, match="factor_precision"):
         run(model, sc.duration, SolverOptions(linear_method="reuse", factor_precision="half"))
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_the_system_at_which_gmres_failed_last_increment_is_factorised_directly(backend):
+    """Each increment: a matrix near the last factorised one, then one far from it (the 3D
+    dots' second Newton system after the first step moved the contact set). GMRES fails on the
+    far one in the first increment (its budget wasted, then a factorisation); from the second
+    increment that system is factorised without a GMRES try, so no budget is wasted again."""
+    rng = np.random.default_rng(11)
+    A = _spd(900, rng)
+    s = linsolve.SymmetricSolver(A, backend, "reuse", factor_cost=15)
+    s.factor(A).solve(rng.standard_normal(900))           # the first factorisation
+    shift = [0.0]
+    for inc in range(3):
+        s.begin_increment()
+        near = _shifted(A, shift[0] + 1e-6)
+        s.factor(near).solve(rng.standard_normal(900))    # near the last factorised: GMRES
+        shift[0] -= 3.0
+        far = _shifted(A, shift[0])
+        x = s.factor(far).solve(b := rng.standard_normal(900))
+        assert np.linalg.norm(far @ x - b) <= 10 * linsolve.KRYLOV_RTOL * np.linalg.norm(b)
+        if inc == 0:
+            assert s.factorizations == 2 and 15 <= s.krylov_iterations <= 19  # one wasted budget
+            spent = s.krylov_iterations
+    # increments 2 and 3: the far system factorised at once (no budget wasted again); the near
+    # one of increment 2 directly too (the back-off after a failure), of increment 3 by GMRES
+    assert s.factorizations == 5 and spent < s.krylov_iterations <= spent + 8 and s._failures == 0

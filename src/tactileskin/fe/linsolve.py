@@ -19,7 +19,9 @@ Methods:
   when that stops paying: when a Krylov solve costs more than the average solve since the
   last factorisation (factorisation included, in units of one preconditioned iteration),
   or when GMRES needs as many iterations as a factorisation costs. The cost ratio comes
-  from PARDISO's flop counts (deterministic: the same run takes the same path).
+  from PARDISO's flop counts (deterministic: the same run takes the same path). A system at
+  which GMRES failed in the last load increment (counted from `begin_increment`) is
+  factorised at once in this one (the 3D dots: t = 5 silicone 41-43 -> 35-36 s wall).
   Measured (benchmarks/results/linsolve3d.md, 3D single dot): linear-solve CPU 1.6x less at
   17.5k free dofs, 1.9x at 57.5k, same Newton iterations. Smoothed-aggregation AMG (pyamg)
   was 6-10x slower than a PARDISO factorisation there and is not used.
@@ -330,6 +332,9 @@ class SymmetricSolver:
         self._cycle = [0.0, 0]        # cost (in preconditioned iterations) and solves since the factorisation
         self._failures = 0            # consecutive GMRES solves that did not converge
         self._direct_left = 0         # factor() calls that refactorise without trying GMRES first
+        # the factor() calls of the current increment (begin_increment), and the indices among
+        # them at which GMRES failed (or was not tried for that reason) in this and the last one
+        self._seq, self._failed_now, self._failed_last = 0, set(), set()
         self._ratio = factor_cost     # factorisation cost / iteration cost
         if backend == "pardiso":
             A = structure.tocsr()
@@ -342,11 +347,24 @@ class SymmetricSolver:
         self.threads = threads if backend == "pardiso" else 1
         self.precision = precision
 
+    def begin_increment(self) -> None:
+        """A new load increment's Newton solve starts. With method "reuse", the system at which
+        GMRES failed in the last increment is factorised directly in this one: the 3D Braille
+        dots' second Newton system failed in 7 of 8 increments at t = 3 mm and in most of the 13
+        at t = 5 (15 failures; the first step moves the contact set), each failure costing its
+        Krylov limit (28-37 iterations) and the factorisation anyway
+        (benchmarks/results/linsolve3d.md)."""
+        self._failed_last, self._failed_now, self._seq = self._failed_now, set(), 0
+
     def factor(self, A: sp.csr_matrix) -> "SymmetricSolver":
         """Take A as the matrix to solve with; factorise it unless the old factorisation is
         to be reused (method "reuse" and it has not gone stale)."""
         self._A = A
-        if self.method == "direct" or self._stale or self._direct_left > 0:
+        seq, self._seq = self._seq, self._seq + 1
+        learned = self.method == "reuse" and seq in self._failed_last
+        if learned:  # kept for the next increment: a system factorised so is not tried
+            self._failed_now.add(seq)
+        if self.method == "direct" or self._stale or self._direct_left > 0 or learned:
             self._direct_left = max(0, self._direct_left - 1)
             return self._factor(A)
         self._fresh = False
@@ -417,6 +435,7 @@ class SymmetricSolver:
                 # a row) refactorise directly for the next 1, 3, 7 ... systems
                 self._failures += 1
                 self._direct_left = min(2 ** self._failures - 1, DIRECT_AFTER_FAILURES_MAX)
+                self._failed_now.add(self._seq - 1)
                 log.debug("GMRES: no convergence in %d iterations with the old factorisation; refactorising"
                           " (directly for the next %d)", k, self._direct_left)
                 t0, c0 = self._factor_within_solve(A, t0, c0)

@@ -378,6 +378,9 @@ def newton(model: Model, u0: np.ndarray, t: float, dt: float, lam, opts: SolverO
     penalty * tol_penetration are released and Newton continues.
     """
     free = model.free
+    ls = getattr(model, "_linsolve", None)
+    if ls is not None:
+        ls.begin_increment()
     dofs, vals = model.prescribed(t)
     u = _lifted(model, u0, dofs, vals, t, dt, lam, stats, opts)
     sticky = None
