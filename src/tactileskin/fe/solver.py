@@ -43,7 +43,7 @@ class SolverOptions:
     # residual norm relative to the internal-force norm. 1e-5 (was 1e-8; Abaqus' default is 5e-3
     # of the average force): Newton is quadratic there, and the iteration from ~1e-6 to 1e-14
     # that 1e-8 asked for moved no peak by more than 0.05 % (36 paper cases in 2D: 1233 -> 1135
-    # Newton iterations; 3D dots: -7 to -11 %, the same peaks to 5 digits;
+    # Newton iterations; the six 3D default dots: -4 to -14 %, the same peaks to 5 digits;
     # benchmarks/results/contact_newton.md)
     rtol: float = 1e-5
     atol: float = 1e-12           # absolute residual floor (N)
