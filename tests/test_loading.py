@@ -227,6 +227,17 @@ def test_a_force_beyond_the_laws_lock_up_names_the_force(mesh):
     assert e.value.name == "force" and "stalled at" in str(e.value) and "N/mm" in str(e.value)
 
 
+def test_a_force_no_trial_travel_meets_names_the_force(mesh):
+    from tactileskin.fe import solve
+
+    # 10000 N/mm on the same ramp time: an increment's force step outgrows what any travel of
+    # it meets ("no convergence ... after 16 trial travels", the parameter unnamed)
+    with pytest.raises(ParameterError, match="force") as e:
+        solve(BASE.replace(force=10000.0), mesh=mesh)
+    assert e.value.name == "force" and "a force this solve reaches" in str(e.value)
+    assert "stalled at" in str(e.value) and "smaller target" in str(e.value)
+
+
 def test_a_stall_in_a_depth_segment_after_a_force_ramp_is_not_called_a_force_lock_up(mesh):
     from tactileskin.fe import _force_controlled, solve
     from tactileskin.fe.solver import SolverOptions

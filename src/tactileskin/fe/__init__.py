@@ -202,17 +202,24 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                                       progress=progress, on_segment=on_segment)
     except ConvergenceError as e:
         forced = [g.target for g in program if g.kind == "force"]
-        if not _force_controlled(program, done[0]) or not last or "increments" not in str(e):
+        lock_up = "increments" in str(e)
+        if not _force_controlled(program, done[0]) or not last or not (lock_up or "trial travels" in str(e)):
             raise
         # a force beyond the law's lock-up: the increments shrink to nothing below the travel
-        # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments")
+        # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments");
+        # or no travel of an increment met its force (10000 N/mm on 1 mm silicone stalled at
+        # 9.6 N/mm, "after 16 trial travels", the parameter unnamed)
         unit = "N" if scene.dim == 3 else "N/mm"
+        stalled = (f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
+                   f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "
+                   f"|stress| up to {worst.get('max_abs_stress_mpa', float('nan')):.3g} MPa")
         raise ParameterError("force", scene.force if scene.force is not None else max(forced),
                              f"a force the skin carries within its travel (at most "
-                             f"{scene.max_travel:.3g} mm = 0.6 x thickness)",
-                             f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
-                             f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "
-                             f"|stress| up to {worst.get('max_abs_stress_mpa', float('nan')):.3g} MPa") from None
+                             f"{scene.max_travel:.3g} mm = 0.6 x thickness)" if lock_up else
+                             "a force this solve reaches",
+                             stalled if lock_up else f"{stalled}; a smaller target may converge (its "
+                             "increments are smaller: 20 N/mm solves on 1 mm silicone where 10000 "
+                             "stalls at 9.4)") from None
     if not best:  # every ramp ended below zero force: report the final state
         on_segment(0, program[0], ev)
     res = best["result"]
