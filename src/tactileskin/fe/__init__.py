@@ -218,8 +218,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                              f"{scene.max_travel:.3g} mm = 0.6 x thickness)" if lock_up else
                              "a force this solve reaches",
                              stalled if lock_up else f"{stalled}; a smaller target may converge (its "
-                             "increments are smaller: 20 N/mm solves on 1 mm silicone where 10000 "
-                             "stalls at 9.4)") from None
+                             "ramp takes smaller force steps)") from None
     if not best:  # every ramp ended below zero force: report the final state
         on_segment(0, program[0], ev)
     res = best["result"]
