@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tactileskin import ownership
+from tactileskin import outdir, ownership
 from tactileskin.cli import main
 from tactileskin.errors import ParameterError
 from tactileskin.film import analyze_scan, compare, paper_eq8
@@ -73,7 +73,8 @@ def test_cli_calibrate_analyze_compare(tmp_path, capsys):
                "--cmap", "jet", "--out", str(tmp_path / "film")])
     assert rc == 0, capsys.readouterr().err
     assert sorted(p.name for p in (tmp_path / "film").iterdir()) == [
-        ".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK, "pressure_map.png", "profile.csv", "summary.json"]
+        ".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK, outdir.RUN_LOCK, "pressure_map.png",
+        "profile.csv", "summary.json"]
     summ = json.loads((tmp_path / "film" / "summary.json").read_text())
     assert summ["unit"] == "MPa/mm" and summ["calibration"]["name"] == "paper_eq8"
     assert summ["metrics_folded"]["peak"] == pytest.approx(0.4, abs=0.0025)  # 8-bit rounding

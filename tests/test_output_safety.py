@@ -85,7 +85,8 @@ def test_solve_rewrites_its_own_folder_and_refuses_unmarked_lookalikes(tmp_path,
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0  # marked as ours: rewritten
     assert sorted(p.name for p in d.iterdir()) == [".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK,
-                                                  "contact.csv", "profile.csv", "result.vtu", "summary.json"]
+                                                  outdir.RUN_LOCK, "contact.csv", "profile.csv", "result.vtu",
+                                                  "summary.json"]
     # without our marker, files with solve's names are the user's: refused, left as they are
     user = tmp_path / "user"
     user.mkdir()
@@ -329,6 +330,55 @@ def counted_cases(monkeypatch):
 
     monkeypatch.setattr(sw, "solve_case", fail)
     return calls
+
+
+def _hold_run_lock(folder: Path):
+    """Hold `folder`'s run lock as another process's run would (flock: a second open file
+    description conflicts even within one process)."""
+    import fcntl
+
+    fd = os.open(folder / outdir.RUN_LOCK, os.O_RDWR | os.O_CREAT, 0o666)
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    return fd
+
+
+def test_a_second_run_into_a_folder_in_use_is_refused_and_changes_nothing(tmp_path, capsys, fake_solve):
+    d = tmp_path / "d"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    before = {p.name: p.read_bytes() for p in d.iterdir()}
+    fd, fd2 = _hold_run_lock(d), None   # the first run still writing (a long sweep into the same --out)
+    try:
+        assert main(["solve", *CHEAP, "-t", "2", "--out", str(d)]) == 2
+        err = _err(capsys)
+        assert str(d) in err and "another tactileskin run" in err and len(err.strip().splitlines()) == 1
+        assert len(fake_solve) == 1   # refused before solving
+        assert {p.name: p.read_bytes() for p in d.iterdir()} == before
+        new = tmp_path / "new"        # the holder's new folder: the refused run removes nothing
+        new.mkdir()
+        fd2 = _hold_run_lock(new)
+        assert main(["solve", *CHEAP, "--out", str(new)]) == 2
+        assert sorted(p.name for p in new.iterdir()) == [".tactileskin", outdir.RUN_LOCK]  # the holder's
+    finally:
+        os.close(fd)
+        if fd2 is not None:
+            os.close(fd2)
+    assert main(["solve", *CHEAP, "-t", "2", "--out", str(d)]) == 0   # released: a run may go on
+
+
+def test_the_api_sweep_refuses_a_folder_in_use(tmp_path, counted_cases):
+    from tactileskin import api
+    from tactileskin.fileio import OutputError
+
+    out = tmp_path / "out"
+    out.mkdir()
+    fd = _hold_run_lock(out)
+    try:
+        with pytest.raises(OutputError, match="another tactileskin run"):
+            api.sweep({"thickness": [1], "material": ["silicone"], "indenter": ["flat"]}, out=out, serial=True,
+                      report=False)
+    finally:
+        os.close(fd)
+    assert counted_cases == []
 
 
 def test_a_sweep_replaces_its_outputs_whole_and_leaves_a_users_file(tmp_path, capsys, counted_cases):

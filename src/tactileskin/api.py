@@ -150,8 +150,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     import pandas as pd
 
     from tactileskin.cache import ResultCache
-    from tactileskin.report.outputs import collect, profile_rows
-    from tactileskin.sweep import run_sweep
+    from tactileskin.report.outputs import profile_rows
 
     for name, value in (("out", out), ("cache", cache)):
         if value is not None:
@@ -162,25 +161,13 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     if cache is None:
         cache = Path(out) / "cache" if out is not None else default_cache_dir()
     rc = ResultCache(cache)
-    if out is not None:
-        from tactileskin.outdir import claim_dir
-
-        claim_dir(Path(out), "sweep", what="out")
-    t0 = time.perf_counter()
-    with _script_not_rerun():
-        outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
-    failed = [oc for oc in outcomes if oc.status == "failed"]
-    if failed:  # the rows say which and why; a notebook user should not miss that some did
-        logging.getLogger(__name__).warning("%d of %d cases failed (status and error columns): %s",
-                                            len(failed), len(outcomes), ", ".join(oc.case for oc in failed))
-    if out is not None:
-        from tactileskin.report.outputs import write_outputs
-
-        # as the command writes it: the wall time, and (with report) the Fig. 9 renders
-        res = write_outputs(Path(out), outcomes, rc, time.perf_counter() - t0, render=report, figures=report)
-        rows, records = res["rows"], res["records"]
+    if out is None:
+        records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, None, report)
     else:
-        records, rows, _ = collect(outcomes, rc)
+        from tactileskin.outdir import claimed
+
+        with claimed(Path(out), "sweep", what="out"):  # a second run into `out` is refused
+            records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, Path(out), report)
     from tactileskin.report.outputs import RESULT_COLUMNS
 
     metrics = pd.DataFrame(rows)
@@ -194,6 +181,28 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         return metrics
     prof = pd.DataFrame(profile_rows(records), columns=["case", "s_mm", "pressure_mpa"])
     return metrics, prof
+
+
+def _sweep_rows(scs, rc, scheduler, workers, serial, out, report):
+    """Run the sweep; write the `sweep` command's folder into `out` (if given); (records, rows)."""
+    from tactileskin.report.outputs import collect
+    from tactileskin.sweep import run_sweep
+
+    t0 = time.perf_counter()
+    with _script_not_rerun():
+        outcomes = run_sweep(scs, rc, scheduler=scheduler, workers=workers, serial=serial)
+    failed = [oc for oc in outcomes if oc.status == "failed"]
+    if failed:  # the rows say which and why; a notebook user should not miss that some did
+        logging.getLogger(__name__).warning("%d of %d cases failed (status and error columns): %s",
+                                            len(failed), len(outcomes), ", ".join(oc.case for oc in failed))
+    if out is None:
+        records, rows, _ = collect(outcomes, rc)
+        return records, rows
+    from tactileskin.report.outputs import write_outputs
+
+    # as the command writes it: the wall time, and (with report) the Fig. 9 renders
+    res = write_outputs(out, outcomes, rc, time.perf_counter() - t0, render=report, figures=report)
+    return res["records"], res["rows"]
 
 
 @contextlib.contextmanager

@@ -17,9 +17,13 @@ from pathlib import Path
 from typing import Iterable, Iterator
 
 from tactileskin.fileio import OutputError, atomic_write_json, clean_stale, is_temporary, make_dirs, os_errors
-from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, record_file
+from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, folder_lock, record_file
 
 MARKER = ".tactileskin"
+# held (flock) by the run writing into the folder: a second run into it is refused, as its
+# result would replace the first's files while the first reports them written
+RUN_LOCK = ".tactileskin-run.lock"
+BOOKKEEPING = (OWNED_FILES, RECORD_LOCK, RUN_LOCK)
 
 
 def _is_ours(folder: Path, kind: str | None) -> bool:
@@ -69,7 +73,7 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     if folder.is_dir():
         with os_errors(folder):
             entries = [p for p in folder.iterdir() if not is_temporary(p.name)
-                       and p.name not in (OWNED_FILES, RECORD_LOCK)]  # our bookkeeping of single files
+                       and p.name not in BOOKKEEPING]  # our bookkeeping of single files
         if entries and not _is_ours(folder, kind):
             other = marker_kind(folder)
             if other is not None:  # ours, but another command's: say so, not "did not write"
@@ -103,29 +107,51 @@ def is_legacy(folder: Path) -> bool:
 
 @contextlib.contextmanager
 def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
-    """claim_dir `folder` for the body; if the body fails and the folder was created here and
-    holds nothing but our marker (and record lock), remove it again: a refused or failed run
-    leaves no empty folder behind."""
+    """claim_dir `folder` for the body, holding its RUN_LOCK (OutputError if another run holds
+    it); if the body fails and the folder was created here and holds nothing but our marker
+    (and locks), remove it again: a refused or failed run leaves no empty folder behind."""
     folder = Path(folder)
     existed = folder.exists() or folder.is_symlink()
     claim_dir(folder, kind, what=what)
+    with run_lock(folder, what):
+        try:
+            yield folder
+        except BaseException:
+            _remove_if_new(folder, existed)
+            raise
+
+
+@contextlib.contextmanager
+def run_lock(folder: Path, what: str = "out") -> Iterator[None]:
+    """Hold the folder's RUN_LOCK for a run writing into it; OutputError at once if another
+    process holds it (a second run into one folder would replace the first's files)."""
+    lock = folder_lock(folder, RUN_LOCK, folder, blocking=False)
     try:
-        yield folder
-    except BaseException:
-        if not existed:
-            with contextlib.suppress(OSError):
-                names = {p.name for p in folder.iterdir()}
-                cache = folder / "cache"  # a sweep stopped before its first case: locks only
-                if "cache" in names and cache.is_dir() and not cache.is_symlink() and all(
-                        p.suffix == ".lock" and p.is_file() for p in cache.iterdir()) \
-                        and _remove_free_locks(cache):
-                    cache.rmdir()
-                    names.discard("cache")
-                if MARKER in names and names <= {MARKER, RECORD_LOCK}:
-                    for n in names:
-                        (folder / n).unlink()
-                    folder.rmdir()
-        raise
+        lock.__enter__()
+    except BlockingIOError:
+        raise OutputError(folder, "another tactileskin run is writing into this folder now; wait for it "
+                                  f"to finish, or give {what} another folder") from None
+    with contextlib.ExitStack() as stack:
+        stack.push(lock)
+        yield
+
+
+def _remove_if_new(folder: Path, existed: bool) -> None:
+    """Remove `folder` if this run created it and it holds nothing but our bookkeeping."""
+    if existed:
+        return
+    with contextlib.suppress(OSError):
+        names = {p.name for p in folder.iterdir()}
+        cache = folder / "cache"  # a sweep stopped before its first case: locks only
+        if "cache" in names and cache.is_dir() and not cache.is_symlink() and all(
+                p.suffix == ".lock" and p.is_file() for p in cache.iterdir()) \
+                and _remove_free_locks(cache):
+            cache.rmdir()
+            names.discard("cache")
+        if MARKER in names and names <= {MARKER, *BOOKKEEPING}:
+            for n in names:
+                (folder / n).unlink()
+            folder.rmdir()
 
 
 def _remove_free_locks(folder: Path) -> bool:

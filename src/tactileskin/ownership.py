@@ -92,6 +92,15 @@ def record_lock(folder: Path) -> Iterator[None]:
     """Hold an exclusive flock on the folder's RECORD_LOCK around a read-modify-write of its
     OWNED_FILES (waits for another writer into the same folder). Without flock (no fcntl, a
     file system without locks) there is no lock, as in the cache."""
+    with folder_lock(folder, RECORD_LOCK, folder / OWNED_FILES):
+        yield
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path, name: str, about: Path, blocking: bool = True) -> Iterator[None]:
+    """Hold an exclusive flock on `folder / name` (created, left in place) for the body; errors
+    name `about`. blocking=False: BlockingIOError at once if another process holds it. Without
+    flock (no fcntl, a file system without locks) there is no lock, with a warning."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX
@@ -99,19 +108,21 @@ def record_lock(folder: Path) -> Iterator[None]:
         return
     # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
     # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
-    with os_errors(folder / OWNED_FILES, own_name=False):
+    with os_errors(about, own_name=False):
         try:
-            fd = os.open(folder / RECORD_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+            fd = os.open(folder / name, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
         except PermissionError:
-            fd = os.open(folder / RECORD_LOCK, os.O_RDONLY | os.O_CREAT, 0o666)
+            fd = os.open(folder / name, os.O_RDONLY | os.O_CREAT, 0o666)
     try:
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX)
+            fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+        except BlockingIOError:
+            raise
         except OSError as e:
             if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.EBADF):
-                with os_errors(folder / OWNED_FILES, own_name=False):
+                with os_errors(about, own_name=False):
                     raise
-            log.warning("no file locks in %s (%s): its record is written without one", folder, e.strerror)
+            log.warning("no file locks in %s (%s): %s is written without one", folder, e.strerror, about.name)
         yield
     finally:
         os.close(fd)  # releases the lock

@@ -34,8 +34,8 @@ from tactileskin.fileio import (
     os_errors,
     tmp_prefix,
 )
-from tactileskin.outdir import MARKER, is_legacy, marker_doc
-from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, entry_digests, is_recorded, read_record, record_lock
+from tactileskin.outdir import BOOKKEEPING, MARKER, is_legacy, marker_doc
+from tactileskin.ownership import OWNED_FILES, entry_digests, is_recorded, read_record, record_lock
 
 
 @contextlib.contextmanager
@@ -199,7 +199,7 @@ def _replace_files(folder: Path, tmp: Path, own: tuple, new: list[str], last, di
                     # film folder's analyze files, upgraded by a compare that writes only its own)
                     subs = {p.name for p in folder.iterdir() if p.is_dir() and not p.is_symlink() and p.name != "cache"}
                     keep.update({rel: file_sha256(folder / rel) for rel in _files(folder, subs)
-                                 if rel not in digests and rel not in keep and rel not in (MARKER, OWNED_FILES, RECORD_LOCK)
+                                 if rel not in digests and rel not in keep and rel not in (MARKER, *BOOKKEEPING)
                                  and (folder / rel).is_file() and not (folder / rel).is_symlink()})
                 atomic_write_json(folder / OWNED_FILES, {**keep, **digests})  # the last step: no undo
                 if legacy:

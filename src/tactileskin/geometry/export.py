@@ -162,7 +162,8 @@ def check_target(out: Path) -> None:
     if not out.is_dir() or kind == FOLDER_KIND:
         return
     with fileio.os_errors(out):
-        entries = [p.name for p in out.iterdir() if not fileio.is_temporary(p.name)]
+        entries = [p.name for p in out.iterdir()
+                   if not fileio.is_temporary(p.name) and p.name not in outdir.BOOKKEEPING]
     valid = "a new or empty folder, or the folder of a previous `tactileskin build`"
     if kind is not None:
         raise ParameterError("out", str(out), valid,
