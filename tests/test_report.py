@@ -183,3 +183,27 @@ def test_one_indenter_at_two_depths_one_suspect_is_no_pair_left_out():
     for r, v in zip(recs, case_variants([r.scene for r in recs])):
         r.variant = v
     assert discrimination_table(recs) == [NO_PAIRS]
+
+
+@pytest.mark.parametrize("curved, verdict", [
+    ((0.4, 2.0), "n/a: t1-silicone-braille-2d (failed) left out (the ok cases alone: distinguishable)"),
+    ((0.48, 3.9), "not distinguishable (already among the ok cases; left out: t1-silicone-braille-2d (failed))")])
+def test_a_discrimination_group_missing_a_failed_case_has_no_verdict_on_the_set(curved, verdict):
+    # t = 1 mm silicone with the Braille case failed: the table read "distinguishable" from flat
+    # against curved alone, a verdict on a set of three that judged two
+    from tactileskin import quality
+    from tactileskin.report.markdown import build_report, discrimination_table
+
+    data = {("silicone", 1.0, ind): v for ind, v in
+            {"flat": (0.5, 4.0), "curved": curved, "braille": (0.3, 0.8)}.items()}
+    recs, rows = _records(data)
+    for r, rec in zip(rows, recs):
+        r.update(case=rec.scene.label(), variant="", depth_mm=rec.scene.indentation, reaction_n_per_mm=0.1)
+        rec.case, rec.variant = r["case"], ""
+    whole = discrimination_table(recs, rows)[2]
+    assert whole.endswith("| not distinguishable |" if verdict.startswith("not") else "| distinguishable |")
+    rows[2] = dict(rows[2], status=quality.failed_status("did not converge"))
+    del recs[2]
+    line = discrimination_table(recs, rows)[2]
+    assert line.startswith("| silicone | 1 | – | curved–flat ") and line.endswith(f"| {verdict} |")
+    assert f"| {verdict} |" in build_report(rows, recs, [], [], [], 1.0)

@@ -274,7 +274,32 @@ NO_TRUSTED_PAIRS = ("No pair of ok profiles to tell apart: the suspect results a
                     "so no verdict.")
 
 
-def discrimination_table(records) -> list[str]:
+def _left_out(rows, braille_dim: int | None = None) -> dict:
+    """(material, thickness, variant) -> ["case (failed)", "case (suspect)", ...]: the cases of
+    each discrimination group that its verdict cannot include (braille_dim as _profiles_by_group)."""
+    out = defaultdict(list)
+    for r in rows:
+        k = quality.kind(str(r.get("status", "")))
+        if k != "ok" and not _other_dim(r.get("indenter"), r.get("dim", 2), braille_dim):
+            out[(r["material"], r["thickness_mm"], r.get("variant", ""))].append(f"{r['case']} ({k})")
+    return out
+
+
+def _with_left_out(verdict: str, left: list[str]) -> str:
+    """A group's verdict when some of its cases failed or are suspect: a pair the ok cases
+    cannot tell apart decides the set; otherwise the set has no verdict (the missing case
+    may be the one that cannot be told apart)."""
+    if not left:
+        return verdict
+    if verdict == "not distinguishable":
+        return f"not distinguishable (already among the ok cases; left out: {', '.join(left)})"
+    return f"n/a: {', '.join(left)} left out (the ok cases alone: {verdict})"
+
+
+def discrimination_table(records, rows=()) -> list[str]:
+    """The discrimination table of the sweep's groups; `rows` (the sweep's rows, failed cases
+    too) mark a group that misses a case, whose verdict then covers the ok cases only."""
+    left = _left_out(rows)
     groups = [g for g in _profiles_by_group(records, with_text=True) if len(g[1]) >= 2]
     if not groups:
         # pairs there were, among the results before the suspect ones were left out (grouped as
@@ -286,16 +311,18 @@ def discrimination_table(records) -> list[str]:
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     for (mat, t, variant), profs in groups:
         d, verdict = _discrimination_cells(profs)
+        verdict = _with_left_out(verdict, left.get((mat, t, variant), []))
         lines.append(f"| {mat} | {t:g} | {variant or '–'} | {d} | {verdict} |")
     return lines
 
 
-def discrimination_by_model(records) -> list[dict]:
+def discrimination_by_model(records, rows=()) -> list[dict]:
     """The discrimination verdict of each (material, thickness, variant) group twice, with
     the Braille cases as the 2D ridge and as the 3D dots: dict(group, distances={dim: ..},
     verdict={dim: ..}, changed)."""
     merged: dict[tuple, dict] = {}
     braille = defaultdict(dict)  # group -> {dim: its Braille profiles' names}
+    left = {dim: _left_out(rows, dim) for dim in BRAILLE_MODELS}
     for dim in BRAILLE_MODELS:
         for key, profs in _profiles_by_group(records, with_text=True, braille_dim=dim):
             m = merged.setdefault(key, dict(group=key, distances={}, verdict={}))
@@ -310,6 +337,8 @@ def discrimination_by_model(records) -> list[dict]:
         for dim in BRAILLE_MODELS:
             if dim in m["verdict"] and braille[key].get(dim, set()) != names:
                 m["verdict"][dim] = "n/a (a Braille case of it failed, is suspect or was not run)"
+            elif dim in m["verdict"]:  # a flat or curved case (both models share it) failed
+                m["verdict"][dim] = _with_left_out(m["verdict"][dim], left[dim].get(key, []))
     for m in merged.values():
         v = m["verdict"]
         m["changed"] = (len(v) == len(BRAILLE_MODELS) and not any(x.startswith("n/a") for x in v.values())
@@ -590,7 +619,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
             f"Relative L2 distance between profiles; distinguishable when every pair differs by ≥ {THRESHOLD} "
             "(see tactileskin/discrimination.py for why).", ""]
     if two_models:
-        groups = discrimination_by_model(records)
+        groups = discrimination_by_model(records, rows)
         out += discrimination_table_by_model(groups)
         changed = [m["group"] for m in groups if m["changed"]]
         dims = {r.get("dim", 2) for r in rows if r.get("indenter") == "braille"}
@@ -600,7 +629,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                 + ("." if len(dims) > 1 else f" (but the sweep has Braille in {BRAILLE_MODELS[min(dims)]} only: "
                    "the other model's verdicts leave Braille out; `--braille-dim both` compares them).")]
     else:
-        out += discrimination_table(records)
+        out += discrimination_table(records, rows)
     sus = _suspect_records(records)
     if sus:
         out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]
