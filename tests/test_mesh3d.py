@@ -260,3 +260,16 @@ def test_a_cell_folded_by_its_snapped_mid_nodes_gets_straight_edges(slab_t3):
     # an unfolded mesh is returned as it is
     same, n0 = _unfold(m)
     assert same is m and n0 == 0
+
+
+@pytest.mark.parametrize("fields", [
+    dict(dim=2, indenter="curved", thickness=3.0),
+    dict(dim=3, indenter="braille", braille_text="l", thickness=1.0, mesh_size=1.6, refinement=4),
+    dict(dim=3, skin="pad", indenter="sphere", indenter_radius=2.5, thickness=2.0, mesh_size=2.0, refinement=4)])
+def test_a_skins_size_plan_is_the_plan_its_mesh_is_made_by(fields):
+    # size_plan checks a request against the dofs cap before any solve (array --validate):
+    # it must plan exactly what build_mesh then meshes
+    from tactileskin.scene import Scene
+
+    sc = Scene(**fields)
+    assert sc.skin_kind.size_plan(sc).as_dict() == sc.skin_kind.build_mesh(sc).sizes

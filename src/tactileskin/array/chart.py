@@ -818,6 +818,12 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         if reference_mesh is not None:
             fulls = [f.replace(mesh_size=float(reference_mesh[0]), refinement=float(reference_mesh[1])) for f in fulls]
         cases[t] = dot, fulls, blank, shallow
+        for x, sc in zip(texts, fulls):  # before any solve: a text too large to mesh failed after the others
+            try:
+                sc.skin_kind.size_plan(sc)
+            except ParameterError as e:
+                raise ParameterError("validate text", x, f"a text whose full 3D solve at t = {t:g} mm fits "
+                                     "the mesh limit (fewer Braille cells)", hint=str(e)) from None
     say(f"validation {material}: {len(texts) * len(cases)} full solves (cached cases are read)")
     recs = solve_cached([x for c in cases.values() for x in (c[0], c[2], c[3], *c[1]) if x is not None],
                         cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),

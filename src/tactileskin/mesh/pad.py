@@ -51,6 +51,21 @@ def _add_rectangle(gmsh, w2: float, t: float, roi_s: float, full: bool = False) 
     return {"bone_interface": bottom, "outer_surface": [top], **edges, "interface_roi": roi, "surface": [surf]}
 
 
+def pad_plan(scene, section=None, *, mesh_size: float | None = None, refinement: float | None = None,
+             order: int | None = None, use_z_symmetry: bool = True, local: bool = True):
+    """(sizing plan, z-symmetric) of build_pad_mesh's mesh, without meshing: ParameterError if
+    it exceeds the dofs cap (sizing.plan)."""
+    from tactileskin.geometry.indenters import indenter_symmetry
+
+    section = scene.section() if section is None else section
+    dim = scene.dim
+    zsym = indenter_symmetry(scene)[1] and use_z_symmetry and dim == 3
+    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=dim,
+                       length=section.length if dim == 3 else None, z_symmetric=zsym,
+                       order=scene.order if order is None else order, local=local)
+    return plan, zsym
+
+
 def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refinement: float | None = None,
                    order: int | None = None, cell: str = "tri", use_z_symmetry: bool = True,
                    local: bool = True) -> SkinMesh:
@@ -65,11 +80,10 @@ def build_pad_mesh(scene, section=None, *, mesh_size: float | None = None, refin
         raise ParameterError("cell", cell, "'tri' or 'quad' in 2D, 'tri' in 3D")
     w2, t = section.half_width, section.thickness
     length = section.length
-    xsym, zsym = indenter_symmetry(scene)
-    zsym = zsym and use_z_symmetry and dim == 3
+    xsym, _ = indenter_symmetry(scene)
     full = not xsym  # a half model with a symmetry plane would solve the mirrored indenter too
-    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=dim,
-                       length=length if dim == 3 else None, z_symmetric=zsym, order=order, local=local)
+    plan, zsym = pad_plan(scene, section, mesh_size=mesh_size, refinement=refinement, order=order,
+                          use_z_symmetry=use_z_symmetry, local=local)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"skin": "pad", "width": section.width, "thickness": t, "order": order, "cell": cell,
               "full_width": full,

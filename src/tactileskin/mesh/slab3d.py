@@ -55,6 +55,19 @@ def _unfold(mesh):
     return dataclasses.replace(mesh, doflocs=p), int(edges.size)
 
 
+def slab_plan(scene, section=None, *, mesh_size: float | None = None, refinement: float | None = None,
+              order: int | None = None, length: float | None = None, use_z_symmetry: bool = True,
+              local: bool = True):
+    """(sizing plan, slab length, z-symmetric) of build_slab_mesh's mesh, without meshing:
+    ParameterError if it exceeds the dofs cap (sizing.plan)."""
+    section = scene.section() if section is None else section
+    length = section.fingertip.sample_length if length is None else length
+    zsym = use_z_symmetry and z_symmetric(scene)
+    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3, length=length,
+                       z_symmetric=zsym, order=scene.order if order is None else order, local=local)
+    return plan, length, zsym
+
+
 def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
                     refinement: float | None = None, order: int | None = None,
                     length: float | None = None, use_z_symmetry: bool = True,
@@ -64,13 +77,11 @@ def build_slab_mesh(scene, section=None, *, mesh_size: float | None = None,
     strip and bone ROI instead (the former plan, kept for comparisons)."""
     section = scene.section() if section is None else section
     order = scene.order if order is None else order
-    length = section.fingertip.sample_length if length is None else length
-    zsym = use_z_symmetry and z_symmetric(scene)
     if not x_symmetric(scene):
         logger.warning("the indenter (%s) is not symmetric about x = 0, but the slab is the half "
                        "x >= 0 with a symmetry plane there", scene.indenter_label())
-    plan = sizing.plan(scene, section, mesh_size=mesh_size, refinement=refinement, dim=3,
-                       length=length, z_symmetric=zsym, order=order, local=local)
+    plan, length, zsym = slab_plan(scene, section, mesh_size=mesh_size, refinement=refinement, order=order,
+                                   length=length, use_z_symmetry=use_z_symmetry, local=local)
     z0, z1 = (0.0, 0.5 * length) if zsym else (-0.5 * length, 0.5 * length)
     params = {"thickness": section.thickness, "order": order, "length": length, "z_symmetric": zsym,
               **plan.as_dict()}

@@ -17,6 +17,8 @@ A skin is a class (no instances: every answer is a function of the Scene) with
   `symmetry` (x = 0) and, in 3D, `end_front` / `end_back` (z = +-L/2; `end_back` is z = 0
   when the indenter is z-symmetric); other names are free surfaces unless listed here;
 - `build_mesh(scene, **overrides) -> SkinMesh` (gmsh, imported inside);
+- `size_plan(scene)`: the mesh's sizing plan without meshing (ParameterError above the dofs
+  cap: a request is refused before any other solve runs), or None where only meshing tells;
 - `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
 - `label(scene)`: the prefix of case labels ("" for the paper's fingertip);
 - `cache_content(scene)`: digests of files it reads, for cache.cache_key (a user's skin file).
@@ -72,6 +74,10 @@ class Skin:
     @classmethod
     def build_mesh(cls, scene, *, cell: str = "tri", **overrides):
         raise NotImplementedError
+
+    @classmethod
+    def size_plan(cls, scene):
+        return None
 
     @classmethod
     def build_parts(cls, thickness: float, *, molds: bool = True, **params) -> list:

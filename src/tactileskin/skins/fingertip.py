@@ -57,6 +57,16 @@ class FingertipSkin(Skin):
         return build_slab_mesh(scene, **overrides)
 
     @classmethod
+    def size_plan(cls, scene):
+        if scene.dim == 2:
+            from tactileskin.mesh import sizing
+
+            return sizing.plan(scene, scene.section(), dim=2)
+        from tactileskin.mesh.slab3d import slab_plan
+
+        return slab_plan(scene)[0]
+
+    @classmethod
     def build_parts(cls, thickness, *, molds=True, **params):
         from tactileskin.geometry.parts import build_parts
 

@@ -124,6 +124,12 @@ class PadSkin(Skin):
         return build_pad_mesh(scene, cell=cell, **overrides)
 
     @classmethod
+    def size_plan(cls, scene):
+        from tactileskin.mesh.pad import pad_plan
+
+        return pad_plan(scene)[0]
+
+    @classmethod
     def build_parts(cls, thickness, *, molds=True, pad_width=DEFAULT_WIDTH, pad_length=DEFAULT_LENGTH, **_):
         from tactileskin.geometry.pad_parts import build_pad_parts
 
