@@ -155,3 +155,20 @@ def test_a_text_without_a_raised_dot_is_refused_by_the_scene_not_by_the_solve(tm
     rc = main(["sweep", "--scene", str(f), "--out", str(tmp_path / "out"), "--serial", "--no-render"])
     err = capsys.readouterr().err
     assert rc == 2 and "raised dot" in err and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("fields, words", [
+    (dict(skin="pad", pad_width=10.0, braille_text="abcd"), ["|x| <= 5 mm", "pad_width >= 22.4 mm"]),
+    (dict(skin="pad", pad_length=1.0, braille_text="l"), ["|z| <= 0.5 mm", "pad_length >= 6.12 mm"]),
+    (dict(braille_text="abc"), ["fingertip skin's top (|x| <= 8 mm", "x -8.09 to 8.09 mm"])])
+def test_a_text_past_the_skins_top_is_refused_naming_the_room_it_needs(fields, words):
+    # abcd on a 10 mm pad solved 'ok': its outer dots pressed nothing, the result a shorter text's
+    from tactileskin.errors import ParameterError
+    from tactileskin.scene import Scene
+
+    with pytest.raises(ParameterError, match="braille_text") as e:
+        Scene(dim=3, indenter="braille", thickness=1.0, **fields)
+    assert all(w in str(e.value) for w in words), str(e.value)
+    fits = {**fields, "braille_text": fields["braille_text"][:1]} if "pad_length" not in fields else \
+        {**fields, "pad_length": 6.2}
+    Scene(dim=3, indenter="braille", thickness=1.0, **fits)   # the text that fits is taken

@@ -17,6 +17,8 @@ A skin is a class (no instances: every answer is a function of the Scene) with
   `symmetry` (x = 0) and, in 3D, `end_front` / `end_back` (z = +-L/2; `end_back` is z = 0
   when the indenter is z-symmetric); other names are free surfaces unless listed here;
 - `build_mesh(scene, **overrides) -> SkinMesh` (gmsh, imported inside);
+- `top_extent(scene)`: (x, z) half extents of the top an indenter presses (mm), or None where
+  the skin does not know it before meshing (a Braille text is refused past it);
 - `size_plan(scene)`: the mesh's sizing plan without meshing (ParameterError above the dofs
   cap: a request is refused before any other solve runs), or None where only meshing tells;
 - `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
@@ -77,6 +79,10 @@ class Skin:
 
     @classmethod
     def size_plan(cls, scene):
+        return None
+
+    @classmethod
+    def top_extent(cls, scene) -> tuple[float, float] | None:
         return None
 
     @classmethod

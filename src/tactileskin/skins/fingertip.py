@@ -57,6 +57,10 @@ class FingertipSkin(Skin):
         return build_slab_mesh(scene, **overrides)
 
     @classmethod
+    def top_extent(cls, scene) -> tuple[float, float]:
+        return float(cls.section(scene).half_width), 0.5 * cls.sample_length(scene)
+
+    @classmethod
     def size_plan(cls, scene):
         if scene.dim == 2:
             from tactileskin.mesh import sizing

@@ -124,6 +124,10 @@ class PadSkin(Skin):
         return build_pad_mesh(scene, cell=cell, **overrides)
 
     @classmethod
+    def top_extent(cls, scene) -> tuple[float, float]:
+        return 0.5 * float(scene.pad_width), 0.5 * float(scene.pad_length)
+
+    @classmethod
     def size_plan(cls, scene):
         from tactileskin.mesh.pad import pad_plan
 

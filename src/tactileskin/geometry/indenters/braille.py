@@ -56,7 +56,29 @@ class BrailleIndenter(Indenter):
             # and on a text with no raised dot (only spaces): refused with the scene, as any bad
             # field, not by the solve (a sweep reported it as a failed case in a written folder)
             _braille.dot_centres(scene.braille_text, std)
+            cls._check_on_top(scene, std)
         return {}
+
+    @classmethod
+    def _check_on_top(cls, scene, std) -> None:
+        """Every dot's base on the skin's top: a dot past its edge presses nothing, and the
+        result would be that of a shorter text, unflagged (abcd on a 10 mm pad solved 'ok')."""
+        extent = scene.skin_kind.top_extent(scene)
+        if extent is None:
+            return
+        xh, zh = extent
+        xmin, xmax, zmin, zmax = _braille.footprint(scene.braille_text, std)
+        x_out = max(-xmin, xmax) > xh + 1e-9
+        z_out = scene.dim == 3 and max(-zmin, zmax) > zh + 1e-9
+        if x_out or z_out:
+            fixes = [f"{name} >= {2 * need:.3g} mm" for name, need, out in
+                     (("pad_width", max(-xmin, xmax), x_out), ("pad_length", max(-zmin, zmax), z_out))
+                     if out and scene.skin == "pad"]
+            hint = (f"its dot bases span x {xmin:.3g} to {xmax:.3g} mm, z {zmin:.3g} to {zmax:.3g} mm; "
+                    + (f"give {' and '.join(fixes)} or " if fixes else "") + "use fewer cells")
+            raise ParameterError("braille_text", scene.braille_text,
+                                 f"a text whose dots lie on the {scene.skin} skin's top (|x| <= {xh:g} mm"
+                                 + (f", |z| <= {zh:g} mm" if scene.dim == 3 else "") + ")", hint)
 
     @classmethod
     def label(cls, scene) -> str:
