@@ -73,7 +73,7 @@ def _scene(scene, fields: dict):
     from tactileskin import scenefile
     from tactileskin.scene import Scene
 
-    quality = None
+    quality, mesh = None, {}
     if isinstance(scene, Scene):
         base = scene
     elif scene is None:
@@ -82,9 +82,11 @@ def _scene(scene, fields: dict):
         sf = scenefile.read(scene)
         quality = sf.quality
         base = Scene.from_dict(scenefile.single_scene_fields(sf, "tactileskin.solve"))
+        # the file's mesh sizes go over the quality preset, as `tactileskin solve --scene` takes them
+        mesh = {k: sf.fields[k] for k in scenefile.MESH_FIELDS if k in sf.fields}
     else:
         raise ParameterError("scene", type(scene).__name__, "a Scene, a TOML file path or None")
-    mesh = {k: fields[k] for k in scenefile.MESH_FIELDS if fields.get(k) is not None}
+    mesh.update({k: fields[k] for k in scenefile.MESH_FIELDS if fields.get(k) is not None})
     return (base.replace(**fields) if fields else base), quality, mesh
 
 
