@@ -520,7 +520,7 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
 
     dot = dot_scene(t, material, cfg)
     return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
-                    model=model, extent=cfg.read_extent, taxel=cfg.min_taxel)
+                    model=model, extent=cfg.read_extent, taxel=cfg.min_taxel, standard=cfg.standard)
 
 
 def letters_judgment(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:

@@ -25,6 +25,18 @@ DATA = ("data", "surrogate_validation.json")
 DATA_TAXEL = 0.4
 # the source named for this run's validation rows
 RUN_SOURCE = "this run's validation"
+# the Braille standard the data file's rows were measured on (a case's "standard", if it names
+# one), from the shipped geometry files: they say nothing of other dots (ADA's 0.75 mm high,
+# 2.4 mm apart) or of an edited braille.toml / indenters.toml (TACTILESKIN_GEOMETRY)
+DATA_STANDARD = "standard_american"
+DATA_GEOMETRY = ("braille.toml", "indenters.toml")
+
+
+def _shipped_dots() -> bool:
+    """Whether the Braille dots are built from the shipped geometry files."""
+    from tactileskin.params import geometry_changes
+
+    return not set(geometry_changes() or ()) & set(DATA_GEOMETRY)
 
 
 @lru_cache(maxsize=1)
@@ -63,14 +75,16 @@ def _taxel_ok(row_taxel: float, taxel: float | None) -> bool:
 
 
 def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None,
-             model: str = "sum", extent: float | None = None, taxel: float | None = None) -> dict:
+             model: str = "sum", extent: float | None = None, taxel: float | None = None,
+             standard: str = DATA_STANDARD) -> dict:
     """{"error": worst taxel error over the peak or None, "texts": the validated characters,
     "source": where the numbers come from, "status": "within" | "exceeds" | "not validated",
     "reference_mesh": (mesh_size, refinement) of the full solves judged against, finer than
     `mesh` or `mesh` itself}; `extent`: the half side (mm) of the square the chart reads
     (ChartConfig.read_extent), which a row's own extent must cover; `taxel`: the chart's smallest
     taxel side (mm; 0 = point sensors), which must be at least the rows' (DATA_TAXEL where a row
-    does not say)."""
+    does not say); `standard`: the chart's Braille standard (the data file's rows answer only
+    for the dots they were measured on: DATA_STANDARD, from the shipped geometry files)."""
     rows = []
     for r in validation or ():
         rt = float(r.get("taxel_mm", DATA_TAXEL))
@@ -80,7 +94,10 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
                 and _covers(r, extent) and _taxel_ok(rt, taxel):
             rows.append({"text": r["text"], "taxel_max_error": r[key],
                          "reference_mesh": r.get("reference_mesh"), "source": RUN_SOURCE})
+    shipped = _shipped_dots()
     for case in load()["cases"]:
+        if not shipped or case.get("standard", DATA_STANDARD) != standard:
+            continue
         if case["material"] != material or case["skin"] != skin or \
                 not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):
             continue
