@@ -355,6 +355,31 @@ def test_geometry_edited_during_a_solve_is_not_stored(tmp_path, geometry, monkey
     assert not [p for p in cache.root.iterdir() if p.is_dir()]   # stored under neither key
 
 
+def test_results_key_column_names_the_entry_its_numbers_came_from(tmp_path, monkeypatch):
+    """results.csv's key was recomputed from the files at report time: a material file edited
+    during the sweep (its new case failed, the cached one reported) gave the cached row the
+    key of the new content, an entry that does not hold its numbers (or one solved later)."""
+    import tactileskin.sweep as sw
+
+    mat = _material_file(tmp_path / "pu.toml")
+    a = Scene(material=str(mat), indenter="flat", **COARSE)
+    b = a.replace(indenter="curved")
+    cache = ResultCache(tmp_path / "cache")
+    run_sweep([a], cache, serial=True)
+    real = sw.solve_case
+
+    def edit_then_solve(scene):
+        _material_file(mat, mu_scale=10.0)   # the user edits the file while b is solved
+        return real(scene)
+
+    monkeypatch.setattr(sw, "solve_case", edit_then_solve)
+    outcomes = run_sweep([a, b], cache, serial=True)
+    assert [o.status for o in outcomes] == ["cached", "failed"]
+    _, rows, _ = collect(outcomes, cache)
+    assert rows[0]["key"] == outcomes[0].record.path.name != cache_key(a)
+    assert rows[1]["key"] == outcomes[1].key == cache_key(a.replace(indenter="curved", material="polyurethane"))
+
+
 def test_one_entry_shared_by_equal_cases_is_solved_once(tmp_path, monkeypatch):
     calls = _counting_solver(monkeypatch)
     cache = ResultCache(tmp_path / "cache")

@@ -309,6 +309,7 @@ class CaseOutcome:
     diagnosis: dict = field(default_factory=dict)
     case: str = ""              # the case id within the sweep (case_ids)
     record: CaseRecord | None = None  # the validated cache entry, unless failed
+    key: str = ""               # the cache key the sweep computed for it (the entry's name)
 
 
 def solve_case(scene: Scene):
@@ -504,7 +505,7 @@ def run_sweep(
             locks[i] = lock
             return True
         lock.release()
-        emit(CaseOutcome(scenes[i], "cached", case=ids[i], record=rec), i)
+        emit(CaseOutcome(scenes[i], "cached", case=ids[i], record=rec, key=keys[i]), i)
         return False
 
     def finish(i: int, packed) -> None:
@@ -522,7 +523,7 @@ def run_sweep(
         locks.pop(i).release()
         if status == "failed":  # the caller reports it (on_event, the outcome's status): not twice
             log.info("case %s failed: %s", ids[i], err)
-        emit(CaseOutcome(sc, status, secs, err, diag, case=ids[i], record=rec), i)
+        emit(CaseOutcome(sc, status, secs, err, diag, case=ids[i], record=rec, key=keys[i]), i)
 
     _raise_fd_limit(len(scenes))
     runner = _Runner(scenes, keys, serial=serial, scheduler=scheduler, workers=workers)
@@ -532,7 +533,7 @@ def run_sweep(
             if keys[i] in held:
                 busy.append(i)  # the same entry as an earlier case of this sweep
             elif (rec := cache.lookup(sc, keys[i], repair=False)) is not None:
-                emit(CaseOutcome(sc, "cached", case=ids[i], record=rec), i)
+                emit(CaseOutcome(sc, "cached", case=ids[i], record=rec, key=keys[i]), i)
             elif claim(i, blocking=False):
                 todo.append(i)
                 held.add(keys[i])

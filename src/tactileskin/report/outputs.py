@@ -33,7 +33,8 @@ def collect(outcomes, cache):
     records, rows, failures = [], [], []
     for oc, case, variant in zip(outcomes, ids, variants):
         sc = oc.scene
-        row = dict(case=case, variant=variant, paper=at_paper_conditions(sc), key=cache.key(sc),
+        # the key the sweep computed (its entry's name), not the files' as they are now
+        row = dict(case=case, variant=variant, paper=at_paper_conditions(sc), key=oc.key or cache.key(sc),
                    thickness_mm=sc.thickness, material=sc.material,
                    indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
                    rate_mm_s=sc.rate, dim=sc.dim)
