@@ -137,10 +137,10 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     _write_parquet(out / "results.parquet", RESULT_COLUMNS + ["dim", "variant"], rows)
 
     buf = io.StringIO()
-    buf.write("case,s_mm,pressure_mpa\n")
+    w = csv.writer(buf, lineterminator="\n")  # quoted where needed: a case id can hold a comma (braille[,a,])
+    w.writerow(["case", "s_mm", "pressure_mpa"])
     prof = list(profile_rows(records))
-    for case, s, p in prof:
-        buf.write(f"{case},{s:.6g},{p:.6g}\n")
+    w.writerows((case, f"{s:.6g}", f"{p:.6g}") for case, s, p in prof)
     atomic_write_text(out / "profiles.csv", buf.getvalue())
     _write_parquet(out / "profiles.parquet", ["case", "s_mm", "pressure_mpa"], prof)
 
