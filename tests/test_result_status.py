@@ -355,3 +355,30 @@ def test_the_figures_of_a_suspect_solve_say_so(tmp_path, monkeypatch):
     assert main(["solve", "-t", "3", "-i", "curved", "--quality", "preview", "--depth", "1e-6",
                  "--sensors", str(tmp_path / "s.toml"), "--out", str(out)]) == 3
     assert len(titles) == 1 and "SUSPECT: no contact" in titles[0], titles
+
+
+# --- the law's range scales with the material's own modulus -----------------------------------
+
+def test_lockup_of_a_soft_material_is_flagged_relative_to_its_modulus(tmp_path):
+    # Table I silicone with every mu 1000x smaller (mu0 = 90 Pa): the same 60 % press reaches
+    # the same lock-up state (max |stress| 4.3e5 mu0, J 0.956), each stress 1000x smaller:
+    # 38.5 MPa read "ok" against the absolute 50 MPa, while the silicone itself (38,460 MPa)
+    # was suspect
+    from tactileskin.fe import solve
+
+    mat = tmp_path / "soft.toml"
+    mat.write_text("[hyperfoam]\nmu = [0.00008, 0.00001]\nalpha = [0.001, 15.5]\nnu = 0.49\n")
+    r = solve(Scene(thickness=1, indenter="flat", depth=0.6, material=str(mat), viscoelastic=False,
+                    mesh_size=1, refinement=5))
+    summ = r.summary()
+    assert summ["max_abs_stress_mpa"] < quality.MAX_ABS_STRESS_MPA          # 38.5 MPa
+    assert summ["material_mu0_mpa"] == pytest.approx(9e-5)
+    assert "stress_range" in [f["code"] for f in summ["flags"]]
+    assert summ["status"].startswith("suspect: stress")
+    # the ratio threshold keeps Table I's results as they were (50 MPa is 556 mu0 of silicone)
+    lim = quality.MAX_STRESS_OVER_MU0
+    assert quality.status({**NORMAL, "material_mu0_mpa": 0.09, "max_abs_stress_mpa": 45.0}) == "ok"
+    assert quality.status({**NORMAL, "material_mu0_mpa": 1e-3, "max_abs_stress_mpa": 0.999 * lim * 1e-3}) == "ok"
+    (f,) = quality.flags({**NORMAL, "material_mu0_mpa": 1e-3, "max_abs_stress_mpa": 1.001 * lim * 1e-3})
+    assert f.code == "stress_range" and "mu0" in f.reason
+

@@ -19,6 +19,12 @@ from dataclasses import dataclass
 # hyperfoam's volumetric term J^(-alpha*beta) (alpha*beta = 379.75 for Table I silicone term
 # 2: 4e5 MPa at J = 0.95), i.e. the lock-up of the law, not from the skin's response.
 MAX_ABS_STRESS_MPA = 50.0
+# ... and relative to the law's own small-strain shear modulus mu0: the lock-up scales with the
+# moduli (every mu_i 1000x smaller: the same state at 1/1000 of each stress), so a soft gel's
+# lock-up stays far below 50 MPa (Table I silicone with mu/1000 pressed 60 %: 38.5 MPa = 4.3e5
+# mu0, J 0.956, read "ok"). 550 mu0 is the 50 MPa of Table I silicone (mu0 = 0.09 MPa: 556 mu0),
+# so Table I results keep their status (the hardest "ok" one, 1 mm silicone at 40 %: 360 mu0).
+MAX_STRESS_OVER_MU0 = 550.0
 
 # Volume ratio J (current / reference volume) range the material law may visit. Table I's
 # elastomers have nu = 0.47-0.49, i.e. a small-strain bulk modulus of only 2.7-4.5 MPa,
@@ -73,7 +79,7 @@ def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
     Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
-    material_nu0, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm),
+    material_nu0, material_mu0_mpa, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm),
     profile_plane_from_map / profile_plane_unknown with peak_map_edge_* and profile_plane_z,
     indenter_cap, mirrored_x, mirrored_z (a
     key that is missing is not checked; a non-finite value is flagged).
@@ -92,11 +98,15 @@ def flags(summary: dict) -> list[Flag]:
     if none:
         out.append(Flag("no_contact", "no contact (" + ", ".join(none) + "): the indenter never "
                         "pressed the skin within the indentation depth"))
-    stress = _num(summary, "max_abs_stress_mpa")
+    stress, mu0 = _num(summary, "max_abs_stress_mpa"), _num(summary, "material_mu0_mpa")
     if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "
                         "(more than a skin elastomer bears: the material law or its parameters are outside their "
                         "range, e.g. a hyperfoam's volumetric lock-up or a modulus far above an elastomer's)"))
+    elif stress is not None and mu0 is not None and mu0 > 0 and abs(stress) > MAX_STRESS_OVER_MU0 * mu0:
+        out.append(Flag("stress_range", f"stress {stress:.4g} MPa = {abs(stress) / mu0:.3g} mu0 beyond "
+                        f"{MAX_STRESS_OVER_MU0:g} mu0 (the law's small-strain shear modulus mu0 = {mu0:.4g} MPa): "
+                        "the material law outside its range, e.g. a hyperfoam's volumetric lock-up"))
     J, nu0 = _num(summary, "min_J"), _num(summary, "material_nu0")
     lo, hi = J_RANGE
     if J is not None and not (lo <= J <= hi) and (nu0 is None or nu0 >= NU_SOLID):

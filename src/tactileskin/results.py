@@ -326,7 +326,8 @@ class Result:
             reaction_key(self.dim): float(self.reaction),
             "contact_points": int(len(self.contact_x)),
             # extremes of the material law's state (fe.output.law_state)
-            **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa", "material_nu0")
+            **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa", "material_nu0",
+                                                       "material_mu0_mpa")
                if k in self.stats},
             **({"element_order": int(self.stats["order"])} if "order" in self.stats else {}),
             **({"mesh_sizes_mm": dict(self.stats["mesh_sizes_mm"])} if "mesh_sizes_mm" in self.stats else {}),

@@ -358,6 +358,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         res.stats["mirrored_z"] = True
     # tactileskin.quality judges the volume ratio and the element by the law's compressibility
     res.stats["material_nu0"] = float(nu0(law))
+    res.stats["material_mu0_mpa"] = float(law.mu0)  # ... and the stress range by its modulus
     res.stats["order"] = int(scene.order)
     if sized and scene.skin != "file":
         res.stats["mesh_sizes_mm"] = _sizes_against_preview(scene)
