@@ -382,3 +382,22 @@ def test_lockup_of_a_soft_material_is_flagged_relative_to_its_modulus(tmp_path):
     (f,) = quality.flags({**NORMAL, "material_mu0_mpa": 1e-3, "max_abs_stress_mpa": 1.001 * lim * 1e-3})
     assert f.code == "stress_range" and "mu0" in f.reason
 
+
+# --- elements through the skin -----------------------------------------------------------------
+
+def test_a_skin_thinner_than_the_presets_elements_is_flagged():
+    # a 0.1 mm pad at `preview` (refined 0.2 mm, twice the skin): peak 0.711 and reaction 0.151
+    # N/mm against 0.811 / 0.203 mesh-converged (-12 %, -26 %), status "ok" before
+    from tactileskin.fe import solve
+
+    r = solve(Scene(skin="pad", pad_width=1, thickness=0.1, indenter="cylinder", indenter_radius=2,
+                    viscoelastic=False, mesh_size=1.0, refinement=5))
+    summ = r.summary()
+    assert [f["code"] for f in summ["flags"]] == ["coarse_mesh"]
+    assert "thickness" in summ["flags"][0]["reason"]
+    assert summ["mesh_sizes_mm"]["thickness"] == pytest.approx(0.1)
+    # at half the skin's thickness (and below) it is not
+    assert quality.flags({**NORMAL, "mesh_sizes_mm": {"global": 0.25, "refined": 0.05, "preview_global": 1.0,
+                                                      "preview_refined": 0.2, "thickness": 0.1}}) == []
+    assert quality.flags({**NORMAL, "mesh_sizes_mm": {"global": 1.0, "refined": 0.2, "preview_global": 1.0,
+                                                      "preview_refined": 0.2, "thickness": 0.4}}) == []

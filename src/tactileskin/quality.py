@@ -46,6 +46,12 @@ NU_LOCKING = 0.4
 # (t = 1 flat / Braille), 1 mm -13 to -80 %, 2 mm -46 to -86 %.
 COARSE_REFINED = 1.5
 COARSE_GLOBAL = 2.0
+# ... and a refined size above this fraction of the skin's thickness: the presets' sizes are
+# absolute, their errors measured on skins of t >= 0.5 mm (2D preview: 0.2 mm = 0.4 t there, -2.8 %
+# at t = 0.5); a thinner pad gets fewer elements through it. 0.1 mm pad under an R 2 cylinder,
+# refined size / t = 2, 1, 0.6, 0.4, 0.2: peak -12, -4.6, -4.3, -3.3, -0.8 %, reaction -26, -13,
+# -5.8, -3.3, -0.9 % against h = 0.05 t (preview, 2 x t, read "ok").
+COARSE_OVER_THICKNESS = 0.5
 
 
 @dataclass(frozen=True)
@@ -133,6 +139,10 @@ def flags(summary: dict) -> list[Flag]:
                   (("refined", "refined", COARSE_REFINED), ("global", "global", COARSE_GLOBAL))
                   if _num(sizes, k) is not None and _num(sizes, "preview_" + k) is not None
                   and sizes[k] > f * sizes["preview_" + k]]
+        t = _num(sizes, "thickness")
+        if t is not None and _num(sizes, "refined") is not None and sizes["refined"] > COARSE_OVER_THICKNESS * t:
+            coarse.append(f"refined size {sizes['refined']:g} mm against the skin's thickness {t:g} mm "
+                          f"(at most {COARSE_OVER_THICKNESS:g} t)")
         if coarse:
             out.append(Flag("coarse_mesh", "mesh coarser than the preview preset's (" + ", ".join(coarse) +
                             "), the coarsest whose error is measured: peaks on such meshes read 3-86 % low "

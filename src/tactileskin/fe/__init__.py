@@ -284,12 +284,14 @@ def _force_controlled(program, i: int) -> bool:
 
 def _sizes_against_preview(scene) -> dict:
     """The scene's global and refined element sizes (mm) and the `preview` preset's for the
-    same dimension, indenter, thickness and skin (the coarsest sizes whose error is measured)."""
+    same dimension, indenter, thickness and skin (the coarsest sizes whose error is measured),
+    and the skin thickness (quality judges the refined size against it too)."""
     from tactileskin.scene import preset_mesh
 
     size, ratio = preset_mesh("preview", scene.dim, scene.indenter, scene.thickness, scene.skin)
     return {"global": float(scene.mesh_size), "refined": float(scene.mesh_size / scene.refinement),
-            "preview_global": float(size), "preview_refined": float(size / ratio)}
+            "preview_global": float(size), "preview_refined": float(size / ratio),
+            "thickness": float(scene.thickness)}
 
 
 class _StatsView:
