@@ -268,3 +268,22 @@ def test_a_pad_too_small_for_the_mold_names_its_size_and_no_molds():
     with pytest.raises(ParameterError, match=r"pad_length=2\.0 is invalid; valid: > 4 mm .*--no-molds"):
         build_pad_parts(2.0, 20.0, 2.0)
     assert [p.name for p in build_pad_parts(2.0, 3.0, 2.0, molds=False)] == ["skin"]
+
+
+def test_a_full_width_pad_sees_the_dots_at_x_below_zero():
+    # 'e' (dots 1, 5) puts its section's one dot at x = -1.17 mm: the pad models its full width
+    # for it, and the dot touches the flat top at once; the contact check sampled only the half
+    # x >= 0 and refused a 0.4 mm press on 2 mm ("first touches the skin after 0.48 mm of
+    # travel ... the half model (x >= 0) does not see the dots at x < 0")
+    from tactileskin.fe import solve
+    from tactileskin.geometry.indenters import first_contact_travel, require_contact
+
+    sc = Scene(skin="pad", pad_width=10, thickness=2, indenter="braille", braille_text="e", depth=0.1,
+               viscoelastic=False, mesh_size=1.0, refinement=5)
+    assert "symmetry" not in build_mesh(sc).boundaries                     # the full width
+    assert first_contact_travel(sc) == pytest.approx(0.0, abs=1e-6)
+    require_contact(sc.replace(depth=0.4))
+    r = solve(sc)
+    assert r.peak > 0 and r.reaction > 0 and r.status == "ok"
+    # the dot presses where it is: the profile's peak lies under it, at x = -1.17
+    assert r.s[np.argmax(r.pressure)] == pytest.approx(-1.17, abs=0.3)

@@ -44,6 +44,9 @@ class Skin:
     # modelled as its half x >= 0 whatever the indenter (the pad takes its full width for an
     # x-asymmetric indenter; a user's file skin is meshed as given)
     halves_x: ClassVar[bool] = False
+    # its section's outer_points are the half x >= 0 of a skin it meshes in full width for an
+    # x-asymmetric indenter (the pad): the first-contact check mirrors them there
+    full_width_if_asymmetric: ClassVar[bool] = False
     # the bonded surface ends free where the bone profile ends (a pad's side): a corner
     # singularity there is flagged (quality "edge_peak"); False where it continues into another
     # bonded part (the fingertip's bone into the nail)

@@ -90,6 +90,7 @@ class PadSection:
 class PadSkin(Skin):
     name = "pad"
     local_plan = True
+    full_width_if_asymmetric = True  # mesh.pad: x in [-W/2, W/2] for an x-asymmetric indenter
     order = 1
     scene_params = ("pad_width", "pad_length")
     fixed_boundaries = ("bone_interface",)

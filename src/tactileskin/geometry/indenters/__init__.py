@@ -62,6 +62,8 @@ def make_indenter(kind, *, y0: float | None = None, dim: int = 2, row: int | Non
 
 def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> Indenter:
     """The scene's indenter; its lowest point initially touches the skin top on x = 0."""
+    # (no half-section warning for a skin that models its full width for such an indenter)
+    warn = warn and not scene.skin_kind.full_width_if_asymmetric
     return make_indenter(scene.indenter, y0=scene.section().top, dim=scene.dim, row=row,
                          sample_length=scene.sample_length, warn=warn,
                          **scene_kind_params(scene))
@@ -86,7 +88,8 @@ def mirrored_x(scene) -> bool:
 
 def first_contact_travel(scene, samples: int = 4000) -> float:
     """Travel (mm) after which the scene's indenter first touches the skin, as the model
-    sees it: the smallest gap at the start over the outer contour x >= 0 (the half model),
+    sees it: the smallest gap at the start over the outer contour x >= 0 (the half model; both
+    halves where the skin models its full width, a pad under an x-asymmetric indenter),
     sampled every ~0.01 mm, in 3D on the kind's contact planes (`contact_planes`: the
     Braille dot rows; the slab is uniform along z, so a dot's gap is smallest in its own
     row's plane). 0 for plates, cylinders and spheres (they touch at x = 0 at the start); a
@@ -94,6 +97,8 @@ def first_contact_travel(scene, samples: int = 4000) -> float:
     ind = indenter_for_scene(scene, warn=False)
     sec = scene.section()
     pts = sec.outer_points(samples)
+    if scene.skin_kind.full_width_if_asymmetric and not indenter_symmetry(scene)[0]:
+        pts = np.concatenate([pts, pts * np.array([-1.0, 1.0])])  # the x < 0 half is modelled too
     if scene.dim == 3:
         # a plane beyond the slab's end (a file indenter placed past it) is read at the end
         half = 0.5 * scene.sample_length
@@ -121,7 +126,7 @@ def require_contact(scene) -> None:
             why += (f"; its nearest modelled dot is at x = {seen.min():.3g} mm, where the fingertip has "
                     f"curved away{'' if scene.dim == 3 else ' (a 3D model has the same contour)'}")
         symmetric = ind.section_symmetric if scene.dim == 2 else ind.symmetry()[0]
-        if not symmetric:
+        if not symmetric and not scene.skin_kind.full_width_if_asymmetric:
             why += "; the half model (x >= 0) does not see the dots at x < 0"
     elif scene.dim == 3 and scene.skin_kind.halves_x and mirrored_x(scene):
         why += "; the half model (x >= 0) sees the indenter's part at x >= 0 only, mirrored"
