@@ -66,11 +66,6 @@ def claim_file(path, what: str = "--out") -> Path:
     return path
 
 
-def has_any_record(folder) -> bool:
-    """Whether `folder` has an OWNED_FILES record (this version's writes leave one)."""
-    return (Path(folder) / OWNED_FILES).exists()
-
-
 def record_file(path) -> None:
     """Note in the folder's OWNED_FILES that the toolkit wrote `path` as it is now."""
     path = Path(path)

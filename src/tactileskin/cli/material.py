@@ -10,14 +10,6 @@ MARK = "# written by tactileskin material fit"
 EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
 
-def _has_mark(path: Path) -> bool:
-    try:
-        with open(path, "rb") as fh:
-            return fh.read(len(MARK)) == MARK.encode()
-    except OSError:
-        return False
-
-
 @click.group("material")
 def command() -> None:
     """Material laws and presets; fit a law to your own uniaxial test."""
@@ -61,13 +53,9 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
     if outp.suffix != ".toml":
         raise ParameterError("--out", out, "a path ending in .toml")
     # before the fit: only a file this command wrote and nobody changed since is replaced (the
-    # folder's record; the MARK line alone is kept by a hand-edited copy). In a folder with no
-    # record at all, a file with the MARK line is an earlier version's (it kept none): replaced
-    # as then
-    earlier = (outp.is_file() and not outp.is_symlink() and not ownership.has_any_record(outp.parent)
-               and _has_mark(outp))
-    if not earlier:
-        ownership.claim_file(outp)
+    # folder's record). A file with the MARK line but no record is refused too: an earlier
+    # version's output and a hand-edited copy of ours look the same, and only one may go
+    ownership.claim_file(outp)
     if test == "indentation":
         from tactileskin.materials.indentation import fit_indentation, read_indentation_csv
 
