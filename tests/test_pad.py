@@ -287,3 +287,26 @@ def test_a_full_width_pad_sees_the_dots_at_x_below_zero():
     assert r.peak > 0 and r.reaction > 0 and r.status == "ok"
     # the dot presses where it is: the profile's peak lies under it, at x = -1.17
     assert r.s[np.argmax(r.pressure)] == pytest.approx(-1.17, abs=0.3)
+
+
+def test_a_slender_pad_pressed_past_its_buckling_strain_is_suspect():
+    # t = 10 mm, 2 mm wide under the plate at 20 %: the half model (and a symmetric full one)
+    # cannot buckle, and read 'ok'; Euler's strain of a column clamped to the board and guided
+    # by the plate is pi^2/12 (2/10)^2 = 3.3 %
+    import math
+
+    from tactileskin import quality
+    from tactileskin.fe import solve
+
+    tall = Scene(dim=2, skin="pad", indenter="flat", thickness=10.0, pad_width=2.0, mesh_size=0.5, refinement=2)
+    assert tall.skin_kind.buckling_strain(tall) == pytest.approx(math.pi ** 2 / 12 * 0.04)
+    s = solve(tall).summary()
+    assert s["buckling"]["strain"] == pytest.approx(0.2) and "buckles" in s["status"]
+    assert [f["code"] for f in s["flags"]] == ["buckling"]
+    # 3D: the smaller side decides; a stocky pad (Euler strain 0.21 > 0.2) and a sphere are not judged
+    block = Scene(dim=3, skin="pad", indenter="flat", thickness=4.0, pad_width=20.0, pad_length=2.0)
+    assert block.skin_kind.buckling_strain(block) == pytest.approx(math.pi ** 2 / 12 * 0.25)
+    stocky = Scene(dim=2, skin="pad", indenter="flat", thickness=4.0, pad_width=2.0, mesh_size=0.5, refinement=2)
+    assert quality.status(solve(stocky).summary()) == "ok"
+    ball = Scene(dim=3, skin="pad", indenter="sphere", indenter_radius=2.5, thickness=10.0, pad_width=2.0)
+    assert ball.skin_kind.buckling_strain(ball) is None

@@ -56,7 +56,7 @@ COARSE_OVER_THICKNESS = 0.5
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "mirrored_x" | "mirrored_z" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "buckling" | "mirrored_x" | "mirrored_z" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -159,6 +159,12 @@ def flags(summary: dict) -> list[Flag]:
                         f"working face ({_num(cap, 'cap_mm') or math.nan:.3g} mm: a sphere's cap is 0.95 R high, its mount "
                         "plate starts there): the printed part would press with its mount, and the model's skin "
                         "wraps round the ball; use a larger radius or a smaller force"))
+    buck = summary.get("buckling")
+    if isinstance(buck, dict):
+        out.append(Flag("buckling", f"pressed to {_num(buck, 'strain') or math.nan:.3g} of its thickness, past the "
+                        f"{_num(buck, 'euler_strain') or math.nan:.3g} at which this slender pad buckles under the "
+                        "plate (Euler, clamped to the board and guided by the plate); the model cannot buckle "
+                        "and reads the unbuckled state: a real pad bends sideways and presses less"))
     if summary.get("mirrored_x"):
         out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
                         "half x >= 0: the result is that of the indenter and its mirror image together "

@@ -344,6 +344,8 @@ class Result:
             **({"profile_sides": 2} if self.sides == 2 else {}),
             # a half model (x >= 0) of an indenter that is not symmetric about x = 0 (quality flag)
             **({"indenter_cap": dict(self.stats["indenter_cap"])} if self.stats.get("indenter_cap") else {}),
+            # pressed past a slender pad's buckling strain (the model cannot buckle: quality flag)
+            **({"buckling": dict(self.stats["buckling"])} if self.stats.get("buckling") else {}),
             **({"mirrored_x": True} if self.stats.get("mirrored_x") else {}),
             **({"mirrored_z": True} if self.stats.get("mirrored_z") else {}),
             **self._edge_summary(),

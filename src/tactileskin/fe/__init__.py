@@ -354,6 +354,9 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     travel = res.stats.get("max_travel_mm", float(model.d))
     if travel > cap:  # a force or a creep took the indenter past its printed working face
         res.stats["indenter_cap"] = {"travel_mm": travel, "cap_mm": float(cap)}
+    eb = scene.skin_kind.buckling_strain(scene)
+    if eb is not None and travel / scene.thickness > eb:  # the model cannot buckle: the skin would
+        res.stats["buckling"] = {"strain": travel / scene.thickness, "euler_strain": eb}
     if sm.halved and mirrored_x(scene):
         res.stats["mirrored_x"] = True
     if getattr(sm, "z_symmetric", False) and not indenter_symmetry(scene)[1]:  # a file's symmetry_z

@@ -19,6 +19,9 @@ A skin is a class (no instances: every answer is a function of the Scene) with
 - `build_mesh(scene, **overrides) -> SkinMesh` (gmsh, imported inside);
 - `top_extent(scene)`: (x, z) half extents of the top an indenter presses (mm), or None where
   the skin does not know it before meshing (a Braille text is refused past it);
+- `buckling_strain(scene)`: the nominal strain at which the skin, pressed as the scene presses
+  it, would buckle, where the model (no imperfection, often a symmetric half) cannot show it;
+  None where that does not apply;
 - `size_plan(scene)`: the mesh's sizing plan without meshing (ParameterError above the dofs
   cap: a request is refused before any other solve runs), or None where only meshing tells;
 - `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
@@ -86,6 +89,10 @@ class Skin:
 
     @classmethod
     def top_extent(cls, scene) -> tuple[float, float] | None:
+        return None
+
+    @classmethod
+    def buckling_strain(cls, scene) -> float | None:
         return None
 
     @classmethod
