@@ -34,8 +34,20 @@ def test_both_dims_double_only_the_braille_cases():
 
 
 def test_default_and_3d_only():
+    # the default quality answers Braille with both models; preview, fine, explicit mesh sizes
+    # and a force axis keep the scene's dim
     plain = expand_grid(thicknesses=[1.0], materials=["silicone"])
-    assert expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2]) == plain
+    assert plain == expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2, 3])
+    assert plain == expand_grid(thicknesses=[1.0], materials=["silicone"], quality="default")
+    assert [(sc.indenter.value, sc.dim) for sc in plain] == [("flat", 2), ("curved", 2), ("braille", 2),
+                                                             ("braille", 3)]
+    for kw in (dict(quality="preview"), dict(quality="fine"), dict(overrides={"mesh_size": 0.5}),
+               dict(forces=[0.1])):
+        grid = expand_grid(thicknesses=[1.0], materials=["silicone"], **kw)
+        assert {sc.dim for sc in grid} == {2}, kw
+    with pytest.raises(ParameterError, match="one dimension with a force axis"):
+        expand_grid(thicknesses=[1.0], materials=["silicone"], forces=[0.1], braille_dims=[2, 3])
+    assert [sc.dim for sc in expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2])] == [2, 2, 2]
     only3 = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=(3,))
     assert [(sc.indenter.value, sc.dim) for sc in only3] == [("flat", 2), ("curved", 2), ("braille", 3)]
 
@@ -72,7 +84,7 @@ class _Stop(TactileSkinError):
     pass
 
 
-@pytest.mark.parametrize("opt, dims", [(None, {2}), ("2", {2}), ("3", {3}), ("both", {2, 3})])
+@pytest.mark.parametrize("opt, dims", [(None, {2, 3}), ("2", {2}), ("3", {3}), ("both", {2, 3})])
 def test_cli_braille_dim_option(tmp_path, monkeypatch, opt, dims):
     import tactileskin.sweep as sweep
 

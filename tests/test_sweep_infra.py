@@ -13,13 +13,14 @@ from tactileskin.sweep import ResultCache, expand_grid, parse_values
 
 
 def test_paper_grid_has_18_distinct_cases():
-    scenes = expand_grid()
+    scenes = expand_grid(braille_dims=[2])  # the default quality adds the six Braille cases in 3D
     assert len(scenes) == 18 and len({s.key() for s in scenes}) == 18
+    assert len(expand_grid()) == 24 and len(expand_grid(quality="preview")) == 18
     assert sorted({round(s.indentation, 12) for s in scenes}) == pytest.approx([0.2, 0.6, 1.0])
 
 
 def test_braille_texts_only_multiply_braille_cases():
-    scenes = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_texts=["", "ab"])
+    scenes = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_texts=["", "ab"], braille_dims=[2])
     assert len(scenes) == 4  # flat, curved, braille, braille 'ab'
 
 

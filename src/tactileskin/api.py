@@ -139,7 +139,8 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     grid: {"thickness": [1, 3, 5], "material": [...], "indenter": [...], "depth": [...],
       "braille_text": [...], "braille_dim": [2, 3]} (any subset; other Scene fields such as
       rate=2 or dim=3 apply to every case), a list of Scenes, a scene/sweep TOML path, or
-      None (the paper's 18 cases).
+      None (the paper's 18 cases). Without "braille_dim" the Braille cases are both the 2D
+      ridge and the 3D dots at the default quality (sweep.default_braille_dims), else 2D.
     quality: mesh preset of each case's dimension ('preview', 'default', 'fine').
     out: also write the folder the `tactileskin sweep` command writes (results.csv and
       .parquet, profiles.csv and .parquet, figures with the Fig. 9 renders, report.md);

@@ -79,6 +79,26 @@ MAX_CASES = 10_000
 BRAILLE_DIMS = (2, 3)
 
 
+def default_braille_dims(base: Scene, quality: str | None, overrides: dict | None,
+                         forced: bool = False) -> tuple[int, ...]:
+    """The Braille cases' dimensions when a sweep does not say: at the `default` quality (given,
+    or the Scene's own sizes, which are that preset's) both the paper's 2D ridge and the 3D dots
+    on a skin that has both models, so that the report sets them side by side and judges the
+    paper's claims with the dots, the model that holds (the ridge reads 1.9-3.1x their peak;
+    the 18 cases with six 3D dots took 96 s on 2 cores, benchmarks/results/paper_sweep_3d.md).
+    Else base.dim: `preview` stays the quick 2D look, `fine` 3D dots take minutes each, and
+    explicit mesh sizes are a 2D mesh's, and a force axis presses N/mm in 2D but N in 3D."""
+    if (quality is None and overrides) or forced:
+        return (base.dim,)
+    if (quality or "default") != "default" or base.dim != 2 or base.skin_kind.fixes_thickness:
+        return (base.dim,)
+    try:
+        base.replace(dim=3, indenter="braille", braille_text="")
+    except ParameterError:  # a skin without a 3D model
+        return (base.dim,)
+    return BRAILLE_DIMS
+
+
 _NONE = object()
 
 
@@ -98,8 +118,8 @@ def expand_grid(
 
     braille_dims: the dimensions of the Braille cases (2: the paper's ridge section, 3: the
     slab with real dots; both: one case each). Flat and curved cases keep `base.dim`: they
-    are uniform along the finger, so the 2D section is exact for them. None: every case
-    has base.dim (as without the axis).
+    are uniform along the finger, so the 2D section is exact for them. None:
+    `default_braille_dims` (both at the default quality, else base.dim).
     quality: a planner quality preset applied to each scene after its indenter and dim are
     set (planner.with_quality), then `overrides` (Scene fields such as mesh_size, which
     override the preset).
@@ -121,7 +141,13 @@ def expand_grid(
     if any(f is not None for f in forces) and any(d is not None for d in depths):
         raise ParameterError("forces", list(forces), "either forces or depths, not both",
                              "a case is pressed to a depth or to a force")
-    dims = check_braille_dims(braille_dims) if braille_dims is not None else (base.dim,)
+    forced = any(f is not None for f in forces)
+    dims = (check_braille_dims(braille_dims) if braille_dims is not None
+            else default_braille_dims(base, quality, overrides, forced))
+    if forced and len(set(dims)) > 1 and any(get_kind(i).section_2d == "ridge" for i in indenters):
+        raise ParameterError("braille_dims", list(dims), "one dimension with a force axis",
+                             "a force is N/mm of the half section in 2D and N on the whole indenter in 3D: "
+                             "the ridge and the dots would not be pressed alike")
     n = (len(thicknesses) * len(materials) * len(indenters) * len(depths) * len(forces)
          * max(len(braille_texts), 1) * len(dims))
     if n > MAX_CASES:
