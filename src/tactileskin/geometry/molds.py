@@ -34,7 +34,7 @@ import build123d as bd
 import numpy as np
 
 from tactileskin import params
-from tactileskin.errors import ParameterError
+from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.fingertip import Section
 from tactileskin.geometry.solids import _single, base_face, box, check_solid, contour_solid, occ_guard
 
@@ -136,6 +136,28 @@ def vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: 
                                   plane=bd.Plane((x, y_from, z), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
 
 
+def _bspline_offset(wire: bd.Wire, distance: float) -> bd.Wire:
+    """`wire` offset by `distance` (mm) in its plane, round at convex corners, with every
+    offset curve replaced by a B-spline within 1e-7 mm of it: the STEP writer drops the faces
+    swept from OCC's offset curves (the mold halves' STEP files lost 22 of 48 and 18 of 36
+    faces and re-read as open shells), as solids.py builds the interface as a B-spline."""
+    from OCP.Approx import Approx_Curve3d
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.GeomAbs import GeomAbs_C2
+
+    edges = []
+    for e in wire.offset_2d(distance, kind=bd.Kind.ARC).edges():
+        if e.geom_type == bd.GeomType.OFFSET:
+            approx = Approx_Curve3d(BRepAdaptor_Curve(e.wrapped), 1e-7, GeomAbs_C2, 200, 9)
+            if not (approx.IsDone() and approx.HasResult()):
+                raise CadError(f"offsetting the mold seat by {distance:g} mm: no B-spline within 1e-7 mm "
+                               f"(max error {approx.MaxError():g} mm)")
+            e = bd.Edge(BRepBuilderAPI_MakeEdge(approx.Curve()).Edge())
+        edges.append(e)
+    return bd.Wire(edges)
+
+
 def core_seat(sec: Section, clearance: float) -> bd.Solid:
     """The room the mold leaves for the printed core (the rigid base) with `clearance` c (mm):
     over the sample length, the core's section widened below the nail rays, and an arc c
@@ -149,7 +171,7 @@ def core_seat(sec: Section, clearance: float) -> bd.Solid:
     z0 = -0.5 * L
     with occ_guard("building the core seat", thickness=sec.thickness, core_clearance=c):
         contour = bd.Wire([bd.Edge.make_ellipse(ft.half_width, ft.height, plane=bd.Plane.XY.offset(z0))])
-        grown = bd.Face(contour.offset_2d(c, kind=bd.Kind.ARC)).translate((0.0, c, 0.0))
+        grown = bd.Face(_bspline_offset(contour, c)).translate((0.0, c, 0.0))
         # below both nail rays (polar angle from +y beyond the nail angle): the core's side,
         # and c further along the contour, so that the core's corners at the nail edges fit too
         s = 4.0 * (ft.half_width + ft.height)
@@ -160,7 +182,7 @@ def core_seat(sec: Section, clearance: float) -> bd.Solid:
         seat = _single(bd.Solid.extrude(grown, (0.0, 0.0, L)).intersect(bd.Solid.extrude(wedge, (0.0, 0.0, L))))
         section = base_face(sec, full=True, z=z0)
         core = bd.Solid.extrude(section, (0.0, 0.0, L))
-        slot = bd.Face(section.outer_wire().offset_2d(c, kind=bd.Kind.ARC))
+        slot = bd.Face(_bspline_offset(section.outer_wire(), c))
         ends = [bd.Solid.extrude(slot.translate((0.0, 0.0, z)), (0.0, 0.0, c)) for z in (-c, L)]
         return _single(core.fuse(seat, *ends).clean())
 
