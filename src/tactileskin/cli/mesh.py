@@ -16,6 +16,7 @@ from tactileskin.cli._common import scene_from_options, scene_options
                    "the solver meshes with triangles).")
 def command(out, cell, scene_opts):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
+    import numpy as np
     from rich.markup import escape
     from rich.table import Table
 
@@ -49,10 +50,13 @@ def command(out, cell, scene_opts):
     if scene.skin_kind.fixes_thickness:  # a user's file: no CAD section to compare with
         table.add_row("bonded boundary measure (mm^%d)" % (sm.dim - 1), f"{sm.boundary_measure('bone_interface'):.6g}")
     else:
-        lz = 1.0 if sm.dim == 2 else (0.5 if sm.z_symmetric else 1.0) * sm.length
+        # 3D: over the bonded surface's own z extent (a dome's bone_interface ends where its
+        # tip begins: z in [-L, 0], not the whole skin's L + dome_tip)
+        bonded = np.unique(sm.mesh.facets[:, sm.boundaries["bone_interface"]])
+        lz = 1.0 if sm.dim == 2 else float(np.ptp(sm.mesh.p[2, bonded]))
         L = sm.boundary_measure("bone_interface") / lz
-        table.add_row("bone interface length (mm)",
-                      f"{L:.6f} (CAD {sec.interface_length:.6f}, rel. err {abs(L / sec.interface_length - 1):.1e})")
+        cad = sec.interface_length * (1.0 if sm.halved else 2.0)  # from x = 0; a full-width model has both sides
+        table.add_row("bone interface length (mm)", f"{L:.6f} (CAD {cad:.6f}, rel. err {abs(L / cad - 1):.1e})")
     for name, f in sm.boundaries.items():
         table.add_row(f"facets: {name}", str(len(f)))
     if sm.dim == 3 and not scene.skin_kind.fixes_thickness:
