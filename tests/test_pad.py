@@ -270,6 +270,25 @@ def test_a_pad_too_small_for_the_mold_names_its_size_and_no_molds():
     assert [p.name for p in build_pad_parts(2.0, 3.0, 2.0, molds=False)] == ["skin"]
 
 
+def test_a_pad_mold_keeps_its_vents_apart_from_the_sprue():
+    """The vents stand vent_inset from the pocket's ends, on the sprue's line: an 8 mm pad's
+    vents (z = +-2, 1.5 mm across) opened into the 4 mm sprue, a 5 mm pad's lay inside it,
+    and the mold was written with one hole. As the dome's mold: 1 mm of mold between them."""
+    from tactileskin.geometry.molds import MoldParams
+    from tactileskin.geometry.pad_parts import build_pad_parts
+
+    mp = MoldParams.from_params()
+    need = 2.0 * (mp.vent_inset + 0.5 * (mp.pour_diameter + mp.vent_diameter) + 1.0)  # 11.5 mm
+    for length in (5.0, 8.0, need - 0.1):
+        with pytest.raises(ParameterError, match=r"pad_length=.* >= 11\.5 mm .*vents.*--no-molds"):
+            build_pad_parts(2.0, 40.0, length)
+    lower, lid = (p.shape for p in build_pad_parts(2.0, 40.0, need)[1:])
+    pins = 4 * np.pi * (0.5 * (mp.pin_diameter + mp.pin_clearance)) ** 2 * (mp.pin_height + mp.pin_depth_clearance)
+    holes = lid.bounding_box().size.Y * np.pi * 0.25 * (mp.pour_diameter ** 2 + 2 * mp.vent_diameter ** 2)
+    box = lid.bounding_box().size
+    assert lid.volume == pytest.approx(box.X * box.Y * box.Z - pins - holes, rel=1e-6)  # three separate holes
+
+
 def test_a_full_width_pad_sees_the_dots_at_x_below_zero():
     # 'e' (dots 1, 5) puts its section's one dot at x = -1.17 mm: the pad models its full width
     # for it, and the dot touches the flat top at once; the contact check sampled only the half

@@ -41,6 +41,12 @@ def pad_mold(width: float, length: float, thickness: float, mp: MoldParams | Non
             raise ParameterError("pad_length", length, f">= {2 * mp.vent_inset:g} mm for the mold's vents "
                                  "(molds.toml [pour] vent_inset)", no_molds)
         raise ParameterError("molds.pour.vent_inset", mp.vent_inset, f"[{0.5 * mp.vent_diameter:g}, {z:g}] mm")
+    # as the dome's mold: the vents 1 mm of mold apart from the sprue, or they open into it
+    # and the air at the pocket's ends has no way out (an 8 mm pad had one hole, a 5 mm one none)
+    need = mp.vent_inset + 0.5 * (mp.pour_diameter + mp.vent_diameter) + 1.0
+    if z < need:
+        raise ParameterError("pad_length", length, f">= {2 * need:g} mm for the mold's sprue and two vents "
+                             "(molds.toml [pour])", no_molds)
     hole = mp.pin_diameter + mp.pin_clearance
     xp = w + mp.wall + 0.5 * hole
     A, Z = xp + 0.5 * hole + mp.pin_flange, z + mp.wall
