@@ -49,8 +49,8 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
 
     mp = MoldParams.from_params()
     hole = mp.pin_diameter + mp.pin_clearance
-    A_, B_ = A + dome_parts.MOLD_WALL + hole + mp.pin_flange, B + dome_parts.MOLD_WALL
-    half_block = 2 * A_ * B_ * (L + dome_parts.BONE_STEM + c + 2 * dome_parts.MOLD_WALL)
+    A_, B_ = A + mp.wall + hole + mp.pin_flange, B + mp.wall
+    half_block = 2 * A_ * B_ * (L + dome_parts.BONE_STEM + c + 2 * mp.wall)
     body = dome_parts.body(A, B, c, L).volume + math.pi * (A - t) * (B - t) * dome_parts.BONE_STEM
     pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
     holes = 4 * math.pi * (0.5 * hole) ** 2 * (mp.pin_height + mp.pin_depth_clearance)
@@ -59,8 +59,8 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
     # the sprue and the vents: cylinders through the wall above the pulp (3 mm on the straight
     # part; B_ - y of the cap at z = c/2 for the tip vent); the top's curvature under a 4 mm
     # sprue moves its length by < 0.2 mm, hence 10 %
-    through = (math.pi * (0.5 * mp.pour_diameter) ** 2 * dome_parts.MOLD_WALL
-               + math.pi * (0.5 * mp.vent_diameter) ** 2 * (dome_parts.MOLD_WALL + B_ - B * math.sqrt(0.75)))
+    through = (math.pi * (0.5 * mp.pour_diameter) ** 2 * mp.wall
+               + math.pi * (0.5 * mp.vent_diameter) ** 2 * (mp.wall + B_ - B * math.sqrt(0.75)))
     assert half_block - 0.5 * body - holes - upper == pytest.approx(through, rel=0.1)
     # and they open the skin's cavity to the outside: no mold above the pulp there, elsewhere a roof
     up = parts[3].shape
@@ -72,17 +72,35 @@ def test_parts_are_valid_solids_with_the_analytic_volume():
         dome_parts.mold(A, B, 4.0, 2.0, 1.0)
 
 
+def test_mold_walls_are_the_molds_toml_wall():
+    """One wall for every mold: the dome's was a constant of its own (3 mm) while molds.toml
+    [block] wall (4 mm) made the fingertip's and the pad's, and editing it left the dome's alone."""
+    from tactileskin.geometry.molds import MoldParams
+
+    t, c, L = 1.0, 8.0, 10.0
+    for wall in (MoldParams.from_params().wall, 6.0):
+        mp = MoldParams.from_params(wall=wall)
+        lower, upper = dome_parts.mold(A, B, c, L, t, mp)
+        lo, up = lower.bounding_box(), upper.bounding_box()
+        assert up.max.Y == pytest.approx(B + wall, abs=1e-6) and lo.min.Y == pytest.approx(-B - wall, abs=1e-6)
+        assert lo.min.Z == pytest.approx(-L - dome_parts.BONE_STEM - wall, abs=1e-6)
+        assert lo.max.Z == pytest.approx(c + wall, abs=1e-6)
+
+
 def test_mold_closes_behind_the_core_stem():
     """The bone core is cantilevered from its stem: an end wall behind the stem's seat stops it
     along the finger (where it sits sets the skin's thickness at the tip) and closes the cavity;
     the seat used to run out through the block's end face (no stop, and a leak path)."""
+    from tactileskin.geometry.molds import MoldParams
+
+    mp = MoldParams.from_params()
     t, c, L = 1.0, 8.0, 10.0
     lower, upper = dome_parts.mold(A, B, c, L, t)
     z_end = -L - dome_parts.BONE_STEM  # the stem's end face
     y = 0.5 * (B - t)
     assert not lower.is_inside((0.0, -y, z_end + 0.1)) and not upper.is_inside((0.0, y, z_end + 0.1))  # the seat
     assert lower.is_inside((0.0, -y, z_end - 0.1)) and upper.is_inside((0.0, y, z_end - 0.1))  # the stop
-    assert lower.bounding_box().min.Z == pytest.approx(z_end - dome_parts.MOLD_WALL, abs=1e-6)
+    assert lower.bounding_box().min.Z == pytest.approx(z_end - mp.wall, abs=1e-6)
 
 
 def test_mesh_named_surfaces_and_volume():
@@ -132,8 +150,8 @@ def test_build_cli_exports_watertight_dome_parts(tmp_path):
 
     mp = MoldParams.from_params()
     hole = mp.pin_diameter + mp.pin_clearance
-    half_block = 2 * (A + dome_parts.MOLD_WALL + hole + mp.pin_flange) * (B + dome_parts.MOLD_WALL) * (
-        L + dome_parts.BONE_STEM + c + 2 * dome_parts.MOLD_WALL)
+    half_block = 2 * (A + mp.wall + hole + mp.pin_flange) * (B + mp.wall) * (
+        L + dome_parts.BONE_STEM + c + 2 * mp.wall)
     pins = 4 * math.pi * (0.5 * mp.pin_diameter) ** 2 * mp.pin_height
     exact = {"skin": dome_parts.skin_volume(A, B, c, L, t),
              "bone_core": math.pi * ai * bi * L + stem + 2.0 / 3.0 * math.pi * ai * bi * (c - t),

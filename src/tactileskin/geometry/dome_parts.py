@@ -20,7 +20,6 @@ import build123d as bd
 from tactileskin.errors import ParameterError
 from tactileskin.geometry.solids import box, check_solid, occ_guard
 
-MOLD_WALL = 3.0  # mm around the outer body
 BONE_STEM = 5.0  # mm of bone core beyond the skin's end z = -L (held by the mold)
 
 
@@ -65,7 +64,7 @@ def skin_volume(a, b, c, length, t, *, half: bool = False) -> float:
 def mold(a, b, c, length, t, mp=None):
     """(lower, upper) mold halves split at y = 0: a block around the outer body minus it; the
     bone core rests in the half-round seats its stem leaves at z < -L, pushed home against the
-    end wall behind them (MOLD_WALL thick), which fixes it along the finger and closes the cavity. As the fingertip's mold
+    end wall behind them (molds.toml [block] wall thick), which fixes it along the finger and closes the cavity. As the fingertip's mold
     (molds.toml): four alignment pins on the lower half beside the cavity, in holes of the
     upper one; an air vent near each end of the pulp line (the straight part's end, half way up
     the tip) and a sprue onto the pulp half way between, so the skin can be poured and the air
@@ -75,12 +74,12 @@ def mold(a, b, c, length, t, mp=None):
     mp = mp or MoldParams.from_params()
     p = dict(a=a, b=b, c=c, length=length, thickness=t)
     hole = mp.pin_diameter + mp.pin_clearance
-    xp = a + MOLD_WALL + 0.5 * hole          # the wall between the cavity and a pin hole
-    A, B = xp + 0.5 * hole + mp.pin_flange, b + MOLD_WALL
+    xp = a + mp.wall + 0.5 * hole            # the wall between the cavity and a pin hole
+    A, B = xp + 0.5 * hole + mp.pin_flange, b + mp.wall
     # an end wall behind the stem: the core's stop along the finger (the skin's tip thickness
     # depends on it) and the cavity's end (the stem's seat ran out through the block's end face,
     # leaving the core free to slide and the silicone a way out along it)
-    z0, z1 = -length - BONE_STEM - MOLD_WALL, c + MOLD_WALL
+    z0, z1 = -length - BONE_STEM - mp.wall, c + mp.wall
     if mp.pin_height + mp.pin_depth_clearance >= B:
         raise ParameterError("molds.pins.height", mp.pin_height, f"< {B - mp.pin_depth_clearance:g} mm (the dome "
                              f"mold's upper half is {B:g} mm thick)")
