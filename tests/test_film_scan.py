@@ -186,3 +186,15 @@ def test_a_strip_read_along_the_wrong_axis_is_flagged():
     assert analyze_scan(np.ascontiguousarray(img.T), axis="y").warnings == []
     # a box the user gives is analysed as given
     assert analyze_scan(np.ascontiguousarray(img.T), axis="x", box_px=(24, 0, 48, 160)).warnings == []
+
+
+def test_the_band_brackets_the_profile_of_a_box_with_white_margins():
+    # a box wider than the strip averages white (zero) rows into the profile; the band was taken
+    # at the column-mean grayscale, where the white rows read 245 beyond the calibration's light
+    # end: at the peak P 0.171 MPa but band [0.132, 0.139]. The band must bracket the profile.
+    gs = np.array([200, 180, 160, 140, 120, 100.])
+    p = 0.978 - SLOPE * gs + np.array([0.002, -0.003, 0.001, 0.002, -0.002, 0.0])
+    cal = fit_calibration(gs, p, model="linear")
+    img = render_scan(gaussian_profile(0.4, 1.0), cal, background_gs=245.0)
+    fp = analyze_scan(img, cal, box_px=(0, 0, img.shape[1], img.shape[0]))
+    assert np.all(fp.band_lo <= fp.pressure + 1e-12) and np.all(fp.band_hi >= fp.pressure - 1e-12)
