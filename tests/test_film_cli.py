@@ -107,3 +107,16 @@ def test_example_runs(tmp_path):
     assert r.returncode == 0, r.stdout + r.stderr
     assert "recovered peak" in r.stdout
     assert (tmp_path / "film" / "overlay.png").exists()
+
+
+def test_a_two_sided_simulation_not_symmetric_about_its_centre_is_flagged(tmp_path):
+    # a full-width model under an off-centre dot (braille 'e': its dot at x = -1.17) has its peak at
+    # s = -1.2; folded about s = 0 it read 0.150 for a 0.3 peak and a span 92 % long, against the
+    # film of the same pressure (0.298) with status "ok". The fold must say it averages unlike sides.
+    prof = gaussian_profile(0.3, 0.6)
+    img = render_scan(prof, paper_eq8(), length_mm=14, background_gs=245)
+    s = np.linspace(-7, 7, 141)
+    off = compare(analyze_scan(img), (s, prof(s + 1.2)))
+    assert off.status == "suspect" and "simulation" in off.warnings[0] and "s = -1.2" in off.warnings[0]
+    centred = compare(analyze_scan(img), (s, prof(s)))
+    assert centred.status == "ok" and abs(centred.percent_diff["peak"]) < 1

@@ -142,6 +142,9 @@ def compare(film_dir, sim_dir, out):
     status = str(comp.sim_meta.get("status", "ok"))
     if status != "ok":  # comparison.json carries it too (sim_meta, status, warnings)
         click.echo(f"warning: the simulated result is {status}", err=True)
+    for w in comp.warnings:  # the comparison's own about the simulation (an asymmetric fold)
+        if w.startswith("simulation: ") and w != f"simulation: {status}":
+            click.echo(f"warning: {w}", err=True)
     for w in comp.film_warnings:  # the film's own (summary.json): the comparison inherits them
         click.echo(f"warning: the film profile is suspect: {w}", err=True)
     click.echo(f"wrote {out or film_dir}")
