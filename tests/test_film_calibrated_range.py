@@ -66,3 +66,22 @@ def test_a_fold_about_an_off_centre_origin_is_flagged():
     assert any("not symmetric" in w and "--centre midspan" in w for w in off.warnings)
     mid = analyze_scan(img, TRUE, centre="midspan")
     assert mid.folded["asymmetry"] < 0.1 and mid.warnings == []
+
+
+def test_unactivated_film_reads_zero_below_an_activation_threshold():
+    # --activation-range 0.02 0.35 (a film that shows nothing below 0.02 MPa): white film read
+    # 0.02, the clip's bottom, everywhere: over a box the strip's length the folded area was 0.585
+    # for 0.451 (+30 %) with no warning, and at 0.05 the folded span 9.9 mm for 2.6 ("widen the region")
+    wide = np.linspace(0.01, 0.35, 8)
+    s = np.linspace(0, 10, 100001)
+    for lo in (0.02, 0.05):
+        p = gaussian_profile(0.3, 1.2)(s)
+        truth = np.trapezoid(np.where(p >= lo, p, 0.0), s)  # the folded area the film can see
+        cal = fit_calibration(TRUE.grayscale(wide), wide, activation_range=(lo, 0.35))
+        assert cal.pressure(245.0) == 0.0 and cal.pressure(TRUE.grayscale(lo + 0.01)) > lo
+        lo_b, hi_b = cal.band(np.array([245.0, 100.0]))
+        assert lo_b[0] == 0.0 and lo_b[1] >= lo
+        img = _scan()
+        fp = analyze_scan(img, cal, box_px=(0, 16, img.shape[1], 56))
+        assert fp.folded["metrics"]["auc"] == pytest.approx(truth, rel=0.02)
+        assert not fp.cut_ends

@@ -10,7 +10,9 @@ Conversion rule (``Calibration.pressure``), in words:
   the pressure is held at its value at that end (no extrapolation beyond what was measured);
 - lighter than the lightest press the function is continued along its tangent, down to
   zero (unactivated film reads zero);
-- the result is clipped to the activation range ``p_range`` (the film's stated range).
+- the result is clipped to the activation range ``p_range`` (the film's stated range); a
+  reading below its bottom is unactivated film and reads zero (not the bottom: white film
+  read as the threshold pressure added it to every column of the profile).
 ``film.scan.analyze_scan`` flags a profile read on either continuation (summary.json
 ``beyond_calibration`` and ``warnings``): pixels held at the darkest press below the
 activation range's top (a lower bound), and a span whose 10 % level lies below the lightest
@@ -132,7 +134,8 @@ class Calibration:
         slope = float((self._f(g_ext + inward) - self._f(g_ext)) / inward)
         beyond = (gs < g0) if g_ext == g0 else (gs > g1)
         p = np.where(beyond, float(self._f(g_ext)) + slope * (gs - g_ext), p)
-        return np.clip(p, *self.p_range)
+        lo, hi = self.p_range
+        return np.where(p < lo, 0.0, np.minimum(p, hi))  # below the threshold: unactivated
 
     def band(self, gs) -> tuple[np.ndarray, np.ndarray] | None:
         """90 % confidence band of the calibration at gs (clipped like ``pressure``), or None."""
@@ -142,7 +145,8 @@ class Calibration:
         hw = models.band_halfwidth(self.model, self.params, self.cov, self.dof,
                                    np.clip(gs, *self.gs_range))
         p = self.pressure(gs)
-        return np.clip(p - hw, *self.p_range), np.clip(p + hw, *self.p_range)
+        floor = np.where(p > 0, self.p_range[0], 0.0)  # unactivated film (0): no threshold under it
+        return np.clip(p - hw, floor, self.p_range[1]), np.clip(p + hw, floor, self.p_range[1])
 
     def grayscale(self, p) -> np.ndarray:
         """Inverse map: the grayscale that reads as pressure p (for rendering synthetic scans).
