@@ -85,3 +85,19 @@ def test_unactivated_film_reads_zero_below_an_activation_threshold():
         fp = analyze_scan(img, cal, box_px=(0, 16, img.shape[1], 56))
         assert fp.folded["metrics"]["auc"] == pytest.approx(truth, rel=0.02)
         assert not fp.cut_ends
+
+
+def test_a_background_read_as_pressure_is_flagged():
+    # unpressed film scanned at GS 228, darker than Eq. 8's zero (230.1): every column carries
+    # 0.0089 MPa/mm, 2 % of the peak (below the 10 % of a cut end), and over the 30 mm strip the
+    # folded area read 0.605 for 0.501 (+21 %) with no warning
+    from tactileskin.film import paper_eq8
+
+    prof = gaussian_profile(0.4, 1.0)
+    dark = analyze_scan(render_scan(prof, paper_eq8(), length_mm=30, background_gs=228.0))
+    assert dark.folded["metrics"]["auc"] > 1.15 * 0.4 * np.sqrt(2 * np.pi) / 2
+    assert any("does not return to zero" in w for w in dark.warnings)
+    for noise in (0.0, 2.0):
+        clean = analyze_scan(render_scan(prof, paper_eq8(), length_mm=30, background_gs=245.0,
+                                         noise_gs=noise, seed=4))
+        assert clean.warnings == []

@@ -243,6 +243,11 @@ SPAN_LEVEL = 0.1  # the span's threshold as a fraction of the peak (tactileskin.
 # peak by --centre peak read 1.0, with a span 50 % long; noise and blur read below 0.05)
 ASYMMETRY = 0.2
 PLATEAU = 0.9     # a given region whose every column reads >= this x the peak lies inside the press
+# both ends of the profile above zero: the unpressed film reads as pressure (scanned darker than the
+# calibration's zero), a baseline in every column; flagged when it makes more than this share of the
+# area (half the film's +-10 %): white film at GS 228 under Eq. 8 (zero at 230.1) read 0.0089 MPa/mm,
+# 2 % of the peak, and the folded area +21 % over a 30 mm strip
+BASELINE = 0.05
 
 
 def calibration_coverage(cal: Calibration, gray: np.ndarray, pmap: np.ndarray) -> dict:
@@ -403,6 +408,14 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                         f"region's {' and '.join(ends)} ({'x' if axis == 'x' else 'y'} "
                         f"{x_mm[0] - 0.5 / px_per_mm:.4g}-{x_mm[-1] + 0.5 / px_per_mm:.4g} mm): the span and area "
                         "are cut there (lower bounds); widen the region")
+        log.warning("%s", warnings[-1])
+    base = float(min(prof[0], prof[-1]))
+    area = float(auc(x_mm, prof))
+    if not ends and not plateau and base > 0 and area > 0 and base * (x_mm[-1] - x_mm[0]) > BASELINE * area:
+        warnings.append(f"the profile does not return to zero: both ends of the region read >= {base:.4g} {cal.unit} "
+                        f"({base / np.max(prof):.1%} of the peak), {base * (x_mm[-1] - x_mm[0]) / area:.0%} of the "
+                        "area over its length: the unpressed film reads as pressure (scanned darker than the "
+                        f"calibration's zero, GS {cal.threshold_gs:.4g}?); the area includes that baseline")
         log.warning("%s", warnings[-1])
     if coverage["extrapolated_fraction"] > 0 and level < coverage["low_end_pressure"]:
         warnings.append(f"the span's 10 % level ({level:.4g} {cal.unit}) is below the calibration's lowest "
