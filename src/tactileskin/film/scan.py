@@ -248,6 +248,22 @@ PLATEAU = 0.9     # a given region whose every column reads >= this x the peak l
 # area (half the film's +-10 %): white film at GS 228 under Eq. 8 (zero at 230.1) read 0.0089 MPa/mm,
 # 2 % of the peak, and the folded area +21 % over a 30 mm strip
 BASELINE = 0.05
+# a strip tilted on the scan: averaging across its width smears the profile over the drift of its
+# centre across the width; flagged above this share of the span (a Gaussian's peak reads ~5 % low
+# there): 6 mm wide at 10 degrees read a 0.5 peak (sd 0.5 mm) as 0.430 and its span +17 %
+TILT = 0.25
+
+
+def _tilt(pmap: np.ndarray) -> float:
+    """Drift of the pressure centroid along the strip per row across it (columns per row; a
+    line fitted to each row's centroid of the pixels >= 10 % of the largest), 0 if undefined."""
+    w = np.where(pmap >= SPAN_LEVEL * pmap.max(), pmap, 0.0)
+    ws = w.sum(axis=1)
+    rows = np.flatnonzero(ws > 0)
+    if rows.size < 3:
+        return 0.0
+    c = (w[rows] @ np.arange(pmap.shape[1])) / ws[rows]
+    return float(np.polyfit(rows, c, 1)[0])
 
 
 def calibration_coverage(cal: Calibration, gray: np.ndarray, pmap: np.ndarray) -> dict:
@@ -408,6 +424,15 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                         f"region's {' and '.join(ends)} ({'x' if axis == 'x' else 'y'} "
                         f"{x_mm[0] - 0.5 / px_per_mm:.4g}-{x_mm[-1] + 0.5 / px_per_mm:.4g} mm): the span and area "
                         "are cut there (lower bounds); widen the region")
+        log.warning("%s", warnings[-1])
+    smear = abs(_tilt(pmap)) * (pmap.shape[0] - 1) / px_per_mm
+    span_two = float(span(x_mm, prof))
+    if not wrong_axis and span_two > 0 and smear > TILT * span_two:
+        angle = np.degrees(np.arctan(smear * px_per_mm / (pmap.shape[0] - 1)))
+        warnings.append(f"the strip is tilted on the scan by {angle:.1f} degrees: its centre moves {smear:.3g} mm "
+                        f"along it across the region's width, {smear / span_two:.0%} of the span, so the mean across "
+                        "the width is smeared (the peak reads low, the span long); rotate the scan to align the strip "
+                        "or narrow the region across it")
         log.warning("%s", warnings[-1])
     base = float(min(prof[0], prof[-1]))
     area = float(auc(x_mm, prof))
