@@ -625,3 +625,13 @@ def test_a_folder_an_earlier_version_wrote_without_the_record_is_rerun(tmp_path)
     # from now on the record's rule: a user's file of a result's name is refused, not replaced
     (d / ".tactileskin-files.json").write_text(json.dumps({k: v for k, v in rec.items() if k != "contact.csv"}))
     assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+
+
+@pytest.mark.parametrize("t, words", [("1", "reads 2.6x the peak of the 3D dots measured"), ("2", "1.9-3.1x the peak")])
+def test_a_2d_braille_solve_says_it_is_the_ridge_not_the_dots(tmp_path, capsys, fake_solve, t, words):
+    # the ridge's 0.0997 MPa at t = 1 silicone read as a plain 'ok' answer for a dot 2.6x lower
+    assert main(["solve", "-i", "braille", "-t", t, "--elastic", "--out", str(tmp_path / "o")]) == 0
+    out = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    assert "the paper's 2D ridge" in out and words in out and "--dim 3 solves the dots" in out
+    assert main(["solve", "-i", "flat", "-t", t, "--elastic", "--out", str(tmp_path / "o")]) == 0
+    assert "2D ridge" not in capsys.readouterr().out

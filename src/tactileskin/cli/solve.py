@@ -109,6 +109,8 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     if "peak_sensor_pressure_mpa" in s:
         t.add_row("sensors / peak sensor P", f"{s['sensors']} / {s['peak_sensor_pressure_mpa']:.4g} MPa "
                   f"({s['peak_sensor_id']})")
+    if scene.dim == 2 and scene.indenter_kind.section_2d == "ridge":
+        t.add_row("model", _ridge_note(scene))
     t.add_row("dofs / increments / Newton", f"{s['dofs']} / {s['increments']} / {s['newton_iterations']}")
     t.add_row("wall time", f"{s['wall_s']:.2f} s")
     t.add_row("files", ", ".join(sorted({n.split("/")[0] for n in RESULT_FILES if any(path.glob(n))})))
@@ -131,6 +133,16 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                            "compare_2d.json: ", style="bold yellow") + Text(str(r2_error).splitlines()[0]),
                       highlight=False)
     return rc
+
+
+def _ridge_note(scene) -> str:
+    """What a 2D Braille result is: the paper's ridge, not the dots (their measured ratio)."""
+    from tactileskin.planner import measured_ridge_vs_dots
+
+    meas = measured_ridge_vs_dots(scene)
+    ratio = (f"{1.0 + meas['peak']:.2g}x the peak of the 3D dots measured at this thickness and material"
+             if meas else "1.9-3.1x the peak of real dots where measured (t = 1, 3, 5 mm)")
+    return f"the paper's 2D ridge (a dot row as a ridge along the finger): it reads {ratio}; --dim 3 solves the dots"
 
 
 @contextlib.contextmanager
