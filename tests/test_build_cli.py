@@ -63,6 +63,19 @@ def test_invalid_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys, argv,
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
+@pytest.mark.parametrize("argv", [
+    ["--indenter", "flat", "--braille-text", "zz"],
+    ["--indenter", "none", "--braille-standard", "klingon"],
+])
+def test_braille_options_without_a_braille_indenter_are_refused(tmp_path, capsys, argv):
+    # they were ignored, and manifest.json recorded them as if a Braille indenter had been built
+    out = tmp_path / "out"
+    assert main(["build", "--out", str(out), "--no-molds", *argv]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert argv[2] in err and "--indenter braille" in err, err
+    assert not out.exists()
+
+
 def test_out_folder_with_other_files_is_refused(tmp_path, capsys):
     (tmp_path / "notes.txt").write_text("keep me")
     assert main(["build", "--out", str(tmp_path), "--indenter", "none", "--no-molds"]) == 2

@@ -71,6 +71,9 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         raise click.UsageError("--indenter-radius needs --indenter sphere or cylinder")
     if indenter_axis is not None and indenter != "cylinder":
         raise click.UsageError("--indenter-axis needs --indenter cylinder")
+    if indenter not in ("braille", "all") and (braille_text or braille_standard != "standard_american"):
+        # else ignored, and recorded in manifest.json as if a Braille indenter had been built
+        raise click.UsageError("--braille-text and --braille-standard need --indenter braille (or all)")
     ind_params = {k: v for k, v in (("indenter_radius", indenter_radius), ("indenter_axis", indenter_axis))
                   if v is not None}
 
