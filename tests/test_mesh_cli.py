@@ -33,6 +33,18 @@ def test_mesh_command_3d(tmp_path, capsys):
     assert "P2 tetrahedra" in capsys.readouterr().out and "end_front" in meshio.read(out).field_data
 
 
+def test_mesh_command_table_names_the_boundaries_as_the_file_does(tmp_path, capsys):
+    # a z-symmetric slab's mid-plane is written as symmetry_z; the table called it end_back,
+    # a name the file does not have
+    out = tmp_path / "slab.vtu"
+    assert main(["mesh", "-t", "1", "--dim", "3", "--quality", "preview", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    names = set(meshio.read(out).field_data) - {"skin"}
+    assert "symmetry_z" in names
+    assert all(f"facets: {n}" in text for n in names), text
+    assert "end_back" not in text
+
+
 def test_mesh_command_rejects_bad_requests(tmp_path, capsys):
     assert main(["mesh", "--mesh-size", "0.002", "--refinement", "20", "--out", str(tmp_path / "m.vtu")]) == 2
     err = capsys.readouterr().err

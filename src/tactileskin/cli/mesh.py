@@ -57,10 +57,10 @@ def command(out, cell, scene_opts):
         L = sm.boundary_measure("bone_interface") / lz
         cad = sec.interface_length * (1.0 if sm.halved else 2.0)  # from x = 0; a full-width model has both sides
         table.add_row("bone interface length (mm)", f"{L:.6f} (CAD {cad:.6f}, rel. err {abs(L / cad - 1):.1e})")
-    for name, f in sm.boundaries.items():
-        table.add_row(f"facets: {name}", str(len(f)))
+    for name, f in sm.boundaries.items():  # as the written file names them
+        table.add_row(f"facets: {sm.file_name(name)}", str(len(f)))
     if sm.dim == 3 and not scene.skin_kind.fixes_thickness:
-        table.add_row("z symmetry", "yes (end_back is z = 0)" if sm.z_symmetric else "no")
+        table.add_row("z symmetry", f"yes ({sm.file_name('end_back')} is z = 0)" if sm.z_symmetric else "no")
     table.add_row("wall time (s)", f"{q['wall_s']:.2f}")
     console = new_console()
     console.print(table)

@@ -62,6 +62,12 @@ class SkinMesh:
         skin without a symmetry group, a pad under an x-asymmetric indenter)."""
         return len(self.boundaries.get("symmetry", ())) > 0
 
+    def file_name(self, name: str) -> str:
+        """A boundary's name in written mesh files: a z-symmetric slab's end_back is its
+        mid-plane, written as `symmetry_z` (a file skin reads it as u_z = 0; an `end_back`
+        would be a free end)."""
+        return SYMMETRY_Z if name == "end_back" and self.dim == 3 and self.z_symmetric else name
+
     # --- export ----------------------------------------------------------------------
     def to_meshio(self):
         """meshio.Mesh with the cells, the named boundary facets (cell sets, gmsh physical
@@ -83,9 +89,7 @@ class SkinMesh:
         cell_sets = {"skin": [np.arange(len(cell_nodes))] + [np.array([], dtype=int)] * len(self.boundaries)}
         point_sets = {}
         for i, (name, facets) in enumerate(self.boundaries.items()):
-            # a z-symmetric slab's end_back is its mid-plane: written under a name that says so
-            # (a file skin reads `symmetry_z` as u_z = 0; an `end_back` would be a free end)
-            name = SYMMETRY_Z if name == "end_back" and self.dim == 3 and self.z_symmetric else name
+            name = self.file_name(name)
             fn = facet_nodes(m, facets, self.dim, self.order)
             cells.append((ftype, fn))
             phys.append(np.full(len(fn), i + 1))
