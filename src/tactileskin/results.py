@@ -316,7 +316,8 @@ class Result:
 
     def summary(self) -> dict:
         """The result's numbers, with its status ("ok" or "suspect: reasons") and flags
-        (tactileskin.quality: no contact, material law outside its range)."""
+        (tactileskin.quality: no contact, material law outside its range, locking, coarse
+        mesh, a peak at the bonded edge, ...)."""
         from tactileskin import quality
 
         out = {

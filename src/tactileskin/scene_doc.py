@@ -40,8 +40,8 @@ FIELDS: dict[str, tuple[str, str, str]] = {
     "indenter_file": ("mm", "a closed STL/OBJ/PLY/OFF or STEP surface in mm; 'file' indenter only",
                       "the user's indenter surface"),
     "force": ("N (3D), N/mm (2D)", "(0, 10000]; instead of depth", "force control: the target reaction"),
-    "force_rate": ("N/s (N/mm/s in 2D)", "> 0; with force, not with load_time", "force ramp rate"),
-    "load_time": ("s", "> 0; with force, not with force_rate",
+    "force_rate": ("N/s (N/mm/s in 2D)", "[1e-6, 1e6]; with force, not with load_time", "force ramp rate"),
+    "load_time": ("s", "(0, 1e6]; with force, not with force_rate",
                   "time to reach the force (None: depth_fraction * t / rate)"),
     "loading": ("mm, N, s", "[[loading]] segments after the first ramp: depth (mm) or force at a rate "
                 "or in a time, hold (s)", "indent-hold-release history (history.csv)"),

@@ -22,8 +22,8 @@ def command() -> None:
 @click.option("--model", type=click.Choice(["auto", *models.MODELS]), default="auto",
               show_default=True, help="Fitting function; auto selects by AICc.")
 @click.option("--activation-range", nargs=2, type=float, default=None,
-              help="Clip range LO HI of the readings, LO < HI (default 0 .. darkest press); "
-                   "a reading below LO is unactivated film: 0.")
+              help="Clip range LO HI (MPa) of the pressure readings, 0 <= LO < HI (default 0 .. the "
+                   "reading at the darkest press); a reading below LO is unactivated film: 0.")
 @click.option("--plot", type=click.Path(dir_okay=False), default=None,
               help="Also write a PNG of the fit, its 90 % band and residuals.")
 def calibrate(cal_csv, out, model, activation_range, plot):

@@ -20,8 +20,10 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
 
 
 @click.command("solve", epilog=(
-    "Exit status: 0 the result is ok; 3 the result was written but is suspect (no contact, or "
-    "the material law outside its range: see 'status' and 'flags' in summary.json); 2 an "
+    "Exit status: 0 the result is ok; 3 the result was written but is suspect (no contact, "
+    "the material law outside its range, locking P1 elements, a mesh coarser than the preview "
+    "preset's, a peak at the bonded skin's edge, ...: see 'status' and 'flags' in summary.json "
+    "and docs/hard_cases.md, \"Result status\"); 2 an "
     "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), required=True,

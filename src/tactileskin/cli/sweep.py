@@ -17,8 +17,10 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 
 @click.command("sweep", epilog=(
     "Exit status: 0 every case ok; 1 some case failed (the others are reported); 3 no case "
-    "failed but some result is suspect (no contact, or the material law outside its range: "
-    "the 'status' column of results.csv and the top of report.md say why); 2 an error "
+    "failed but some result is suspect (no contact, the material law outside its range, "
+    "locking P1 elements, a mesh coarser than the preview preset's, a peak at the bonded "
+    "skin's edge, ...: the 'status' column of results.csv and the top of report.md say why; "
+    "docs/hard_cases.md, \"Result status\"); 2 an error "
     "before any case ran (bad parameter, output folder)."))
 @scene_options(grid=True)
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out", show_default=True,
