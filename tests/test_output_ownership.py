@@ -65,6 +65,22 @@ def test_an_edited_report_is_not_overwritten(tmp_path, capsys, fake_solve):
     assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
 
 
+def test_an_edited_result_file_is_refused_before_the_solve(tmp_path, capsys, monkeypatch):
+    # the refusal came after the solve, whose result (minutes of a 3D solve) was thrown away
+    calls = []
+    monkeypatch.setattr(tactileskin.fe, "solve", lambda scene, **kw: calls.append(1) or fake_result())
+    d = tmp_path / "s1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    (d / "profile.csv").write_text("s_mm,pressure_mpa\n0,1\n")
+    (d / "contact.csv").unlink()  # a file of ours the user removed is no obstacle
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert str(d / "profile.csv") in err and "changed since" in err and len(err.strip().splitlines()) == 1
+    assert calls == [1]  # not solved again
+    (d / "profile.csv").unlink()
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0 and calls == [1, 1]
+
+
 def test_staged_files_in_a_marked_folder_replace_only_recorded_files(tmp_path):
     d = outdir.claim_dir(tmp_path / "d", "test")
     own = ("a.csv", "fig9_*.png", "sub/x_*.csv")

@@ -111,6 +111,19 @@ def _check_owned(folder: Path, old: list[str], new: list[str], rec: dict) -> lis
     return ours
 
 
+def check_replaceable(folder, names: Iterable[str]) -> None:
+    """Before the work: OutputError if a run that will write `names` (paths relative to the
+    folder) into the marked `folder` would be refused by staged_files when it moves them in
+    (a file of ours the user edited, a user's file or folder of that name), so that a long
+    solve is not done to be thrown away. A name that is not there is no obstacle."""
+    folder = Path(folder)
+    if not (folder / MARKER).is_file() or is_legacy(folder):
+        return
+    names = list(names)
+    old = [n for n in names if (folder / n).is_file()]
+    _check_owned(folder, old, names, read_record(folder))
+
+
 @contextlib.contextmanager
 def staged_files(folder, own: Iterable[str], *, last: str | None = None) -> Iterator[Path]:
     """Yield an empty staging folder inside `folder` for the body to write one result into.

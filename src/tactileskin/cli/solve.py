@@ -14,6 +14,7 @@ from tactileskin.cli._common import claimed_output, has_2d_section, scene_from_o
 # as the result's files after a solve
 OWN_FILES = results.SOLVE_FILES
 RESULT_FILES = (*results.OWN_FILES, "bone_map.png", "sensors.png")
+ALWAYS_WRITTEN = ("profile.csv", "contact.csv", "summary.json", "result.vtu")  # by every solve
 
 
 EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see the help text)
@@ -67,6 +68,8 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     if compare_2d and not has_2d_section(scene):
         raise click.UsageError(f"--compare-2d needs a skin with a 2D section (fingertip, pad), not {scene.skin}")
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
+        # ... and one where this result's files could not replace the earlier ones (edited)
+        staging.check_replaceable(out, ALWAYS_WRITTEN)
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)
         r2, r2_error = None, None
