@@ -81,6 +81,15 @@ def test_an_edited_result_file_is_refused_before_the_solve(tmp_path, capsys, mon
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0 and calls == [1, 1]
 
 
+def test_the_solve_table_lists_the_2d_comparison_it_wrote(tmp_path, capsys, fake_solve):
+    # the "files" row left out compare_2d.json and section_2d/ of --compare-2d
+    d = tmp_path / "s3"
+    assert main(["solve", "--dim", "3", "-i", "braille", "--compare-2d", *CHEAP, "--out", str(d)]) == 0
+    assert (d / "compare_2d.json").is_file() and (d / "section_2d" / "profile.csv").is_file()
+    out = " ".join(capsys.readouterr().out.split())
+    assert "compare_2d.json" in out and "section_2d" in out, out
+
+
 def test_staged_files_in_a_marked_folder_replace_only_recorded_files(tmp_path):
     d = outdir.claim_dir(tmp_path / "d", "test")
     own = ("a.csv", "fig9_*.png", "sub/x_*.csv")

@@ -10,10 +10,9 @@ import click
 from tactileskin import quality, results
 from tactileskin.cli._common import claimed_output, has_2d_section, scene_from_options, scene_options
 
-# every file of a solve folder (results.SOLVE_FILES, shared with Result.write); the ones listed
-# as the result's files after a solve
-OWN_FILES = results.SOLVE_FILES
-RESULT_FILES = (*results.OWN_FILES, "bone_map.png", "sensors.png")
+# every file of a solve folder (results.SOLVE_FILES, shared with Result.write), all listed as
+# the result's files after a solve (--compare-2d's compare_2d.json and section_2d/ too)
+OWN_FILES = RESULT_FILES = results.SOLVE_FILES
 ALWAYS_WRITTEN = ("profile.csv", "contact.csv", "summary.json", "result.vtu")  # by every solve
 
 
