@@ -309,3 +309,23 @@ def test_the_3d_reaction_allowance_is_bounded_and_2d_keeps_rtol():
     # a shallow press (2 um): slope x tolerance grows as 1/travel; the allowance stops at the cap
     inc.slope = 1.5 / 0.002
     assert inc._tolerance(m3, 1.0, 0.002, 1.0) == pytest.approx(NOISE_CAP)
+
+
+def test_a_force_ramp_that_fails_names_its_target_and_unit(monkeypatch):
+    """`solve --force 1000` on a 1 mm skin failed with 'no converged state reaches 22.6337
+    (failed at travel ...)': the ramp's force at that increment, without its unit, not the
+    1000 N/mm asked for."""
+    from types import SimpleNamespace
+
+    from tactileskin.fe import loading
+    from tactileskin.fe.solver import _Failure
+
+    def fail(*a, **kw):
+        raise _Failure("Newton did not converge", {})
+
+    monkeypatch.setattr(loading, "_solve_increment", fail)
+    inc = loading.ForceIncrement(lambda t: 22.6337, 0.6, lambda F: 0.05, goal=1000.0)
+    model = SimpleNamespace(m=2, d=0.0, contact=None, travel_fixed=None)
+    with pytest.raises(_Failure) as e:
+        inc(model, None, 0.0045, 1e-6, None, SimpleNamespace(force_trials=0))
+    assert "22.6337 N/mm" in e.value.why and "on the way to 1000 N/mm" in e.value.why, e.value.why

@@ -48,6 +48,11 @@ def vertical_reaction(model, ev) -> float:
     return indenter_force(model, ev)
 
 
+def _unit(model) -> str:
+    """The reaction's unit: N on the whole indenter in 3D, N/mm of the half section in 2D."""
+    return "N" if getattr(model, "m", 3) == 3 else "N/mm"
+
+
 class ForceIncrement:
     """Increment solver for fe.solver.run(increment=) under force control: finds the travel
     d at which the reaction equals target(t) to FORCE_RTOL.
@@ -129,8 +134,9 @@ class ForceIncrement:
                     fails += 1
                     log.debug("force control: travel %.6g mm failed (%s)", d, e.why)
                     if fails > 3 or lo is None and d <= 1e-9:
-                        raise _Failure(f"force control: no converged state reaches {F:.6g} "
-                                       f"(failed at travel {d:.6g} mm: {e.why})", e.diag) from None
+                        raise _Failure(f"force control: no converged state reaches {F:.6g} {_unit(model)}"
+                                       f"{self._on_way(F, model)} (failed at travel {d:.6g} mm: {e.why})",
+                                       e.diag) from None
                     lo_d = lo[0] if lo is not None else (d0 if d0 < d else 0.0)
                     if hi is None or d < hi[0]:
                         hi = (d, math.inf)
@@ -152,6 +158,13 @@ class ForceIncrement:
         raise _Failure(f"force control: reaction not within {self._tolerance(model, F, last[0], last[1] + F):.3g} "
                        f"of {F:.6g} after {MAX_TRIALS} trial travels",
                        {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts]})
+
+    def _on_way(self, F: float, model) -> str:
+        """' on the way to GOAL unit' when the ramp's force F at this increment is not the
+        segment's final force (a failure names what was asked for, not only F)."""
+        if self.goal is None or abs(self.goal - F) <= 1e-9 * max(abs(self.goal), 1.0):
+            return ""
+        return f" on the way to {self.goal:.6g} {_unit(model)}"
 
     def _next(self, d, f, lo, hi, pts, F, model) -> float:
         # the secant through the last two trials, in log-log where both reactions are
