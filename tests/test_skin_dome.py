@@ -203,3 +203,21 @@ def test_a_dome_much_thinner_than_t_somewhere_is_refused():
     Scene(skin="dome", thickness=2.0, dome_tip=4.0)               # 8.7 % thinner: taken
     with pytest.raises(ParameterError, match=r"dome_tip=20.*2.9 mm at its thinnest"):
         Scene(skin="dome", thickness=3.5, dome_tip=20.0)
+
+
+def test_the_default_dome_molds_step_files_reread_as_their_solids(tmp_path):
+    # the sprue's rim was tangent to the seam of the straight part and the tip (z in [-4, 0]):
+    # mold_upper.step re-read as an invalid solid, 3.7 mm3 off, while the STL was fine
+    import build123d as bd
+
+    from tactileskin.geometry.export import cad_volume
+
+    sc = Scene(dim=3, skin="dome", thickness=2.0)
+    sec = sc.section()
+    assert dome_parts._off_the_seam(-2.0, 2.0, (-8.0, 4.0), 0.75) == pytest.approx(-2.25)
+    assert dome_parts._off_the_seam(-3.0, 2.0, (-8.0, 4.0), 0.75) == -3.0   # clear of it: kept
+    for name, solid in zip(("lower", "upper"), dome_parts.mold(sec.a, sec.b, sec.c, sec.length, sc.thickness)):
+        bd.export_step(solid, tmp_path / f"{name}.step")
+        back = bd.import_step(tmp_path / f"{name}.step")
+        assert len(back.solids()) == 1 and back.is_valid, name
+        assert cad_volume(back) == pytest.approx(cad_volume(solid), rel=1e-6), name
