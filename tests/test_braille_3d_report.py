@@ -48,6 +48,14 @@ def test_default_and_3d_only():
     with pytest.raises(ParameterError, match="one dimension with a force axis"):
         expand_grid(thicknesses=[1.0], materials=["silicone"], forces=[0.1], braille_dims=[2, 3])
     assert [sc.dim for sc in expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2])] == [2, 2, 2]
+    # a force on the base (sweep --force), the base's own mesh sizes, quality default with sizes
+    # over it, and a text whose 3D dots do not fit the pad keep 2D (they were added: N/mm against N,
+    # a 2D mesh size on the 3D dots, a sweep refused that ran in 2D)
+    for kw in (dict(base=Scene(force=0.05)), dict(base=Scene(mesh_size=0.3)),
+               dict(quality="default", overrides={"mesh_size": 0.5}),
+               dict(base=Scene(skin="pad", pad_length=4.0), braille_texts=["\u283f"])):
+        grid = expand_grid(thicknesses=[1.0], materials=["silicone"], **kw)
+        assert {sc.dim for sc in grid} == {2} and len(grid) == 3, kw
     only3 = expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=(3,))
     assert [(sc.indenter.value, sc.dim) for sc in only3] == [("flat", 2), ("curved", 2), ("braille", 3)]
 

@@ -127,6 +127,8 @@ def scenes(grid=None, *, quality: str | None = None, base=None) -> list:
     mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
     b = base if base is not None else Scene()
     b = b.replace(**fields) if fields else b
+    if "dim" in fields and "braille_dims" not in axes:  # a dim asked for: the Braille cases' too
+        axes["braille_dims"] = (b.dim,)
     return expand_grid(base=b, quality=quality or file_quality, overrides=mesh or None, **axes)
 
 
@@ -139,8 +141,9 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     grid: {"thickness": [1, 3, 5], "material": [...], "indenter": [...], "depth": [...],
       "braille_text": [...], "braille_dim": [2, 3]} (any subset; other Scene fields such as
       rate=2 or dim=3 apply to every case), a list of Scenes, a scene/sweep TOML path, or
-      None (the paper's 18 cases). Without "braille_dim" the Braille cases are both the 2D
-      ridge and the 3D dots at the default quality (sweep.default_braille_dims), else 2D.
+      None (the paper's 18 cases; 24 at the default quality). Without "braille_dim" (or "dim")
+      the Braille cases are both the 2D ridge and the 3D dots at the default quality
+      (sweep.default_braille_dims), else 2D.
     quality: mesh preset of each case's dimension ('preview', 'default', 'fine').
     out: also write the folder the `tactileskin sweep` command writes (results.csv and
       .parquet, profiles.csv and .parquet, figures with the Fig. 9 renders, report.md);

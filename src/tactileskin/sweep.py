@@ -86,12 +86,20 @@ def default_braille_dims(base: Scene, quality: str | None, overrides: dict | Non
     on a skin that has both models, so that the report sets them side by side and judges the
     paper's claims with the dots, the model that holds (the ridge reads 1.9-3.1x their peak;
     the 18 cases with six 3D dots took 96 s on 2 cores, benchmarks/results/paper_sweep_3d.md).
-    Else base.dim: `preview` stays the quick 2D look, `fine` 3D dots take minutes each, and
-    explicit mesh sizes are a 2D mesh's, and a force axis presses N/mm in 2D but N in 3D."""
-    if (quality is None and overrides) or forced:
+    Else base.dim: `preview` stays the quick 2D look, `fine` 3D dots take minutes each, explicit
+    mesh sizes (overrides, or the base's own) are a 2D mesh's, and a force (an axis, the base's,
+    a [[loading]] segment) presses N/mm in 2D but N in 3D. expand_grid falls back to base.dim
+    too where a case's 3D scene is refused (a text too long for the pad)."""
+    from tactileskin.scene import default_mesh
+
+    forced = forced or base.force is not None or any(g.kind == "force" for g in base.loading)
+    if overrides or forced or base.dim != 2 or base.skin_kind.fixes_thickness:
         return (base.dim,)
-    if (quality or "default") != "default" or base.dim != 2 or base.skin_kind.fixes_thickness:
+    if (quality or "default") != "default":
         return (base.dim,)
+    if quality is None and (base.mesh_size, base.refinement) != default_mesh(2, base.indenter, base.thickness,
+                                                                          base.skin):
+        return (base.dim,)  # the base's own sizes: a 2D mesh's
     try:
         base.replace(dim=3, indenter="braille", braille_text="")
     except ParameterError:  # a skin without a 3D model
@@ -142,6 +150,7 @@ def expand_grid(
         raise ParameterError("forces", list(forces), "either forces or depths, not both",
                              "a case is pressed to a depth or to a force")
     forced = any(f is not None for f in forces)
+    chosen = braille_dims is None  # the default, not the caller's: falls back to 2D where 3D is refused
     dims = (check_braille_dims(braille_dims) if braille_dims is not None
             else default_braille_dims(base, quality, overrides, forced))
     if forced and len(set(dims)) > 1 and any(get_kind(i).section_2d == "ridge" for i in indenters):
@@ -168,7 +177,15 @@ def expand_grid(
         for text in (braille_texts if braille else ("",)):
             for dim in own:
                 fc = {} if f is None else {"force": f}
-                s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim, **fc)
+                try:
+                    s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim, **fc)
+                except ParameterError as e:
+                    if not (chosen and dim == 3 and len(dims) > 1):
+                        raise
+                    log.warning("the Braille cases stay 2D (the ridge): the 3D dots of %s at t = %g mm are "
+                                "refused (%s); --braille-dim 3 asks for them", text or "the dot", t, e)
+                    return expand_grid(thicknesses, materials, indenters, depths, braille_texts, base,
+                                       (base.dim,), quality, overrides, forces)
                 if quality is not None:
                     s = with_quality(s, quality)
                 if overrides:

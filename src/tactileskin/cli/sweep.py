@@ -131,6 +131,8 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
             raise ParameterError("--braille-dim", braille_dim, "3 with skin = " + base.skin,
                                  f"the {base.skin} skin has no 2D section")
         axes["braille_dims"] = BRAILLE_DIM_CHOICES[braille_dim]
+    elif "braille_dims" not in axes and (o.get("dim") is not None or "dim" in fields):
+        axes["braille_dims"] = (base.dim,)  # a dim asked for: the Braille cases' too
     # the preset per scene (it depends on the indenter and dim), explicit mesh sizes over it
     return expand_grid(base=base, quality=o.get("quality") or sf.quality, overrides=mesh or None, **axes)
 
