@@ -85,6 +85,8 @@ def test_unactivated_film_reads_zero_below_an_activation_threshold():
         fp = analyze_scan(img, cal, box_px=(0, 16, img.shape[1], 56))
         assert fp.folded["metrics"]["auc"] == pytest.approx(truth, rel=0.02)
         assert not fp.cut_ends
+        # 0.05 is above the span's 10 % level (0.03): the span ends at the threshold, said so
+        assert any("activation threshold" in w for w in fp.warnings) == (lo > 0.03), (lo, fp.warnings)
 
 
 def test_a_background_read_as_pressure_is_flagged():
