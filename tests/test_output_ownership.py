@@ -79,6 +79,13 @@ def test_an_edited_result_file_is_refused_before_the_solve(tmp_path, capsys, mon
     assert calls == [1]  # not solved again
     (d / "profile.csv").unlink()
     assert main(["solve", *CHEAP, "--out", str(d)]) == 0 and calls == [1, 1]
+    # a 3D solve's own files are checked too (a map edited after a 3D run); a 2D solve, which
+    # does not write a map, leaves the edited one where it is
+    (d / "bone_map.csv").write_text("s_mm,z_mm,pressure_mpa\n0,0,1\n")
+    assert main(["solve", "--dim", "3", "-i", "braille", *CHEAP, "--out", str(d)]) == 2
+    assert "bone_map.csv" in _err(capsys) and calls == [1, 1]
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0 and calls == [1, 1, 1]
+    assert (d / "bone_map.csv").read_text().endswith("0,0,1\n")
 
 
 def test_the_solve_table_lists_the_2d_comparison_it_wrote(tmp_path, capsys, fake_solve):

@@ -68,7 +68,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         raise click.UsageError(f"--compare-2d needs a skin with a 2D section (fingertip, pad), not {scene.skin}")
     with claimed_output(out, "solve"):  # a folder of other files is refused before solving
         # ... and one where this result's files could not replace the earlier ones (edited)
-        staging.check_replaceable(out, ALWAYS_WRITTEN)
+        staging.check_replaceable(out, _will_write(scene, history, compare_2d))
         with solve_progress(scene.label()) as show:
             res = solve(scene, progress=show, history=history)
         r2, r2_error = None, None
@@ -137,6 +137,23 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                            "compare_2d.json: ", style="bold yellow") + Text(str(r2_error).splitlines()[0]),
                       highlight=False)
     return rc
+
+
+def _will_write(scene, history: bool, compare_2d: bool) -> list[str]:
+    """The result files this solve will write (a map only in 3D, and only where the skin has
+    one: a name it may not write is left out, as an edited file it does not replace stays)."""
+    names = list(ALWAYS_WRITTEN)
+    if scene.dim == 3 and scene.skin != "file":
+        names += ["bone_map.csv", "profile_max_z.csv", "bone_map.png"]
+    if scene.sensors:
+        names += ["sensors.csv", "sensors.png"]
+    if scene.loading or scene.force is not None:
+        names.append("history.csv")
+    if history:
+        names.append("result.pvd")
+    if compare_2d:
+        names += ["compare_2d.json", *(f"section_2d/{n}" for n in ALWAYS_WRITTEN)]
+    return names
 
 
 def _ridge_note(scene) -> str:
