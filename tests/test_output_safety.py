@@ -635,3 +635,18 @@ def test_a_2d_braille_solve_says_it_is_the_ridge_not_the_dots(tmp_path, capsys, 
     assert "the paper's 2D ridge" in out and words in out and "--dim 3 solves the dots" in out
     assert main(["solve", "-i", "flat", "-t", t, "--elastic", "--out", str(tmp_path / "o")]) == 0
     assert "2D ridge" not in capsys.readouterr().out
+
+
+def test_build_refuses_a_folder_in_use_before_its_cad(tmp_path, capsys, monkeypatch):
+    # build took the folder's run lock only when it wrote, after minutes of CAD
+    import tactileskin.geometry.parts as gp
+
+    monkeypatch.setattr(gp, "build_parts", lambda *a, **k: (_ for _ in ()).throw(AssertionError("CAD started")))
+    out = tmp_path / "parts"
+    out.mkdir()
+    fd = _hold_run_lock(out)
+    try:
+        assert main(["build", "-t", "1", "--no-molds", "-i", "none", "--out", str(out)]) == 2
+    finally:
+        os.close(fd)
+    assert "another tactileskin run" in _err(capsys)

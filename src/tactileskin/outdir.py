@@ -136,6 +136,15 @@ def run_lock(folder: Path, what: str = "out") -> Iterator[None]:
         yield
 
 
+def check_free(folder, what: str = "out") -> None:
+    """OutputError now if another run holds `folder`'s RUN_LOCK (a command that works long
+    before it claims its folder: build's CAD); the run takes the lock itself when it writes."""
+    folder = Path(folder)
+    if (folder / RUN_LOCK).is_file() and not (folder / RUN_LOCK).is_symlink():
+        with run_lock(folder, what):
+            pass
+
+
 def _remove_if_new(folder: Path, existed: bool) -> None:
     """Remove `folder` if this run created it and it holds nothing but our bookkeeping."""
     if existed:

@@ -79,10 +79,12 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
 
     t0 = time.perf_counter()
     with console.status("building solids (build123d)..."):
+        from tactileskin import outdir
         from tactileskin.geometry.export import check_target, export_parts
         from tactileskin.geometry.parts import build_parts
 
         check_target(Path(out_dir).absolute())  # refuse a folder of other files before the work
+        outdir.check_free(out_dir, "--out")       # ... and one another run is writing into
         if pad:
             from tactileskin.skins import get
 
