@@ -147,10 +147,10 @@ def flags(summary: dict) -> list[Flag]:
         if t is not None and _num(sizes, "refined") is not None and sizes["refined"] > COARSE_OVER_THICKNESS * t:
             why.append(f"refined size {sizes['refined']:g} mm against the skin's thickness {t:g} mm (more than "
                        f"{COARSE_OVER_THICKNESS:g} t: too few elements through the skin, whose preset errors are "
-                       "measured from t = 0.5 mm at 0.4 t; 0.6 t read the peak 4 % and the reaction 6 % low, 2 t "
-                       "12 % and 26 %; use a smaller mesh size)")
+                       "measured from t = 0.5 mm at 0.4 t: 0.6 t read the peak 4 % and the reaction 6 % low, 2 t "
+                       "12 % and 26 %, so use a smaller mesh size)")
         if why:
-            out.append(Flag("coarse_mesh", "; ".join(why)))
+            out.append(Flag("coarse_mesh", ", and ".join(why)))  # one flag: "; " parts the status
     pi = _num(summary, "peak_interior_mpa")
     if pi is not None and peak is not None:
         out.append(Flag("edge_peak", f"the peak {peak:.4g} MPa is at s = {_num(summary, 'peak_edge_s_mm'):g} mm, "
