@@ -650,3 +650,18 @@ def test_build_refuses_a_folder_in_use_before_its_cad(tmp_path, capsys, monkeypa
     finally:
         os.close(fd)
     assert "another tactileskin run" in _err(capsys)
+
+
+def test_result_write_refuses_a_folder_another_run_is_writing_into(tmp_path):
+    from tactileskin.fileio import OutputError
+
+    d = fake_result().write(tmp_path / "r")
+    before = {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()}
+    fd = _hold_run_lock(d)
+    try:
+        with pytest.raises(OutputError, match="another tactileskin run"):
+            fake_result().write(d)
+    finally:
+        os.close(fd)
+    assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
+    fake_result().write(d)

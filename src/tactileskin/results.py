@@ -433,11 +433,12 @@ class Result:
     def write(self, directory) -> Path:
         """Write the result into `directory`: a new or empty folder, or one tactileskin marked
         as a solve's (outdir.claim_dir; a folder of other files is refused, OutputError, and
-        left as it is). See write_owned for the files; the earlier result there goes whole, a
+        left as it is, and so is one another run is writing into). See write_owned for the files; the earlier result there goes whole, a
         CLI solve's figures, 2D section and comparison included (SOLVE_FILES)."""
         validate.path(directory, "directory", "a folder path (str or os.PathLike)")
         directory = outdir.claim_dir(directory, "solve", what="directory")
-        with staging.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
+        with outdir.run_lock(directory, "directory"), \
+                staging.staged_files(directory, SOLVE_FILES, last="summary.json") as tmp:
             self._write_files(tmp)
         return directory
 

@@ -155,7 +155,7 @@ class Comparison:
         else:
             outdir.claim_dir(out, "film-compare")
         doc = json.loads(json.dumps(self.to_dict(), default=str))
-        with staging.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
+        with outdir.run_lock(out, "out"), staging.staged_files(out, COMPARE_NAMES) as tmp:  # both or neither
             fileio.atomic_write_json(tmp / "comparison.json", _finite_or_none(doc))
             plots.overlay(self, tmp / "overlay.png")
         return {"comparison": out / "comparison.json", "overlay": out / "overlay.png"}
