@@ -329,3 +329,21 @@ def test_a_force_ramp_that_fails_names_its_target_and_unit(monkeypatch):
     with pytest.raises(_Failure) as e:
         inc(model, None, 0.0045, 1e-6, None, SimpleNamespace(force_trials=0))
     assert "22.6337 N/mm" in e.value.why and "on the way to 1000 N/mm" in e.value.why, e.value.why
+
+
+def test_reached_force_is_the_scene_force_ramps_not_a_later_segments(mesh):
+    """summary.json `reached_force` answers `target_force` (the scene's force ramp): with a
+    later, larger force segment it was that segment's reaction (0.08 reported as reached
+    against the target 0.05: force control looked 60 % off), and `reached_travel_mm` is the
+    travel of that state."""
+    from tactileskin.fe import solve
+
+    r = solve(BASE.replace(force=0.01, loading=[{"force": 0.02, "time": 0.2}]), mesh=mesh)
+    lo = r.loading
+    assert lo["target_force"] == 0.01
+    assert abs(lo["reached_force"] - 0.01) <= 1e-4 * 0.01
+    first = [x for x in r.history if x["segment"] == 0][-1]
+    assert lo["reached_travel_mm"] == pytest.approx(first["d"], rel=1e-12)
+    # the profile stays the peak-load state: the end of the 0.02 ramp, deeper
+    assert abs(lo["profile_reaction"] - 0.02) <= 1e-4 * 0.02
+    assert lo["profile_travel_mm"] > lo["reached_travel_mm"]

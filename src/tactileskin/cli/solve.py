@@ -107,7 +107,7 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         lo, unit = s["loading"], "N" if scene.dim == 3 else "N/mm"
         if lo.get("target_force") is not None:
             t.add_row("force control", f"{lo['reached_force']:.5g} {unit} (target {lo['target_force']:.5g}) "
-                      f"at travel {lo['profile_travel_mm']:.4g} mm")
+                      f"at travel {lo['reached_travel_mm']:.4g} mm")
         t.add_row("profile state", f"peak load, t = {lo['profile_t_s']:.4g} s; final: t = {lo['final']['t_s']:.4g} s, "
                   f"travel {lo['final']['travel_mm']:.4g} mm, reaction {lo['final']['reaction']:.4g} {unit}")
     if "peak_sensor_pressure_mpa" in s:

@@ -168,7 +168,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
 
     multi = len(program) > 1
     peak_of = bone_peak(model) if multi else None
-    best = {}
+    best, first = {}, {}
     done = [0]  # segments finished (the next one is the one running)
     deepest = [0.0]  # the largest travel of any increment (a creep hold sinks past the peak load's)
     last = {}  # the last converged increment's travel and reaction
@@ -188,6 +188,8 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     def on_segment(i, seg, ev):
         done[0] = i + 1
         F = indenter_force(model, ev)
+        if i == 0 and not first:  # the scene's own ramp: what target_force asks for
+            first.update(reaction=F, d=model.d)
         if seg.kind != "hold" and (not best or F > best["reaction"]):
             best.update(reaction=F, t=model.t, d=model.d, segment=i,
                         result=make_result(model, ev, _StatsView(), s_of_point=section.s_of_point,
@@ -237,7 +239,10 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         # the forces and reactions below: per mm of depth of the half section in 2D, on the
         # whole indenter in 3D
         "force_unit": "N" if scene.dim == 3 else "N/mm",
-        "target_force": scene.force, "reached_force": best["reaction"] if scene.force is not None else None,
+        # reached at the end of the scene's force ramp (a later, larger force or depth segment
+        # gives the peak-load state below, not the answer to target_force)
+        "target_force": scene.force, "reached_force": first["reaction"] if scene.force is not None else None,
+        "reached_travel_mm": first["d"] if scene.force is not None else None,
         "profile_state": "peak load",
         "law_state": "extremes over every increment (min_J, max_abs_stress_mpa, max_pressure_mpa)",
         "profile_t_s": best["t"], "profile_travel_mm": best["d"], "profile_reaction": best["reaction"],
