@@ -45,3 +45,16 @@ def test_a_verdict_within_sampling_noise_of_the_threshold_says_borderline():
     assert v["0.75"]["verdict"] == "supported" and "borderline" not in v["0.75"]["evidence"]
     lo, hi = wilson(46 / 48, 48)
     assert lo < 0.95 < hi and 0.85 < lo
+
+
+def test_a_chart_with_t_5_but_no_paper_set_does_not_say_there_is_no_t_5():
+    # -t 1,5 --set shapes (or letters): the 5 mm claim is about the paper set, which is absent;
+    # the verdict said "not evaluated (no t = 5 mm)" of a chart that has t = 5 mm
+    for sets in (("letters",), ("shapes",)):
+        cfg = ChartConfig(thicknesses=(1.0, 5.0), pitches=(0.75, 2.0), noise_fs=(0.01,), sets=sets, letters="abl")
+        five = {x["claim"][:4]: x for x in verdicts(Chart(cfg))}["5 mm"]
+        assert five["verdict"] == "not evaluated (no paper set)"
+        assert "no t = 5" not in five["verdict"] and "paper set" in five["evidence"]
+    # without t = 5 the reason stays the thickness
+    cfg = ChartConfig(thicknesses=(1.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("shapes",))
+    assert {x["claim"][:4]: x for x in verdicts(Chart(cfg))}["5 mm"]["verdict"] == "not evaluated (no t = 5 mm)"

@@ -776,6 +776,10 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
                         "verdict": ("supported" if best < GOOD else "not supported") + off,
                         "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}" + line + off})
+        elif 5.0 in cfg.thicknesses:  # the claim is the paper set's: a chart with t = 5 but without it
+            out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
+                        "verdict": "not evaluated (no paper set)",
+                        "evidence": "needs the paper set (flat/curved/Braille dot, --set paper) at t = 5 mm"})
         else:
             thick = [t for t in cfg.thicknesses if "paper" in cfg.sets]
             ev = ", ".join(f"t = {t:g}: {max(chart.accuracy(material, t, 'paper', p, noise, method) for p in cfg.pitches):.2f}"
