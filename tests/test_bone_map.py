@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from tactileskin import ownership
+from tactileskin import outdir, ownership
 from tactileskin.errors import ParameterError
 from tactileskin.fe import Dirichlet, make_result, model_for_scene, run
 from tactileskin.fe.model import Model
@@ -158,7 +158,8 @@ def test_write_round_trips_and_a_3d_entry_caches(plane_strain, tmp_path):
     # history, sensors.csv (a scene without sensors) and history.csv (one loading segment);
     # the marker of a folder Result.write claimed, with its record of the files written
     expect = set(OWN_FILES) - {"result.pvd", "result_steps/step_*.vtu", "sensors.csv", "history.csv"}
-    assert {p.name for p in out.iterdir()} == expect | {".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK}
+    assert {p.name for p in out.iterdir()} == expect | {".tactileskin", ownership.OWNED_FILES, ownership.RECORD_LOCK,
+                                                     outdir.RUN_LOCK}
     bm = read_bone_map(out / "bone_map.csv", section_z=res.bone_map.section_z)
     np.testing.assert_allclose(bm.s, res.bone_map.s, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(bm.z, res.bone_map.z, rtol=1e-9, atol=1e-12)

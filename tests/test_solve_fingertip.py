@@ -49,7 +49,8 @@ def test_result_write_is_complete(flat_1mm, tmp_path):
     names = sorted(p.name for p in out.iterdir())
     # solved with history=True: also the time series result.pvd over result_steps/; the marker
     # of the folder Result.write claimed, with its record of the files written (and its lock)
-    assert names == [".tactileskin", ".tactileskin-files.json", ".tactileskin-files.lock", "contact.csv",
+    assert names == [".tactileskin", ".tactileskin-files.json", ".tactileskin-files.lock", ".tactileskin-run.lock",
+                     "contact.csv",
                      "profile.csv", "result.pvd", "result.vtu", "result_steps", "summary.json"]
     rows = list(csv.reader(open(out / "profile.csv")))
     assert rows[0] == ["s_mm", "pressure_mpa"]
