@@ -85,7 +85,7 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     m = scene.dim
     allc = tuple(range(m))
     # the skin's bonded surfaces are fixed (fingertip: bone and nail; pad: the board)
-    bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries]
+    bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries if name in mesh.boundaries]
     if mesh.halved:  # a whole model (a user's full skin, a full-width pad) has none
         bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):

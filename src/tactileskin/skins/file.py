@@ -5,7 +5,9 @@ Scene fields: `skin_file` (the path; its bytes, not its path, enter the cache ke
 `skin_bonded` (.msh: comma-separated physical-group names of the bonded surface(s), default
 the first of bone_interface, bonded, board, bone, base, fixed; STEP: a rule, default
 "normal:-y"), `skin_outer` (.msh: the contact surface's group(s), default outer_surface,
-outer, contact, skin_surface or top, else the rest of the boundary).
+outer, contact, skin_surface or top, else the rest of the boundary). Groups named `nail_edge`
+or `bone_tip` (the fingertip's and the dome's other bonded surfaces, as `tactileskin mesh`
+writes them) are held fixed as well.
 
 What the file fixes: `dim` (a 3D file makes the scene 3D; dim = 3 with a 2D file is refused),
 `thickness` (measured: the distance from the top point to the bonded surface; a different
@@ -169,7 +171,9 @@ class FileSkin(Skin):
     name = "file"
     order = 3
     scene_params = ("skin_file", "skin_bonded", "skin_outer")
-    fixed_boundaries = ("bone_interface",)
+    # the other bonded surfaces `tactileskin mesh` writes (the fingertip's nail, the dome's bone
+    # under its tip) are held fixed too where the file has them
+    fixed_boundaries = ("bone_interface", "nail_edge", "bone_tip")
     fixes_thickness = True
 
     @classmethod
