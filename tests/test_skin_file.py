@@ -18,7 +18,7 @@ PAD = dict(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, indenter="f
 
 
 def _gmsh_block(path, w=4.0, t=2.0, names=("bonded", "outer_surface"), dim=3, order=1, mixed=False):
-    """A block x in [0, w], y in [0, t] (z in [0, w] in 3D) written by gmsh with physical groups:
+    """A block x in [0, w], y in [0, t] (z in [-w/2, w/2] in 3D: across the indenters' axis) written by gmsh with physical groups:
     the bottom names[0], the top names[1], x = 0 `symmetry`, the rest `sides`."""
     import gmsh
 
@@ -28,7 +28,7 @@ def _gmsh_block(path, w=4.0, t=2.0, names=("bonded", "outer_surface"), dim=3, or
         gmsh.model.add("block")
         occ = gmsh.model.occ
         if dim == 3:
-            occ.addBox(0, 0, 0, w, t, w)
+            occ.addBox(0, 0, -w / 2, w, t, w)
         elif mixed:  # two halves, one of them recombined into quadrilaterals
             occ.fragment([(2, occ.addRectangle(0, 0, 0, w / 2, t))], [(2, occ.addRectangle(w / 2, 0, 0, w / 2, t))])
         else:
@@ -114,7 +114,7 @@ def test_gmsh_written_block_maps_common_names_and_elevates_order(tmp_path):
     assert sm.order == 2 and sm.measure() == pytest.approx(32.0, rel=1e-12)
     assert sm.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-12)
     assert sm.boundary_measure("outer_surface") == pytest.approx(16.0, rel=1e-12)
-    assert sm.boundary_measure("sides") == pytest.approx(3 * 8.0, rel=1e-12)  # x = 4, z = 0, z = 4
+    assert sm.boundary_measure("sides") == pytest.approx(3 * 8.0, rel=1e-12)  # x = 4, z = -2, z = 2
     with pytest.raises(ParameterError, match=r"skin_bonded.*found: board, sides, symmetry, top"):
         Scene(skin="file", skin_file=str(path), skin_bonded="bottom")
     with pytest.raises(ParameterError, match=r"skin_outer.*no group named 'contact'"):
@@ -338,3 +338,73 @@ def test_the_fingertips_own_msh_keeps_its_nail_edge_bonded(tmp_path):
     a, b = solve(ft, mesh=sm), solve(user, mesh=um)
     assert b.reaction == pytest.approx(a.reaction, rel=1e-9)
     assert b.peak == pytest.approx(a.peak, rel=1e-9)
+
+
+def _gmsh_polygon(path, pts, groups, h=0.5):
+    """A 2D polygon skin; `groups`: {name: [edge indices]} (edge k runs from pts[k] to pts[k+1])."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        p = [occ.addPoint(x, y, 0) for x, y in pts]
+        lines = [occ.addLine(p[k], p[(k + 1) % len(p)]) for k in range(len(p))]
+        occ.addPlaneSurface([occ.addCurveLoop(lines)])
+        occ.synchronize()
+        for name, edges in groups.items():
+            gmsh.model.addPhysicalGroup(1, [lines[k] for k in edges], name=name)
+        gmsh.model.addPhysicalGroup(2, [1], name="skin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def test_a_skin_placed_where_the_indenters_do_not_press_it_as_meant_is_refused(tmp_path):
+    """The indenters come down (-y) centred on x = z = 0 and start at the contact surface's
+    highest point. Each of these solved without a word or with a misleading one:
+    - a block with its corner at the origin (x in [0, 16], no symmetry group): the cylinder
+      pressed the free corner, reaction 0.0060 against 0.0163 N/mm, status ok;
+    - the top sloping from y = 2 to 3 (highest at x = 8): depth 0.6 pressed the axis 0.1 deep
+      (the gap first), status ok;
+    - upside down (bonded group on top, contact group below): 'no contact'; with the rest of
+      the boundary as contact: 'depth=0.1 is invalid; valid: (0, 0] mm';
+    - a symmetric half on x <= 0: flagged 'edge peak'."""
+    rect = [(-8, 0), (8, 0), (8, 2), (-8, 2)]
+    kw = dict(indenter="cylinder", indenter_radius=2.0, depth=0.1)
+    ok = _gmsh_polygon(tmp_path / "ok.msh", rect, {"bonded": [0], "outer_surface": [2]})
+    assert Scene(skin="file", skin_file=str(ok), **kw).thickness == pytest.approx(2.0)
+    corner = _gmsh_polygon(tmp_path / "corner.msh", [(x + 8, y) for x, y in rect], {"bonded": [0]})
+    with pytest.raises(ParameterError, match=r"skin_file.*across the indenters' axis x = 0.*x in \[0, 16\]"):
+        Scene(skin="file", skin_file=str(corner), **kw)
+    sloped = _gmsh_polygon(tmp_path / "sloped.msh", [(-8, 0), (8, 0), (8, 3), (-8, 2)], {"bonded": [0]})
+    with pytest.raises(ParameterError, match=r"skin_file.*highest on the indenters' axis.*x = 8 mm.*0.5 mm lower"):
+        Scene(skin="file", skin_file=str(sloped), **{**kw, "depth": 0.6})
+    upside = _gmsh_polygon(tmp_path / "upside.msh", rect, {"bonded": [2], "outer_surface": [0]})
+    with pytest.raises(ParameterError, match=r"skin_outer.*contact surface on top.*upside down"):
+        Scene(skin="file", skin_file=str(upside), **kw)
+    upside_rest = _gmsh_polygon(tmp_path / "upside_rest.msh", rect, {"bonded": [2]})
+    with pytest.raises(ParameterError, match=r"skin_bonded.*thickness 0.*upside down"):
+        Scene(skin="file", skin_file=str(upside_rest), **kw)
+    mirrored = _gmsh_polygon(tmp_path / "mirrored.msh", [(-8, 0), (0, 0), (0, 2), (-8, 2)],
+                             {"bonded": [0], "symmetry": [1]})
+    with pytest.raises(ParameterError, match=r"skin_file.*half model on x >= 0.*mirror it"):
+        Scene(skin="file", skin_file=str(mirrored), **kw)
+    half = _gmsh_polygon(tmp_path / "half.msh", [(0, 0), (8, 0), (8, 2), (0, 2)], {"bonded": [0], "symmetry": [3]})
+    assert Scene(skin="file", skin_file=str(half), **kw).section().top == pytest.approx(2.0)
+
+
+def test_an_upside_down_or_off_centre_step_is_refused(tmp_path):
+    import build123d as bd
+
+    box = bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER))  # y in [-2, 0]
+    bd.export_step(box, str(tmp_path / "up.step"))
+    with pytest.raises(ParameterError, match=r"skin_bonded='normal:\+y'.*thickness 0"):
+        Scene(skin="file", skin_file=str(tmp_path / "up.step"), skin_bonded="normal:+y")
+    corner = bd.Box(8.0, 2.0, 8.0, align=(bd.Align.MIN, bd.Align.MIN, bd.Align.MIN))
+    bd.export_step(corner, str(tmp_path / "corner.step"))
+    with pytest.raises(ParameterError, match=r"skin_file.*axis x = 0.*x in \[0, 8\]"):
+        Scene(skin="file", skin_file=str(tmp_path / "corner.step"))

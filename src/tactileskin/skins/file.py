@@ -13,7 +13,8 @@ What the file fixes: `dim` (a 3D file makes the scene 3D; dim = 3 with a 2D file
 `thickness` (measured: the distance from the top point to the bonded surface; a different
 value given is refused), the top point (highest point of the outer surface, nearest the axis
 x = z = 0 among equals), where indenters start (y0 = its y; indenters stay centred on
-x = z = 0). s along the bonded surface is x - x_top (signed), the section plane of a 3D
+x = z = 0; `check_placement` refuses a skin upside down, off the axis or highest off it). s
+along the bonded surface is x - x_top (signed), the section plane of a 3D
 profile z = 0. Sensor layouts are refused on a file skin (its sensor frames are undefined).
 The model is the half x >= 0 only when the file names a `symmetry` group.
 """
@@ -45,6 +46,35 @@ class FileGeometry:
     outer_xy: np.ndarray      # (n, 2): (x, y) of the outer surface's nodes (first-contact estimate)
     symmetric: bool           # the file names a `symmetry` group (half model x >= 0)
     groups: tuple = ()
+    z_symmetric: bool = False  # 3D: the file names a `symmetry_z` group (half model z >= 0)
+    axis_y: float | None = None  # y of the outer surface on the indenters' axis (None: it misses it)
+
+
+AXIS_GAP = 0.02  # of t: how far the outer surface on the axis may lie below the top point
+
+
+def _axis_height(mesh, facets, size: float):
+    """Highest y where the axis x = 0 (2D) or x = z = 0 (3D) crosses the straight facets (None
+    where it crosses none)."""
+    v = mesh.p[:, mesh.facets[:, facets]].T            # (n, nv, dim)
+    eps = 1e-9 * size
+    if v.shape[-1] == 2:
+        x0, x1, y0, y1 = v[:, 0, 0], v[:, 1, 0], v[:, 0, 1], v[:, 1, 1]
+        hit = (np.minimum(x0, x1) <= eps) & (np.maximum(x0, x1) >= -eps)
+        dx = np.where(np.abs(x1 - x0) > eps, x1 - x0, 1.0)
+        u = np.clip(np.where(np.abs(x1 - x0) > eps, -x0 / dx, 1.0), 0.0, 1.0)
+        y = np.where(np.abs(x1 - x0) > eps, y0 + u * (y1 - y0), np.maximum(y0, y1))
+    else:
+        a, b, c = (v[:, k][:, [0, 2]] for k in range(3))
+        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        ok = np.abs(det) > eps * size
+        det = np.where(ok, det, 1.0)
+        l1 = ((-a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (-a[:, 1])) / det
+        l2 = ((b[:, 0] - a[:, 0]) * (-a[:, 1]) - (-a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+        tol = 1e-9
+        hit = ok & (l1 >= -tol) & (l2 >= -tol) & (l1 + l2 <= 1 + tol)
+        y = v[:, 0, 1] + l1 * (v[:, 1, 1] - v[:, 0, 1]) + l2 * (v[:, 2, 1] - v[:, 0, 1])
+    return float(y[hit].max()) if hit.any() else None
 
 
 def _distance_to_facets(point, mesh, facets) -> float:
@@ -84,7 +114,52 @@ def measure(skinmesh, groups=()) -> FileGeometry:
     t = _distance_to_facets(top, m, b["bone_interface"])
     return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
                         lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
-                        symmetric="symmetry" in b, groups=tuple(groups))
+                        symmetric="symmetry" in b, groups=tuple(groups),
+                        z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
+                        axis_y=_axis_height(m, b["outer_surface"], size))
+
+
+def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
+    """ParameterError unless the skin lies as the indenters expect it: its contact surface on
+    top (they press down, -y, from above), the bonded surface below it, the axis x = 0 (and
+    z = 0 in 3D) through the skin (the model's edge where it is a symmetric half, which lies on
+    x >= 0 / z >= 0) and the contact surface's highest point on that axis (indenters are centred
+    there and start at its height)."""
+    name = Path(str(path)).name
+    size = float(np.max(np.subtract(geo.hi, geo.lo)))
+    eps = 1e-6 * size
+    x, y = geo.top_point[0], geo.top_point[1]
+    if geo.hi[1] > y + eps:
+        raise ParameterError("skin_outer" if kind == "msh" else "skin_bonded",
+                             (outer or "its default") if kind == "msh" else (bonded or "normal:-y"),
+                             "a contact surface on top of the skin (indenters press down, -y, from above)",
+                             f"{name}'s contact surface reaches y = {y:.4g} mm, its skin y = {geo.hi[1]:.4g} mm: "
+                             "is the skin upside down, or the contact group the inner face?")
+    if geo.thickness <= eps:
+        raise ParameterError("skin_bonded", bonded or ("the default group" if kind == "msh" else "normal:-y"),
+                             "a bonded surface below the contact surface's highest point",
+                             f"that point ({', '.join(f'{c:.4g}' for c in geo.top_point)}) of {name} lies on the "
+                             "bonded surface (thickness 0): is the skin upside down?")
+    axes = [(0, "x", geo.symmetric, "symmetry")] + ([(2, "z", geo.z_symmetric, "symmetry_z")] if geo.dim == 3 else [])
+    for k, a, half, group in axes:
+        lo, hi = geo.lo[k], geo.hi[k]
+        if half and lo < -eps:
+            raise ParameterError("skin_file", str(path), f"a half model on {a} >= 0 (its {group!r} group on {a} = 0)",
+                                 f"{name} spans {a} in [{lo:.4g}, {hi:.4g}] mm: mirror it to {a} >= 0")
+        if not half and not (lo < -eps and hi > eps):
+            raise ParameterError("skin_file", str(path), f"a skin across the indenters' axis {a} = 0 (or a half "
+                                 f"model with a {group!r} group on {a} = 0)",
+                                 f"{name} spans {a} in [{lo:.4g}, {hi:.4g}] mm: the indenter would press its edge; "
+                                 "centre the skin on the axis")
+    gap = y - geo.axis_y if geo.axis_y is not None else float("inf")
+    if gap > AXIS_GAP * geo.thickness:
+        where = "misses the contact surface" if geo.axis_y is None else f"meets it {gap:.4g} mm lower"
+        raise ParameterError("skin_file", str(path), "a skin whose contact surface is highest on the indenters' "
+                             "axis x = 0" + (", z = 0" if geo.dim == 3 else "") + f" (within {AXIS_GAP:.0%} of t)",
+                             f"{name}'s highest point is at x = {x:.4g}"
+                             + (f", z = {geo.top_point[2]:.4g}" if geo.dim == 3 else "")
+                             + f" mm and the axis {where}: the indenters start at that height on the axis, so "
+                             "the depth would be short by the gap; move the skin's top to the axis")
 
 
 @functools.lru_cache(maxsize=16)
@@ -93,12 +168,15 @@ def _analyse(kind: str, path: str, digest: str, bonded, outer) -> FileGeometry:
 
     if kind == "msh":
         sm, groups = skinfile.load_msh(path, bonded=bonded, outer=outer)
-        return measure(sm, groups)
-    sm = skinfile.mesh_step(path, bonded=bonded, mesh_size=None, order=1)  # a coarse mesh (size / 8)
-    g = measure(sm)
-    top = skinfile.refine_top(path, g.top_point)
-    t = _distance_to_facets(top, sm.mesh, sm.boundaries["bone_interface"])
-    return FileGeometry(**{**g.__dict__, "top_point": tuple(float(c) for c in top), "thickness": t})
+        g = measure(sm, groups)
+    else:
+        sm = skinfile.mesh_step(path, bonded=bonded, mesh_size=None, order=1)  # a coarse mesh (size / 8)
+        g = measure(sm)
+        top = skinfile.refine_top(path, g.top_point)
+        t = _distance_to_facets(top, sm.mesh, sm.boundaries["bone_interface"])
+        g = FileGeometry(**{**g.__dict__, "top_point": tuple(float(c) for c in top), "thickness": t})
+    check_placement(g, path, kind, bonded, outer)
+    return g
 
 
 def geometry(scene) -> FileGeometry:
