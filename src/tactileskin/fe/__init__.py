@@ -85,7 +85,9 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
     m = scene.dim
     allc = tuple(range(m))
     # the skin's bonded surfaces are fixed (fingertip: bone and nail; pad: the board)
-    bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries if name in mesh.boundaries]
+    # (a file skin lists the other bonded groups `tactileskin mesh` writes: fixed where present)
+    bcs = [Dirichlet(name, allc) for name in scene.skin_kind.fixed_boundaries
+           if name in mesh.boundaries or name == "bone_interface"]
     if mesh.halved:  # a whole model (a user's full skin, a full-width pad) has none
         bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
