@@ -175,3 +175,17 @@ def test_report_states_geometry_files_that_are_not_the_shipped_ones(tmp_path, mo
     md = build_report(rows, [], [], [], [], 1.0, scenes=scenes)
     assert md.count("fingertip.toml differs from the shipped files") == 2  # run settings and the paper section
     assert str(geo) in md
+
+
+def test_profiles_legend_names_every_series_not_only_the_first_panels(tmp_path, monkeypatch):
+    # the legend was taken from the first panel (silicone, t = 1): with its flat case failed or
+    # suspect (left out), 'flat' was drawn at t = 3 but missing from the legend
+    s = np.linspace(0, 8, 81)
+    recs = [CaseRecord(Scene(thickness=t, material="silicone", indenter=ind), s, 0.3 * np.exp(-s ** 2), {}, Path("."))
+            for t, inds in ((1.0, ("curved", "braille")), (3.0, ("flat", "curved", "braille"))) for ind in inds]
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.profiles_figure(recs, tmp_path)
+    fig = got["fig10_profiles"]
+    assert [t.get_text() for leg in fig.legends for t in leg.get_texts()] == ["flat", "curved", "braille"]
+    figures._plt().close("all")

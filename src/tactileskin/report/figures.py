@@ -111,17 +111,19 @@ def profiles_figure(records, out: Path) -> list[Path]:
     variants = sorted({getattr(r, "variant", "") for r in records})
     dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
     used = set()
+    legend = {}  # every panel's series, not the first panel's: a case may be missing from it
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
             ax = axes[i * rows_per_mat + j // cols][j % cols]
             used.add(id(ax))
-            for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t),
-                            key=lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,
-                                           getattr(r, "variant", ""), r.scene.dim)):
+            order = lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,  # noqa: E731
+                               getattr(r, "variant", ""), r.scene.dim)
+            for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t), key=order):
                 k = variants.index(getattr(r, "variant", "")) + len(variants) * dims.index(r.scene.dim)
                 name = _ind_name(r) + (f" {r.scene.dim}d" if len(dims) > 1 else "")
-                ax.plot(r.s, r.pressure, _DASHES[k % len(_DASHES)], color=COLOURS.get(r.scene.indenter.value),
-                        label=name)
+                line, = ax.plot(r.s, r.pressure, _DASHES[k % len(_DASHES)], color=COLOURS.get(r.scene.indenter.value),
+                                label=name)
+                legend.setdefault(name, (order(r), line))
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
             ax.set_xlim(0, 8)
@@ -133,9 +135,10 @@ def profiles_figure(records, out: Path) -> list[Path]:
         for ax in row:
             if id(ax) not in used:
                 ax.set_visible(False)
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=min(len(labels), 4), fontsize=8)
+    labels = sorted(legend, key=lambda n: legend[n][0])
+    if labels:
+        fig.legend([legend[n][1] for n in labels], labels, loc="outside lower center", ncols=min(len(labels), 4),
+                   fontsize=8)
     fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)", fontsize=10)
     _fit_width(fig)
     return _save(fig, out, "fig10_profiles")
