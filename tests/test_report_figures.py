@@ -189,3 +189,24 @@ def test_profiles_legend_names_every_series_not_only_the_first_panels(tmp_path, 
     fig = got["fig10_profiles"]
     assert [t.get_text() for leg in fig.legends for t in leg.get_texts()] == ["flat", "curved", "braille"]
     figures._plt().close("all")
+
+
+def test_profiles_figure_shows_a_two_sided_profile_whole(tmp_path, monkeypatch):
+    # a whole model's profile runs across the centre (a full-width pad under Braille 'ab': s from
+    # -10 to 10, peak 0.0883 at s = -3.0 at t = 2): the s axis was fixed to 0-8 mm, so half the
+    # profile and the reported peak were off the figure; the fingertip's profiles keep 0-8 mm
+    s = np.linspace(0, 13.5, 136)
+    tip = CaseRecord(Scene(thickness=1.0, material="silicone", indenter="flat"), s, 0.3 * np.exp(-(s / 1.5) ** 2),
+                     {}, Path("."))
+    s2 = np.linspace(-10, 10, 201)
+    whole = CaseRecord(Scene(thickness=2.0, material="silicone", indenter="flat"), s2,
+                       0.09 * np.exp(-((s2 + 3) / 0.8) ** 2) + 0.08 * np.exp(-((s2 - 3) / 0.8) ** 2), {}, Path("."))
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.profiles_figure([tip], tmp_path)
+    assert got.pop("fig10_profiles").axes[0].get_xlim() == (0.0, 8.0)
+    figures.profiles_figure([tip, whole], tmp_path)
+    for ax in got["fig10_profiles"].axes:
+        lo, hi = ax.get_xlim()
+        assert lo <= -4.0 and hi >= 8.0
+    figures._plt().close("all")

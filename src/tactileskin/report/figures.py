@@ -96,6 +96,21 @@ def _order(indenter: str) -> int:
 
 
 _DASHES = ("-", "--", ":", "-.")
+PROFILE_VIEW = (0.0, 8.0)   # Fig. 10's s axis (mm), the paper's; widened to show the loaded part of every profile
+VIEW_FRACTION = 0.02        # ... where P >= this fraction of the profile's peak
+
+
+def _profile_xlim(records) -> tuple[float, float]:
+    """PROFILE_VIEW widened to every s where a profile reaches VIEW_FRACTION of its peak: a
+    two-sided profile (a whole model: s < 0) or a wide pad's (s > 8) was cut at the view's ends."""
+    lo, hi = PROFILE_VIEW
+    for r in records:
+        s, p = np.asarray(r.s, float), np.asarray(r.pressure, float)
+        if p.size and p.max() > 0:
+            loaded = s[p >= VIEW_FRACTION * p.max()]
+            lo, hi = min(lo, float(loaded.min())), max(hi, float(loaded.max()))
+    return lo, hi
+
 _HATCHES = ("", "//", "..", "xx", "\\\\", "++")
 
 
@@ -112,6 +127,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
     dims = sorted({r.scene.dim for r in records})  # 2D ridge and 3D dots: told apart
     used = set()
     legend = {}  # every panel's series, not the first panel's: a case may be missing from it
+    xlim = _profile_xlim(records)
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
             ax = axes[i * rows_per_mat + j // cols][j % cols]
@@ -126,7 +142,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
                 legend.setdefault(name, (order(r), line))
             ax.set_title(f"{m}, t = {t:g} mm", fontsize=9)
             ax.axhline(0, color="0.7", lw=0.5)
-            ax.set_xlim(0, 8)
+            ax.set_xlim(*xlim)
             if j % cols == 0:
                 ax.set_ylabel("mean pressure P (MPa)")
             ax.set_xlabel("distance along bone s (mm)")
