@@ -207,3 +207,21 @@ def test_a_discrimination_group_missing_a_failed_case_has_no_verdict_on_the_set(
     line = discrimination_table(recs, rows)[2]
     assert line.startswith("| silicone | 1 | – | curved–flat ") and line.endswith(f"| {verdict} |")
     assert f"| {verdict} |" in build_report(rows, recs, [], [], [], 1.0)
+
+
+def test_paper_claims_are_not_checked_on_a_material_the_paper_did_not_test():
+    # sweep -t 1,3 -m lock.toml,silicone: the report's "paper says" table had 'lock.toml 1 mm:
+    # peak order flat > curved > Braille holds', 'lock.toml, flat: span shrinks as the skin
+    # thickens' (differs) and 'lock.toml 1 mm: indenters distinguishable', claims the paper
+    # makes about its Table I silicone and polyurethane only
+    data = {}
+    for mat in ("gel.toml", "silicone"):
+        for t in (1.0, 3.0, 5.0):
+            for ind, (pk, w) in {"flat": (0.5, 4.0), "curved": (0.4, 2.0), "braille": (0.3, 0.8)}.items():
+                data[(mat, t, ind)] = (pk / t, w)
+    recs, rows = _records(data)
+    claims = [c["claim"] for c in paper_checks(rows, recs)]
+    assert claims and not [c for c in claims if "gel" in c]
+    assert any(c.startswith("silicone 5 mm: indenters") for c in claims)
+    recs, rows = _records({k: v for k, v in data.items() if k[0] == "gel.toml"})
+    assert paper_checks(rows, recs) == []
