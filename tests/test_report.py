@@ -225,3 +225,17 @@ def test_paper_claims_are_not_checked_on_a_material_the_paper_did_not_test():
     assert any(c.startswith("silicone 5 mm: indenters") for c in claims)
     recs, rows = _records({k: v for k, v in data.items() if k[0] == "gel.toml"})
     assert paper_checks(rows, recs) == []
+
+
+def test_the_suspect_section_names_the_kinds_of_suspect_result_a_sweep_reports():
+    # sweep -t 1,3 --mesh-size 3: all six cases suspect for their coarse mesh, under a heading
+    # that said suspect meant "no contact, or the material law outside its range"
+    from tactileskin.report.markdown import build_report
+
+    recs, rows = _records({("silicone", 1.0, "flat"): (0.5, 3.0)})
+    rows[0].update(case="t1-silicone-flat-2d", depth_mm=0.2, reaction_n_per_mm=0.1,
+                   status="suspect: mesh coarser than the preview preset's (refined size 1 mm against 0.2)")
+    md = build_report(rows, recs, [], [], [], 1.0, scenes=[recs[0].scene])
+    intro = md.split("## Failed and suspect cases")[1].split("\n- ")[0]
+    for kind in ("no contact", "outside its range", "locking", "mesh coarser", "edge"):
+        assert kind in intro, kind

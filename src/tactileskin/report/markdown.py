@@ -549,8 +549,9 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
     bad = [r for r in _status_order(rows) if quality.kind(r.get("status", "")) != "ok"]
     if bad:
         out += ["", "## Failed and suspect cases", "",
-                "Suspect results (no contact, or the material law outside its range: "
-                "tactileskin/quality.py, docs/hard_cases.md) are listed in the tables but left out of "
+                "Suspect results (no contact, the material law outside its range, locking P1 elements, "
+                "a mesh coarser than the preview preset's, a peak at the bonded skin's edge, ...: each "
+                "case's reason below; tactileskin/quality.py, docs/hard_cases.md) are listed in the tables but left out of "
                 "the paper checks and the discrimination verdicts; failed cases have no result.", ""]
         out += [f"- {r['case']}: {r['status']}" for r in bad]
     out += ["", "## Which thickness?", "",
