@@ -210,3 +210,25 @@ def test_profiles_figure_shows_a_two_sided_profile_whole(tmp_path, monkeypatch):
         lo, hi = ax.get_xlim()
         assert lo <= -4.0 and hi >= 8.0
     figures._plt().close("all")
+
+
+def test_bar_legends_name_only_series_with_an_ok_case_and_no_case_ok_draws_no_figure(tmp_path, monkeypatch):
+    # sweep -t 1 -m lock2.toml,silicone -i flat,curved --depth 0.2,0.6: every d0.6 case failed or
+    # suspect, yet Figs. 11-13 listed 'flat d0.6' and 'curved d0.6' in their legends with no bar
+    # anywhere; sweep -t 1,3 --mesh-size 3 (all six suspect) wrote empty bar and
+    # metrics-against-thickness figures (y from -0.04 to 0.04, a legend of three series)
+    recs, rows = _one_thickness_2d_3d()
+    rows[3] = dict(rows[3], status="suspect: mesh coarser")
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [stem])
+    figures.all_figures(recs[:3], rows, tmp_path)
+    for stem in ("fig11_peak", "fig12_span", "fig13_auc"):
+        assert [t.get_text() for leg in got[stem].legends for t in leg.get_texts()] == ["flat 2d", "curved 2d", "braille 2d"]
+    got.clear()
+    assert figures.all_figures([], [dict(r, status="suspect: x") for r in rows], tmp_path) == [] and not got
+    from tactileskin.report.markdown import build_report
+
+    sus = [dict(r, status="suspect: x", case=f"c{i}", depth_mm=0.2, reaction_n_per_mm=0.1) for i, r in enumerate(rows)]
+    md = build_report(sus, recs, [], [], [], 1.0, scenes=[r.scene for r in recs])
+    assert "No figures: no case is ok" in md and "The figures show" not in md
+    figures._plt().close("all")

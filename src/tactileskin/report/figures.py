@@ -168,7 +168,8 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     thick = sorted({r["thickness_mm"] for r in rows})
     key = lambda r: (_order(r["indenter"]), r.get("braille_text") or "", r.get("variant") or "",  # noqa: E731
                      r.get("dim", 2))
-    series = sorted({key(r) + (r["indenter"],) for r in rows})
+    # the series with an ok case: one that only failed or is suspect has no bar to name
+    series = sorted({key(r) + (r["indenter"],) for r in rows if r.get("status", "ok") == "ok"})
     variants = sorted({r.get("variant") or "" for r in rows})
     dims = {r.get("dim", 2) for r in rows}
     dim_list = sorted(dims)  # the 2D ridge and the 3D dots: one colour, told apart by hatch
@@ -250,6 +251,8 @@ def all_figures(records, rows, out: Path) -> list[Path]:
     draws the ok results only: a suspect profile is not a result to compare with (it is in
     the tables, marked)."""
     make_dirs(out)
+    if not any(r.get("status", "ok") == "ok" for r in rows):
+        return []  # no ok case: every figure would be empty axes under a legend
     paths = thickness_figure(rows, out)
     ok = [r for r in records if quality.status(r.summary) == "ok"]
     if ok:

@@ -638,7 +638,9 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
     if sus:
         out += ["", "Left out as suspect: " + ", ".join(getattr(r, "case", "") or r.scene.label() for r in sus) + "."]
     out += ["", "## Figures", ""]
-    if bad:
+    if bad and not figures:
+        out += ["No figures: no case is ok (the suspect and failed ones are in the tables above).", ""]
+    elif bad:
         out += ["The figures show the ok cases only; the suspect and failed ones are in the tables above.", ""]
     for p in figures:
         if p.suffix == ".png" and p.stem != "metrics_vs_thickness":
