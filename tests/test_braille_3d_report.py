@@ -45,8 +45,9 @@ def test_default_and_3d_only():
                dict(forces=[0.1])):
         grid = expand_grid(thicknesses=[1.0], materials=["silicone"], **kw)
         assert {sc.dim for sc in grid} == {2}, kw
-    with pytest.raises(ParameterError, match="one dimension with a force axis"):
-        expand_grid(thicknesses=[1.0], materials=["silicone"], forces=[0.1], braille_dims=[2, 3])
+    for kw in (dict(forces=[0.1]), dict(base=Scene(force=0.5))):   # sweep --force 0.5 --braille-dim both ran
+        with pytest.raises(ParameterError, match="one dimension under force control"):
+            expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2, 3], **kw)
     assert [sc.dim for sc in expand_grid(thicknesses=[1.0], materials=["silicone"], braille_dims=[2])] == [2, 2, 2]
     # a force on the base (sweep --force), the base's own mesh sizes, quality default with sizes
     # over it, and a text whose 3D dots do not fit the pad keep 2D (they were added: N/mm against N,

@@ -149,12 +149,13 @@ def expand_grid(
     if any(f is not None for f in forces) and any(d is not None for d in depths):
         raise ParameterError("forces", list(forces), "either forces or depths, not both",
                              "a case is pressed to a depth or to a force")
-    forced = any(f is not None for f in forces)
+    forced = (any(f is not None for f in forces) or base.force is not None
+              or any(g.kind == "force" for g in base.loading))
     chosen = braille_dims is None  # the default, not the caller's: falls back to 2D where 3D is refused
     dims = (check_braille_dims(braille_dims) if braille_dims is not None
             else default_braille_dims(base, quality, overrides, forced))
     if forced and len(set(dims)) > 1 and any(get_kind(i).section_2d == "ridge" for i in indenters):
-        raise ParameterError("braille_dims", list(dims), "one dimension with a force axis",
+        raise ParameterError("braille_dims", list(dims), "one dimension under force control",
                              "a force is N/mm of the half section in 2D and N on the whole indenter in 3D: "
                              "the ridge and the dots would not be pressed alike")
     n = (len(thicknesses) * len(materials) * len(indenters) * len(depths) * len(forces)

@@ -30,7 +30,7 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
               help="Braille cases as the paper's 2D ridge section (2), as the 3D slab with real "
                    "dots (3), or both side by side in the report. Default: both at the default "
                    "quality (--quality default, or none and no mesh sizes; the paper sweep then takes "
-                   "about 100 s on 2 cores), else the [scene] dim; one dim with a force axis. Flat and "
+                   "about 100 s on 2 cores), else the [scene] dim; one dim under force control. Flat and "
                    "curved cases stay 2D (exact for them). 3D solves take 4-60 s each at default.")
 @click.option("--scheduler", default=None, help="Address of a running Dask scheduler (tcp://host:8786).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
