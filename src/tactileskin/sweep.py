@@ -87,12 +87,12 @@ def default_braille_dims(base: Scene, quality: str | None, overrides: dict | Non
     paper's claims with the dots, the model that holds (the ridge reads 1.9-3.1x their peak;
     the 18 cases with six 3D dots took 96 s on 2 cores, benchmarks/results/paper_sweep_3d.md).
     Else base.dim: `preview` stays the quick 2D look, `fine` 3D dots take minutes each, explicit
-    mesh sizes (overrides, or the base's own) are a 2D mesh's, and a force (an axis, the base's,
-    a [[loading]] segment) presses N/mm in 2D but N in 3D. expand_grid falls back to base.dim
-    too where a case's 3D scene is refused (a text too long for the pad)."""
+    mesh sizes (overrides, or the base's own) are a 2D mesh's, and `forced` cases (expand_grid's
+    test: a force axis, the base's force, a [[loading]] force) press N/mm in 2D but N in 3D.
+    expand_grid falls back to base.dim too where a case's 3D scene is refused (a text too long
+    for the pad)."""
     from tactileskin.scene import default_mesh
 
-    forced = forced or base.force is not None or any(g.kind == "force" for g in base.loading)
     if overrides or forced or base.dim != 2 or base.skin_kind.fixes_thickness:
         return (base.dim,)
     if (quality or "default") != "default":
