@@ -255,31 +255,34 @@ def test_a_scene_files_skin_file_implies_the_file_skin_as_the_option_does(tmp_pa
     assert Scene.from_toml(tmp_path / "s.toml").skin == "file"
 
 
-def _gmsh_rectangle(path, w=8.0, t=2.0, h=0.25):
-    """A whole 2D block x in [-w/2, w/2], y in [0, t] (no symmetry group): bottom `bonded`,
-    top `outer_surface`, the ends `sides`."""
+def _gmsh_polygon(path, pts, groups, h=0.5):
+    """A 2D polygon skin; `groups`: {name: [edge indices]} (edge k runs from pts[k] to pts[k+1])."""
     import gmsh
 
     gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("rect")
         occ = gmsh.model.occ
-        occ.addRectangle(-w / 2, 0, 0, w, t)
+        p = [occ.addPoint(x, y, 0) for x, y in pts]
+        lines = [occ.addLine(p[k], p[(k + 1) % len(p)]) for k in range(len(p))]
+        occ.addPlaneSurface([occ.addCurveLoop(lines)])
         occ.synchronize()
-        groups = {"bonded": [], "outer_surface": [], "sides": []}
-        for _, f in gmsh.model.getEntities(1):
-            c = occ.getCenterOfMass(1, f)
-            groups["bonded" if abs(c[1]) < 1e-9 else "outer_surface" if abs(c[1] - t) < 1e-9 else "sides"].append(f)
-        for name, ents in groups.items():
-            gmsh.model.addPhysicalGroup(1, ents, name=name)
-        gmsh.model.addPhysicalGroup(2, [e for _, e in gmsh.model.getEntities(2)], name="skin")
+        for name, edges in groups.items():
+            gmsh.model.addPhysicalGroup(1, [lines[k] for k in edges], name=name)
+        gmsh.model.addPhysicalGroup(2, [1], name="skin")
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
         gmsh.model.mesh.generate(2)
         gmsh.write(str(path))
     finally:
         gmsh.finalize()
     return path
+
+
+def _gmsh_rectangle(path, w=8.0, t=2.0, h=0.25):
+    """A whole 2D block x in [-w/2, w/2], y in [0, t] (no symmetry group): bottom `bonded`,
+    top `outer_surface`, the ends `sides`."""
+    return _gmsh_polygon(path, [(-w / 2, 0.0), (w / 2, 0.0), (w / 2, t), (-w / 2, t)],
+                         {"bonded": [0], "sides": [1, 3], "outer_surface": [2]}, h=h)
 
 
 def test_a_whole_2d_skin_reads_like_the_halved_pad(tmp_path):
@@ -338,29 +341,6 @@ def test_the_fingertips_own_msh_keeps_its_nail_edge_bonded(tmp_path):
     a, b = solve(ft, mesh=sm), solve(user, mesh=um)
     assert b.reaction == pytest.approx(a.reaction, rel=1e-9)
     assert b.peak == pytest.approx(a.peak, rel=1e-9)
-
-
-def _gmsh_polygon(path, pts, groups, h=0.5):
-    """A 2D polygon skin; `groups`: {name: [edge indices]} (edge k runs from pts[k] to pts[k+1])."""
-    import gmsh
-
-    gmsh.initialize(interruptible=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        occ = gmsh.model.occ
-        p = [occ.addPoint(x, y, 0) for x, y in pts]
-        lines = [occ.addLine(p[k], p[(k + 1) % len(p)]) for k in range(len(p))]
-        occ.addPlaneSurface([occ.addCurveLoop(lines)])
-        occ.synchronize()
-        for name, edges in groups.items():
-            gmsh.model.addPhysicalGroup(1, [lines[k] for k in edges], name=name)
-        gmsh.model.addPhysicalGroup(2, [1], name="skin")
-        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-        gmsh.model.mesh.generate(2)
-        gmsh.write(str(path))
-    finally:
-        gmsh.finalize()
-    return path
 
 
 def test_a_skin_placed_where_the_indenters_do_not_press_it_as_meant_is_refused(tmp_path):
