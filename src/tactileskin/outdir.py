@@ -125,14 +125,12 @@ def claimed(folder, kind: str, *, what: str = "out") -> Iterator[Path]:
 def run_lock(folder: Path, what: str = "out") -> Iterator[None]:
     """Hold the folder's RUN_LOCK for a run writing into it; OutputError at once if another
     process holds it (a second run into one folder would replace the first's files)."""
-    lock = folder_lock(folder, RUN_LOCK, folder, blocking=False)
-    try:
-        lock.__enter__()
-    except BlockingIOError:
-        raise OutputError(folder, "another tactileskin run is writing into this folder now; wait for it "
-                                  f"to finish, or give {what} another folder") from None
     with contextlib.ExitStack() as stack:
-        stack.push(lock)
+        try:  # only the taking of the lock: a BlockingIOError of the body is the body's
+            stack.enter_context(folder_lock(folder, RUN_LOCK, folder, blocking=False))
+        except BlockingIOError:
+            raise OutputError(folder, "another tactileskin run is writing into this folder now; wait for it "
+                                      f"to finish, or give {what} another folder") from None
         yield
 
 
