@@ -365,6 +365,64 @@ def test_a_second_run_into_a_folder_in_use_is_refused_and_changes_nothing(tmp_pa
     assert main(["solve", *CHEAP, "-t", "2", "--out", str(d)]) == 0   # released: a run may go on
 
 
+def _in_the_lock_window(monkeypatch, then):
+    """Run `then` once, between a taker's open of a lock file and its flock: the instant another
+    run removes the file (deterministic, not timed)."""
+    import fcntl
+
+    real = fcntl.flock
+
+    def flock(fd, op):
+        monkeypatch.setattr(fcntl, "flock", real)
+        then()
+        return real(fd, op)
+
+    monkeypatch.setattr(fcntl, "flock", flock)
+
+
+def test_a_run_locking_the_lock_file_a_failed_run_removed_does_not_go_on(tmp_path, monkeypatch):
+    # run A created `out` and failed: it removed the folder, its lock file too, still holding the
+    # lock; run B had opened that file and took the lock once A let go: B went on, holding a lock
+    # on a removed file, into a folder that no longer exists
+    out = tmp_path / "out"
+    a = outdir.claimed(out, "solve")
+    a.__enter__()
+    _in_the_lock_window(monkeypatch, lambda: a.__exit__(RuntimeError, RuntimeError("run A failed"), None))
+    with pytest.raises(fileio.OutputError):
+        with outdir.run_lock(out):
+            pass
+    assert not out.exists()  # A's cleanup stands; B wrote nothing
+
+
+def test_a_run_lock_taken_on_a_removed_lock_file_is_taken_again(tmp_path, monkeypatch):
+    # the folder stays, the lock file goes in B's window: B must hold the file a third run opens,
+    # else both "hold" the folder (the third created a new lock file and locked it)
+    d = tmp_path / "d"
+    d.mkdir()
+    _in_the_lock_window(monkeypatch, lambda: (d / outdir.RUN_LOCK).unlink())
+    with outdir.run_lock(d):
+        assert (d / outdir.RUN_LOCK).is_file()
+        with pytest.raises(fileio.OutputError, match="another tactileskin run"):
+            with outdir.run_lock(d):
+                pass
+
+
+def test_a_case_lock_taken_on_a_removed_lock_file_is_taken_again(tmp_path, monkeypatch):
+    # outdir's cleanup of a failed sweep's new folder removes its free case locks: a sweep that
+    # opened one just before must not compute the case beside a third that locked the new file
+    from tactileskin.cache import ResultCache
+
+    rc = ResultCache(tmp_path / "cache")
+    rc.root.mkdir()
+    (rc.root / "k.lock").touch()
+    _in_the_lock_window(monkeypatch, lambda: (rc.root / "k.lock").unlink())
+    lock = rc.lock("k", blocking=True)
+    try:
+        assert rc.lock("k", blocking=False) is None
+    finally:
+        lock.release()
+
+
 def test_the_api_sweep_refuses_a_folder_in_use(tmp_path, counted_cases):
     from tactileskin import api
     from tactileskin.fileio import OutputError

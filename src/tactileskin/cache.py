@@ -311,15 +311,20 @@ class ResultCache:
         path = self.root / f"{key}.lock"
         if fcntl is None:
             return CaseLock(path, None)
-        fileio.make_dirs(self.root)
-        with fileio.os_errors(path):
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, fileio.file_mode())
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
-        except BlockingIOError:
+        while True:
+            fileio.make_dirs(self.root)
+            with fileio.os_errors(path):
+                fd = os.open(path, os.O_RDWR | os.O_CREAT, fileio.file_mode())
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
+                if fileio.is_open_file(fd, path):
+                    return CaseLock(path, fd)
+            except BlockingIOError:
+                os.close(fd)
+                return None
+            except BaseException:
+                os.close(fd)
+                raise
+            # removed while we waited (outdir's cleanup of a failed sweep's new folder): a lock
+            # on the removed file would not keep a third run off the case
             os.close(fd)
-            return None
-        except BaseException:
-            os.close(fd)
-            raise
-        return CaseLock(path, fd)

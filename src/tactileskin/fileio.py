@@ -229,6 +229,20 @@ def atomic_write_json(path, obj) -> Path:
     return atomic_write_text(path, text + "\n")
 
 
+def is_open_file(fd: int, path) -> bool:
+    """Whether `path` still names the file open as `fd`. A lock taken on a lock file that was
+    removed (a failed run removing its new folder) meanwhile locks nothing the next run opens:
+    the taker retries on the path's file. False only if the path is gone or another file."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return False
+    except OSError:  # cannot tell: as before the check
+        return True
+    f = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (f.st_dev, f.st_ino)
+
+
 def file_sha256(path: Path) -> str:
     """The hex SHA-256 of a file's bytes: the digests of the record of written files
     (ownership) and of the cache's entries."""

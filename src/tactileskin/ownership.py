@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-from tactileskin.fileio import OutputError, atomic_write_json, file_sha256, os_errors
+from tactileskin.fileio import OutputError, atomic_write_json, file_sha256, is_open_file, os_errors
 
 log = logging.getLogger(__name__)
 
@@ -101,23 +101,32 @@ def folder_lock(folder: Path, name: str, about: Path, blocking: bool = True) -> 
     except ImportError:  # pragma: no cover - not POSIX
         yield
         return
-    # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
-    # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
-    with os_errors(about, own_name=False):
-        try:
-            fd = os.open(folder / name, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
-        except PermissionError:
-            fd = os.open(folder / name, os.O_RDONLY | os.O_CREAT, 0o666)
-    try:
+    while True:
+        # opened for writing (NFS emulates flock by byte-range locks, which need it), else read-only:
+        # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
+        with os_errors(about, own_name=False):
+            try:
+                fd = os.open(folder / name, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+            except PermissionError:
+                fd = os.open(folder / name, os.O_RDONLY | os.O_CREAT, 0o666)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
         except BlockingIOError:
+            os.close(fd)
             raise
         except OSError as e:
             if e.errno not in (errno.ENOLCK, errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.EBADF):
+                os.close(fd)
                 with os_errors(about, own_name=False):
                     raise
             log.warning("no file locks in %s (%s): %s is written without one", folder, e.strerror, about.name)
+            break
+        if is_open_file(fd, folder / name):
+            break
+        # the holder removed the lock file before releasing it (a failed run removing its new
+        # folder): a lock on the removed file excludes no one who opens the path now
+        os.close(fd)
+    try:
         yield
     finally:
         os.close(fd)  # releases the lock
