@@ -154,3 +154,24 @@ def test_a_failed_analyze_leaves_no_folder(tmp_path, capsys, scan, monkeypatch):
     out = tmp_path / "film"
     assert main(["film", "analyze", str(scan), "--out", str(out)]) == 2
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == [scan.name]
+
+
+def test_film_profile_write_refuses_a_folder_another_run_is_writing_into(tmp_path, scan):
+    # only the CLI held the run lock: the API's write went into a folder a CLI run was writing
+    import fcntl
+
+    from tactileskin.film import analyze_scan
+
+    fp = analyze_scan(scan)
+    d = tmp_path / "film"
+    fp.write(d)
+    before = {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()}
+    fd = os.open(d / outdir.RUN_LOCK, os.O_RDWR | os.O_CREAT, 0o666)  # held as another process's run holds it
+    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    try:
+        with pytest.raises(fileio.OutputError, match="another tactileskin run"):
+            fp.write(d)
+    finally:
+        os.close(fd)
+    assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
+    assert sorted(fp.write(d)) == ["map", "profile", "summary"]  # released: written

@@ -101,7 +101,7 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
     fp = analyze_scan(scan, cal, px_per_mm=px_per_mm, box_px=box_px or None,
                       box_mm=box_mm or None, axis=axis, centre=centre)
     with claimed_output(out, "film-analyze"):  # a failed write leaves no folder of a marker alone
-        fp.write(out, cmap=cmap)
+        fp.write_owned(out, cmap=cmap)  # the lock is held: fp.write would take it again
     x0, y0, x1, y1 = fp.box_px
     how = ("found automatically (the activated strip; --box-px/--box-mm to override)"
            if fp.region.get("method") == "auto" else f"given ({fp.region.get('method')})")

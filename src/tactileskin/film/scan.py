@@ -199,8 +199,9 @@ class FilmProfile:
     def write(self, out, *, cmap: str = "viridis") -> dict[str, Path]:
         """Write profile.csv, summary.json and pressure_map.png into ``out``.
 
-        ``out`` must be new, empty or a `film analyze` folder (outdir.claim_dir). The files
-        are staged and moved in together (staging.staged_files): a failed write leaves the
+        ``out`` must be new, empty or a `film analyze` folder (outdir.claim_dir), and no other
+        run may be writing into it (its run lock; OutputError, the folder left as it is). The
+        files are staged and moved in together (staging.staged_files): a failed write leaves the
         folder as it was. A comparison left there by an earlier `film compare` is removed: it
         describes the previous profile.
         """
@@ -208,6 +209,16 @@ class FilmProfile:
 
         plots._check_cmap(cmap)
         out = outdir.claim_dir(out, "film-analyze")
+        with outdir.run_lock(out, "out"):
+            return self.write_owned(out, cmap=cmap)
+
+    def write_owned(self, out, *, cmap: str = "viridis") -> dict[str, Path]:
+        """`write` into a folder the caller has claimed and holds the run lock of (the CLI's
+        outdir.claimed): the lock is not taken again, as a second flock would be refused."""
+        from tactileskin.film import plots
+
+        plots._check_cmap(cmap)
+        out = Path(out)
         names = {"profile": "profile.csv", "summary": "summary.json", "map": "pressure_map.png"}
         lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
         for k in range(self.s_mm.size):
