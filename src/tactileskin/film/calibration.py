@@ -122,6 +122,13 @@ class Calibration:
 
     def pressure(self, gs) -> np.ndarray:
         """Pressure (``unit``) for grayscale values (any shape); see module docstring."""
+        p = self.reading(gs)
+        return np.where(p < self.p_range[0], 0.0, p)  # below the threshold: unactivated
+
+    def reading(self, gs) -> np.ndarray:
+        """``pressure`` before its low rule: lighter than the threshold the tangent goes on
+        below it (negative). A mean of these across a strip, set to 0 below the threshold
+        after averaging, keeps the scan noise about the threshold zero-mean (film.scan)."""
         gs = np.asarray(gs, float)
         if not np.all(np.isfinite(gs)):
             raise ParameterError("grayscale", "non-finite values", "finite numbers in [0, 255]")
@@ -134,17 +141,22 @@ class Calibration:
         slope = float((self._f(g_ext + inward) - self._f(g_ext)) / inward)
         beyond = (gs < g0) if g_ext == g0 else (gs > g1)
         p = np.where(beyond, float(self._f(g_ext)) + slope * (gs - g_ext), p)
-        lo, hi = self.p_range
-        return np.where(p < lo, 0.0, np.minimum(p, hi))  # below the threshold: unactivated
+        return np.minimum(p, self.p_range[1])
 
     def band(self, gs) -> tuple[np.ndarray, np.ndarray] | None:
         """90 % confidence band of the calibration at gs (clipped like ``pressure``), or None."""
+        hw = self.halfwidth(gs)
+        return None if hw is None else self.band_at(self.pressure(gs), hw)
+
+    def halfwidth(self, gs) -> np.ndarray | None:
+        """Half-width of the 90 % band at gs (in the calibrated range), or None (no covariance)."""
         if self.cov is None or not self.dof:
             return None
-        gs = np.asarray(gs, float)
-        hw = models.band_halfwidth(self.model, self.params, self.cov, self.dof,
-                                   np.clip(gs, *self.gs_range))
-        p = self.pressure(gs)
+        return models.band_halfwidth(self.model, self.params, self.cov, self.dof,
+                                     np.clip(np.asarray(gs, float), *self.gs_range))
+
+    def band_at(self, p, hw) -> tuple[np.ndarray, np.ndarray]:
+        """The band p -/+ hw of pressures p (as ``pressure`` gives them), clipped like them."""
         floor = np.where(p > 0, self.p_range[0], 0.0)  # unactivated film (0): no threshold under it
         return np.clip(p - hw, floor, self.p_range[1]), np.clip(p + hw, floor, self.p_range[1])
 
