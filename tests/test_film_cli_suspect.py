@@ -83,3 +83,17 @@ def test_the_figures_of_a_suspect_film_and_comparison_say_so(tmp_path, monkeypat
     _sim_dir(tmp_path / "sim")
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "cmp")]) == 3
     assert "SUSPECT: 1 warning in comparison.json" in titles["overlay.png"]
+
+
+def test_an_inverted_scan_is_said_to_look_inverted(tmp_path, capsys):
+    # white on black: its dark background read as the profile, and the reasons given were
+    # 'still at 100 % of its peak at the region's ends: widen the region' (or 'try --axis y'
+    # on a stained background), which no region or axis mends
+    img = render_scan(gaussian_profile(0.4, 1.0), paper_eq8(), background_gs=245, noise_gs=1, seed=3)
+    scan = save_scan(255 - img, tmp_path / "inverted.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
+    assert "1 reason(s)" in capsys.readouterr().err
+    warnings = json.loads((tmp_path / "film" / "summary.json").read_text())["warnings"]
+    assert len(warnings) == 1 and "looks inverted" in warnings[0] and "widen the region" not in warnings[0]
+    # the same scan the right way round is not
+    assert main(["film", "analyze", str(save_scan(img, tmp_path / "scan.png")), "--out", str(tmp_path / "ok")]) == 0

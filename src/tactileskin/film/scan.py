@@ -42,6 +42,10 @@ PEAK_WINDOW = 0.8        # parabola fitted to the samples >= 80 % of the maximum
 # activated columns) is above AXIS_CV and AXIS_RATIO x that of the strip found along the other
 # axis runs the other way (a transposed scan read along x: 18 % against 2.6 %, peak 17 % low)
 AXIS_CV, AXIS_RATIO = 0.1, 2.0
+# an inverted scan (a light strip on dark film): the region's ends and the image's edges read
+# alike (within this share) as its highest pressure, and the region dips below that by more
+# (a 0.05 MPa/mm press inverted dipped 3 %; 8-bit noise moves a column mean by < 0.5 %)
+INVERTED = 0.02
 ANALYZE_NAMES = ("profile.csv", "summary.json", "pressure_map.png")
 COMPARE_NAMES = ("comparison.json", "overlay.png")
 
@@ -299,6 +303,31 @@ def calibration_coverage(cal: Calibration, gray: np.ndarray, pmap: np.ndarray) -
             "extrapolated_fraction": float(np.mean(past_lo & (pmap > lo)))}
 
 
+def _looks_inverted(cal: Calibration, gray: np.ndarray, pmaps) -> str:
+    """The warning for a scan whose surroundings read as pressure and whose strip reads less
+    (white on black, or unpressed film that is not white), else "", judged on each pressure map
+    of `pmaps` (the region's; found automatically, also the whole image's: the region found
+    may be a band of the background). Such a scan read its dark background as the profile, and
+    the reason given was 'widen the region' or 'try --axis y'."""
+    edges = np.concatenate([gray[0], gray[-1], gray[:, 0], gray[:, -1]])
+    g = float(np.median(edges))  # a real scan's edges: white film or the scanner's lid
+    p_edge = float(cal.pressure(g))
+    if p_edge <= 0:
+        return ""
+    for m in (m for pm in pmaps for m in (pm.mean(axis=0), pm.mean(axis=1))):  # along, across
+        top = float(m.max())
+        # the region's ends read as the surroundings, nothing in it darker, and a lighter dip
+        if (min(m[0], m[-1]) >= (1 - INVERTED) * top and top <= (1 + INVERTED) * p_edge
+                and float(m.min()) < (1 - INVERTED) * top):
+            return (f"the scan looks inverted (white on black) or its unpressed film is not white: the image's "
+                    f"edges (median GS {g:.0f}) are darker than the activation threshold (GS "
+                    f"{cal.threshold_gs:.4g}) and read as pressure, the region is lighter inside than at its "
+                    "ends; the numbers describe the background, not the press. No option inverts a scan "
+                    "(0 = black): save it as dark film on white, or give --box-px/--box-mm on the film if only "
+                    "its surroundings are dark")
+    return ""
+
+
 def _variation(pmap: np.ndarray) -> float:
     """Pressure-weighted mean over the columns of the std / mean across the rows (axis 0), over
     the columns whose mean is at least 10 % of the largest."""
@@ -421,8 +450,12 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                         f"highest-pressure press (GS {g_end:.4g}): read as {p_end:.4g} {cal.unit}, the calibrated "
                         f"maximum, below the activation range's top ({hi:g} {cal.unit}); the pressure there "
                         "is a lower bound (calibrate to higher pressures)")
+    inverted = _looks_inverted(cal, gray, [pmap] + ([p_all] if region_info["method"] == "auto" else []))
+    if inverted:
+        warnings.append(inverted)
     across = _variation(pmap)
-    wrong_axis = across_other is not None and across > AXIS_CV and across > AXIS_RATIO * across_other
+    wrong_axis = (not inverted and across_other is not None and across > AXIS_CV
+                  and across > AXIS_RATIO * across_other)
     if wrong_axis:
         other = "y" if axis == "x" else "x"
         warnings.append(f"the pressure varies across the strip by {across:.0%} of its mean, across a strip along "
@@ -440,7 +473,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         origin = centre
     s = x_mm - origin
     sh, ph, asym = fold_profile(s, prof)
-    if asym > ASYMMETRY and not wrong_axis:  # a wrong axis is the root cause, said already
+    if asym > ASYMMETRY and not wrong_axis and not inverted:  # the root cause, said already
         hint = ""
         if centre != "midspan":
             other = fold_profile(x_mm - _midspan_position(x_mm, prof), prof)[2]
@@ -455,7 +488,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     # a region the user put inside the pressed area (every column within 10 % of the peak) is read
     # as given: it has no profile to cut (the span is the region, plainly); summary.json cut_ends
     plateau = region_info["method"] != "auto" and float(np.min(prof)) >= PLATEAU * float(np.max(prof))
-    if ends and not plateau:
+    if ends and not plateau and not inverted:  # 'widen the region' would not help an inverted scan
         warnings.append(f"the profile is still at {max(prof[0], prof[-1]) / np.max(prof):.0%} of its peak at the "
                         f"region's {' and '.join(ends)} ({'x' if axis == 'x' else 'y'} "
                         f"{x_mm[0] - 0.5 / px_per_mm:.4g}-{x_mm[-1] + 0.5 / px_per_mm:.4g} mm): the span and area "
@@ -466,7 +499,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     slope, rows = _tilt(pmap)
     smear = abs(slope) * rows / px_per_mm
     span_two = float(span(x_mm, prof))
-    if not wrong_axis and span_two > 0 and smear > TILT * span_two:
+    if not wrong_axis and not inverted and span_two > 0 and smear > TILT * span_two:
         angle = np.degrees(np.arctan(abs(slope)))
         warnings.append(f"the strip is tilted on the scan by {angle:.1f} degrees: its centre moves {smear:.3g} mm "
                         f"along it across the region's width, {smear / span_two:.0%} of the span, so the mean across "
@@ -475,7 +508,8 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         log.warning("%s", warnings[-1])
     base = float(min(prof[0], prof[-1]))
     area = float(auc(x_mm, prof))
-    if not ends and not plateau and base > 0 and area > 0 and base * (x_mm[-1] - x_mm[0]) > BASELINE * area:
+    if (not ends and not plateau and not inverted and base > 0 and area > 0
+            and base * (x_mm[-1] - x_mm[0]) > BASELINE * area):
         warnings.append(f"the profile does not return to zero: both ends of the region read >= {base:.4g} {cal.unit} "
                         f"({base / np.max(prof):.1%} of the peak), {base * (x_mm[-1] - x_mm[0]) / area:.0%} of the "
                         "area over its length: the unpressed film reads as pressure (scanned darker than the "
