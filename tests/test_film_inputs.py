@@ -48,6 +48,20 @@ def test_a_box_in_mm_outside_the_image_states_the_range_in_mm(tmp_path, capsys, 
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("box, needles", [
+    # ordered as given, but under a pixel: it said "(x1 <= x0 or y1 <= y0)"
+    (["0", "0", "0.01", "0.01"], ["box_mm", "x1 - x0 and y1 - y0 >= 0.125 mm", "--box-mm is rounded to pixel edges",
+                                  "x 0-0, y 0-0 px"]),
+    # a pixel wide but under 3 along the strip: it said "region length=2 ... >= 3 px", no option named
+    (["5", "2", "5.3", "7"], ["box_mm", ">= 0.375 mm along the strip (x)", "--box-mm", "2 px along it"]),
+])
+def test_a_box_in_mm_too_small_for_its_pixels_says_how_small_it_may_be(tmp_path, capsys, scan, box, needles):
+    err = _fails(capsys, ["film", "analyze", str(scan), "--px-per-mm", "8", "--box-mm", *box,
+                          "--out", str(tmp_path / "o")], *needles)
+    assert "x1 <= x0" not in err and "region length" not in err
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize("opts, needle", [
     (["--px-per-mm", "inf"], "px_per_mm"),
     (["--px-per-mm", "nan"], "px_per_mm"),

@@ -90,8 +90,14 @@ def select_region(gray: np.ndarray, *, box_px=None, box_mm=None, px_per_mm: floa
         why = ("x1 <= x0 or y1 <= y0" if (x1 <= x0 or y1 <= y0) else "region outside the image")
         if box_mm is not None:  # the range in the option's unit: the image's size in mm
             wm, hm = (f"{v / px_per_mm:.4g}" for v in (w, h))
-            raise ParameterError(name, tuple(box_mm), f"0 <= x0 < x1 <= {wm}, 0 <= y0 < y1 <= {hm} mm "
-                                 f"(the image is {wm} x {hm} mm: {w} x {h} px at {px_per_mm:g} px/mm)", hint=why)
+            given = tuple(float(v) for v in box_mm)
+            if given[0] < given[2] and given[1] < given[3] and (x1 <= x0 or y1 <= y0):
+                # ordered as asked, but under a pixel: 'x1 <= x0' named what the user did not give
+                why = (f"--box-mm is rounded to pixel edges ({1 / px_per_mm:.4g} mm at {px_per_mm:g} px/mm): "
+                       f"this box is x {x0}-{x1}, y {y0}-{y1} px, empty")
+            raise ParameterError(name, tuple(box_mm), f"0 <= x0 < x1 <= {wm}, 0 <= y0 < y1 <= {hm} mm, "
+                                 f"x1 - x0 and y1 - y0 >= {1 / px_per_mm:.4g} mm (a pixel; the image is {wm} x "
+                                 f"{hm} mm: {w} x {h} px at {px_per_mm:g} px/mm)", hint=why)
         raise ParameterError(name, tuple(box_px), f"0 <= x0 < x1 <= {w}, 0 <= y0 < y1 <= {h} px "
                              f"(the image is {w} x {h} px)", hint=why)
     return gray[y0:y1, x0:x1], (x0, y0, x1, y1)
@@ -420,6 +426,13 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     if axis == "y":
         region = region.T
     if region.shape[1] < 3:
+        if region_info["method"] == "box_mm":  # the option's unit, not the 'region length' it came to
+            raise ParameterError("box_mm", tuple(region_info["given"]), f"a box >= {3 / px_per_mm:.4g} mm along the "
+                                 f"strip ({axis}): 3 px at {px_per_mm:g} px/mm",
+                                 hint=f"--box-mm is rounded to pixel edges: this box is {region.shape[1]} px along it")
+        if region_info["method"] == "box_px":
+            raise ParameterError("box_px", tuple(int(v) for v in region_info["given"]),
+                                 f"a box >= 3 px along the strip ({axis})")
         raise ParameterError("region length", region.shape[1], ">= 3 px along the strip")
 
     pmap = cal.pressure(region)
