@@ -137,6 +137,31 @@ def test_no_bonded_group_wrong_units_and_mixed_cells(tmp_path):
         Scene(skin="file", skin_file=str(mixed))
 
 
+def test_a_bonded_group_inside_the_mesh_names_skin_bonded_and_the_file(tmp_path):
+    """Two layers glued along y = 1, the glue line named as the bonded group: it lies between
+    cells, not on the skin's boundary. The error named neither the parameter nor the file
+    ("boundary 'bone_interface': a gmsh facet is not a boundary facet of the mesh")."""
+    import gmsh
+
+    path = tmp_path / "layers.msh"
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        occ.fragment([(2, occ.addRectangle(-2, 0, 0, 4, 1))], [(2, occ.addRectangle(-2, 1, 0, 4, 1))])
+        occ.synchronize()
+        glue = [c for _, c in gmsh.model.getEntities(1) if abs(occ.getCenterOfMass(1, c)[1] - 1.0) < 1e-9]
+        gmsh.model.addPhysicalGroup(1, glue, name="glue")
+        gmsh.model.addPhysicalGroup(2, [e for _, e in gmsh.model.getEntities(2)], name="skin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    with pytest.raises(ParameterError, match=r"skin_bonded='glue'.*layers\.msh.*'glue' lies inside the mesh"):
+        Scene(skin="file", skin_file=str(path), skin_bonded="glue")
+
+
 def test_cache_key_follows_bytes_not_path(tmp_path):
     a = _gmsh_block(tmp_path / "a.msh", dim=2)
     b = tmp_path / "sub" / "b.msh"

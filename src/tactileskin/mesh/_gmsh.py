@@ -33,6 +33,15 @@ FACET_TYPE = {(2, 1): LINE2, (2, 2): LINE3, (3, 1): TRI3, (3, 2): TRI6}
 _TET10_GMSH_TO_SKFEM = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 8])
 
 
+class InnerFacetError(MeshError):
+    """A named group has a facet between two cells (not on the mesh's boundary); `name` and
+    `entity` (the gmsh entity tag) let a caller name the user's group (mesh.skinfile)."""
+
+    def __init__(self, name: str, entity: int):
+        self.name, self.entity = name, int(entity)
+        super().__init__(f"boundary '{name}': a gmsh facet is not a boundary facet of the mesh")
+
+
 @contextlib.contextmanager
 def session(name: str, params: dict):
     """A fresh gmsh model; gmsh errors become MeshError naming `params`."""
@@ -158,7 +167,7 @@ def to_skfem(gmsh, dim: int, order: int, groups: dict[str, list[int]], cell: str
                 for key in np.sort(verts, axis=1).tolist():
                     f = fkeys.get(tuple(key))
                     if f is None:
-                        raise MeshError(f"boundary '{name}': a gmsh facet is not a boundary facet of the mesh")
+                        raise InnerFacetError(name, ent)
                     found.append(f)
         if not found:
             raise MeshError(f"boundary '{name}' has no facets (gmsh entities {ents})")

@@ -152,7 +152,17 @@ def load_msh(path, *, bonded=None, outer=None, order: int | None = None):
         ents: dict[str, list[int]] = {}
         for name, tags in groups.items():
             ents.setdefault(rename.get(name, name), []).extend(tags)
-        mesh, boundaries = _gmsh.to_skfem(gmsh, dim, order, ents)
+        try:
+            mesh, boundaries = _gmsh.to_skfem(gmsh, dim, order, ents)
+        except _gmsh.InnerFacetError as e:
+            # the message named the internal name ('bone_interface'), not the user's group or file
+            group = next((n for n, tags in groups.items() if rename.get(n, n) == e.name and e.entity in tags),
+                         e.name)
+            field, value = (("skin_bonded", bonded or group) if group in bnames else
+                            ("skin_outer", outer or group) if group in onames else ("skin_file", str(path)))
+            raise ParameterError(field, value, f"a group on the boundary of {path.name}'s mesh",
+                                 f"its group {group!r} lies inside the mesh, between cells, not on its "
+                                 "outer boundary: name a surface of the skin") from None
     z_sym = dim == 3 and SYMMETRY_Z in boundaries
     if dim == 2:
         boundaries.pop(SYMMETRY_Z, None)
