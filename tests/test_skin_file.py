@@ -224,6 +224,25 @@ def test_open_step_is_refused(tmp_path):
         Scene(skin="file", skin_file=str(path))
 
 
+@pytest.mark.parametrize("shape", ["cap", "crown"])
+def test_a_step_skins_top_is_its_point_on_the_axis(tmp_path, shape):
+    """A sphere cap (radius 6) and a crown (a cylinder along z) 2 mm thick on a flat base: the
+    top point, where indenters start and s = x - x_top is measured from, is the surface's point
+    on the axis x = z = 0. It was the refined highest node of the coarse mesh: the cap's 0.34 mm
+    off the axis (t read 1.990), the crown's at z = -3.2 along its top line."""
+    import build123d as bd
+
+    from tactileskin.skins.file import geometry
+
+    round_ = bd.Sphere(6.0) if shape == "cap" else bd.Cylinder(6.0, 8.0)  # the cylinder's axis: z
+    base = bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    path = tmp_path / f"{shape}.step"
+    bd.export_step(bd.Pos(0, -4.0, 0) * round_ & base, str(path))
+    geo = geometry(Scene(skin="file", skin_file=str(path)))
+    assert geo.top_point == (pytest.approx(0.0, abs=1e-9), pytest.approx(2.0, abs=1e-9), pytest.approx(0.0, abs=1e-9))
+    assert geo.thickness == pytest.approx(2.0, abs=1e-9)
+
+
 def test_step_block_solves_like_the_pad_block(tmp_path):
     """A STEP block (full model, no symmetry) bonded at y = 0 by the default rule and pressed by
     a flat plate carries the force of the pad's block of the same size, solved as a quarter (the
