@@ -249,3 +249,7 @@ def test_a_file_skin_without_a_map_warns_once_per_solve(plane_strain, monkeypatc
                    for _ in range(3)]
     assert all(r.bone_map is None for r in results)
     assert sum("no bone map" in m for m in caplog.messages) == 1
+    # why, in the user's terms: not the internal ParameterError passed on ("... is invalid; valid: ...")
+    (msg,) = [m for m in caplog.messages if "no bone map" in m]
+    assert "bonded surface" in msg and "folds" in msg and "s = 0, z = 0 mm" in msg
+    assert "invalid" not in msg and "bone map point" not in msg

@@ -387,7 +387,13 @@ def make_result(model: Model, ev: Evaluation, stats, *, s_of_point=None, path: s
             # a user's bonded surface that is no graph over x (s = x - x_top folds where it
             # curves back: the fingertip written as a file): the result without its map
             if not getattr(model, "_no_map_warned", False):  # once per solve, not per load segment
-                logger.warning("no bone map for this skin file (%s); the profile is on z = %g", e, plane_z)
+                # in the user's terms, not surface_grid's ParameterError on an internal grid point
+                at = e.value if isinstance(e.value, tuple) and len(e.value) == 2 else None
+                logger.warning("no bone map for this skin file: its bonded surface is not one sheet over x and z "
+                               "(s = x - x_top folds where the surface curves back under itself, as the "
+                               "fingertip's does, or the surface has a gap%s); the profile is on z = %g mm only",
+                               "" if at is None else f": no point of it at s = {at[0]:.3g}, z = {at[1]:.3g} mm",
+                               plane_z)
                 model._no_map_warned = True
             grid = None
         if grid is not None:
