@@ -160,7 +160,8 @@ def test_a_text_without_a_raised_dot_is_refused_by_the_scene_not_by_the_solve(tm
 @pytest.mark.parametrize("fields, words", [
     (dict(skin="pad", pad_width=10.0, braille_text="abcd"), ["|x| <= 5 mm", "pad_width >= 22.4 mm"]),
     (dict(skin="pad", pad_length=1.0, braille_text="l"), ["|z| <= 0.5 mm", "pad_length >= 6.12 mm"]),
-    (dict(braille_text="abc"), ["fingertip skin's top (|x| <= 8 mm", "x -8.09 to 8.09 mm"])])
+    (dict(braille_text="abc"), ["fingertip skin's top (|x| <= 8 mm", "x -8.09 to 8.09 mm"]),
+    (dict(braille_text="a b"), ["travel 0.6 t = 0.6 mm", "|x| = 6.2 mm first touch it after 1.81 mm"])])
 def test_a_text_past_the_skins_top_is_refused_naming_the_room_it_needs(fields, words):
     # abcd on a 10 mm pad solved 'ok': its outer dots pressed nothing, the result a shorter text's
     from tactileskin.errors import ParameterError
@@ -172,3 +173,28 @@ def test_a_text_past_the_skins_top_is_refused_naming_the_room_it_needs(fields, w
     fits = {**fields, "braille_text": fields["braille_text"][:1]} if "pad_length" not in fields else \
         {**fields, "pad_length": 6.2}
     Scene(dim=3, indenter="braille", thickness=1.0, **fits)   # the text that fits is taken
+
+
+def test_a_fingertip_text_whose_outer_dots_never_touch_is_refused():
+    """The fingertip's top falls away inside its half width 8 mm: 'abc' (dot bases to +-8.09 mm)
+    was refused, but 'a b' (a space cell: dots at x = +-6.2 mm, where the surface lies 2.6 mm
+    below the top) was taken, and only its base plate pressed (it touches at the dot height
+    0.48 mm). Each dot's first touch is read on the contour: refused by the scene where no
+    depth (<= 0.6 t) reaches it, by the solve where the scene's depth does not."""
+    from tactileskin.geometry.indenters import BrailleIndenter, first_contact_travel, require_contact
+    from tactileskin.scene import Scene
+
+    for t in (1.0, 2.0):
+        for dim in (2, 3):
+            with pytest.raises(ParameterError, match=r"braille_text='a b'.*travel 0.6 t.*6.2 mm first touch it after 1.81"):
+                Scene(thickness=t, dim=dim, indenter="braille", braille_text="a b")
+    far = Scene(thickness=5.0, indenter="braille", braille_text="a b")      # 3 mm of travel reaches the dots
+    with pytest.raises(ParameterError, match=r"depth=1.0.*> 1.81 mm.*would press nothing") as e:
+        require_contact(far)                                                 # but not its 1 mm depth
+    assert e.value.name == "depth"
+    require_contact(far.replace(depth=2.0))
+    # the dots' first touch is the indenter's own: 'ab' (dots at +-3.1 mm only) touches with them
+    ab = Scene(thickness=1.0, indenter="braille", braille_text="ab")
+    x, touch = BrailleIndenter.dot_touch(ab, get_standard(ab.braille_standard))
+    assert x.tolist() == [3.1] and touch[0] == pytest.approx(first_contact_travel(ab), abs=1e-3)
+    require_contact(ab.replace(depth=0.55))

@@ -95,14 +95,15 @@ def test_two_depth_sweep_writes_two_rows_profiles_and_bars(tmp_path, capsys, mon
 def test_profiles_csv_quotes_a_case_id_with_a_comma(tmp_path, monkeypatch):
     """A Braille text with a comma (',a,') puts one in the case id: profiles.csv wrote it
     unquoted, so every row read as 4 fields under 3 columns (case 't2-silicone-braille[', s_mm
-    'a', pressure_mpa ']-2d'); results.csv and sensors.csv quote it."""
+    'a', pressure_mpa ']-2d'); results.csv and sensors.csv quote it. A lone comma: the commas of
+    ',a,' lie at x = +-6.2 mm, where the fingertip falls away past any depth at t = 2 (refused)."""
     out = tmp_path / "out"
     monkeypatch.setattr(figures, "_save", lambda fig, o, stem: [])
-    assert main(["sweep", "--out", str(out), "-t", "2", "-m", "silicone", "-i", "braille", "--braille-text", ",a,",
+    assert main(["sweep", "--out", str(out), "-t", "2", "-m", "silicone", "-i", "braille", "--braille-text", ",",
                  "--quality", "preview", "--serial", "--no-render"]) == 0
     with open(out / "results.csv", newline="") as fh:
         (row,) = list(csv.DictReader(fh))
-    assert row["case"] == "t2-silicone-braille[,a,]-2d"
+    assert row["case"] == "t2-silicone-braille[,]-2d"
     with open(out / "profiles.csv", newline="") as fh:
         prof = list(csv.DictReader(fh))
     assert len(prof) >= 2 and all(None not in p and p["case"] == row["case"] for p in prof)

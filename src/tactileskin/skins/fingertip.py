@@ -17,6 +17,7 @@ class FingertipSkin(Skin):
     fixed_boundaries = ("bone_interface", "nail_edge")
     profile_ends_free = False  # the bone runs on into the bonded nail
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
+    top_curved = True
 
     @classmethod
     def model(cls, scene):

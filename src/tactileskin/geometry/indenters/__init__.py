@@ -108,12 +108,32 @@ def first_contact_travel(scene, samples: int = 4000) -> float:
     return max(0.0, float(np.min(g)))
 
 
+def _require_every_dot(scene) -> None:
+    """ParameterError naming the depth if a Braille text's dots on a curved top (the fingertip)
+    do not all touch it within the travel: the base plate touches at the dot height (0.48 mm)
+    wherever the dots are, and a text whose outer dots press nothing read as a shorter text's
+    ('a b' at t = 5, depth 1: its dots touch after 1.81 mm, the plate pressed alone)."""
+    if not (scene.indenter_kind.name == "braille" and scene.braille_text and scene.skin_kind.top_curved):
+        return
+    from tactileskin.geometry import braille as _braille
+
+    x, touch = BrailleIndenter.dot_touch(scene, _braille.get_standard(scene.braille_standard))
+    far = touch >= scene.reach - 1e-9
+    if far.any():
+        need = float(touch.max())
+        raise ParameterError("depth", scene.indentation,
+                             f"> {need:.3g} mm for the text {scene.braille_text!r}, at most {scene.max_travel:g} mm",
+                             f"its dots at |x| = {x[far].min():.3g} mm first touch the skin after "
+                             f"{touch[far].min():.3g} mm and would press nothing; use a larger --depth or fewer cells")
+
+
 def require_contact(scene) -> None:
     """Raise ParameterError if the scene's indenter cannot touch the skin within its depth
     (a solve would return zero pressure everywhere: no contact)."""
     travel = first_contact_travel(scene)
     depth = scene.indentation
     if depth > travel + 1e-9:
+        _require_every_dot(scene)
         return
     label = get_kind(scene.indenter).label(scene)
     why = f"the {label} indenter first touches the skin after {travel:.3g} mm of travel"

@@ -79,6 +79,31 @@ class BrailleIndenter(Indenter):
             raise ParameterError("braille_text", scene.braille_text,
                                  f"a text whose dots lie on the {scene.skin} skin's top (|x| <= {xh:g} mm"
                                  + (f", |z| <= {zh:g} mm" if scene.dim == 3 else "") + ")", hint)
+        if scene.skin_kind.top_curved:
+            # inside the half width a curved top falls away: 'a b' (dots at x = +-6.2 mm, where
+            # the fingertip lies 2.6 mm below its top) passed, and only its base plate pressed
+            x, touch = cls.dot_touch(scene, std)
+            far = touch >= scene.max_travel - 1e-9
+            if far.any():
+                raise ParameterError("braille_text", scene.braille_text,
+                                     f"a text whose dots all reach the {scene.skin} skin within the deepest "
+                                     f"travel 0.6 t = {scene.max_travel:g} mm",
+                                     f"its dots at |x| = {x[far].min():.3g} mm first touch it after "
+                                     f"{touch[far].min():.3g} mm, where its top has fallen away; use fewer cells")
+
+    @classmethod
+    def dot_touch(cls, scene, std) -> tuple[np.ndarray, np.ndarray]:
+        """(|x|, travel) of each distinct |x| of the text's dots: the travel (mm, from the start
+        at the skin's top) after which a dot there first touches the skin's section contour, the
+        same in every z plane of a `top_curved` skin (undeformed: the skin pulled down around a
+        pressed dot only delays it). A dot's sphere (radius R, centre R above its tip) beyond
+        its cap lies inside the base plate, so the sphere's distance is the dot's."""
+        sec = scene.section()
+        pts = sec.outer_points(4000)
+        R = float(std.sphere_radius)
+        x = np.unique(np.round(np.abs(_braille.dot_centres(scene.braille_text, std)[:, 0]), 9))
+        gap = np.hypot(pts[None, :, 0] - x[:, None], pts[None, :, 1] - (sec.top + R)) - R
+        return x, np.maximum(gap.min(axis=1), 0.0)
 
     @classmethod
     def label(cls, scene) -> str:
