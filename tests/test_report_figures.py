@@ -232,3 +232,21 @@ def test_bar_legends_name_only_series_with_an_ok_case_and_no_case_ok_draws_no_fi
     md = build_report(sus, recs, [], [], [], 1.0, scenes=[r.scene for r in recs])
     assert "No figures: no case is ok" in md and "The figures show" not in md
     figures._plt().close("all")
+
+
+def test_profiles_figure_labels_s_by_what_it_is_on_the_figures_skins(tmp_path, monkeypatch):
+    # Fig. 10 said "distance along bone s" and "along the bone" for a pad too, which has no bone:
+    # its s is x on the board (skins.pad); the fingertip keeps the paper's label
+    s = np.linspace(0, 8, 81)
+    p = 0.3 * np.exp(-s ** 2)
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.profiles_figure([CaseRecord(Scene(thickness=2.0, skin="pad"), s, p, {}, Path("."))], tmp_path)
+    fig = got.pop("fig10_profiles")
+    assert fig.axes[0].get_xlabel() == "distance across the pad s = x (mm)"
+    assert "board" in fig._suptitle.get_text() and "bone" not in fig._suptitle.get_text()
+    figures.profiles_figure([CaseRecord(Scene(thickness=2.0), s, p, {}, Path("."))], tmp_path)
+    fig = got.pop("fig10_profiles")
+    assert fig.axes[0].get_xlabel() == "distance along bone s (mm)"
+    assert "along the bone" in fig._suptitle.get_text()
+    figures._plt().close("all")

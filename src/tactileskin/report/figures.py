@@ -115,8 +115,9 @@ _HATCHES = ("", "//", "..", "xx", "\\\\", "++")
 
 
 def profiles_figure(records, out: Path) -> list[Path]:
-    """Fig. 10 style: P(s) along the bone; one panel per (material, thickness), thicknesses
-    in rows of at most MAX_COLUMNS per material; one y axis for all (they are compared)."""
+    """Fig. 10 style: P(s) along the bone (the bonded surface of the figure's skins); one panel
+    per (material, thickness), thicknesses in rows of at most MAX_COLUMNS per material; one y
+    axis for all (they are compared)."""
     plt = _plt()
     mats, thick = _axes_keys(records)
     rows_per_mat, cols = _grid(len(thick))
@@ -128,6 +129,11 @@ def profiles_figure(records, out: Path) -> list[Path]:
     used = set()
     legend = {}  # every panel's series, not the first panel's: a case may be missing from it
     xlim = _profile_xlim(records)
+    # s and its path as the figure's skins define them (a pad has no bone: s = x on the board)
+    kinds = sorted({r.scene.skin_kind for r in records}, key=lambda k: k.order)
+    xlabel = "; ".join(dict.fromkeys(k.s_axis for k in kinds)) + " (mm)"
+    paths = {k.s_path for k in kinds}
+    path = paths.pop() if len(paths) == 1 else "the bonded surface"
     for i, m in enumerate(mats):
         for j, t in enumerate(thick):
             ax = axes[i * rows_per_mat + j // cols][j % cols]
@@ -145,7 +151,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
             ax.set_xlim(*xlim)
             if j % cols == 0:
                 ax.set_ylabel("mean pressure P (MPa)")
-            ax.set_xlabel("distance along bone s (mm)")
+            ax.set_xlabel(xlabel)
             ax.label_outer()
     for row in axes:
         for ax in row:
@@ -155,7 +161,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
     if labels:
         fig.legend([legend[n][1] for n in labels], labels, loc="outside lower center", ncols=min(len(labels), 4),
                    fontsize=8)
-    fig.suptitle("Subsurface mean pressure along the bone (cf. paper Fig. 10)", fontsize=10)
+    fig.suptitle(f"Subsurface mean pressure along {path} (cf. paper Fig. 10)", fontsize=10)
     _fit_width(fig)
     return _save(fig, out, "fig10_profiles")
 

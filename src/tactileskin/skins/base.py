@@ -26,6 +26,7 @@ A skin is a class (no instances: every answer is a function of the Scene) with
   cap: a request is refused before any other solve runs), or None where only meshing tells;
 - `build_parts(thickness, molds=True, **params) -> list[Part]` (build123d, imported inside);
 - `label(scene)`: the prefix of case labels ("" for the paper's fingertip);
+- `s_path` / `s_axis`: what the profile's path is and what s measures on it (figure labels);
 - `cache_content(scene)`: digests of files it reads, for cache.cache_key (a user's skin file).
 """
 
@@ -62,6 +63,10 @@ class Skin:
     # Braille dot on it presses only if its section contour comes within the travel of the dot
     # (geometry.indenters.braille), not wherever it lies inside `top_extent`
     top_curved: ClassVar[bool] = False
+    # the path of the pressure profile and what s is on it (the sweep's Fig. 10 labels): a pad
+    # has no bone, its s is x on the board
+    s_path: ClassVar[str] = "the bonded surface"
+    s_axis: ClassVar[str] = "distance along the bonded surface s"
 
     @classmethod
     def boundaries_3d(cls) -> tuple[str, ...]:

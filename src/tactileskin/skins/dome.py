@@ -142,6 +142,8 @@ class DomeSkin(Skin):
     order = 2
     scene_params = ("dome_length", "dome_tip")
     fixed_boundaries = ("bone_interface", "bone_tip")
+    s_path = "the bone"
+    s_axis = "distance along bone s"  # arc length on the bone's ellipse, section z = 0
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "bone_tip")
 
     @classmethod

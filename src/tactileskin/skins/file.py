@@ -260,6 +260,7 @@ class FileSkin(Skin):
     # under its tip) are held fixed too where the file has them
     fixed_boundaries = ("bone_interface", "nail_edge", "bone_tip")
     fixes_thickness = True
+    s_axis = "s = x - x_top along the bonded surface"
 
     @classmethod
     def check_scene(cls, scene) -> dict:

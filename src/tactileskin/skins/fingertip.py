@@ -18,6 +18,8 @@ class FingertipSkin(Skin):
     profile_ends_free = False  # the bone runs on into the bonded nail
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "nail_edge")
     top_curved = True
+    s_path = "the bone"
+    s_axis = "distance along bone s"  # arc length from x = 0, the paper's
 
     @classmethod
     def model(cls, scene):

@@ -94,6 +94,8 @@ class PadSkin(Skin):
     order = 1
     scene_params = ("pad_width", "pad_length")
     fixed_boundaries = ("bone_interface",)
+    s_path = "the board"
+    s_axis = "distance across the pad s = x"  # on the board, from the centre line
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "side")
 
     @classmethod
