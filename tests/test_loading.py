@@ -347,3 +347,20 @@ def test_reached_force_is_the_scene_force_ramps_not_a_later_segments(mesh):
     # the profile stays the peak-load state: the end of the 0.02 ramp, deeper
     assert abs(lo["profile_reaction"] - 0.02) <= 1e-4 * 0.02
     assert lo["profile_travel_mm"] > lo["reached_travel_mm"]
+
+
+def test_a_segment_force_is_shown_in_the_scenes_unit(mesh, caplog):
+    """The loading log said 'force to 0.01 N' in 2D, where a force is N/mm of the half section
+    (plane strain); N stays for 3D."""
+    import logging
+
+    from tactileskin.fe import solve
+
+    with caplog.at_level(logging.INFO, logger="tactileskin.fe.loading"):
+        solve(BASE.replace(force=0.01, load_time=0.2), mesh=mesh)
+    said = [r.getMessage() for r in caplog.records if "loading segment" in r.getMessage()]
+    assert said and "force to 0.01 N/mm in 0.2 s" in said[0], said
+    seg = Segment("force", 0.5, rate=2.0)
+    assert seg.describe(3) == "force to 0.5 N at 2 N/s"
+    assert seg.describe(2) == "force to 0.5 N/mm at 2 N/mm/s"
+    assert Segment("depth", 0.4, time=1.0).describe(2) == "depth to 0.4 mm in 1 s"

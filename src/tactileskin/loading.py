@@ -56,10 +56,12 @@ class Segment:
             return float(self.time)
         return abs(self.target - start) / self.rate
 
-    def describe(self) -> str:
+    def describe(self, dim: int) -> str:
+        """The segment in words; a force is N on the whole indenter in 3D, N/mm of the half
+        section in 2D (plane strain), so the scene's `dim` is needed."""
         if self.kind == "hold":
             return f"hold {self.time:g} s"
-        unit = "mm" if self.kind == "depth" else "N"
+        unit = "mm" if self.kind == "depth" else ("N" if dim == 3 else "N/mm")
         how = f"at {self.rate:g} {unit}/s" if self.rate is not None else f"in {self.time:g} s"
         return f"{self.kind} to {self.target:g} {unit} {how}"
 
@@ -73,7 +75,7 @@ def segment_from(value, where: str, *, max_depth: float, default_rate: float) ->
     validate.known_keys(d, ("depth", "force", "hold", "rate", "time"), where)
     kinds = [k for k in KINDS if k in d]
     if len(kinds) != 1:
-        raise ParameterError(where, d, "exactly one of depth = mm, force = N, hold = s")
+        raise ParameterError(where, d, "exactly one of depth = mm, force = N (N/mm in 2D), hold = s")
     kind = kinds[0]
     if kind == "hold":
         if "rate" in d or "time" in d:

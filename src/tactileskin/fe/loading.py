@@ -284,7 +284,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
         # 2.7x too far in the first hold increment, then rose); start each segment with the chord
         if hasattr(model.history, "dt_prev"):
             model.history.dt_prev = None
-        log.info("loading segment %d: %s (t %.4g -> %.4g s)", i, seg.describe(), t0, T)
+        log.info("loading segment %d: %s (t %.4g -> %.4g s)", i, seg.describe(getattr(model, "m", 3)), t0, T)
         ev, stats = run(model, T, opts, history=True, record=rec, progress=progress, increment=increment,
                         stats=stats)
         f_now = vertical_reaction(model, ev)
