@@ -122,6 +122,43 @@ def test_viscoelastic_step_hold_relaxes_by_the_prony_function(mesh):
     assert hold[-1]["reaction"] / fe_ < 0.75  # it did relax (g(2 s) = 0.704)
 
 
+def test_a_long_hold_resolves_the_relaxation(mesh):
+    """A 300 s hold was sampled at quarters, its first point at 75 s: the relaxation (tau 0.1,
+    1.38, 25.5 s) was mostly over by then and the history's curve went straight from the step to
+    g(75 s), 31 % of the step's force above g(t) at t = 5.4 s. Now its points follow the Prony
+    times (23 increments, first at 0.05 s, the curve within 0.44 %)."""
+    from tactileskin.fe import solve
+
+    pu = BASE.replace(material="polyurethane", depth=0.04, rate=100.0)  # a step, as above
+    fe_ = solve(pu, mesh=mesh).reaction
+    r = solve(pu.replace(viscoelastic=True, loading=[{"hold": 300.0}]), mesh=mesh)
+    g = get_material("polyurethane").prony
+    tr = 0.04 / 100.0
+    hold = [x for x in r.history if x["segment"] == 1]
+    t = np.array([tr] + [x["t"] for x in hold])
+    f = np.array([r.history[len(r.history) - len(hold) - 1]["reaction"]] + [x["reaction"] for x in hold]) / fe_
+    assert t[1] - tr <= min(g.tau) and t[-1] == pytest.approx(300.0 + tr) and len(hold) <= 32
+    # each point on g(t) as in the 2 s hold above, and the curve through them too: within 1 %
+    # of the step's force everywhere (the relaxation is 44 % of it)
+    assert np.allclose(f[1:], g.relaxation(t[1:] - tr / 2), rtol=2e-3)
+    dense = tr + np.geomspace(1e-3, 300.0, 400)
+    assert np.max(np.abs(np.interp(dense, t, f) - g.relaxation(dense - tr / 2))) < 1e-2
+
+
+def test_hold_times_follow_the_shortest_prony_time():
+    from tactileskin.fe.loading import HOLD_MAX_INCREMENTS, hold_times
+    from tactileskin.fe.solver import SolverOptions
+    from tactileskin.materials.prony import Prony
+
+    sil = get_material("silicone").prony  # tau 0.025, 0.15, 0.3 s
+    t = hold_times(sil, 300.0, SolverOptions())
+    assert t[0] == pytest.approx(0.5 * 0.025) and t[-1] == 300.0 and len(t) == 26
+    assert np.all(t[1:] / t[:-1] <= 1.5 + 1e-12)
+    assert len(hold_times(sil, 1e6, SolverOptions())) == HOLD_MAX_INCREMENTS  # bounded
+    # the solver's quarters where they are as fine (a short hold) or nothing relaxes
+    assert hold_times(sil, 0.04, SolverOptions()) is None and hold_times(Prony.elastic(), 300.0, SolverOptions()) is None
+
+
 def test_viscoelastic_force_hold_creeps(mesh):
     from tactileskin.fe import solve
 

@@ -24,11 +24,12 @@ from __future__ import annotations
 
 import logging
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from tactileskin.errors import ConvergenceError
-from tactileskin.fe.solver import Stats, _Failure, _solve_increment, run
+from tactileskin.fe.solver import SolverOptions, Stats, _Failure, _solve_increment, run
 
 log = logging.getLogger(__name__)
 
@@ -38,6 +39,12 @@ NOISE_FRACTION = 0.1  # of slope x tol_penetration: the accepted reaction error 
 NOISE_CAP = 1e-3      # ... but never more than this fraction of the force (3D sphere at 0.3 mm: 3e-4)
 UNDERSHOOT = 0.05  # of a predicted travel step (about 3 % of it is the predictor's error)
 SECANT_BASE = 0.1  # the committed states' force difference, as a fraction of the step it predicts
+# a hold's increments end at times growing geometrically from HOLD_FIRST x the shortest Prony
+# time: the relaxation (creep) is fastest at the hold's start, and the solver's equal quarters
+# put a 300 s hold's first point at 75 s, after all of silicone's (tau 0.025-0.3 s)
+HOLD_FIRST = 0.5
+HOLD_GROWTH = 1.5         # largest ratio of successive end times (from the hold's start)
+HOLD_MAX_INCREMENTS = 32  # bounds a long hold's cost (past it the ratio grows: 1e6 s of silicone, 1.80)
 
 
 def vertical_reaction(model, ev) -> float:
@@ -238,6 +245,22 @@ def _secant(a, b, F: float) -> float | None:
     return da - fa / k if k > 0 else None
 
 
+def hold_times(prony, span: float, opts: SolverOptions) -> np.ndarray | None:
+    """End times (s from the hold's start) of a hold's increments: geometric from HOLD_FIRST x
+    the shortest relaxation time to `span`, ratio at most HOLD_GROWTH unless that takes more
+    than HOLD_MAX_INCREMENTS; None where the solver's own first increment is that short already
+    (or nothing relaxes: no Prony terms)."""
+    if prony is None or prony.n_terms == 0:
+        return None
+    first = HOLD_FIRST * min(prony.tau)
+    if opts.dt0_fraction * span <= first:
+        return None
+    n = min(HOLD_MAX_INCREMENTS, math.ceil(math.log(span / first) / math.log(HOLD_GROWTH)) + 1)
+    times = first * (span / first) ** (np.arange(n) / (n - 1))
+    times[-1] = span
+    return times
+
+
 def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None, progress=None,
                 on_segment=None):
     """Run the segments of a loading history (tactileskin.loading.Segment list) from the
@@ -246,6 +269,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
     on_segment(index, segment, ev): called after each segment (e.g. to keep the peak-load
     state's result). Each record: t, travel d, reaction, segment index (+ record(model, ev))."""
     stats = Stats()
+    opts = opts or SolverOptions()
     control, f_now, force_inc = None, 0.0, None
     ev = None
     for i, seg in enumerate(program):
@@ -257,7 +281,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
                 r.update(record(model, ev))
             return r
 
-        increment = None
+        increment, stops = None, None
         if seg.kind == "depth":
             d0, d1 = model.d, seg.target
             T = t0 + seg.duration(d0)
@@ -272,6 +296,7 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
             increment, control = force_inc, "force"
         else:  # hold
             T = t0 + seg.time
+            stops = hold_times(getattr(getattr(model, "history", None), "prony", None), seg.time, opts)
             if control == "depth":
                 model.travel_path = (lambda t, d=model.d: d)
             else:
@@ -285,8 +310,15 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
         if hasattr(model.history, "dt_prev"):
             model.history.dt_prev = None
         log.info("loading segment %d: %s (t %.4g -> %.4g s)", i, seg.describe(getattr(model, "m", 3)), t0, T)
-        ev, stats = run(model, T, opts, history=True, record=rec, progress=progress, increment=increment,
-                        stats=stats)
+        if stops is None:
+            ev, stats = run(model, T, opts, history=True, record=rec, progress=progress, increment=increment,
+                            stats=stats)
+        else:  # one increment per stop (cut back as any), the progress told the hold's end
+            one = replace(opts, dt0_fraction=1.0, dt_max_fraction=1.0)
+            told = None if progress is None else (lambda info, T=T: progress(replace(info, T=T)))
+            for stop in stops:
+                ev, stats = run(model, t0 + stop, one, history=True, record=rec, progress=told,
+                                increment=increment, stats=stats)
         f_now = vertical_reaction(model, ev)
         if increment is not None:
             f_now = increment.reached
