@@ -234,3 +234,18 @@ def test_the_fallback_help_says_the_run_rows_join_the_projects_measurements():
     assert "else the project's" not in text and "together with the project's measurements" in text
     readme = Path(__file__).resolve().parents[1] / "README.md"
     assert "rows first, else the project's" not in " ".join(readme.read_text(encoding="utf-8").split())
+
+
+def test_the_readme_names_every_column_of_accuracies_csv():
+    """accuracies.csv's `n_test` (test readings per stimulus) was explained nowhere, nor were
+    most of its columns: the README named only `status`."""
+    import re
+    from pathlib import Path
+
+    from tactileskin.array.chart import Chart, ChartConfig
+
+    header = Chart(ChartConfig()).to_csv().splitlines()[0].split(",")
+    readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8").split())
+    cell = re.search(r"`accuracies\.csv` \((.*?)\), `array_chart\.md`", readme).group(1)
+    assert "n_test" in header and [c for c in header if f"`{c}`" not in cell] == []
+    assert "test readings per stimulus" in cell

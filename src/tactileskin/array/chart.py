@@ -470,9 +470,10 @@ class Chart:
         return float("nan")
 
     def to_csv(self, indicative: dict | None = None) -> str:
-        """The accuracy rows; `indicative` {(material, thickness): reason} marks the letters rows
-        whose surrogate is not shown within the tolerance (status "indicative: reason"), as the
-        report's daggers do."""
+        """The accuracy rows (columns in README.md, `tactileskin array`; `n_test`: test readings per
+        stimulus, so an accuracy counts n_test / chance readings); `indicative` {(material,
+        thickness): reason} marks the letters rows whose surrogate is not shown within the
+        tolerance (status "indicative: reason"), as the report's daggers do."""
         cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "noise_fs", "noise_mpa",
                 "full_scale_mpa", "bits", "method", "accuracy", "chance", "n_test"]
         lines = [",".join(cols + ["status"])]
