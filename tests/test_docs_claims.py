@@ -38,3 +38,17 @@ def test_architecture_and_readme_ridge_ranges_match_the_planner():
     assert f"peak is {lo}-{hi}x the dots', spans within {slo}..+{shi} %" in _text("docs/architecture.md")
     readme = _text("README.md")
     assert f"reads {lo}-{hi} times their bone pressure" in readme and f"reads {lo}-{hi}x their peak" in readme
+
+
+def test_hard_cases_status_table_gives_the_status_a_solve_gets_now():
+    """docs/hard_cases.md's status table (h = 1 mm, refinement 2) read 'ok' for the 20 % plate
+    after such meshes came to be flagged coarse_mesh; its first row solved as the table says."""
+    from tactileskin.fe import solve
+    from tactileskin.scene import Scene
+
+    words = {"stress_range": "stress", "volume_range": "J", "coarse_mesh": "coarse mesh"}
+    r = solve(Scene(thickness=1, material="silicone", indenter="flat", mesh_size=1.0, refinement=2))
+    codes = [f["code"] for f in r.summary()["flags"]]
+    status = "suspect (" + ", ".join(words[c] for c in codes) + ")" if codes else "ok"
+    assert f"| t1 silicone flat, 20 % | {r.peak:.3f} | {r.summary()['min_J']:.3f} |" in _text("docs/hard_cases.md")
+    assert f"| t1 silicone flat, 20 % | 0.308 | 0.986 | 0.33 | {status} |" in _text("docs/hard_cases.md")
