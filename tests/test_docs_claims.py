@@ -52,3 +52,40 @@ def test_hard_cases_status_table_gives_the_status_a_solve_gets_now():
     status = "suspect (" + ", ".join(words[c] for c in codes) + ")" if codes else "ok"
     assert f"| t1 silicone flat, 20 % | {r.peak:.3f} | {r.summary()['min_J']:.3f} |" in _text("docs/hard_cases.md")
     assert f"| t1 silicone flat, 20 % | 0.308 | 0.986 | 0.33 | {status} |" in _text("docs/hard_cases.md")
+
+
+
+def _contact_pressures(scene, out):
+    """contact.csv's (x, pressure per current area) and the largest facet value of result.vtu's
+    contact_pressure_MPa (per reference area), as a user reads them."""
+    import csv
+
+    import meshio
+    import numpy as np
+
+    from tactileskin.fe import solve
+
+    solve(scene).write(out)
+    with open(out / "contact.csv", newline="") as f:
+        rows = [(float(r["x_mm"]), float(r["contact_pressure_mpa"])) for r in csv.DictReader(f)]
+    reference = meshio.read(out / "result.vtu").cell_data_dict["contact_pressure_MPa"]["line"]
+    return np.array(rows), float(reference.max())
+
+
+def test_readme_contact_pressure_numbers_are_what_the_files_read(tmp_path):
+    """The README quoted 'Braille 0.28-0.29 against 0.33' beside the silicone plate without
+    naming the material: those are polyurethane's; silicone's ridge reads 0.19 against 0.23."""
+    import numpy as np
+
+    from tactileskin.planner import with_quality
+    from tactileskin.scene import Scene
+
+    readme = _text("README.md")
+    flat = with_quality(Scene(thickness=1, material="silicone", indenter="flat"), "preview")
+    cur, ref = _contact_pressures(flat, tmp_path / "flat")
+    centre = cur[np.argmin(np.abs(cur[:, 0])), 1]
+    assert f"silicone at `preview`: {centre:.3f} against {ref:.3f} MPa at the centre" in readme
+    dot = with_quality(Scene(thickness=1, material="polyurethane", indenter="braille"), "preview")
+    cur, ref = _contact_pressures(dot, tmp_path / "dot")
+    top = np.sort(cur[:, 1])[-2:]
+    assert f"polyurethane Braille ridge {top[0]:.2f}-{top[1]:.2f} against {ref:.2f})" in readme
