@@ -89,3 +89,11 @@ def test_readme_contact_pressure_numbers_are_what_the_files_read(tmp_path):
     cur, ref = _contact_pressures(dot, tmp_path / "dot")
     top = np.sort(cur[:, 1])[-2:]
     assert f"polyurethane Braille ridge {top[0]:.2f}-{top[1]:.2f} against {ref:.2f})" in readme
+
+
+def test_architecture_does_not_say_the_dome_parts_are_refused():
+    """docs/architecture.md said the dome's STLs were not watertight and export_parts refused
+    them, long after `build --skin dome` wrote them watertight (tests/test_skin_dome.py)."""
+    doc = _text("docs/architecture.md")
+    assert "`export_parts` refuses them" not in doc
+    assert "`build --skin dome` exports them all as watertight STLs" in doc
