@@ -97,3 +97,20 @@ def test_architecture_does_not_say_the_dome_parts_are_refused():
     doc = _text("docs/architecture.md")
     assert "`export_parts` refuses them" not in doc
     assert "`build --skin dome` exports them all as watertight STLs" in doc
+
+
+def test_speed_vs_error_states_the_2d_presets_of_presets_json():
+    """docs/speed_vs_error.md's last section, 'Quality presets (proposal for --quality)', gave
+    preview 1.0 / 2 and default 0.25 / 3 as the presets; they are 1 / 5 and 0.5 / 3 (Braille
+    0.5 / 6) since the second speed pass."""
+    from tactileskin.presets import load
+
+    p = load()["2"]
+
+    def sizes(q, key="mesh"):
+        return "{:g} / {:g}".format(*p[q][key])
+
+    doc = _text("docs/speed_vs_error.md")
+    assert (f"preview {sizes('preview')}, default {sizes('default')} (Braille {sizes('default', 'braille_mesh')}), "
+            f"fine {sizes('fine')} (mesh_size / refinement)") in doc
+    assert "## Quality presets (proposal for `--quality`)" not in doc
