@@ -114,3 +114,14 @@ def test_speed_vs_error_states_the_2d_presets_of_presets_json():
     assert (f"preview {sizes('preview')}, default {sizes('default')} (Braille {sizes('default', 'braille_mesh')}), "
             f"fine {sizes('fine')} (mesh_size / refinement)") in doc
     assert "## Quality presets (proposal for `--quality`)" not in doc
+
+
+def test_readme_layout_lists_every_package():
+    """The README's Layout left out skins/ and array/ (the pad, dome and file skins; the
+    sensor-array chart), so a reader found no home for half of the Commands table."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    layout = text[text.index("## Layout"):text.index("## Documentation")]
+    pkgs = sorted(p.name for p in (ROOT / "src" / "tactileskin").iterdir()
+                  if (p / "__init__.py").is_file())
+    assert len(pkgs) >= 9
+    assert [p for p in pkgs if f"\n  {p}/" not in layout] == []
