@@ -125,3 +125,17 @@ def test_readme_layout_lists_every_package():
                   if (p / "__init__.py").is_file())
     assert len(pkgs) >= 9
     assert [p for p in pkgs if f"\n  {p}/" not in layout] == []
+
+
+def test_architecture_newton_range_holds_a_default_solve():
+    """docs/architecture.md gave 29-284 Newton iterations per default 2D solve (the
+    2026-11-22 solver); the 18 paper cases take 22-87 now (t1 polyurethane curved 25)."""
+    import re
+
+    from tactileskin.fe import solve
+    from tactileskin.scene import Scene
+
+    lo, hi = map(int, re.search(r"Speed: a default-quality 2D solve takes [^;]*?(\d+)-(\d+) Newton iterations",
+                                _text("docs/architecture.md")).groups())
+    r = solve(Scene(thickness=1, material="polyurethane", indenter="curved"))
+    assert lo <= r.stats["newton_iterations"] <= hi
