@@ -139,3 +139,19 @@ def test_architecture_newton_range_holds_a_default_solve():
                                 _text("docs/architecture.md")).groups())
     r = solve(Scene(thickness=1, material="polyurethane", indenter="curved"))
     assert lo <= r.stats["newton_iterations"] <= hi
+
+
+def test_hard_cases_p1_note_says_the_scene_is_refused():
+    """Solver note 1 said Scene accepts order=1 silently and gave a scene to reproduce the
+    locking; that scene is refused now (ParameterError naming order), so the note says so."""
+    import pytest
+
+    from tactileskin.errors import ParameterError
+    from tactileskin.scene import Scene
+
+    with pytest.raises(ParameterError, match="order"):
+        Scene(thickness=1, material="silicone", indenter="flat", order=1, mesh_size=0.354, refinement=3)
+    Scene(thickness=1, material="silicone", indenter="flat", order=1, mesh_size=0.354, refinement=3,
+          formulation="displacement")
+    doc = _text("docs/hard_cases.md")
+    assert "*Resolved:* `Scene` refuses `order=1` with the mixed formulation" in doc
