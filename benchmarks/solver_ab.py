@@ -13,7 +13,8 @@ fe.linsolve.DIRECT_AFTER_FAILURES_MAX, and "tol_relative", fe.model.Contact.tol_
 Built-in case sets (--set): "braille2d" (the 2D ridge at t = 1, 3, 5, both paper materials,
 preview and default meshes), "paper2d" (the paper's 18 cases in 2D, preview and default), "braille3d" (the single 3D dot: t = 1 default, t = 3 preview,
 t = 5 preview, silicone), "braille3d_default" (t = 3 and 5 at the default preset), "dots3d" (the single dot at
-t = 1, 3, 5, both materials, default), "cell3d" (the full cell at t = 1, 3, 5, silicone, default), "chart" (the array chart's 3D dots at t = 5 on the pad, 0.4 mm).
+t = 1, 3, 5, both materials, default), "cell3d" (the full cell at t = 1, 3, 5, silicone, default), "chart" (the array chart's 3D dots at t = 5 on the pad, 0.4 mm), "shallow3d" (the single dot pressed 0.005-0.1 mm at
+t = 1 and 5, default: the contact tolerance against the travel).
 """
 
 from __future__ import annotations
@@ -49,6 +50,10 @@ SETS = {
     "cell3d": {f"t{t:g}-silicone-cell-3d-default": dict(thickness=t, dim=3, indenter="braille", braille_text="\u283f",
                                                        quality="default")
                for t in (1.0, 3.0, 5.0)},
+    "shallow3d": {f"t{t:g}-{m}-dot-3d-default-d{d:g}": dict(thickness=t, material=m, dim=3, indenter="braille",
+                                                             quality="default", depth=d)
+                  for m in ("silicone", "polyurethane") for t, d in ((1.0, 0.005), (1.0, 0.02), (5.0, 0.02),
+                                                                     (5.0, 0.1))},
     "chart": {f"pad-t5-{m}-dot-3d-0.4mm": dict(thickness=5.0, material=m, dim=3, indenter="braille", skin="pad",
                                                pad_width=20.0, pad_length=20.0, depth=0.4, mesh_size=1.2,
                                                refinement=8.0)
@@ -134,7 +139,7 @@ def main(argv=None) -> int:
                 line = f"| {cname} | {vname} | failed: {r['error'][:80]} | | | | | | | |"
             else:
                 line = (f"| {cname} | {vname} | {r['dofs']:,} | {r['increments']} | {r['newton']} | {r['cutbacks']} | "
-                        f"{r['peak']:.6f} | {r['span']:.3f} | {r['cpu']:.1f} | {r['wall']:.1f} |")
+                        f"{r['peak']:.6g} | {r['span']:.3f} | {r['cpu']:.1f} | {r['wall']:.1f} |")
             print(line, flush=True)
             lines.append(line)
     if a.out:

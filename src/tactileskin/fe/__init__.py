@@ -20,7 +20,8 @@ Choices (each measured; see tests/test_fe_*.py and benchmarks/solve.py):
 - rigid frictionless contact on 2 Gauss points per P2 edge / 3 per P2 triangle (more
   over-constrain the multipliers), penalty 20 K0 / h with Uzawa updates (inside the Newton
   solve) until the gap at the pressed points is below 1e-4 h in 2D, 1e-3 h in 3D
-  (Contact.tol_relative, fe.model.TOL_RELATIVE; h the contact facet size); points stay
+  (Contact.tol_relative, fe.model.TOL_RELATIVE; h the contact facet size) and below 1e-3
+  of the scene's travel (fe.model.TOL_TRAVEL); points stay
   active within a Newton solve (no active-set cycling);
 - Newton with a Crisfield line search on s(eta) = du.R, inadmissible states halve the
   step; increments grow x1.5 after <= 7 iterations, cut back x0.35 on failure, and stay
@@ -92,7 +93,9 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
         bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
-    contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate)
+    # travel: the largest depth, or under force control the expected travel depth_fraction x t
+    contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate,
+                      travel=scene.indentation)
     model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
                   formulation=scene.formulation.value, contact=contact, order=scene.order,
                   stiffness=max(law.K0, law.mu0))
