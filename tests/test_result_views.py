@@ -9,6 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
+import dataclasses  # noqa: E402
+
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
@@ -41,6 +43,17 @@ def test_plot_draws_the_profile_and_writes_nothing_unless_asked(res, tmp_path, m
     with pytest.raises(ParameterError, match="suffix"):
         res.plot(tmp_path / "p.jpeg")
     assert not (tmp_path / "p.jpeg").exists()
+
+
+def test_plot_labels_s_by_what_it_is_on_the_results_skin(res):
+    # a pad has no bone: its s is x across the board (the label said "s along the bone" for every skin)
+    fig, ax = res.plot()
+    assert ax.get_xlabel() == "distance along bone s (mm)"
+    plt.close(fig)
+    pad = dataclasses.replace(res, scene={**res.scene, "skin": "pad"})
+    fig, ax = pad.plot()
+    assert ax.get_xlabel() == "distance across the pad s = x (mm)"
+    plt.close(fig)
 
 
 def test_plot_into_the_callers_axes(res):

@@ -18,8 +18,20 @@ def _label(result) -> str:
     return f"t = {sc['thickness']:g} mm, {sc.get('material', '?')}, {sc.get('indenter', '?')} ({sc.get('dim', 2)}D)"
 
 
+def _s_label(result) -> str:
+    """What s is on the result's skin (Skin.s_axis): arc length along the bone on the fingertip,
+    x across the board on a pad, x - x_top on a user's file."""
+    from tactileskin import skins
+
+    try:
+        kind = skins.get((result.scene or {}).get("skin") or "fingertip")
+    except ParameterError:  # a skin this version does not know (a result file from another)
+        return "s (mm)"
+    return f"{kind.s_axis} (mm)"
+
+
 def plot_result(result, path=None, *, ax=None):
-    """(figure, axes) of `result`: P(s) along the bone; a 3D result with a bone map adds the
+    """(figure, axes) of `result`: P(s) along the bonded surface; a 3D result with a bone map adds the
     maximum over z (dashed) and a second panel, the map P(s, z) (viridis, colour bar in MPa).
     `ax` draws the profile into the caller's axes (2D results only). `path` also writes the
     figure (atomically; .png, .svg or .pdf)."""
@@ -46,7 +58,7 @@ def plot_result(result, path=None, *, ax=None):
     plane = result.stats.get("profile_plane_z")
     pax.plot(s, p, color="#0072B2", lw=1.6,
              label="section plane z = %g mm" % plane if plane is not None else "P(s)")
-    pax.set_xlabel("s along the bone from the symmetry line (mm)")
+    pax.set_xlabel(_s_label(result))
     pax.set_ylabel("mean pressure P (MPa)")
     pax.set_title(_label(result), loc="left", fontsize="medium")
     pax.grid(alpha=0.3)
