@@ -158,9 +158,11 @@ def test_a_level_meshed_with_another_bone_layout_does_not_count_for_the_preset()
         assert lv is not None and lv["bone_scale"] == now  # the t = 5 study is one capped family
         other = dict(case, levels=[dict(v, bone_scale=3.4722) if v is lv else v for v in case["levels"]])
         assert presets.preset_level(key, other, q) is None
-    # below t = 3.3 mm the rule is unchanged: levels without a recorded scale count
+    # below t = 3.3 mm the rule is unchanged: levels with or without a recorded scale count
     t1 = presets.load()["cases3d"]["t1-silicone-\u2801"]
-    assert "bone_scale" not in t1["levels"][0] and presets.preset_level("t1-silicone-\u2801", t1, "fine")
+    bare = dict(t1, levels=[{k: v for k, v in lv.items() if k != "bone_scale"} for lv in t1["levels"]])
+    for case in (t1, bare):
+        assert presets.preset_level("t1-silicone-\u2801", case, "fine")
 
 def test_the_3d_preset_errors_say_which_thicknesses_they_cover():
     from tactileskin.planner import QUALITY
