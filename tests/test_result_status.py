@@ -357,6 +357,50 @@ def test_the_figures_of_a_suspect_solve_say_so(tmp_path, monkeypatch):
     assert len(titles) == 1 and "SUSPECT: no contact" in titles[0], titles
 
 
+@pytest.mark.parametrize("figure", ["bone_map", "sensors"])
+def test_a_suspect_figure_title_fits_its_figure(tmp_path, monkeypatch, figure):
+    """The SUSPECT line of a figure's title was one line of up to 100 characters, centred: on
+    the 8-inch bone map of a 3D pad's edge peak it ran past both sides, its "SUSPECT" cut off."""
+    import types
+
+    import matplotlib.pyplot as plt
+
+    from tactileskin.cli.solve import _figure_title
+    from tactileskin.results import BoneMap
+    from tactileskin.sensors import SensorReadings
+
+    why = ("the peak 0.02813 MPa is at s = 2 mm, within one skin thickness of where the bonded skin "
+           "ends: a corner singularity that grows with mesh refinement; the interior peak is 0.02262 MPa at s = 0 mm")
+    bm = BoneMap(s=np.linspace(0, 2, 5), z=np.linspace(0, 2, 5), pressure=np.ones((5, 5)))
+    res = types.SimpleNamespace(bone_map=bm, sensors=None, summary=lambda: {"status": "suspect: " + why})
+    title = _figure_title(res, "bone pressure, pad4x4-t2-polyurethane-flat-3d")
+    seen = []  # (suptitle text, its extent, figure width) as drawn, before the figure is closed
+    close = plt.close
+
+    def measure(fig=None):
+        seen.append((fig._suptitle.get_text(), fig._suptitle.get_window_extent(fig.canvas.get_renderer()),
+                     fig.bbox.width))
+        close(fig)
+
+    monkeypatch.setattr(plt, "close", measure)
+    if figure == "bone_map":
+        from tactileskin.report.bone_map import write_bone_map_figure
+        write_bone_map_figure(bm, tmp_path / "m.png", title=title)
+    else:
+        from tactileskin.report.sensors import write_sensors_figure
+        n = 3
+        rd = SensorReadings(ids=[f"a-{i}" for i in range(n)], layout=["a"] * n,
+                            xyz=np.c_[np.arange(n), np.zeros(n), np.zeros(n)], s=np.arange(n, dtype=float),
+                            depth=np.full(n, 0.5), normal=np.tile([0.0, 1.0, 0.0], (n, 1)),
+                            pressure=np.ones(n), sigma_nn=-np.ones(n),
+                            tau_1=np.zeros(n), tau_2=np.zeros(n), taxel_points=np.ones(n, int))
+        write_sensors_figure(rd, tmp_path / "s.png", title=title)
+    text, box, width = seen[-1]
+    assert "SUSPECT" in text
+    assert box.x0 >= 0 and box.x1 <= width, (box, width)   # every line of it is on the figure
+    assert "refinement" in title                  # the reason is kept, not cut at 100 characters
+
+
 # --- the law's range scales with the material's own modulus -----------------------------------
 
 def test_lockup_of_a_soft_material_is_flagged_relative_to_its_modulus(tmp_path):

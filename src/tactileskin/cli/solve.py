@@ -209,8 +209,14 @@ def _figure_title(res, text: str) -> str:
     status = str(res.summary().get("status", "ok"))
     if quality.kind(status) == "ok":
         return text
-    why = status.split(":", 1)[-1].strip()
-    return f"{text}\nSUSPECT: {why[:97] + '...' if len(why) > 100 else why}"
+    import textwrap
+
+    # wrapped: one centred line of 100 characters ran past both sides of the 8-inch map,
+    # "SUSPECT" cut off; 72 fit it (the narrowest figure) at the title's size
+    lines = textwrap.wrap("SUSPECT: " + status.split(":", 1)[-1].strip(), 72)
+    if len(lines) > 3:
+        lines = lines[:2] + [lines[2][:69] + "..."]
+    return "\n".join([text, *lines])
 
 
 def _write_map_figure(res, path, label: str) -> None:
