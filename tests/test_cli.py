@@ -69,6 +69,7 @@ def test_solve_compare_2d_reports_ridge_against_dot(tmp_path, capsys):
         assert doc[k]["2d"] == s2[k] and doc[k]["3d"] == s3[k]
         assert doc[k]["relative_difference"] == (s2[k] - s3[k]) / s3[k]
     assert s3["peak_mpa"] > 0 and doc["peak_mpa"]["relative_difference"] > 0.3
+    assert doc["status"] == "suspect: 3D: " + s3["status"].split(": ", 1)[1]  # the 3D side's flag carried
     assert "2D section" in capsys.readouterr().out
     assert not list(out.glob("*.partial"))
 
@@ -78,6 +79,25 @@ def test_solve_compare_2d_needs_a_3d_scene(tmp_path, capsys):
                  "--out", str(tmp_path / "o")]) == 2
     assert "--compare-2d" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()  # refused before solving: nothing written
+
+
+def test_compare_2d_doc_carries_either_side_s_status():
+    """compare_2d.json gave the 2D - 3D differences plainly when either result was suspect
+    (a coarse 3D mesh, a 2D section's edge peak): its status says which side and why."""
+    import types
+
+    from tactileskin.cli.solve import _compare_doc
+    from tactileskin.scene import Scene
+
+    dot = Scene(dim=3, indenter="braille", braille_text="a", thickness=1)
+    ok = {"peak_mpa": 0.1, "span_mm": 1.0, "status": "ok"}
+    coarse = {**ok, "peak_mpa": 0.05, "status": "suspect: mesh coarser than the preview preset's"}
+    two = lambda s: types.SimpleNamespace(summary=lambda: s)  # noqa: E731  (r2: only its summary is read)
+    assert _compare_doc(dot, ok, two(ok))["status"] == "ok"
+    doc = _compare_doc(dot, coarse, two(ok))
+    assert doc["status"] == "suspect: 3D: mesh coarser than the preview preset's"
+    assert doc["peak_mpa"]["relative_difference"] == pytest.approx(1.0)   # the numbers as before
+    assert _compare_doc(dot, ok, two(coarse))["status"] == "suspect: 2D: mesh coarser than the preview preset's"
 
 
 def test_compare_2d_section_takes_the_2d_mesh_of_the_3d_quality(monkeypatch):

@@ -255,7 +255,11 @@ def _compare_doc(scene, s3: dict, r2) -> dict:
     # no relative difference when the 3D value is 0 (no contact reached the bone): None, not NaN
     rows = {k: (s2[k], s3[k], (s2[k] - s3[k]) / s3[k] if s3[k] > 0 else None)
             for k in ("peak_mpa", "span_mm")}
+    # a difference from a suspect side is suspect too (the file gave it plainly, with no status)
+    bad = [f"{d}: {st.split(': ', 1)[-1]}" for d, st in (("3D", s3.get("status", "ok")),
+                                                          ("2D", s2.get("status", "ok"))) if quality.kind(st) != "ok"]
     return {"scene_3d": scene.label(), "scene_2d": scene.replace(dim=2).label(),
+            "status": "suspect: " + "; ".join(bad) if bad else "ok",
             **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
 
 
