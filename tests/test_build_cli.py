@@ -116,3 +116,44 @@ def test_molds_toml_values_are_checked_for_every_skin(tmp_path, monkeypatch, cap
     err = " ".join(capsys.readouterr().err.split())
     assert all(w in err for w in words) and "Traceback" not in err, err
     assert not out.exists()
+
+
+def _scene_file(tmp_path, text):
+    p = tmp_path / "scene.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_build_scene_prints_the_skin_the_scene_solves(tmp_path):
+    # a scene with fingertip overrides was solved as a 30 mm, 9 mm finger, but build had no option
+    # for them and printed the default 20 mm, 8 mm one
+    from tactileskin.scene import Scene
+
+    p = _scene_file(tmp_path, 'dim = 3\nthickness = 2.0\nindenter = "sphere"\nindenter_radius = 3.0\n'
+                              '[fingertip]\nsample_length = 30.0\nhalf_width = 9.0\n')
+    out = tmp_path / "b"
+    assert main(["build", "--scene", str(p), "--out", str(out), "--no-molds"]) == 0
+    m = json.loads((out / "manifest.json").read_text())
+    parts = {e["name"]: e for e in m["parts"]}
+    assert list(parts) == ["skin", "rigid_base", "indenter_sphere"]
+    sc = Scene.from_toml(p)
+    sec = sc.section()
+    skin = parts["skin"]
+    size = [hi - lo for lo, hi in zip(skin["bbox_min"], skin["bbox_max"])]
+    assert size[0] == pytest.approx(2 * sec.half_width, abs=0.01) and sec.half_width == pytest.approx(9.0)
+    assert size[2] == pytest.approx(sc.sample_length, abs=0.01) and sc.sample_length == pytest.approx(30.0)
+    assert m["parameters"]["thickness"] == 2.0 and m["parameters"]["indenter_radius"] == 3.0
+    assert m["parameters"]["fingertip"] == {"half_width": 9.0, "sample_length": 30.0}
+
+
+def test_build_scene_with_geometry_options_or_a_skin_file_is_refused(tmp_path, capsys):
+    p = _scene_file(tmp_path, "thickness = 2.0\n")
+    assert main(["build", "--scene", str(p), "-t", "3", "--out", str(tmp_path / "a")]) == 2
+    assert "--thickness" in capsys.readouterr().err
+    msh = tmp_path / "skin.msh"
+    msh.write_text("not read", encoding="utf-8")
+    p2 = _scene_file(tmp_path, f'skin_file = "{msh.name}"\n')
+    assert main(["build", "--scene", str(p2), "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert "skin_file" in err and "Traceback" not in err
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

@@ -8,7 +8,44 @@ from pathlib import Path
 import click
 
 
+GEOMETRY_OPTIONS = ("thickness", "indenter", "indenter_radius", "indenter_axis", "braille_text", "braille_standard",
+                    "skin", "pad_width", "pad_length", "dome_length", "dome_tip")
+
+
+def _scene_options(path: str) -> dict:
+    """build's geometry options from a scene (or one-case sweep) TOML: the skin that `solve
+    --scene` solves, its fingertip overrides included (`build` had no option for them and printed
+    the default 20 mm, 8 mm fingertip for a scene that solves a 30 mm, 9 mm one)."""
+    from tactileskin import scenefile
+    from tactileskin.errors import ParameterError
+    from tactileskin.scene import Scene
+
+    sc = Scene.from_dict(scenefile.single_scene_fields(scenefile.read(path), "build"))
+    if sc.skin == "file":
+        raise ParameterError("skin_file", str(sc.skin_file), "a built-in skin (fingertip, pad, dome) for `build`",
+                             "a skin file is your own CAD: print it from there")
+    kind = sc.indenter.value
+    if kind == "file":
+        raise ParameterError("indenter_file", str(sc.indenter_file), "a built-in indenter for `build`",
+                             "a file indenter is your own CAD: print it from there")
+    opts = dict(thickness=sc.thickness, indenter=kind, skin=sc.skin, braille_text="",
+                braille_standard="standard_american", indenter_radius=None, indenter_axis=None,
+                pad_width=None, pad_length=None, dome_length=None, dome_tip=None, fingertip=dict(sc.fingertip))
+    if kind == "braille":
+        opts.update(braille_text=sc.braille_text, braille_standard=sc.braille_standard)
+    if kind in ("sphere", "cylinder"):
+        opts.update(indenter_radius=sc.indenter_radius, indenter_axis=sc.indenter_axis if kind == "cylinder" else None)
+    if sc.skin == "pad":
+        opts.update(pad_width=sc.pad_width, pad_length=sc.pad_length)
+    if sc.skin == "dome":
+        opts.update(dome_length=sc.dome_length, dome_tip=sc.dome_tip)
+    return opts
+
+
 @click.command("build")
+@click.option("--scene", "scene_file", type=click.Path(exists=True, dir_okay=False), default=None,
+              help="Scene TOML (as for solve --scene): print its skin (thickness, fingertip overrides, pad or dome "
+                   "sizes) and its indenter; the other geometry options are then not given.")
 @click.option("--thickness", "-t", type=float, default=None,
               help="Skin thickness (mm); default from data/geometry/fingertip.toml.")
 @click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
@@ -34,7 +71,7 @@ import click
               help="Dome: semi-axis of the dome along the finger (mm); default the section's half width.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
             pad_width=None, pad_length=None, dome_length=None, dome_tip=None, indenter_radius=None,
-            indenter_axis=None):
+            indenter_axis=None, scene_file=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -48,6 +85,20 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     from tactileskin.geometry.parts import default_thickness, resolve_indenters
 
     console = new_console()
+    overrides = {}
+    if scene_file is not None:
+        ctx = click.get_current_context()
+        given = [n for n in GEOMETRY_OPTIONS if ctx.get_parameter_source(n) == click.core.ParameterSource.COMMANDLINE]
+        if given:
+            raise click.UsageError("--scene gives the skin and the indenter: leave out "
+                                   + ", ".join("--" + n.replace("_", "-") for n in given))
+        opts = _scene_options(scene_file)
+        overrides = opts.pop("fingertip") if opts["skin"] == "fingertip" else {}
+        thickness, indenter, skin = opts["thickness"], opts["indenter"], opts["skin"]
+        braille_text, braille_standard = opts["braille_text"], opts["braille_standard"]
+        indenter_radius, indenter_axis = opts["indenter_radius"], opts["indenter_axis"]
+        pad_width, pad_length, dome_length, dome_tip = (opts[k] for k in ("pad_width", "pad_length", "dome_length",
+                                                                           "dome_tip"))
     t = default_thickness() if thickness is None else thickness
     pad = {}
     if skin != "pad" and (pad_width is not None or pad_length is not None):
@@ -65,7 +116,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         sc = Scene(skin="dome", thickness=t, dome_length=dome_length, dome_tip=dome_tip)  # validates
         pad = dict(dome_length=sc.dome_length, dome_tip=sc.dome_tip)
     else:
-        Fingertip.from_params().check_thickness(t)  # fail fast, before the CAD imports
+        Fingertip.from_params(**overrides).check_thickness(t)  # fail fast, before the CAD imports
     resolve_indenters(indenter)
     if indenter_radius is not None and indenter not in ("sphere", "cylinder"):
         raise click.UsageError("--indenter-radius needs --indenter sphere or cylinder")
@@ -94,12 +145,14 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
                                  indenter_params=ind_params, skin_scene=sc.replace(dim=3))
         else:
             parts = build_parts(t, indenters=indenter, braille_text=braille_text,
-                                braille_standard=braille_standard, molds=not no_molds, indenter_params=ind_params)
+                                braille_standard=braille_standard, molds=not no_molds, indenter_params=ind_params,
+                                fingertip_overrides=overrides)
     t1 = time.perf_counter()
     with console.status(f"writing {len(parts)} parts to {escape(str(out_dir))}..."):
         manifest = export_parts(parts, out_dir, meta=dict(thickness=t, indenter=indenter, braille_text=braille_text,
                                                           braille_standard=braille_standard, molds=not no_molds, **ind_params,
-                                                          **({"skin": skin, **pad} if pad else {})))
+                                                          **({"skin": skin, **pad} if pad else {}),
+                                                          **({"fingertip": overrides} if overrides else {})))
     t2 = time.perf_counter()
 
     table = Table(title=escape(f"t = {t:g} mm -> {out_dir}/<part>.stl, .step"))
