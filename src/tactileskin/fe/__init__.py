@@ -360,8 +360,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
     if getattr(model, "_linsolve", None) is not None:
         res.stats["linear_solver"] = model._linsolve.describe()
-    ind = getattr(model.contact, "indenter", None)
-    cap = ind.working_travel(section, scene.sample_length) if hasattr(ind, "working_travel") else math.inf
+    cap = getattr(getattr(model.contact, "indenter", None), "working_depth", math.inf)
     travel = res.stats.get("max_travel_mm", float(model.d))
     if travel > cap:  # a force or a creep took the indenter past its printed working face
         res.stats["indenter_cap"] = {"travel_mm": travel, "cap_mm": float(cap)}

@@ -45,29 +45,11 @@ class CylinderIndenter(Indenter):
             raise ParameterError("dim", 2, "3 for a cylinder with indenter_axis = 'x'",
                                  "a cylinder across the finger is not uniform along it; use dim = 3, "
                                  "or indenter_axis = 'z' for the plane-strain section")
-        cls._check_face(scene, indenter_radius=radius, indenter_axis=axis)
         return {"indenter_radius": radius, "indenter_axis": axis}
 
     @classmethod
     def label(cls, scene) -> str:
         return f"cylinder-R{scene.indenter_radius:g}" + ("-x" if scene.indenter_axis == "x" else "")
-
-    @classmethod
-    def _check_face(cls, scene, **kind_params) -> None:
-        """A depth the scene sets stays on the printed face (`working_travel`), as a sphere's
-        stays on its cap; a force or a history finds its travel in the solve, flagged past it."""
-        if scene.force is not None or scene.loading:
-            return
-        depth = scene.depth if scene.depth is not None else scene.depth_fraction * scene.thickness
-        ind = cls.from_params(y0=scene.section().top, dim=scene.dim, length=scene.sample_length, **kind_params)
-        cap = ind.working_travel(scene.section(), scene.sample_length)
-        if depth > cap:
-            raise ParameterError("depth", depth, f"<= {cap:.3g} mm for the {cls.name} indenter on this "
-                                 f"{scene.skin} skin",
-                                 f"its printed face is the cylinder's {ind.chord:g} mm wide strip; past it the "
-                                 f"face's edges, back and mount (from {ind.sagitta:.3g} mm above its lowest line) "
-                                 "would press the skin, where the model's cylinder goes on round: use a smaller "
-                                 "depth" + (" or a larger indenter_radius" if "indenter_radius" in kind_params else ""))
 
     @classmethod
     def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None,
@@ -97,27 +79,6 @@ class CylinderIndenter(Indenter):
         """Rise of the arc from its lowest point to the face edge (half the chord off the axis)."""
         R, c = self.radius, 0.5 * self.chord
         return R - math.sqrt(R * R - c * c)
-
-    def working_travel(self, section, length: float) -> float:
-        """The printed face is the strip of the cylinder one chord wide (solids.cylinder_indenter):
-        its edges, and the back and the mount above them, start the sagitta above its lowest line,
-        where the model's cylinder goes on round. The travel after which they first meet the
-        undeformed skin: the sagitta plus how far below y0 the skin's top lies where the face ends
-        (across the axis); inf where the skin ends within the face."""
-        c = 0.5 * self.chord
-        if self.axis == "x":  # the chord runs along z, where the skin's top is straight
-            return self.sagitta if 0.5 * length > c + 1e-9 else math.inf
-        pts = section.outer_points(4000)
-        x, y = np.abs(pts[:, 0]), pts[:, 1]
-        beyond = x > c + 1e-9
-        if not beyond.any():
-            return math.inf
-        top = float(y[beyond].max())
-        if not beyond.all():  # the top at x = c itself, between the samples either side (a file's are unordered)
-            i = np.flatnonzero(~beyond)[np.argmax(x[~beyond])]
-            j = np.flatnonzero(beyond)[np.argmin(x[beyond])]
-            top = max(top, float(np.interp(c, [x[i], x[j]], [y[i], y[j]])))
-        return self.sagitta + max(self.y0 - top, 0.0)
 
     def _gap(self, p, d):
         R = self.radius
@@ -174,7 +135,6 @@ class CurvedIndenter(CylinderIndenter):
 
     @classmethod
     def check_scene(cls, scene) -> dict:
-        cls._check_face(scene)
         return {}
 
     @classmethod
