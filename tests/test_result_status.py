@@ -276,6 +276,22 @@ def test_meshes_coarser_than_preview_are_flagged(sizes, coarse):
     assert r.summary()["mesh_sizes_mm"]["preview_refined"] == pytest.approx(0.2)
 
 
+def test_a_contact_zone_narrower_than_the_mesh_is_flagged():
+    # a 1e-3 mm press: the presets' refined sizes are absolute, so one contact point carried the
+    # whole contact and the peak read 8-13 % low with status "ok" (quality.MIN_CONTACT_POINTS)
+    from tactileskin.fe import solve
+
+    assert [f.code for f in quality.flags({**NORMAL, "contact_points": 1})] == ["coarse_mesh"]
+    assert quality.flags({**NORMAL, "contact_points": 2}) == []
+    tiny = Scene(thickness=1, indenter="flat", depth=1e-3, viscoelastic=False)
+    coarse = solve(tiny.replace(mesh_size=1.0, refinement=5.0))      # preview
+    fine = solve(tiny.replace(mesh_size=0.177, refinement=3.0))      # fine: 3 points
+    assert coarse.summary()["contact_points"] == 1 and fine.summary()["contact_points"] >= 2
+    assert fine.peak > 1.08 * coarse.peak                             # measured +12.3 %
+    assert [f["code"] for f in coarse.summary()["flags"]] == ["coarse_mesh"]
+    assert "contact point" in coarse.status and fine.status == "ok"
+
+
 def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
     from tactileskin.results import edge_peak
 
@@ -290,7 +306,7 @@ def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
     p2 = 0.17 - 0.001 * np.abs(s2)
     p2[0] = 0.25
     assert edge_peak(s2, p2, 2.0)[:2] == (0.25, -10.0)
-    r = Result(s=s, pressure=p, contact_x=np.array([0.0]), contact_pressure=np.array([0.2]), reaction=1.0,
+    r = Result(s=s, pressure=p, contact_x=np.array([0.0, 0.1]), contact_pressure=np.array([0.2, 0.1]), reaction=1.0,
                stats={"min_J": 0.99, "max_abs_stress_mpa": 0.3}, scene={"thickness": 2.0, "skin": "pad"})
     summ = r.summary()
     assert [f["code"] for f in summ["flags"]] == ["edge_peak"]
