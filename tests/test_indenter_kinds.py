@@ -282,3 +282,25 @@ def test_a_force_past_the_spheres_cap_is_flagged():
     assert quality.flags(normal) == []
     found = quality.flags({**normal, "indenter_cap": {"travel_mm": 0.521, "cap_mm": 0.475}})
     assert [f.code for f in found] == ["indenter_cap"] and "0.521 mm" in found[0].reason
+
+
+def test_a_contact_past_the_printed_face_is_flagged():
+    # the printed cylinder is the arc of chord 1.8 R under a flat back; the model's gap is the
+    # whole circle. Measured (preview, elastic polyurethane): R 0.5 on 1 mm at 0.6 mm touched out
+    # to x = 0.470 mm (the face ends at 0.45), status ok before 2026-11-27. Plates need no bound:
+    # the printed plate covers the skin's width (geometry.parts._covering)
+    from tactileskin.fe import solve
+
+    assert indenter_for_scene(Scene(indenter="cylinder", indenter_radius=0.5)).face_halfwidths() == (
+        pytest.approx(0.45), float("inf"))
+    assert indenter_for_scene(Scene(indenter="flat")).face_halfwidths() == (float("inf"),) * 2
+    assert indenter_for_scene(Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=1.0,
+                                    depth=0.1)).face_halfwidths() == (float("inf"),) * 2
+    kw = dict(material="polyurethane", mesh_size=1.0, refinement=5.0, viscoelastic=False)
+    deep = solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.6, **kw)).summary()
+    assert [f["code"] for f in deep["flags"]] == ["indenter_cap"]
+    assert deep["indenter_cap"]["contact_mm"] > deep["indenter_cap"]["face_half_mm"] == pytest.approx(0.45)
+    assert "0.45 mm" in deep["status"]
+    # at 0.4 mm the contact stays on the arc (x <= 0.413 mm): no flag
+    assert solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.4, **kw)).status == "ok"
+    assert solve(Scene(skin="pad", pad_width=40, thickness=2, indenter="flat", depth=0.1, **kw)).status == "ok"

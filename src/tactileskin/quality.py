@@ -168,7 +168,13 @@ def flags(summary: dict) -> list[Flag]:
                         f"grows with mesh refinement; the interior peak is {pi:.4g} MPa at s = "
                         f"{_num(summary, 'peak_interior_s_mm'):g} mm"))
     cap = summary.get("indenter_cap")
-    if isinstance(cap, dict):
+    if isinstance(cap, dict) and _num(cap, "contact_mm") is not None:
+        out.append(Flag("indenter_cap", f"the contact reaches {_num(cap, 'contact_mm'):.3g} mm from the indenter's "
+                        f"centre along {cap.get('axis', 'x')}, past its printed working face (half width "
+                        f"{_num(cap, 'face_half_mm') or math.nan:.3g} mm): there the printed part has its sides or "
+                        "mount, the model more of the face (a cylinder's whole circle); use a larger radius or a "
+                        "smaller depth or force"))
+    elif isinstance(cap, dict):
         out.append(Flag("indenter_cap", f"the indenter travelled {_num(cap, 'travel_mm') or math.nan:.3g} mm, past its printed "
                         f"working face ({_num(cap, 'cap_mm') or math.nan:.3g} mm: a sphere's cap is 0.95 R high, its mount "
                         "plate starts there): the printed part would press with its mount, and the model's skin "

@@ -364,6 +364,16 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     travel = res.stats.get("max_travel_mm", float(model.d))
     if travel > cap:  # a force or a creep took the indenter past its printed working face
         res.stats["indenter_cap"] = {"travel_mm": travel, "cap_mm": float(cap)}
+    elif res.contact_points is not None and len(res.contact_points):
+        # the contact reaches past the printed face's extent, where the model's gap continues it
+        # (a cylinder's whole circle) and the printed part has its sides or mount
+        faces = getattr(getattr(model.contact, "indenter", None), "face_halfwidths", lambda: (math.inf, math.inf))
+        half = np.asarray(faces()[: model.m - 1], float)
+        reach = np.abs(np.asarray(res.contact_points, float)[:, [0, 2][: model.m - 1]]).max(axis=0)
+        if np.any(reach > half):
+            k = int(np.argmax(reach - half))
+            res.stats["indenter_cap"] = {"travel_mm": travel, "contact_mm": float(reach[k]),
+                                         "face_half_mm": float(half[k]), "axis": "xz"[k]}
     eb = scene.skin_kind.buckling_strain(scene)
     if eb is not None and travel / scene.thickness > eb:  # the model cannot buckle: the skin would
         res.stats["buckling"] = {"strain": travel / scene.thickness, "euler_strain": eb}

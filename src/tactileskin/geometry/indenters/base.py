@@ -175,6 +175,12 @@ class Indenter:
         face (its mount); inf where the model is the whole part."""
         return float("inf")
 
+    def face_halfwidths(self) -> tuple[float, float]:
+        """Half extents (x, z; mm) of the printed working face about x = 0, z = 0: past them the
+        printed part has its sides, back or mount where the model has more of the face; inf
+        where the model's face is the whole part's."""
+        return float("inf"), float("inf")
+
     def contact_planes(self) -> np.ndarray:
         """z planes on which the first touch is sought in 3D (the slab is uniform along z)."""
         return np.zeros(1)

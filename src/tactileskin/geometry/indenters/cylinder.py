@@ -101,6 +101,11 @@ class CylinderIndenter(Indenter):
         c = x if self.axis == "z" else (np.zeros(np.shape(x)) if z is None else z)
         return self.y0 - d + R - np.sqrt(R * R - c * c)
 
+    def face_halfwidths(self) -> tuple[float, float]:
+        # the printed face is the arc of `chord` across the axis (solids.cylinder_indenter); the
+        # model's gap is the whole circle
+        return (0.5 * self.chord, float("inf")) if self.axis == "z" else (0.5 * self.width, 0.5 * self.chord)
+
     def contact_zrange(self, depth):
         if self.axis == "z":
             return None  # touches along the whole slab
