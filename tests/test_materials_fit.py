@@ -172,8 +172,22 @@ def test_bad_options_rejected():
             fit("ogden", LAM, P, **kw)
     with pytest.raises(ParameterError, match="nu"):
         fit("hyperfoam", LAM, P)  # no incompressible hyperfoam
+    # the written file must load: the laws' bulk / shear ratio is at most 5000 (nu0 = 0.4999);
+    # nu = 0.49999 was fitted, written and then refused by every solve
+    with pytest.raises(ParameterError, match=r"nu=0\.49999 .*\(-1, 0\.4999\]"):
+        fit("yeoh", LAM, P, nu=0.49999)
     with pytest.raises(ParameterError, match="law"):
         fit("gent", LAM, P)
+
+
+def test_a_fit_at_the_largest_nu_writes_a_file_that_loads(tmp_path):
+    from tactileskin.materials import get_material
+
+    P, _ = uniaxial_nominal(TRUE["neo_hookean"][0], LAM, None)
+    path = tmp_path / "m.toml"
+    path.write_text(fit("neo_hookean", LAM, P, nu=0.4999).material("m", "test").to_toml())
+    law = get_material(str(path)).law
+    assert law.K0 / law.mu0 == pytest.approx(4999.667, rel=1e-6)  # the loader's limit: 5000
 
 
 def test_csv_reader(tmp_path):

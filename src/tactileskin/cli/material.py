@@ -31,7 +31,7 @@ def list_() -> None:
 @click.option("--law", "-l", required=True, help="Law to fit (tactileskin material list).")
 @click.option("--out", "-o", type=click.Path(dir_okay=False), required=True, help="Material TOML to write.")
 @click.option("--nu", type=float, default=None,
-              help="Poisson ratio of the test (default: incompressible; hyperfoam needs it).")
+              help="Poisson ratio of the test, in (-1, 0.4999] (default: incompressible; hyperfoam needs it).")
 @click.option("--terms", type=int, default=None, help="Terms of yeoh (1-3), ogden or hyperfoam (1-3).")
 @click.option("--name", default=None, help="Material name (default: the CSV's name).")
 @click.option("--test", "test", type=click.Choice(["uniaxial", "indentation"]), default="uniaxial", show_default=True,

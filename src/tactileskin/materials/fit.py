@@ -21,6 +21,7 @@ from __future__ import annotations
 import csv
 import io
 import logging
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -186,8 +187,12 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
     cls = get_law(law)
     if nu is not None:
         from tactileskin.errors import check_range
+        from tactileskin.materials.laws import MAX_BULK_OVER_SHEAR as r
 
-        nu = check_range("nu", nu, -1.0, 0.5, lo_open=True, hi_open=True)
+        # at most the nu0 a material file may have (laws.law_from_dict: K0 / mu0 <= 5000, nu0 =
+        # 0.49990001, stated to 4 digits): nu = 0.49999 was fitted and written, and the file then
+        # refused by every solve
+        nu = check_range("nu", nu, -1.0, math.floor(1e4 * (3 * r - 2) / (2 * (3 * r + 1))) / 1e4, lo_open=True)
     elif law == "hyperfoam":
         raise ParameterError("nu", None, "(-1, 0.5)", "hyperfoam has no incompressible form: give nu")
     if law in ("ogden", "hyperfoam"):
