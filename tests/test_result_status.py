@@ -292,6 +292,22 @@ def test_a_contact_zone_narrower_than_the_mesh_is_flagged():
     assert "contact point" in coarse.status and fine.status == "ok"
 
 
+def test_a_3d_contact_zone_of_fewer_points_than_a_facet_is_flagged():
+    # a 3D P2 contact facet has 3 points: an R 2.5 sphere 1e-3 mm into a 1 mm pad touched at 2 and
+    # read the reaction 58 % (preview) and 9 % (default) below the bonded-layer Hertz law, status ok
+    from tactileskin.fe import solve
+    from tactileskin.materials.indentation import bonded_sphere_force
+
+    normal3 = {k: v for k, v in NORMAL.items() if k != "reaction_n_per_mm"} | {"reaction_n": 0.5}
+    assert [f.code for f in quality.flags({**normal3, "contact_points": 2})] == ["coarse_mesh"]
+    assert quality.flags({**normal3, "contact_points": 3}) == []
+    ball = Scene(skin="pad", dim=3, thickness=1.0, indenter="sphere", indenter_radius=2.5, depth=1e-3,
+                 viscoelastic=False, mesh_size=1.6, refinement=8.0)                # preview
+    r = solve(ball)
+    assert r.reaction < 0.6 * bonded_sphere_force(0.27, 1e-3, 2.5, 1.0)              # measured 0.42
+    assert r.summary()["contact_points"] == 2 and [f["code"] for f in r.summary()["flags"]] == ["coarse_mesh"]
+
+
 def test_peak_at_the_bonded_edge_is_flagged_with_the_interior_peak():
     from tactileskin.results import edge_peak
 
