@@ -666,8 +666,12 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
             log.info("increment t=%.5g dt=%.3g failed (%s); cutting back", t + dt, dt, f.why)
             if dt * opts.cutback < dt_min:
                 diag = {"time": t, "dt": dt, "reason": f.why, **f.diag}
-                raise ConvergenceError(f"no convergence at t = {t:.6g} s with dt = {dt:.3g} s: {f.why}",
-                                       diag) from None
+                d = getattr(model, "d", None) if getattr(model, "contact", None) is not None else None
+                where = "" if d is None else f" after {float(d):.4g} mm of indenter travel"
+                raise ConvergenceError(f"no convergence at t = {t:.6g} s{where} with dt = {dt:.3g} s: {f.why} "
+                                       "(the skin or its mesh gives out there: the material law's lock-up, elements "
+                                       "too coarse for the strain or the contact; try a smaller depth or force, or "
+                                       "a finer mesh, --quality fine)", diag) from None
             if opts.failed_dt_fraction > 0.0:
                 dt_cap = min(dt_cap, opts.failed_dt_fraction * dt)
             dt *= opts.cutback
