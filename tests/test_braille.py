@@ -198,3 +198,20 @@ def test_a_fingertip_text_whose_outer_dots_never_touch_is_refused():
     x, touch = BrailleIndenter.dot_touch(ab, get_standard(ab.braille_standard))
     assert x.tolist() == [3.1] and touch[0] == pytest.approx(first_contact_travel(ab), abs=1e-3)
     require_contact(ab.replace(depth=0.55))
+
+
+def test_a_dome_text_whose_outer_dots_never_touch_is_refused():
+    """The dome's section is the fingertip's ellipse, but only the fingertip was checked: 'a b'
+    (dots at x = +-6.2 mm, touching after 1.81 mm) was taken on the dome at t = 1 and, at
+    depth 1 of t = 2, solved with its base plate pressing alone."""
+    from tactileskin.geometry.indenters import require_contact
+    from tactileskin.scene import Scene
+
+    with pytest.raises(ParameterError, match=r"braille_text='a b'.*travel 0.6 t.*6.2 mm first touch it after 1.81"):
+        Scene(skin="dome", dim=3, thickness=1.0, indenter="braille", braille_text="a b")
+    far = Scene(skin="dome", dim=3, thickness=3.5, indenter="braille", braille_text="a b", depth=1.0)
+    with pytest.raises(ParameterError, match=r"depth=1.0.*> 1.81 mm.*would press nothing"):
+        require_contact(far)
+    require_contact(far.replace(depth=2.0))  # 2.1 mm of travel reaches them
+    # 'ab' (dots at +-3.1 mm, first touch 0.476 mm) is taken, as on the fingertip
+    require_contact(Scene(skin="dome", dim=3, thickness=1.0, indenter="braille", braille_text="ab", depth=0.55))

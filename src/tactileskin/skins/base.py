@@ -59,9 +59,10 @@ class Skin:
     # tip, bonded beyond z = 0), so that a load there is not taken for a corner of the map
     map_z_end_free: ClassVar[bool] = True
     boundaries_2d: ClassVar[tuple[str, ...]] = ("bone_interface", "outer_surface", "symmetry")
-    # the top falls away from x = 0 (the fingertip's ellipse), the same in every z plane: a
-    # Braille dot on it presses only if its section contour comes within the travel of the dot
-    # (geometry.indenters.braille), not wherever it lies inside `top_extent`
+    # the top falls away from x = 0 (the fingertip's ellipse), the same in every z plane (or
+    # lower, the dome's tip): a Braille dot on it presses only if its section contour comes
+    # within the travel of the dot (geometry.indenters.braille), not wherever it lies inside
+    # `top_extent`
     top_curved: ClassVar[bool] = False
     # the path of the pressure profile and what s is on it (the sweep's Fig. 10 labels): a pad
     # has no bone, its s is x on the board

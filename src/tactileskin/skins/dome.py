@@ -142,6 +142,9 @@ class DomeSkin(Skin):
     order = 2
     scene_params = ("dome_length", "dome_tip")
     fixed_boundaries = ("bone_interface", "bone_tip")
+    # its section is the fingertip's ellipse: a dot off x = 0 touches as late as there (later
+    # still on the tip, z > 0), so the fingertip's per-dot check holds ('a b' was taken)
+    top_curved = True
     s_path = "the bone"
     s_axis = "distance along bone s"  # arc length on the bone's ellipse, section z = 0
     boundaries_2d = ("bone_interface", "outer_surface", "symmetry", "bone_tip")

@@ -109,10 +109,10 @@ def first_contact_travel(scene, samples: int = 4000) -> float:
 
 
 def _require_every_dot(scene) -> None:
-    """ParameterError naming the depth if a Braille text's dots on a curved top (the fingertip)
-    do not all touch it within the travel: the base plate touches at the dot height (0.48 mm)
-    wherever the dots are, and a text whose outer dots press nothing read as a shorter text's
-    ('a b' at t = 5, depth 1: its dots touch after 1.81 mm, the plate pressed alone)."""
+    """ParameterError naming the depth if a Braille text's dots on a curved top (the fingertip,
+    the dome) do not all touch it within the travel: the base plate touches at the dot height
+    (0.48 mm) wherever the dots are, and a text whose outer dots press nothing read as a shorter
+    text's ('a b' at t = 5, depth 1: its dots touch after 1.81 mm, the plate pressed alone)."""
     if not (scene.indenter_kind.name == "braille" and scene.braille_text and scene.skin_kind.top_curved):
         return
     from tactileskin.geometry import braille as _braille

@@ -64,21 +64,20 @@ class BrailleIndenter(Indenter):
         """Every dot's base on the skin's top: a dot past its edge presses nothing, and the
         result would be that of a shorter text, unflagged (abcd on a 10 mm pad solved 'ok')."""
         extent = scene.skin_kind.top_extent(scene)
-        if extent is None:
-            return
-        xh, zh = extent
-        xmin, xmax, zmin, zmax = _braille.footprint(scene.braille_text, std)
-        x_out = max(-xmin, xmax) > xh + 1e-9
-        z_out = scene.dim == 3 and max(-zmin, zmax) > zh + 1e-9
-        if x_out or z_out:
-            fixes = [f"{name} >= {2 * need:.3g} mm" for name, need, out in
-                     (("pad_width", max(-xmin, xmax), x_out), ("pad_length", max(-zmin, zmax), z_out))
-                     if out and scene.skin == "pad"]
-            hint = (f"its dot bases span x {xmin:.3g} to {xmax:.3g} mm, z {zmin:.3g} to {zmax:.3g} mm; "
-                    + (f"give {' and '.join(fixes)} or " if fixes else "") + "use fewer cells")
-            raise ParameterError("braille_text", scene.braille_text,
-                                 f"a text whose dots lie on the {scene.skin} skin's top (|x| <= {xh:g} mm"
-                                 + (f", |z| <= {zh:g} mm" if scene.dim == 3 else "") + ")", hint)
+        if extent is not None:  # the dome states none: its curved top is checked below
+            xh, zh = extent
+            xmin, xmax, zmin, zmax = _braille.footprint(scene.braille_text, std)
+            x_out = max(-xmin, xmax) > xh + 1e-9
+            z_out = scene.dim == 3 and max(-zmin, zmax) > zh + 1e-9
+            if x_out or z_out:
+                fixes = [f"{name} >= {2 * need:.3g} mm" for name, need, out in
+                         (("pad_width", max(-xmin, xmax), x_out), ("pad_length", max(-zmin, zmax), z_out))
+                         if out and scene.skin == "pad"]
+                hint = (f"its dot bases span x {xmin:.3g} to {xmax:.3g} mm, z {zmin:.3g} to {zmax:.3g} mm; "
+                        + (f"give {' and '.join(fixes)} or " if fixes else "") + "use fewer cells")
+                raise ParameterError("braille_text", scene.braille_text,
+                                     f"a text whose dots lie on the {scene.skin} skin's top (|x| <= {xh:g} mm"
+                                     + (f", |z| <= {zh:g} mm" if scene.dim == 3 else "") + ")", hint)
         if scene.skin_kind.top_curved:
             # inside the half width a curved top falls away: 'a b' (dots at x = +-6.2 mm, where
             # the fingertip lies 2.6 mm below its top) passed, and only its base plate pressed
@@ -95,9 +94,10 @@ class BrailleIndenter(Indenter):
     def dot_touch(cls, scene, std) -> tuple[np.ndarray, np.ndarray]:
         """(|x|, travel) of each distinct |x| of the text's dots: the travel (mm, from the start
         at the skin's top) after which a dot there first touches the skin's section contour, the
-        same in every z plane of a `top_curved` skin (undeformed: the skin pulled down around a
-        pressed dot only delays it). A dot's sphere (radius R, centre R above its tip) beyond
-        its cap lies inside the base plate, so the sphere's distance is the dot's."""
+        same in every z plane of a `top_curved` skin, or later (the dome's tip; undeformed: the
+        skin pulled down around a pressed dot only delays it). A dot's sphere (radius R, centre
+        R above its tip) beyond its cap lies inside the base plate, so the sphere's distance is
+        the dot's."""
         sec = scene.section()
         pts = sec.outer_points(4000)
         R = float(std.sphere_radius)
