@@ -74,6 +74,27 @@ def test_solve_compare_2d_reports_ridge_against_dot(tmp_path, capsys):
     assert not list(out.glob("*.partial"))
 
 
+def test_solve_compare_2d_exits_3_when_the_2d_section_is_suspect(tmp_path, capsys, monkeypatch):
+    """compare_2d.json says suspect when the 2D section is, but beside an ok 3D dot the run
+    exited 0: the exit status follows the files written (3: a result written but suspect)."""
+    import json
+
+    from tactileskin.cli import solve as cli_solve
+    from tactileskin.fe import solve
+
+    # the section on a mesh coarser than the preview's: flagged coarse_mesh (the 3D dot is not)
+    monkeypatch.setattr(cli_solve, "_solve_2d", lambda sc: solve(sc.replace(dim=2, mesh_size=1.0, refinement=2.0)))
+    out = tmp_path / "dot"
+    rc = main(["solve", "--dim", "3", "--indenter", "braille", "--braille-text", "a", "-t", "1", "--depth", "0.05",
+               "--quality", "preview", "--compare-2d", "--out", str(out)])
+    s3 = json.loads((out / "summary.json").read_text())
+    doc = json.loads((out / "compare_2d.json").read_text())
+    assert s3["status"] == "ok" and doc["status"].startswith("suspect: 2D: ")
+    assert rc == 3
+    cap = capsys.readouterr()
+    assert "the 2D section is suspect (exit status 3)" in cap.out + cap.err and "suspect: suspect" not in cap.out
+
+
 def test_solve_compare_2d_needs_a_3d_scene(tmp_path, capsys):
     assert main(["solve", "-t", "1", "--mesh-size", "1.0", "--refinement", "2", "--compare-2d",
                  "--out", str(tmp_path / "o")]) == 2

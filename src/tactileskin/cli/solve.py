@@ -23,7 +23,8 @@ EXIT_SUSPECT = 3  # a result was written but tactileskin.quality flags it (see t
     "Exit status: 0 the result is ok; 3 the result was written but is suspect (no contact, "
     "the material law outside its range, locking P1 elements, a mesh coarser than the preview "
     "preset's, a peak at the bonded skin's edge, ...: see 'status' and 'flags' in summary.json "
-    "and docs/hard_cases.md, \"Result status\"); 2 an "
+    "and docs/hard_cases.md, \"Result status\"; with --compare-2d, also the 2D section's, "
+    "compare_2d.json 'status'); 2 an "
     "error (bad parameter, refused mesh, no convergence, output folder), nothing written."))
 @scene_options
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), required=True,
@@ -131,7 +132,10 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
                       + Text(s["status"].split(": ", 1)[-1]), highlight=False)
         rc = EXIT_SUSPECT
     if r2 is not None:
-        _print_compare_2d(_compare_doc(scene, s, r2), r2.summary())
+        doc = _compare_doc(scene, s, r2)
+        _print_compare_2d(doc, r2.summary())
+        if doc["status"] != "ok":  # a suspect 2D section makes compare_2d.json suspect: not exit 0
+            rc = EXIT_SUSPECT
     if r2_error is not None:
         console.print(Text("warning: --compare-2d: the 2D section could not be solved, so there is no "
                            "compare_2d.json: ", style="bold yellow") + Text(str(r2_error).splitlines()[0]),
@@ -278,5 +282,6 @@ def _print_compare_2d(doc: dict, s2: dict) -> None:
         t.add_row(k, f"{a:.4g}", f"{b:.4g}", "n/a (3D is 0)" if d is None else f"{100 * d:+.1f} %")
     new_console().print(t)
     if s2.get("status", "ok") != "ok":
-        new_console().print(Text(f"warning: the 2D section is suspect: {s2['status']}", style="bold yellow"),
-                        highlight=False)
+        why = s2["status"].split(": ", 1)[-1]
+        new_console().print(Text(f"warning: the 2D section is suspect (exit status 3): {why}", style="bold yellow"),
+                            highlight=False)
