@@ -477,3 +477,15 @@ def test_a_skin_thinner_than_the_presets_elements_is_flagged():
                                                       "preview_refined": 0.2, "thickness": 0.1}}) == []
     assert quality.flags({**NORMAL, "mesh_sizes_mm": {"global": 1.0, "refined": 0.2, "preview_global": 1.0,
                                                       "preview_refined": 0.2, "thickness": 0.4}}) == []
+
+
+def test_a_press_too_shallow_for_the_mesh_says_so_not_that_the_indenter_never_pressed():
+    # the scene is made only if the dot reaches the skin within the depth; at 1e-3 mm its
+    # contact is narrower than the preview mesh's contact points. The flag said "the indenter
+    # never pressed the skin within the indentation depth", which the scene's own check denies
+    from tactileskin.fe import solve
+    from tactileskin.planner import with_quality
+
+    r = solve(with_quality(Scene(thickness=1.0, indenter="braille", depth=1e-3), "preview"))
+    (flag,) = [f for f in quality.flags(r.summary()) if f.code == "no_contact"]
+    assert "never pressed" not in flag.reason and "shallower than the mesh resolves" in flag.reason

@@ -113,8 +113,12 @@ def flags(summary: dict) -> list[Flag]:
     if peak is not None and peak <= 0.0:
         none.append(f"peak {peak:g} MPa")
     if none:
-        out.append(Flag("no_contact", "no contact (" + ", ".join(none) + "): the indenter never "
-                        "pressed the skin within the indentation depth"))
+        # a scene is made only if its indenter reaches the skin within the depth (require_contact):
+        # no pressed point then means a contact narrower than the mesh's contact points (a 1e-3 mm
+        # press of a Braille dot at preview), which "never pressed" misread
+        out.append(Flag("no_contact", "no contact (" + ", ".join(none) + "): the indenter pressed no contact "
+                        "point of the skin within the indentation depth (a press shallower than the mesh resolves: "
+                        "a deeper press or a finer mesh)"))
     stress, mu0 = _num(summary, "max_abs_stress_mpa"), _num(summary, "material_mu0_mpa")
     if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "
