@@ -87,22 +87,29 @@ def test_discriminate_verdict():
 def test_workers_get_their_pardiso_share_and_this_process_keeps_its_environment(monkeypatch):
     """A local cluster's workers read TACTILESKIN_THREADS = CPUs // workers; the nanny's
     pre-spawn variables must not land in this process (a later lone solve or sweep here
-    would take a leftover MKL_NUM_THREADS=1 or thread share for the user's setting)."""
+    would take a leftover MKL_NUM_THREADS=1 or thread share for the user's setting; dask's
+    OMP_NUM_THREADS=1 and OPENBLAS_NUM_THREADS=1 stayed here after a sweep, and fe.blas_threads
+    then took them for the user's choice and left a later solve's BLAS unlimited)."""
     import os
 
     from tactileskin.sweep import _Runner
     from tactileskin.threads import available_cpus
 
-    for v in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS"):
+    blas = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+    for v in ("TACTILESKIN_THREADS", "MKL_NUM_THREADS", *blas):
         monkeypatch.delenv(v, raising=False)
     runner = _Runner([], [], serial=False, scheduler=None, workers=1)
     try:
         client = runner._start(1)
         seen = client.run(lambda: (os.environ.get("TACTILESKIN_THREADS"), os.environ.get("MKL_NUM_THREADS")))
+        blas_seen = client.run(lambda: [os.environ.get(v) for v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")])
+        here_running = [os.environ.get(v) for v in blas]
     finally:
         runner.close()
     assert list(seen.values()) == [(str(available_cpus()), None)]
     assert "TACTILESKIN_THREADS" not in os.environ and "MKL_NUM_THREADS" not in os.environ
+    assert list(blas_seen.values()) == [["1", "1"]]  # the workers keep one BLAS thread
+    assert here_running == [None, None] and [os.environ.get(v) for v in blas] == [None, None]
 
 
 def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_traceback(monkeypatch):

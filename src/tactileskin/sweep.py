@@ -397,6 +397,7 @@ class _Runner:
         self.scenes, self.keys = scenes, keys
         self.serial, self.scheduler, self.workers = serial, scheduler, workers
         self.client = self.cluster = None
+        self._environ = {}  # this process's values of the nanny's pre-spawn variables
 
     def __call__(self, idx: list[int], finish) -> None:
         if not idx:
@@ -432,6 +433,11 @@ class _Runner:
         n = max(1, min(self.workers or os.cpu_count() or 1, ncases))
         import dask
 
+        # The nanny sets its other pre-spawn variables (OMP_NUM_THREADS=1, OPENBLAS_NUM_THREADS=1)
+        # here too, before each worker starts: the workers keep them (numpy reads them as it
+        # loads), this process gets its own values back, or a later lone solve here would take
+        # them for the user's thread count (fe.blas_threads) and leave its BLAS unlimited
+        self._environ = {k: os.environ.get(k) for k in dask.config.get("distributed.nanny.pre-spawn-environ")}
         # dask sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also switches off
         # glibc's adaptive mmap threshold: every numpy temporary over 128 KiB is then
         # mmapped and unmapped, and a solve spent ~30 % of its time in the kernel (t1
@@ -459,6 +465,8 @@ class _Runner:
             except BaseException:
                 _close_unfinished_clusters(before)
                 raise
+            finally:
+                _restore_environ(self._environ)
         self.client = Client(self.cluster)
         return self.client
 
@@ -467,6 +475,16 @@ class _Runner:
             self.client.close()
         if self.cluster is not None:
             self.cluster.close()
+        _restore_environ(self._environ)  # a worker its nanny restarted set them again
+
+
+def _restore_environ(saved: dict) -> None:
+    """Put back this process's values (None: unset) of the variables in `saved`."""
+    for k, v in saved.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
 
 
 def _close_unfinished_clusters(before: set) -> None:
