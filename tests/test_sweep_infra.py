@@ -112,6 +112,32 @@ def test_workers_get_their_pardiso_share_and_this_process_keeps_its_environment(
     assert here_running == [None, None] and [os.environ.get(v) for v in blas] == [None, None]
 
 
+def test_a_sweep_gives_dask_s_loggers_back_their_levels():
+    """The local cluster's loggers are quiet while the sweep runs; they stayed at CRITICAL after
+    it, so a notebook's own dask work later in the process lost its warnings and errors."""
+    import logging
+
+    from tactileskin.sweep import _Runner
+
+    names = ("distributed", "distributed.scheduler", "distributed.worker")
+    saved = {n: logging.getLogger(n).level for n in names}
+    try:
+        for n, level in zip(names, (logging.INFO, logging.WARNING, logging.NOTSET)):
+            logging.getLogger(n).setLevel(level)
+        runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+        try:
+            runner._start(1)
+            during = [logging.getLogger(n).level for n in names]
+        finally:
+            runner.close()
+        after = [logging.getLogger(n).level for n in names]
+    finally:
+        for n, level in saved.items():
+            logging.getLogger(n).setLevel(level)
+    assert during == [logging.CRITICAL] * 3
+    assert after == [logging.INFO, logging.WARNING, logging.NOTSET]
+
+
 def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_traceback(monkeypatch):
     """Ctrl-C during LocalCluster's start left a cluster in Status.init, which dask's exit hook
     then closed with an AssertionError traceback after 'interrupted'."""

@@ -398,6 +398,7 @@ class _Runner:
         self.serial, self.scheduler, self.workers = serial, scheduler, workers
         self.client = self.cluster = None
         self._environ = {}  # this process's values of the nanny's pre-spawn variables
+        self._log_levels = {}  # the levels of dask's loggers before the sweep quietened them
 
     def __call__(self, idx: list[int], finish) -> None:
         if not idx:
@@ -426,6 +427,8 @@ class _Runner:
         if not log.isEnabledFor(logging.INFO):  # dask's scheduler logs at INFO by default
             for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
                          "distributed.http.proxy", "distributed.worker"):
+                # for this sweep only (close): the caller's own dask work after it logs as before
+                self._log_levels.setdefault(name, logging.getLogger(name).level)
                 logging.getLogger(name).setLevel(logging.CRITICAL)
         if self.scheduler:
             self.client = connect(self.scheduler)
@@ -476,6 +479,8 @@ class _Runner:
         if self.cluster is not None:
             self.cluster.close()
         _restore_environ(self._environ)  # a worker its nanny restarted set them again
+        for name, level in self._log_levels.items():
+            logging.getLogger(name).setLevel(level)
 
 
 def _restore_environ(saved: dict) -> None:
