@@ -138,6 +138,34 @@ def test_a_sweep_gives_dask_s_loggers_back_their_levels():
     assert after == [logging.INFO, logging.WARNING, logging.NOTSET]
 
 
+def test_a_sweep_starts_quietly_while_dask_s_port_8787_is_taken():
+    """The cluster has no dashboard, but its scheduler's HTTP server took dask's port 8787: with a
+    notebook's own dashboard (or another sweep) there, every sweep warned 'Port 8787 is already
+    in use' in four lines on stderr."""
+    import socket
+    import warnings
+
+    from tactileskin.sweep import _Runner
+
+    held = socket.socket()
+    try:
+        held.bind(("127.0.0.1", 8787))
+        held.listen()
+    except OSError:  # taken already: as good
+        pass
+    try:
+        runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            try:
+                runner._start(1)
+            finally:
+                runner.close()
+    finally:
+        held.close()
+    assert [str(w.message) for w in seen if "8787" in str(w.message)] == []
+
+
 def test_a_cluster_interrupted_while_starting_is_closed_without_an_exit_traceback(monkeypatch):
     """Ctrl-C during LocalCluster's start left a cluster in Status.init, which dask's exit hook
     then closed with an AssertionError traceback after 'interrupted'."""

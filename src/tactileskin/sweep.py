@@ -462,8 +462,13 @@ class _Runner:
 
             before = set(SpecCluster._instances)  # a user's own clusters (a notebook) stay
             try:
+                # no dashboard; the scheduler's HTTP server still starts, on dask's 8787 unless
+                # told: on any free local port, so that a dashboard there (a notebook's own
+                # cluster, a second sweep) does not earn every sweep a 4-line "Port 8787 is
+                # already in use" UserWarning
                 self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                             dashboard_address=None, silence_logs=quiet,
+                                            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                             env={"TACTILESKIN_THREADS": worker_threads(n)})
             except BaseException:
                 _close_unfinished_clusters(before)
