@@ -178,6 +178,10 @@ def test_a_misspelt_grid_key_or_an_empty_axis_is_a_parameter_error_not_a_silent_
     (lambda r: ts.sweep([]), "grid"),
     (lambda r: ts.sweep({"thickness": [1]}, workers="x"), "workers"),
     (lambda r: ts.sweep({"thickness": [1]}, cache=5), "cache"),
+    # were taken for true ("no" is truthy) or false; the bad thickness ends the old code fast
+    (lambda r: ts.sweep({"thickness": [-1]}, serial="no"), "serial"),
+    (lambda r: ts.sweep({"thickness": [-1]}, profiles="yes"), "profiles"),
+    (lambda r: ts.sweep({"thickness": [-1]}, report="no"), "report"),
     (lambda r: ts.solve(thickness=1, progress=5), "progress"),  # before meshing, not after
     (lambda r: ts.solve(thickness=1, history="yes"), "history"),
     (lambda r: ts.Scene.from_toml(5), "scene file"),            # not read as file descriptor 5

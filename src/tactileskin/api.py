@@ -163,6 +163,8 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
             validate.path(value, name, "a folder path (str or os.PathLike) or None")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError("workers", repr(workers), "a whole number >= 1, or None (one per core)")
+    for name, value in (("serial", serial), ("profiles", profiles), ("report", report)):
+        validate.boolean(value, name)  # serial="no" is truthy: it ran serially
     scs = scenes(grid, quality=quality, base=base)
     if cache is None:
         cache = Path(out) / "cache" if out is not None else default_cache_dir()
