@@ -49,6 +49,25 @@ def test_figures_of_eleven_thicknesses_are_blocks_not_strips(tmp_path):
     assert sum(p.suffix == ".pdf" for p in paths) == 1
 
 
+def test_a_figure_that_cannot_be_written_is_closed_all_the_same(tmp_path, monkeypatch):
+    """A failed write (a full disk) left the figure open in pyplot: a notebook's sweeps each
+    kept one more, until matplotlib warned of more than 20."""
+    import errno
+
+    import matplotlib.pyplot as plt
+
+    from tactileskin.fileio import OutputError
+
+    def full(path, data):
+        raise OutputError(path, errno.errorcode[errno.ENOSPC])
+
+    monkeypatch.setattr(figures, "atomic_write_bytes", full)
+    before = set(plt.get_fignums())
+    with pytest.raises(OutputError):
+        figures.thickness_figure(_grid()[1], tmp_path)
+    assert set(plt.get_fignums()) == before
+
+
 def test_metrics_against_thickness_plots_each_series_in_thickness_order(tmp_path, monkeypatch):
     recs, rows = _grid()
     rows.append(dict(rows[0], thickness_mm=9.0, status="failed: x", peak_mpa=None))  # left out

@@ -60,15 +60,17 @@ def _fit_width(fig) -> None:
 
 def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
-    for ext in DESIGN_FORMATS if stem in DESIGN_STEMS else FORMATS:
-        p = out / f"{stem}.{ext}"
-        buf = io.BytesIO()
-        # every figure has constrained layout, which already keeps its labels inside; a
-        # "tight" bounding box would draw each figure once more per format (~45 % of savefig)
-        fig.savefig(buf, format=ext, dpi=150)
-        atomic_write_bytes(p, buf.getvalue())
-        paths.append(p)
-    _plt().close(fig)
+    try:
+        for ext in DESIGN_FORMATS if stem in DESIGN_STEMS else FORMATS:
+            p = out / f"{stem}.{ext}"
+            buf = io.BytesIO()
+            # every figure has constrained layout, which already keeps its labels inside; a
+            # "tight" bounding box would draw each figure once more per format (~45 % of savefig)
+            fig.savefig(buf, format=ext, dpi=150)
+            atomic_write_bytes(p, buf.getvalue())
+            paths.append(p)
+    finally:  # a failed write (full disk) too: a notebook's pyplot keeps no figure of ours
+        _plt().close(fig)
     return paths
 
 
