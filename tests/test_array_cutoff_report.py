@@ -45,6 +45,10 @@ def test_the_chart_figure_of_a_suspect_chart_says_so(tmp_path, monkeypatch):
     ch = _one_row_chart(3.0)
     ch.notes.append("t = 3 mm: the depth 0.6 mm passes the dot height 0.48 mm: the plate touches")
     titles = []
-    monkeypatch.setattr(array_chart, "_save", lambda fig, out, stem: titles.append(fig._suptitle.get_text()) or [])
+    from tactileskin.report.figures import _plt
+
+    # closed here, as the real _save closes it (it stayed open in pyplot)
+    monkeypatch.setattr(array_chart, "_save",
+                        lambda fig, out, stem: titles.append(fig._suptitle.get_text()) or _plt().close(fig) or [])
     array_chart.write_outputs(ch, tmp_path)
     assert len(titles) == 1 and "SUSPECT parts of the chart: 1 note in array_chart.md" in titles[0], titles
