@@ -36,6 +36,12 @@ def test_help_of_scene_documents_every_field_with_unit_and_range():
     assert "thickness (mm)" in doc and "rate (mm/s)" in doc and "[0.01, 5]" in doc
 
 
+def test_help_of_result_gives_the_metrics_units():
+    """help(r) showed r.peak without a word (span and auc said mm and MPa mm)."""
+    for name, unit in (("peak", "(MPa)"), ("span", "(mm)"), ("auc", "(MPa mm)")):
+        assert unit in (getattr(Result, name).__doc__ or ""), name
+
+
 def test_help_and_signature_of_sweep_are_the_api_function():
     """help(ts.sweep) showed the internal module and inspect.signature() the module's
     __call__(grid=None, **kw), not the documented API."""

@@ -279,6 +279,7 @@ class Result:
 
     @property
     def peak(self) -> float:
+        """Largest mean pressure of the bone profile (MPa)."""
         return peak(*self._profile())
 
     @property
