@@ -140,6 +140,32 @@ def test_a_sweep_leaves_a_users_figure_of_its_pattern(tmp_path, capsys, monkeypa
     assert "report.md" in _err(capsys) and (out / "report.md").read_text() == "my edits\n"
 
 
+def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, monkeypatch):
+    # the refusal came after every case was solved (exit 2, documented as "before any case ran")
+    import tactileskin.sweep as sw
+    from tactileskin.errors import ConvergenceError
+
+    calls = []
+
+    def fail(scene):
+        calls.append(scene.thickness)
+        raise ConvergenceError("not solved in this test", {})
+
+    monkeypatch.setattr(sw, "solve_case", fail)
+    out = tmp_path / "out"
+    argv = ["sweep", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
+    assert main([*argv, "-t", "1"]) == 1 and calls == [1.0]
+    for name in ("report.md", "results.csv"):
+        kept = (out / name).read_bytes()
+        (out / name).write_text("my edits\n")
+        assert main([*argv, "-t", "2"]) == 2
+        err = _err(capsys)
+        assert str(out / name) in err and "changed since" in err and len(err.strip().splitlines()) == 1
+        assert calls == [1.0] and (out / name).read_text() == "my edits\n"
+        (out / name).write_bytes(kept)
+    assert main([*argv, "-t", "2"]) == 1 and calls == [1.0, 2.0]
+
+
 def test_an_api_result_written_into_a_cli_solve_folder_replaces_its_whole_result(tmp_path, capsys, fake_solve):
     d = tmp_path / "s"
     assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0

@@ -49,7 +49,8 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
     from tactileskin.cli import raise_if_signalled
     from tactileskin.cli._console import new_console
 
-    from tactileskin.report.outputs import write_outputs
+    from tactileskin import staging
+    from tactileskin.report.outputs import SWEEP_ALWAYS_WRITTEN, write_outputs
     from tactileskin.sweep import ResultCache, check_reachable, run_sweep
 
     console = new_console()
@@ -59,6 +60,8 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
     out = Path(out)
     cache = ResultCache(cache_dir or out / "cache")
     with claimed_output(out, "sweep"):  # before any solving
+        # an edited report.md or results.csv would be refused only after every case was solved
+        staging.check_replaceable(out, SWEEP_ALWAYS_WRITTEN)
         console.print(f"sweep: {len(scenes)} cases → {escape(str(out))}")
 
         t0 = time.perf_counter()

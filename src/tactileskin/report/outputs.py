@@ -82,6 +82,8 @@ SWEEP_FILES = ("results.csv", "profiles.csv", "results.parquet", "profiles.parqu
                *(f"{stem}.{ext}" for stem in ("metrics_vs_thickness", "fig10_profiles", "fig11_peak", "fig12_span",
                                               "fig13_auc") for ext in ("png", "svg")),
                "metrics_vs_thickness.pdf", "fig9_*.png")
+# the ones every sweep writes, failed cases or not (checked before solving: cli.sweep)
+SWEEP_ALWAYS_WRITTEN = ("results.csv", "profiles.csv", "results.parquet", "profiles.parquet", "report.md")
 
 
 def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = True,
