@@ -59,6 +59,23 @@ def test_key_follows_material_content_not_its_path(tmp_path):
     assert cache_key(Scene(material="polyurethane")) != cache_key(Scene(material="silicone"))
 
 
+def test_key_ignores_the_mold_file_no_solve_reads(geometry):
+    # molds.toml (the casting mold, `build` only) was hashed into every key: widening the mold
+    # wall re-solved every cached case of a sweep; a Braille dimension still changes the key
+    sc = Scene(indenter="braille")
+    k = cache_key(sc)
+    f = geometry / "molds.toml"
+    text = f.read_text()
+    assert "wall = 4.0 " in text
+    f.write_text(text.replace("wall = 4.0 ", "wall = 4.5 "))
+    assert cache_key(sc) == k
+    b = geometry / "braille.toml"
+    text = b.read_text()
+    assert "height = 0.48" in text
+    b.write_text(text.replace("height = 0.48", "height = 0.5"))
+    assert cache_key(sc) != k
+
+
 def test_key_and_loads_follow_geometry_files_within_a_process(geometry):
     sc = Scene(indenter="curved")
     k = cache_key(sc)

@@ -6,8 +6,8 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
 - the scene's fields except the material's name or path;
 - the material's law name and numbers (its parameters and Prony terms), read from the preset table or the
   user's material file: editing the file changes the key, renaming or moving it does not;
-- the bytes of every geometry parameter file (`params.geometry_digest()`: fingertip,
-  indenters, Braille standards, molds);
+- the bytes of every geometry parameter file a solve reads (`params.geometry_digest()`:
+  fingertip, indenters, Braille standards; not molds.toml, read by `build` alone);
 - the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL) and the
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's

@@ -118,13 +118,19 @@ def geometry_changes() -> list[str] | None:
     return sorted(n for n in set(a) | set(b) if a.get(n) != b.get(n))
 
 
+# geometry files no solve reads: the casting mold is CAD for `build` alone (geometry/molds.py),
+# so editing its wall or pins must not re-solve every cached case
+NOT_SOLVED = ("molds.toml",)
+
+
 def geometry_digest() -> str:
-    """SHA-256 of every geometry parameter file (names and bytes, sorted by name): part of
-    the result cache's key, so that editing a dimension invalidates the cached results."""
+    """SHA-256 of every geometry parameter file but NOT_SOLVED (names and bytes, sorted by
+    name): part of the result cache's key, so that editing a dimension invalidates the cached
+    results."""
     folder = geometry_dir()
     try:
-        paths = sorted((p for p in folder.iterdir() if p.name.endswith(".toml") and p.is_file()),
-                       key=lambda p: p.name)
+        paths = sorted((p for p in folder.iterdir() if p.name.endswith(".toml") and p.is_file()
+                        and p.name not in NOT_SOLVED), key=lambda p: p.name)
     except OSError as e:
         raise ParameterError("geometry folder", str(folder), "a readable folder of TOML files",
                              e.strerror or type(e).__name__) from None
