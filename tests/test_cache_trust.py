@@ -6,6 +6,7 @@ import logging
 import shutil
 import threading
 import time
+import tomllib
 
 import numpy as np
 import pytest
@@ -57,6 +58,21 @@ def test_key_follows_material_content_not_its_path(tmp_path):
     _material_file(b, mu_scale=10.0)
     assert cache_key(Scene(material=str(b))) != k            # mu x10: another result
     assert cache_key(Scene(material="polyurethane")) != cache_key(Scene(material="silicone"))
+
+
+def test_an_elastic_key_ignores_the_prony_series_it_does_not_solve_with(tmp_path):
+    # editing g of a material re-solved its elastic cases (viscoelastic = false), whose solve
+    # never reads the Prony series; the viscoelastic cases' key still follows it
+    p = _material_file(tmp_path / "pu.toml")
+    elastic, visco = Scene(material=str(p), viscoelastic=False), Scene(material=str(p))
+    ke, kv = cache_key(elastic), cache_key(visco)
+    d = tomllib.loads(p.read_text())
+    d["prony"]["g"][0] *= 1.01
+    p.write_text(tomli_w.dumps(d))
+    assert cache_key(elastic) == ke and cache_key(visco) != kv
+    d["hyperfoam"]["mu"][0] *= 1.01
+    p.write_text(tomli_w.dumps(d))
+    assert cache_key(elastic) != ke
 
 
 def test_key_ignores_the_mold_file_no_solve_reads(geometry):

@@ -4,7 +4,8 @@ Key. `Scene.key()` hashes the scene's own fields only (it names a scene, e.g. to
 duplicates from a grid). A cached result also depends on files and code the scene merely
 names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
 - the scene's fields except the material's name or path;
-- the material's law name and numbers (its parameters and Prony terms), read from the preset table or the
+- the material's law name and numbers (its parameters, and its Prony terms for a viscoelastic scene:
+  an elastic solve ignores them), read from the preset table or the
   user's material file: editing the file changes the key, renaming or moving it does not;
 - the bytes of every geometry parameter file a solve reads (`params.geometry_digest()`:
   fingertip, indenters, Braille standards; not molds.toml, read by `build` alone);
@@ -121,7 +122,10 @@ def code_digest(root: Path | None = None) -> str:
 def cache_key(scene: Scene) -> str:
     """Hash of everything that can change `scene`'s result (see the module docstring)."""
     fields = _scene_fields(scene)
-    payload = {"scene": fields, "material": material_content(scene.material),
+    material = material_content(scene.material)
+    if not scene.viscoelastic:  # fe.solve leaves the Prony series out: its edit must not re-solve
+        material.pop("prony")
+    payload = {"scene": fields, "material": material,
                "geometry": params.geometry_digest(), "schema": SCHEMA_VERSION, "version": __version__,
                "code": code_digest()}
     files = scene.indenter_kind.cache_content(scene)
