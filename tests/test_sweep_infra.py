@@ -24,6 +24,21 @@ def test_braille_texts_only_multiply_braille_cases():
     assert len(scenes) == 4  # flat, curved, braille, braille 'ab'
 
 
+def test_a_braille_standard_is_the_braille_cases_alone():
+    # [scene] braille_standard = "ada_2010" went onto the flat and curved cases too: their
+    # results were bit-identical, yet re-solved under other keys and left out of the paper checks
+    from tactileskin.cache import cache_key
+    from tactileskin.report.markdown import at_paper_conditions
+
+    grid = dict(thicknesses=[1.0], materials=["silicone"], braille_dims=[2], quality="preview")
+    plain = expand_grid(**grid)
+    ada = expand_grid(base=Scene(braille_standard="ada_2010"), **grid)
+    assert [s.indenter.value for s in ada] == ["flat", "curved", "braille"]
+    for a, p in zip(ada[:2], plain[:2]):
+        assert a == p and cache_key(a) == cache_key(p) and at_paper_conditions(a)
+    assert ada[2].braille_standard == "ada_2010" and cache_key(ada[2]) != cache_key(plain[2])
+
+
 @pytest.mark.parametrize("text, expect", [("1,3,5", [1, 3, 5]), ("1:2:0.5", [1, 1.5, 2]), (" 2 ", [2])])
 def test_parse_values(text, expect):
     assert parse_values(text, "thickness") == pytest.approx(expect)

@@ -108,6 +108,7 @@ def default_braille_dims(base: Scene, quality: str | None, overrides: dict | Non
 
 
 _NONE = object()
+_DEFAULT_STANDARD = Scene.__dataclass_fields__["braille_standard"].default
 
 
 def expand_grid(
@@ -173,13 +174,17 @@ def expand_grid(
         kind = get_kind(ind)  # validates the name
         braille = "braille_text" in kind.scene_params  # the kind reads the texts axis
         own = dims if kind.section_2d == "ridge" else (base.dim,)
+        # a [scene] Braille standard is the Braille cases': on a flat or curved case it changed
+        # nothing solved but the key (re-solved) and left the case out of the paper checks
+        std = {} if "braille_standard" in kind.scene_params else {"braille_standard": _DEFAULT_STANDARD}
         if kind.section_2d is None:
             own = (3,)  # no 2D model of this kind: its cases are 3D
         for text in (braille_texts if braille else ("",)):
             for dim in own:
                 fc = {} if f is None else {"force": f}
                 try:
-                    s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim, **fc)
+                    s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim,
+                                     **fc, **std)
                 except ParameterError as e:
                     if not (chosen and dim == 3 and len(dims) > 1):
                         raise
