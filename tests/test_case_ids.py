@@ -11,16 +11,8 @@ from tactileskin.scene import Scene
 from tactileskin.sweep import case_ids, case_variants, expand_grid
 
 
-@pytest.fixture(autouse=True)
-def _close_the_captured_figures():
-    """The `_save` stubs here keep each figure to look at, so _save's close never runs: close
-    them after the test (this file and test_report_figures.py left 21 open, and matplotlib warned of
-    more than 20 in the test session)."""
-    yield
-    import sys
-
-    if "matplotlib.pyplot" in sys.modules:
-        sys.modules["matplotlib.pyplot"].close("all")
+# the `_save` stubs here keep each figure to look at, so _save's close never runs (conftest.py)
+pytestmark = pytest.mark.usefixtures("close_figures")
 
 
 def test_paper_grid_ids_are_the_plain_labels():

@@ -18,16 +18,8 @@ from tactileskin.sweep import CaseRecord
 THICK = [round(0.5 + 0.5 * i, 1) for i in range(11)]  # 0.5 .. 5.5 mm: 11 thicknesses
 
 
-@pytest.fixture(autouse=True)
-def _close_the_captured_figures():
-    """The `_save` stubs here keep each figure to look at, so _save's close never runs: close
-    them after the test (this file and test_case_ids.py left 21 open, and matplotlib warned of
-    more than 20 in the test session)."""
-    yield
-    import sys
-
-    if "matplotlib.pyplot" in sys.modules:
-        sys.modules["matplotlib.pyplot"].close("all")
+# the `_save` stubs here keep each figure to look at, so _save's close never runs (conftest.py)
+pytestmark = pytest.mark.usefixtures("close_figures")
 
 
 def _grid():
