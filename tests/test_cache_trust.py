@@ -92,6 +92,25 @@ def test_key_ignores_the_mold_file_no_solve_reads(geometry):
     assert cache_key(sc) != k
 
 
+def test_code_digest_leaves_out_the_shipped_mold_file(tmp_path):
+    # the packaged data/geometry/*.toml are also package files: editing the shipped molds.toml in
+    # place (the one source of truth, README) changed code_digest, so every case re-solved anyway
+    from tactileskin.cache import code_digest
+
+    pkg = tmp_path / "pkg"
+    (pkg / "data" / "geometry").mkdir(parents=True)
+    (pkg / "data" / "geometry" / "molds.toml").write_text("wall = 4.0\n")
+    (pkg / "data" / "geometry" / "braille.toml").write_text("height = 0.48\n")
+    d0 = code_digest(pkg)
+    (pkg / "data" / "geometry" / "molds.toml").write_text("wall = 4.5\n")
+    code_digest.cache_clear()
+    assert code_digest(pkg) == d0
+    (pkg / "data" / "geometry" / "braille.toml").write_text("height = 0.5\n")
+    code_digest.cache_clear()
+    assert code_digest(pkg) != d0  # a file a solve reads still counts
+    code_digest.cache_clear()
+
+
 def test_key_and_loads_follow_geometry_files_within_a_process(geometry):
     sc = Scene(indenter="curved")
     k = cache_key(sc)
