@@ -185,16 +185,18 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
     from scipy.optimize import least_squares
 
     cls = get_law(law)
+    from tactileskin.materials.laws import MAX_BULK_OVER_SHEAR as r
+
+    # at most the nu0 a material file may have (laws.law_from_dict: K0 / mu0 <= 5000, nu0 =
+    # 0.49990001, stated to 4 digits): nu = 0.49999 was fitted and written, and the file then
+    # refused by every solve
+    nu_max = math.floor(1e4 * (3 * r - 2) / (2 * (3 * r + 1))) / 1e4
     if nu is not None:
         from tactileskin.errors import check_range
-        from tactileskin.materials.laws import MAX_BULK_OVER_SHEAR as r
 
-        # at most the nu0 a material file may have (laws.law_from_dict: K0 / mu0 <= 5000, nu0 =
-        # 0.49990001, stated to 4 digits): nu = 0.49999 was fitted and written, and the file then
-        # refused by every solve
-        nu = check_range("nu", nu, -1.0, math.floor(1e4 * (3 * r - 2) / (2 * (3 * r + 1))) / 1e4, lo_open=True)
-    elif law == "hyperfoam":
-        raise ParameterError("nu", None, "(-1, 0.5)", "hyperfoam has no incompressible form: give nu")
+        nu = check_range("nu", nu, -1.0, nu_max, lo_open=True)
+    elif law == "hyperfoam":  # the same range as a given nu's, not the (-1, 0.5) it was refused in
+        raise ParameterError("nu", None, f"(-1, {nu_max:g}]", "hyperfoam has no incompressible form: give nu")
     if law in ("ogden", "hyperfoam"):
         terms = 2 if terms is None else terms
         if not (isinstance(terms, int) and 1 <= terms <= 3):
