@@ -166,6 +166,31 @@ def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, 
     assert main([*argv, "-t", "2"]) == 1 and calls == [1.0, 2.0]
 
 
+def test_ts_sweep_refuses_an_edited_result_file_before_solving(tmp_path, monkeypatch):
+    # 80f0cc8 moved the refusal before the solves for the command only: ts.sweep(out=...) still
+    # solved every case and then refused the edited report.md
+    import tactileskin as ts
+    import tactileskin.sweep as sw
+    from tactileskin.errors import ConvergenceError
+    from tactileskin.fileio import OutputError
+
+    calls = []
+
+    def fail(scene):
+        calls.append(scene.thickness)
+        raise ConvergenceError("not solved in this test", {})
+
+    monkeypatch.setattr(sw, "solve_case", fail)
+    out = tmp_path / "out"
+    grid = {"materials": ["silicone"], "indenters": ["flat"]}
+    ts.sweep({**grid, "thicknesses": [1.0]}, out=out, serial=True, report=False)
+    assert calls == [1.0]
+    (out / "report.md").write_text("my edits\n")
+    with pytest.raises(OutputError, match="changed since"):
+        ts.sweep({**grid, "thicknesses": [2.0]}, out=out, serial=True, report=False)
+    assert calls == [1.0] and (out / "report.md").read_text() == "my edits\n"
+
+
 def test_an_api_result_written_into_a_cli_solve_folder_replaces_its_whole_result(tmp_path, capsys, fake_solve):
     d = tmp_path / "s"
     assert main(["solve", "--dim", "3", *CHEAP, "--compare-2d", "--out", str(d)]) == 0

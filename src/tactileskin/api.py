@@ -175,6 +175,11 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         from tactileskin.outdir import claimed
 
         with claimed(Path(out), "sweep", what="out"):  # a second run into `out` is refused
+            from tactileskin import staging
+            from tactileskin.report.outputs import SWEEP_ALWAYS_WRITTEN
+
+            # as the command (cli.sweep): an edited report.md is refused now, not after every case
+            staging.check_replaceable(Path(out), SWEEP_ALWAYS_WRITTEN)
             records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, Path(out), report)
     from tactileskin.report.outputs import RESULT_COLUMNS
 
