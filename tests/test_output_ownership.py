@@ -140,8 +140,9 @@ def test_a_sweep_leaves_a_users_figure_of_its_pattern(tmp_path, capsys, monkeypa
     assert "report.md" in _err(capsys) and (out / "report.md").read_text() == "my edits\n"
 
 
-def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, monkeypatch):
-    # the refusal came after every case was solved (exit 2, documented as "before any case ran")
+@pytest.fixture
+def failing_solves(monkeypatch):
+    """Every case's solve fails at once; the list of the thicknesses it was asked to solve."""
     import tactileskin.sweep as sw
     from tactileskin.errors import ConvergenceError
 
@@ -152,6 +153,12 @@ def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, 
         raise ConvergenceError("not solved in this test", {})
 
     monkeypatch.setattr(sw, "solve_case", fail)
+    return calls
+
+
+def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, failing_solves):
+    # the refusal came after every case was solved (exit 2, documented as "before any case ran")
+    calls = failing_solves
     out = tmp_path / "out"
     argv = ["sweep", "-m", "silicone", "-i", "flat", "--serial", "--no-render", "--out", str(out)]
     assert main([*argv, "-t", "1"]) == 1 and calls == [1.0]
@@ -166,21 +173,13 @@ def test_a_sweep_refuses_an_edited_result_file_before_solving(tmp_path, capsys, 
     assert main([*argv, "-t", "2"]) == 1 and calls == [1.0, 2.0]
 
 
-def test_ts_sweep_refuses_an_edited_result_file_before_solving(tmp_path, monkeypatch):
+def test_ts_sweep_refuses_an_edited_result_file_before_solving(tmp_path, failing_solves):
     # 80f0cc8 moved the refusal before the solves for the command only: ts.sweep(out=...) still
     # solved every case and then refused the edited report.md
     import tactileskin as ts
-    import tactileskin.sweep as sw
-    from tactileskin.errors import ConvergenceError
     from tactileskin.fileio import OutputError
 
-    calls = []
-
-    def fail(scene):
-        calls.append(scene.thickness)
-        raise ConvergenceError("not solved in this test", {})
-
-    monkeypatch.setattr(sw, "solve_case", fail)
+    calls = failing_solves
     out = tmp_path / "out"
     grid = {"materials": ["silicone"], "indenters": ["flat"]}
     ts.sweep({**grid, "thicknesses": [1.0]}, out=out, serial=True, report=False)
