@@ -143,3 +143,31 @@ def test_a_geometry_folder_without_the_mount_thickness_is_a_one_line_error(tmp_p
     assert main(["build", "--out", str(out), "--no-molds", "--indenter", "sphere", "--indenter-radius", "0.5"]) == 2
     cap = capsys.readouterr()
     assert "indenters.stem.mount_thickness" in cap.err and "Traceback" not in cap.err + cap.out
+
+
+def test_a_printed_cylinder_meets_the_skin_off_its_modelled_face_only_past_its_working_travel(tmp_path):
+    """The part beyond the model's face (the chord's edges, back and mount) stays out of the
+    fingertip until `working_travel`, the depth a scene may ask: R 2.5 at t = 5 was accepted to
+    3 mm, where the face's edges lay 1.3 mm and the mount's flat 0.76 mm inside the finger."""
+    import numpy as np
+
+    from tactileskin.geometry.export import write_stl
+    from tactileskin.geometry.solids import indenter_solid
+    from tactileskin.scene import Scene
+
+    sc = Scene(indenter="cylinder", indenter_radius=2.5, thickness=5.0, depth=1.0)
+    ft, ind = Fingertip.from_params(), make_indenter(sc)
+    cap = ind.working_travel(sc.section(), sc.sample_length)
+    write_stl(indenter_solid(ind), tmp_path / "c.stl")
+    pts, _ = trimesh.sample.sample_surface_even(trimesh.load(str(tmp_path / "c.stl")), 40000, seed=1)
+    off = pts[np.abs(ind.gap(pts, 0.0)[0]) > 0.01]  # printed surface that is not the model's cylinder
+
+    def inside_finger(travel):  # below the fingertip's outer contour, within its sample length
+        x, y = off[:, 0], off[:, 1] - travel
+        return int(np.sum((np.abs(x) < ft.half_width) & (np.abs(off[:, 2]) < 0.5 * ft.sample_length)
+                          & (y < ft.height * np.sqrt(np.clip(1.0 - (x / ft.half_width) ** 2, 0.0, None)))))
+
+    assert cap == pytest.approx(1.693, abs=1e-3)
+    assert inside_finger(cap - 0.01) == 0
+    assert inside_finger(cap + 0.1) > 0
+    assert inside_finger(3.0) > 1000  # the depth once accepted: the mount's flat is in the finger

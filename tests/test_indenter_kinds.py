@@ -270,6 +270,51 @@ def test_a_sphere_is_pressed_within_its_printed_cap():
     ChartConfig(thicknesses=(5.0,), sets=("shapes",), sphere_radius=0.5, max_depth=0.4)
 
 
+def test_a_cylinder_pressed_past_its_printed_face_is_flagged():
+    # the printed cylinder is a strip one chord wide (min(18, 1.8 R)) under a flat back and, for a
+    # small R, a 14 mm mount block, all from the sagitta above its lowest line up
+    # (solids.cylinder_indenter); the model's cylinder goes on round. R 2.5 on t = 5 at 3 mm was
+    # solved "ok": the face's edges cut 1.3 mm and the mount's flat (1.96 mm up) 0.76 mm into the skin
+    s = 2.5 - np.sqrt(2.5 ** 2 - 2.25 ** 2)                 # 1.410: the face's edges at |x| = 2.25
+    cap = s + 7.0 - 7.0 * np.sqrt(1.0 - (2.25 / 8.0) ** 2)  # + where the fingertip's top has fallen there
+    ind = indenter_for_scene(Scene(indenter="cylinder", indenter_radius=2.5, thickness=5.0))
+    assert ind.working_travel(Scene(thickness=5.0).section(), 20.0) == pytest.approx(cap, abs=1e-6)
+    # across the finger the chord runs along z, where the top is straight: the sagitta itself
+    x = indenter_for_scene(Scene(dim=3, indenter="cylinder", indenter_radius=2.5, indenter_axis="x", thickness=5.0))
+    assert x.working_travel(Scene(thickness=5.0).section(), 20.0) == pytest.approx(s, abs=1e-9)
+    # a skin that ends within the face never meets its edges: the 16 mm fingertip under an 18 mm
+    # face (R 100), an 18 mm pad under the curved; the curved on a 40 mm pad: its sagitta 4.06 mm
+    big = indenter_for_scene(Scene(indenter="cylinder", indenter_radius=100.0, thickness=5.0))
+    assert big.working_travel(Scene(thickness=5.0).section(), 20.0) == np.inf
+    pad18 = Scene(skin="pad", pad_width=18.0, thickness=25.0, indenter="curved")
+    assert indenter_for_scene(pad18).working_travel(pad18.section(), pad18.sample_length) == np.inf
+    pad40 = Scene(skin="pad", pad_width=40.0, thickness=25.0, indenter="curved")
+    assert indenter_for_scene(pad40).working_travel(pad40.section(), pad40.sample_length) == pytest.approx(4.06, abs=0.01)
+    # flagged, not refused: a soft skin sinks away from the edges, so a depth past the bound is solved
+    # and marked (R 0.5 on a 2 mm pad: sagitta 0.282 mm)
+    from tactileskin.api import solve
+
+    deep = solve(Scene(skin="pad", pad_width=10.0, thickness=2.0, indenter="cylinder", indenter_radius=0.5, depth=0.4))
+    assert deep.stats["indenter_cap"]["cap_mm"] == pytest.approx(0.5 - np.sqrt(0.25 - 0.45 ** 2), rel=1e-9)
+    assert deep.status.startswith("suspect") and "sagitta" in deep.status
+    shallow = solve(Scene(skin="pad", pad_width=10.0, thickness=2.0, indenter="cylinder", indenter_radius=0.5,
+                          depth=0.25))
+    assert "indenter_cap" not in shallow.stats
+
+
+def test_a_force_past_the_cylinders_face_is_flagged():
+    # a force finds its travel in the solve: R 0.5 (0.9 mm face, sagitta 0.282 mm) on a 10 mm pad
+    # went 0.61 mm at 0.3 N/mm and read "ok"
+    from tactileskin.api import solve
+
+    r = solve(Scene(skin="pad", pad_width=10.0, thickness=2.0, indenter="cylinder", indenter_radius=0.5,
+                    force=0.3))
+    cap = r.stats["indenter_cap"]
+    assert cap["cap_mm"] == pytest.approx(0.5 - np.sqrt(0.25 - 0.45 ** 2), rel=1e-9)
+    assert cap["travel_mm"] > 2.0 * cap["cap_mm"]
+    assert r.status.startswith("suspect") and "sagitta" in r.status
+
+
 def test_a_force_past_the_spheres_cap_is_flagged():
     # force control finds the travel only in the solve (measured: R 0.5 on 1 mm silicone at 6x
     # the 0.25 mm reaction went to 0.521 mm, past the 0.475 mm cap, and read "ok")
@@ -301,6 +346,9 @@ def test_a_contact_past_the_printed_face_is_flagged():
     assert [f["code"] for f in deep["flags"]] == ["indenter_cap"]
     assert deep["indenter_cap"]["contact_mm"] > deep["indenter_cap"]["face_half_mm"] == pytest.approx(0.45)
     assert "0.45 mm" in deep["status"]
-    # at 0.4 mm the contact stays on the arc (x <= 0.413 mm): no flag
-    assert solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.4, **kw)).status == "ok"
+    # at 0.4 mm the contact stays on the arc (x <= 0.413 mm), but the travel is past where the face's
+    # edges meet the undeformed top (0.28 mm + the fall of the fingertip's top there): flagged by the travel
+    mid = solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.4, **kw)).summary()
+    assert "contact_mm" not in mid["indenter_cap"] and mid["indenter_cap"]["cap_mm"] < 0.4
+    assert solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.25, **kw)).status == "ok"
     assert solve(Scene(skin="pad", pad_width=40, thickness=2, indenter="flat", depth=0.1, **kw)).status == "ok"

@@ -187,8 +187,9 @@ def flags(summary: dict) -> list[Flag]:
     elif isinstance(cap, dict):
         out.append(Flag("indenter_cap", f"the indenter travelled {_num(cap, 'travel_mm') or math.nan:.3g} mm, past its printed "
                         f"working face ({_num(cap, 'cap_mm') or math.nan:.3g} mm: a sphere's cap is 0.95 R high, its mount "
-                        "plate starts there): the printed part would press with its mount, and the model's skin "
-                        "wraps round the ball; use a larger radius or a smaller force"))
+                        "plate starts there; a cylinder's face is a strip one chord wide, its edges and mount start "
+                        "at the chord's sagitta, met by the undeformed skin's top): the printed part would press "
+                        "with those, which the model does not have; use a larger radius or a smaller depth or force"))
     buck = summary.get("buckling")
     if isinstance(buck, dict):
         out.append(Flag("buckling", f"pressed to {_num(buck, 'strain') or math.nan:.3g} of its thickness, past the "

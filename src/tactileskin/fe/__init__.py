@@ -360,11 +360,13 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                                    recovery=time.perf_counter() - t2, total=stats.wall_s)
     if getattr(model, "_linsolve", None) is not None:
         res.stats["linear_solver"] = model._linsolve.describe()
-    cap = getattr(getattr(model.contact, "indenter", None), "working_depth", math.inf)
+    ind = getattr(model.contact, "indenter", None)
+    cap = ind.working_travel(section, scene.sample_length) if hasattr(ind, "working_travel") else math.inf
     travel = res.stats.get("max_travel_mm", float(model.d))
-    if travel > cap:  # a force or a creep took the indenter past its printed working face
-        res.stats["indenter_cap"] = {"travel_mm": travel, "cap_mm": float(cap)}
-    elif res.contact_points is not None and len(res.contact_points):
+    cap_info = {}
+    if travel > cap:  # the indenter went past its printed working face: its edges or mount would press
+        cap_info = {"travel_mm": travel, "cap_mm": float(cap)}
+    if res.contact_points is not None and len(res.contact_points):
         # the contact reaches past the printed face's extent, where the model's gap continues it
         # (a cylinder's whole circle) and the printed part has its sides or mount
         faces = getattr(getattr(model.contact, "indenter", None), "face_halfwidths", lambda: (math.inf, math.inf))
@@ -372,8 +374,9 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
         reach = np.abs(np.asarray(res.contact_points, float)[:, [0, 2][: model.m - 1]]).max(axis=0)
         if np.any(reach > half):
             k = int(np.argmax(reach - half))
-            res.stats["indenter_cap"] = {"travel_mm": travel, "contact_mm": float(reach[k]),
-                                         "face_half_mm": float(half[k]), "axis": "xz"[k]}
+            cap_info.update(travel_mm=travel, contact_mm=float(reach[k]), face_half_mm=float(half[k]), axis="xz"[k])
+    if cap_info:
+        res.stats["indenter_cap"] = cap_info
     eb = scene.skin_kind.buckling_strain(scene)
     if eb is not None and travel / scene.thickness > eb:  # the model cannot buckle: the skin would
         res.stats["buckling"] = {"strain": travel / scene.thickness, "euler_strain": eb}

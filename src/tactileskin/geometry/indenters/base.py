@@ -181,6 +181,11 @@ class Indenter:
         where the model's face is the whole part's."""
         return float("inf"), float("inf")
 
+    def working_travel(self, section, length: float) -> float:
+        """`working_depth` on a given skin (its `section`, `length` long along z), where the kind
+        can tell that the skin meets the printed part's other faces later or never."""
+        return self.working_depth
+
     def contact_planes(self) -> np.ndarray:
         """z planes on which the first touch is sought in 3D (the slab is uniform along z)."""
         return np.zeros(1)

@@ -80,6 +80,29 @@ class CylinderIndenter(Indenter):
         R, c = self.radius, 0.5 * self.chord
         return R - math.sqrt(R * R - c * c)
 
+    def working_travel(self, section, length: float) -> float:
+        """The printed face is the strip of the cylinder one chord wide (solids.cylinder_indenter):
+        its edges, and the back and the mount above them, start the sagitta above its lowest line,
+        where the model's cylinder goes on round. The travel after which they first meet the
+        undeformed skin: the sagitta plus how far below y0 the skin's top lies where the face ends
+        (across the axis); inf where the skin ends within the face. A travel past it is flagged
+        (fe.solve: indenter_cap), not refused: a soft skin sinks away from the edges (R 0.5 on a 1 mm
+        pad at 0.4 mm: contact to x = 0.413 of the arc's 0.45), so it bounds the trouble from above."""
+        c = 0.5 * self.chord
+        if self.axis == "x":  # the chord runs along z, where the skin's top is straight
+            return self.sagitta if 0.5 * length > c + 1e-9 else math.inf
+        pts = section.outer_points(4000)
+        x, y = np.abs(pts[:, 0]), pts[:, 1]
+        beyond = x > c + 1e-9
+        if not beyond.any():
+            return math.inf
+        top = float(y[beyond].max())
+        if not beyond.all():  # the top at x = c itself, between the samples either side (a file's are unordered)
+            i = np.flatnonzero(~beyond)[np.argmax(x[~beyond])]
+            j = np.flatnonzero(beyond)[np.argmin(x[beyond])]
+            top = max(top, float(np.interp(c, [x[i], x[j]], [y[i], y[j]])))
+        return self.sagitta + max(self.y0 - top, 0.0)
+
     def _gap(self, p, d):
         R = self.radius
         across = 0 if self.axis == "z" else 2   # the coordinate across the axis besides y
