@@ -134,7 +134,7 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("volume_range", f"volume ratio J = {J:.4g} outside [{lo:g}, {hi:g}] "
                         "(material law outside its range)"))
     if _num(summary, "element_order") == 1 and (nu0 is None or nu0 >= NU_LOCKING):
-        out.append(Flag("locking", f"linear (P1) displacement elements with a nearly incompressible law"
+        out.append(Flag("locking", "linear (P1) displacement elements with a nearly incompressible law"
                         + (f" (nu0 = {nu0:.3g})" if nu0 is not None else "") + " lock: the t = 1 mm flat plate "
                         "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
     if summary.get("profile_plane_unknown"):
