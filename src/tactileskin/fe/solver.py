@@ -671,7 +671,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
                 raise ConvergenceError(f"no convergence at t = {t:.6g} s{where} with dt = {dt:.3g} s: {f.why} "
                                        "(the skin or its mesh gives out there: the material law's lock-up, elements "
                                        "too coarse for the strain or the contact; try a smaller depth or force, or "
-                                       "a finer mesh, --quality fine)", diag) from None
+                                       "a finer mesh: quality fine)", diag) from None
             if opts.failed_dt_fraction > 0.0:
                 dt_cap = min(dt_cap, opts.failed_dt_fraction * dt)
             dt *= opts.cutback

@@ -124,7 +124,7 @@ def _require_every_dot(scene) -> None:
         raise ParameterError("depth", scene.indentation,
                              f"> {need:.3g} mm for the text {scene.braille_text!r}, at most {scene.max_travel:g} mm",
                              f"its dots at |x| = {x[far].min():.3g} mm first touch the skin after "
-                             f"{touch[far].min():.3g} mm and would press nothing; use a larger --depth or fewer cells")
+                             f"{touch[far].min():.3g} mm and would press nothing; use a larger depth or fewer cells")
 
 
 def require_contact(scene) -> None:
@@ -154,7 +154,7 @@ def require_contact(scene) -> None:
     if travel < dmax:
         hint = " or a text with a dot on the centre line" if isinstance(ind, BrailleIndenter) else ""
         raise ParameterError("depth", depth, f"> {travel:.3g} mm for this indenter, at most {dmax:g} mm",
-                             f"no contact: {why}; use a larger --depth{hint}")
+                             f"no contact: {why}; use a larger depth{hint}")
     # the kind's own parameters place it: name the first (the text, the file), else the kind
     field_ = next(iter(get_kind(scene.indenter).scene_params), "indenter")
     value = getattr(scene, field_) if field_ != "indenter" else scene.indenter.value
