@@ -36,6 +36,11 @@ MAX_FORCE = 1e4      # N (N/mm): far beyond any soft skin under a fingertip-size
 MIN_FORCE = 1e-4
 
 
+def force_unit(dim: int) -> str:
+    """A force's unit: N on the whole indenter in 3D, N/mm of the half section in 2D (plane strain)."""
+    return "N" if dim == 3 else "N/mm"
+
+
 @dataclass(frozen=True)
 class Segment:
     kind: str                    # "depth" | "force" | "hold"
@@ -61,7 +66,7 @@ class Segment:
         section in 2D (plane strain), so the scene's `dim` is needed."""
         if self.kind == "hold":
             return f"hold {self.time:g} s"
-        unit = "mm" if self.kind == "depth" else ("N" if dim == 3 else "N/mm")
+        unit = "mm" if self.kind == "depth" else force_unit(dim)
         how = f"at {self.rate:g} {unit}/s" if self.rate is not None else f"in {self.time:g} s"
         return f"{self.kind} to {self.target:g} {unit} {how}"
 

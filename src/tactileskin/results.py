@@ -266,7 +266,9 @@ class Result:
         except ParameterError:  # a profile too short for the metrics
             metrics = "no profile"
         extra = ", bone_map" if self.bone_map is not None else ""
-        unit = "N" if self.dim == 3 else "N/mm"
+        from tactileskin.loading import force_unit
+
+        unit = force_unit(self.dim)
         return (f"<Result {name}: {metrics}, reaction={self.reaction:.4g} {unit}, status={self.status!r}; "
                 f"{self.s.size} profile points, {self.contact_x.size} contact points, "
                 f"{int(self.stats.get('dofs', 0))} dofs{extra}>")

@@ -105,7 +105,9 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
     else:
         t.add_row("reaction (half section)", f"{quality.reaction_of(s):.4g} N/mm")
     if "loading" in s:
-        lo, unit = s["loading"], "N" if scene.dim == 3 else "N/mm"
+        from tactileskin.loading import force_unit
+
+        lo, unit = s["loading"], force_unit(scene.dim)
         if lo.get("target_force") is not None:
             t.add_row("force control", f"{lo['reached_force']:.5g} {unit} (target {lo['target_force']:.5g}) "
                       f"at travel {lo['reached_travel_mm']:.4g} mm")

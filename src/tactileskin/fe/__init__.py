@@ -170,6 +170,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
     from tactileskin.errors import ConvergenceError, ParameterError
     from tactileskin.fe.loading import run_program
     from tactileskin.fe.output import bone_peak, law_state
+    from tactileskin.loading import force_unit
 
     multi = len(program) > 1
     peak_of = bone_peak(model) if multi else None
@@ -216,7 +217,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments");
         # or no travel of an increment met its force (10000 N/mm on 1 mm silicone stalled at
         # 9.6 N/mm, "after 16 trial travels", the parameter unnamed)
-        unit = "N" if scene.dim == 3 else "N/mm"
+        unit = force_unit(scene.dim)
         stalled = (f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
                    f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "
                    f"|stress| up to {worst.get('max_abs_stress_mpa', float('nan')):.3g} MPa")
@@ -243,7 +244,7 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         "control": program[0].kind, "segments": [g.to_dict() for g in program],
         # the forces and reactions below: per mm of depth of the half section in 2D, on the
         # whole indenter in 3D
-        "force_unit": "N" if scene.dim == 3 else "N/mm",
+        "force_unit": force_unit(scene.dim),
         # reached at the end of the scene's force ramp (a later, larger force or depth segment
         # gives the peak-load state below, not the answer to target_force)
         "target_force": scene.force, "reached_force": first["reaction"] if scene.force is not None else None,

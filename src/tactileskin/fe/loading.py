@@ -57,7 +57,9 @@ def vertical_reaction(model, ev) -> float:
 
 def _unit(model) -> str:
     """The reaction's unit: N on the whole indenter in 3D, N/mm of the half section in 2D."""
-    return "N" if getattr(model, "m", 3) == 3 else "N/mm"
+    from tactileskin.loading import force_unit
+
+    return force_unit(getattr(model, "m", 3))
 
 
 class ForceIncrement:
