@@ -370,7 +370,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     if res.contact_points is not None and len(res.contact_points):
         # the contact reaches past the printed face's extent, where the model's gap continues it
         # (a cylinder's whole circle) and the printed part has its sides or mount
-        faces = getattr(getattr(model.contact, "indenter", None), "face_halfwidths", lambda: (math.inf, math.inf))
+        faces = getattr(ind, "face_halfwidths", lambda: (math.inf, math.inf))
         half = np.asarray(faces()[: model.m - 1], float)
         reach = np.abs(np.asarray(res.contact_points, float)[:, [0, 2][: model.m - 1]]).max(axis=0)
         if np.any(reach > half):
