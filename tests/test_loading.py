@@ -214,6 +214,32 @@ def test_sweep_over_forces(tmp_path):
         expand_grid(thicknesses=[1], materials=["silicone"], indenters=["curved"], depths=[0.2], forces=[0.1])
 
 
+def test_results_csv_gives_the_force_a_case_asked_for(tmp_path):
+    """A force sweep's results.csv had no column for the force asked for: only the case id's
+    'F0.2' told it, and depth_mm holds the travel reached. Now target_force_n_per_mm (2D) or
+    target_force_n (3D), empty under displacement control."""
+    import csv
+    import dataclasses
+    from types import SimpleNamespace
+
+    from tactileskin.report.outputs import RESULT_COLUMNS, collect
+
+    base = Scene(thickness=1.0, indenter="curved", viscoelastic=False)
+    scenes = [dataclasses.replace(base, force=0.2), dataclasses.replace(base, dim=3, force=0.5), base]
+    outcomes = [SimpleNamespace(scene=sc, status="failed", error="ConvergenceError: x", key="k", record=None)
+                for sc in scenes]
+    _, rows, _ = collect(outcomes, cache=None)
+    assert [(r.get("target_force_n_per_mm"), r.get("target_force_n")) for r in rows] == \
+        [(0.2, None), (None, 0.5), (None, None)]
+    assert {"target_force_n_per_mm", "target_force_n"} <= set(RESULT_COLUMNS)
+    buf = tmp_path / "r.csv"
+    with open(buf, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=RESULT_COLUMNS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    assert [r["target_force_n_per_mm"] for r in csv.DictReader(open(buf))] == ["0.2", "", ""]
+
+
 def test_cli_solve_force_and_history(tmp_path, capsys):
     import json
 

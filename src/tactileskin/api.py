@@ -186,7 +186,8 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     metrics = pd.DataFrame(rows)
     cols = [c for c in RESULT_COLUMNS + ["dim", "variant"] if c in metrics.columns]
     metrics = metrics[cols]
-    for c in ("peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n", "min_J",
+    for c in ("target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
+              "reaction_n", "min_J",
               "max_abs_stress_mpa", "wall_s"):
         if c in metrics.columns:  # a value a case has not (a 2D case's reaction_n, a failed case): NaN
             metrics[c] = pd.to_numeric(metrics[c], errors="coerce").astype(float)

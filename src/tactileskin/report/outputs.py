@@ -16,7 +16,7 @@ from tactileskin.staging import staged_files
 log = logging.getLogger(__name__)
 
 RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter", "braille_text",
-                  "depth_mm", "rate_mm_s", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n",
+                  "depth_mm", "rate_mm_s", "target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n",
                   "min_J", "max_abs_stress_mpa",
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
 
@@ -38,6 +38,8 @@ def collect(outcomes, cache):
                    thickness_mm=sc.thickness, material=sc.material,
                    indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
                    rate_mm_s=sc.rate, dim=sc.dim)
+        if sc.force is not None:  # force control: the force asked for (the reaction columns hold what it reached)
+            row["target_force_n" if sc.dim == 3 else "target_force_n_per_mm"] = sc.force
         if oc.status == "failed":
             row.update(status=quality.failed_status(oc.error), error=oc.error)
             failures.append(oc)
