@@ -89,6 +89,24 @@ def test_sliding_pad_is_homogeneous_plane_strain_compression():
     assert 1.0 + u[side, 0].mean() / 4.0 == pytest.approx(lx, rel=1e-8)
 
 
+def test_sliding_3d_pad_reports_contact_pressure_per_current_area():
+    """The 3D sliding pad compressed 10 % is homogeneous uniaxial compression: the plate's
+    pressure per current area is the force over the top face's current area (4 lx x 4 lz on
+    the quarter), whatever the contact law. contact.csv read the multiplier per reference area
+    in 3D, 10.9 % above it here (lx = lz = 1.053: the top face spreads), while 2D converted it."""
+    sc = _pad(dim=3, depth_fraction=0.1, mesh_size=1.0)
+    model, ev, stats = _solve(sc, [Dirichlet("bone_interface", (1,)), Dirichlet("symmetry", (0,)),
+                                   Dirichlet("end_back", (2,))])
+    res = make_result(model, ev, stats, s_of_point=lambda X: X[:, 0])
+    X, u = model.basis.doflocs.T, model.u.reshape(-1, 3)
+    lx = 1.0 + u[np.abs(X[:, 0] - 4.0) < 1e-9, 0].mean() / 4.0
+    lz = 1.0 + u[np.abs(X[:, 2] - 4.0) < 1e-9, 2].mean() / 4.0
+    assert lx * lz > 1.09  # the current area is 10.9 % larger than the reference one
+    expected = float(reaction(model, ev)[1]) / (4.0 * lx * 4.0 * lz)
+    assert len(res.contact_pressure) > 10
+    assert np.allclose(res.contact_pressure, expected, rtol=1e-6)
+
+
 def test_bonded_pad_lies_between_unconfined_and_confined_compression():
     """Bonded to the board, the pad is stiffer than the laterally free layer (sigma_x = 0)
     and softer than the laterally confined one (lambda_x = 1) at the same plate travel: both
