@@ -175,3 +175,29 @@ def test_film_profile_write_refuses_a_folder_another_run_is_writing_into(tmp_pat
         os.close(fd)
     assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
     assert sorted(fp.write(d)) == ["map", "profile", "summary"]  # released: written
+
+
+def test_compare_flags_a_result_changed_since_it_was_written(tmp_path, capsys, scan, sim):
+    """A simulated profile.csv cut at a line end (a truncated copy, a disk that filled) reads
+    as a valid, shorter profile: compare used it and said "ok" (span 2.0 for 2.27 mm). The
+    folders' records of written files say it is not what tactileskin wrote: suspect, exit 3."""
+    from tactileskin import ownership
+
+    film = tmp_path / "film"
+    assert main(["film", "analyze", str(scan), "--out", str(film)]) == 0
+    for n in ("profile.csv", "summary.json"):  # as a solve records its files
+        ownership.record_file(sim / n)
+    assert main(["film", "compare", str(film), str(sim)]) == 0
+    capsys.readouterr()
+    lines = (sim / "profile.csv").read_text().splitlines(keepends=True)
+    (sim / "profile.csv").write_text("".join(lines[:20]))  # s up to 1.9 mm of 6
+    assert main(["film", "compare", str(film), str(sim)]) == 3
+    assert "warning: simulation: profile.csv changed since tactileskin wrote it" in capsys.readouterr().err
+    doc = json.loads((film / "comparison.json").read_text())
+    assert doc["status"] == "suspect" and any("profile.csv changed" in w for w in doc["warnings"])
+    # the film's own profile, damaged the same way
+    (sim / "profile.csv").write_text("".join(lines))
+    flines = (film / "profile.csv").read_text().splitlines(keepends=True)
+    (film / "profile.csv").write_text("".join(flines[:-5]))
+    assert main(["film", "compare", str(film), str(sim)]) == 3
+    assert "the film profile is suspect: profile.csv changed since `film analyze` wrote it" in capsys.readouterr().err

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, outdir, staging
+from tactileskin import fileio, outdir, ownership, staging
 from tactileskin.errors import ParameterError
 from tactileskin.film.inputs import read_text
 from tactileskin.film.scan import (ASYMMETRY, COMPARE_NAMES, FilmProfile, fold_profile,
@@ -70,6 +70,24 @@ def load_simulation(sim_dir) -> tuple[np.ndarray, np.ndarray, dict]:
                              hint=f"{summary} is missing: no complete result there")
     meta = _read_json(summary, "simulation summary", "valid JSON")
     return s, p, meta
+
+
+def changed_since_written(folder, names=("profile.csv", "summary.json")) -> list[str]:
+    """Of `names` in `folder`, those its record of written files (ownership) lists with other
+    contents: damaged (a truncated copy, a disk that filled) or edited since tactileskin wrote
+    them. A profile cut at a line end reads as a valid, shorter one (span 2.0 for 2.27 mm)."""
+    folder = Path(folder)
+    rec = ownership.read_record(folder)
+    changed = []
+    for n in names:
+        if n in rec:
+            try:
+                same = ownership.is_recorded(rec[n], fileio.file_sha256(folder / n))
+            except OSError:
+                same = False
+            if not same:
+                changed.append(n)
+    return changed
 
 
 def _reject_constant(token: str):
@@ -212,9 +230,14 @@ def compare(film, sim) -> Comparison:
         diff[k] = 100.0 * (sm[k] - fm[k]) / fm[k]
     log.info("film vs sim: %s", diff)
     warnings = [f"film: {w}" for w in film_warnings]
+    if not isinstance(film, FilmProfile) and (changed := changed_since_written(film)):
+        warnings.append(f"film: {', '.join(changed)} changed since `film analyze` wrote it (damaged or edited)")
     status = str(smeta.get("status", "ok"))
     if status != "ok":
         warnings.append(f"simulation: {status}")
+    if isinstance(sim, (str, Path)) and (changed := changed_since_written(sim)):
+        warnings.append(f"simulation: {', '.join(changed)} changed since tactileskin wrote it (damaged or "
+                        "edited): its numbers may not be the solve's")
     if sim_asym > ASYMMETRY:  # as the film's fold is flagged (an off-centre dot on a full-width pad)
         warnings.append(f"simulation: its two-sided profile is not symmetric about s = 0 (peak at s = "
                         f"{sim_peak_s:.3g} mm): |P(+s) - P(-s)| reaches {sim_asym:.2f} of the peak (> "
