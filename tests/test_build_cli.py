@@ -157,3 +157,28 @@ def test_build_scene_with_geometry_options_or_a_skin_file_is_refused(tmp_path, c
     err = capsys.readouterr().err
     assert "skin_file" in err and "Traceback" not in err
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("limit, name, cause", [
+    (300_000, "skin.stl", "the CAD kernel could not write it"),   # the STEP (88 kB) fits, the STL (678 kB) not
+    (50_000, "skin.step", "File too large"),
+])
+def test_a_full_disk_names_the_file_and_its_cause(tmp_path, capsys, limit, name, cause):
+    """A write that fails (a full disk; here a file size limit, ulimit -f) read "exporting skin
+    failed (stl=False, step=True) for thickness=1, ..." or "...: RuntimeError: Failed to write
+    STEP file": a CAD failure of those parameters, no file named. It is a write error now."""
+    import resource
+    import signal
+
+    out = tmp_path / "out"
+    old_limit = resource.getrlimit(resource.RLIMIT_FSIZE)
+    old_handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # the write fails with EFBIG instead
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, old_limit[1]))
+        rc = main(["build", "-t", "1", "--out", str(out), "--indenter", "none", "--no-molds"])
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old_limit)
+        signal.signal(signal.SIGXFSZ, old_handler)
+    err = " ".join(capsys.readouterr().err.split())
+    assert rc == 2 and f"cannot write {out / name}: {cause}" in err, err
+    assert not out.exists()  # nothing half-written left, not even the new folder

@@ -10,6 +10,7 @@ are replaced: a user's files stay, one of ours the user edited is refused.
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import math
@@ -46,7 +47,8 @@ STL_ANGULAR_TOLERANCE = 0.1
 
 def write_stl(shape, path: Path, tolerance: float = STL_TOLERANCE,
               angular_tolerance: float = STL_ANGULAR_TOLERANCE) -> bool:
-    """Binary STL with an absolute chordal deviation `tolerance` (mm)."""
+    """Binary STL with an absolute chordal deviation `tolerance` (mm); False if the shape could
+    not be meshed, None if the mesh could not be written (OCC gives no reason)."""
     from OCP.BRepMesh import BRepMesh_IncrementalMesh
     from OCP.BRepTools import BRepTools
     from OCP.StlAPI import StlAPI_Writer
@@ -59,7 +61,7 @@ def write_stl(shape, path: Path, tolerance: float = STL_TOLERANCE,
     writer = StlAPI_Writer()
     writer.ASCIIMode = False
     if not writer.Write(shape.wrapped, str(path)):
-        return False
+        return None
     drop_pole_facets(Path(path))
     return True
 
@@ -115,9 +117,15 @@ def cad_volume(shape, precision: float = 1e-9) -> float:
 
 def _write_part(part: Part, folder: Path, tolerance: float, angular_tolerance: float) -> dict:
     stl, step = folder / f"{part.name}.stl", folder / f"{part.name}.step"
+    step_bytes = io.BytesIO()  # written by Python below: a full disk is an OSError naming its cause
     with occ_guard(f"exporting {part.name}", **{k: v for k, v in part.parameters.items() if not isinstance(v, dict)}):
         ok_stl = write_stl(part.shape, stl, tolerance, angular_tolerance)
-        ok_step = bd.export_step(part.shape, step)
+        ok_step = bd.export_step(part.shape, step_bytes)
+    if ok_step:
+        fileio.atomic_write_bytes(step, step_bytes.getvalue())
+    if ok_stl is None:  # meshed, but OCC's writer could not write the file, and says no more
+        raise fileio.OutputError(stl, "the CAD kernel could not write it (no space left on the device, "
+                                      "a file size limit or a read-only folder?)")
     if not (ok_stl and ok_step and stl.is_file() and step.is_file()):
         raise CadError(f"exporting {part.name} failed (stl={ok_stl}, step={ok_step}) for {format_params(part.parameters)}")
     mesh = check_stl(stl, part.name, part.parameters)
