@@ -395,3 +395,32 @@ def test_removing_free_locks_removes_nothing_but_lock_files(tmp_path):
     (tmp_path / "case.json").write_text("another run's")
     assert _remove_free_locks(tmp_path) is False
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.json"]
+
+
+def test_a_single_file_whose_record_cannot_be_written_is_replaced_by_the_rerun(tmp_path, capsys, monkeypatch):
+    """`material fit -o` (as mesh, export, film calibrate) wrote the file, then its record: a
+    disk that filled in between left the new file unrecorded, and every rerun refused it as
+    the user's ("tactileskin did not write it"). Now the record lists the new digest before the
+    file is replaced: the failed run leaves the earlier file, and the rerun replaces it."""
+    import numpy as np
+
+    lam = np.linspace(0.8, 1.5, 8)
+    (tmp_path / "t.csv").write_text("stretch,nominal_stress_mpa\n" + "".join(
+        f"{float(a)!r},{float(0.04 * (a - a ** -2))!r}\n" for a in lam))  # neo-Hookean, mu = 0.04 MPa
+    out = tmp_path / "fit" / "gel.toml"
+    argv = ["material", "fit", str(tmp_path / "t.csv"), "-o", str(out), "--law"]
+    assert main(argv + ["neo_hookean"]) == 0
+    earlier = out.read_text()
+    real = ownership.atomic_write_json
+
+    def full_disk(path, obj):
+        raise fileio.OutputError(path, "no space left on the device")
+
+    monkeypatch.setattr(ownership, "atomic_write_json", full_disk)
+    capsys.readouterr()
+    assert main(argv + ["mooney_rivlin"]) == 2
+    assert "cannot write" in _err(capsys) and out.read_text() == earlier  # not a new file unrecorded
+    monkeypatch.setattr(ownership, "atomic_write_json", real)
+    assert main(argv + ["mooney_rivlin"]) == 0, _err(capsys)
+    assert 'law = "mooney_rivlin"' in out.read_text()
+    assert _record(out.parent)["gel.toml"] == fileio.file_sha256(out)

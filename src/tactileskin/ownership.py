@@ -2,7 +2,7 @@
 so that a rerun replaces its own files and never a user's.
 
 A single output file of the CLI replaces an existing file only if the record lists it with
-its current contents (`claim_file` before the work, `record_file` after it); staging keeps
+its current contents (`claim_file` before the work, `written_file` around the write); staging keeps
 the record of a result's files in a marked output folder (outdir). Every read-modify-write
 of the record holds an flock on `.tactileskin-files.lock` beside it (`record_lock`).
 """
@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-from tactileskin.fileio import OutputError, atomic_write_json, file_sha256, is_open_file, os_errors
+from tactileskin.fileio import OutputError, atomic_path, atomic_write_json, file_sha256, is_open_file, os_errors
 
 log = logging.getLogger(__name__)
 
@@ -71,10 +71,34 @@ def record_file(path) -> None:
     path = Path(path)
     with os_errors(path):
         digest = file_sha256(path)
+    _set_entry(path, lambda old: digest)
+
+
+def _set_entry(path: Path, entry) -> None:
+    """Set `path`'s entry in its folder's OWNED_FILES to entry(the current one)."""
     with record_lock(path.parent):  # two writers into one folder must not lose an entry
         rec = {k: v for k, v in read_record(path.parent).items() if (path.parent / k).is_file()}
-        rec[path.name] = digest
+        rec[path.name] = entry(rec.get(path.name))
         atomic_write_json(path.parent / OWNED_FILES, rec)
+
+
+@contextlib.contextmanager
+def written_file(path) -> Iterator[Path]:
+    """Yield a temporary path beside `path` for a writer (same suffix); then the record lists its
+    digest beside the earlier file's, it replaces `path`, and the record keeps it alone. A
+    failure at any step (a full disk) leaves the earlier file and a record that covers the file
+    that is there: a rerun replaces it. (Writing `path`, then `record_file`, left the new file
+    unrecorded when the record's write failed: every rerun refused it as a user's file.)"""
+    path = Path(path)
+    with atomic_path(path, suffix=path.suffix or ".tmp") as tmp:
+        yield path.with_name(tmp.name)  # as the user named the folder (mkstemp's is absolute)
+        with os_errors(path, own_name=False):
+            digest = file_sha256(tmp)
+        _set_entry(path, lambda old: entry_digests(old) + [digest])
+    try:  # in place; the [old, new] entry already covers it if this write fails
+        _set_entry(path, lambda old: digest)
+    except OutputError as e:
+        log.warning("%s", e)
 
 
 # The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,

@@ -34,8 +34,8 @@ def command(out, dialect, scene_opts):
         raise ParameterError("--dialect", dialect, "calculix for a 3D deck",
                              "a 3D Abaqus deck (R3D3 rigid surfaces) is not written yet")
     ownership.claim_file(out)  # before meshing: a user's file of that name is refused
-    deck = write_deck(scene, out, dialect=dialect)
-    ownership.record_file(out)
+    with ownership.written_file(out) as tmp:
+        deck = write_deck(scene, tmp, dialect=dialect)
     extra = (f", {deck.info['indenter_cells']} C3D6 indenter wedges, contact penalty "
              f"{deck.info['penalty_mpa_per_mm']:.3g} MPa/mm" if scene.dim == 3 else "")
     new_console().print(f"wrote {escape(out)}: {deck.n_skin_cells} {deck.etype} cells, {deck.n_skin_nodes} nodes"

@@ -47,10 +47,10 @@ def calibrate(cal_csv, out, model, activation_range, plot):
     if plot:
         from tactileskin.film import plots
 
-        plots.calibration_plot(cal, plot)
-        ownership.record_file(plot)
-    cal.save(out)
-    ownership.record_file(out)
+        with ownership.written_file(plot) as tmp:
+            plots.calibration_plot(cal, tmp)
+    with ownership.written_file(out) as tmp:
+        cal.save(tmp)
     r = cal.report
     lin = r["linear"]
     (a_lo, a_hi), (b_lo, b_hi) = lin["param_ci90"]

@@ -71,8 +71,8 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
                   f"{thickness:g} mm, Hertz with the Dimitriadis 2002 bonded correction, {q['n_points']} points, "
                   f"chi <= {q['chi_max']:.3g}): E = {f.E:.5g} MPa, R^2 = {q['r2']:.5f}, RMSE = {q['rmse_n']:.3g} N, "
                   f"max relative error {100 * q['max_rel_err']:.2f} %")
-        fileio.atomic_write_text(outp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
-        ownership.record_file(outp)
+        with ownership.written_file(outp) as tmp:
+            fileio.atomic_write_text(tmp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
         click.echo(f.describe())
         click.echo(f"wrote {out}")
         return
@@ -87,8 +87,8 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
               f"R^2 = {q['r2']:.5f}, RMSE = {q['rmse_mpa']:.3g} MPa, max relative error "
               f"{100 * q['max_rel_err']:.2f} %" + "".join(f"; SUSPECT: {w}" for w in f.warnings))
     mat = f.material(name or Path(data).stem, source)
-    fileio.atomic_write_text(outp, MARK + "\n" + mat.to_toml())
-    ownership.record_file(outp)
+    with ownership.written_file(outp) as tmp:
+        fileio.atomic_write_text(tmp, MARK + "\n" + mat.to_toml())
     click.echo(f.describe())
     click.echo(f"wrote {out}" + (" (a suspect fit: exit status 3)" if f.warnings else ""))
     return EXIT_SUSPECT if f.warnings else 0

@@ -16,6 +16,8 @@ from tactileskin.cli._common import scene_from_options, scene_options
                    "the solver meshes with triangles).")
 def command(out, cell, scene_opts):
     """Mesh the skin (gmsh) with named boundaries and print counts and quality."""
+    from pathlib import Path
+
     import numpy as np
     from rich.markup import escape
     from rich.table import Table
@@ -65,6 +67,7 @@ def command(out, cell, scene_opts):
     console = new_console()
     console.print(table)
     if out is not None:
-        path = sm.write(out)
-        ownership.record_file(path)
+        path = Path(out)
+        with ownership.written_file(path) as tmp:
+            sm.write(tmp)
         console.print(f"wrote {escape(str(path))}")
