@@ -424,3 +424,33 @@ def test_a_single_file_whose_record_cannot_be_written_is_replaced_by_the_rerun(t
     assert main(argv + ["mooney_rivlin"]) == 0, _err(capsys)
     assert 'law = "mooney_rivlin"' in out.read_text()
     assert _record(out.parent)["gel.toml"] == fileio.file_sha256(out)
+
+
+def test_a_read_only_result_folder_is_refused_before_the_solve(tmp_path, capsys, monkeypatch):
+    """A rerun into an earlier result's folder that has become read-only solved in full (a 3D
+    solve: minutes) and then failed to write; the marker is there, so the claim wrote nothing.
+    (Root ignores folder modes: no new file can be made in `d` stands for read-only.)"""
+    import errno
+    import tempfile
+
+    calls = []
+    monkeypatch.setattr(tactileskin.fe, "solve", lambda scene, **kw: calls.append(1) or fake_result())
+    d = tmp_path / "s"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    before = {p.name: p.read_bytes() for p in d.iterdir()}
+    real = {n: getattr(tempfile, n) for n in ("mkstemp", "mkdtemp")}
+
+    def read_only(name):
+        def make(*a, dir=None, **kw):
+            if dir is not None and Path(dir) == d:
+                raise PermissionError(errno.EACCES, "Permission denied", str(dir))
+            return real[name](*a, dir=dir, **kw)
+        return make
+
+    for n in real:
+        monkeypatch.setattr(tempfile, n, read_only(n))
+    calls.clear()
+    capsys.readouterr()
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 2
+    assert "permission denied" in _err(capsys) and calls == []  # was: solved, then refused
+    assert {p.name: p.read_bytes() for p in d.iterdir()} == before

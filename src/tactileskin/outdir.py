@@ -13,10 +13,12 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import tempfile
 from pathlib import Path
 from typing import Iterable, Iterator
 
-from tactileskin.fileio import OutputError, atomic_write_json, clean_stale, is_temporary, make_dirs, os_errors
+from tactileskin.fileio import (STAGING, OutputError, atomic_write_json, clean_stale, is_temporary, make_dirs,
+                                os_errors, tmp_prefix)
 from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, folder_lock, record_file
 
 MARKER = ".tactileskin"
@@ -87,6 +89,11 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
     clean_stale(folder)
     if not (folder / MARKER).is_file():
         atomic_write_json(folder / MARKER, marker_doc(kind))
+    else:  # nothing written yet: a read-only folder is refused now, not after the work (a solve)
+        with os_errors(folder, own_name=False):
+            fd, probe = tempfile.mkstemp(prefix=tmp_prefix(folder / STAGING), dir=folder)
+            os.close(fd)
+            os.unlink(probe)
     return folder
 
 
