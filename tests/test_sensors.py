@@ -99,6 +99,36 @@ def test_homogeneous_3d_block_tiny():
     assert np.max(np.abs(r.tau_1)) > 0.1 * abs(sig[1, 1] - sig[0, 0])
 
 
+def test_many_sample_points_are_read_in_bounded_memory():
+    """The sampler located all points at once (~160 kB each on a 3D P2 mesh while searching)
+    and scikit-fem's isoparametric mapping kept every Jacobian it evaluated (~27 kB a point,
+    never freed): a valid sensor file (19881 taxels of 16 x 16 points) was killed at 20 GB."""
+    import tracemalloc
+
+    from skfem import MeshTet2
+
+    from tactileskin.fe.output import STRESS_COMPONENTS
+
+    m = MeshTet2.from_mesh(MeshTet.init_tensor(*(np.linspace(0, 1, 3),) * 3))  # curved-capable, as the solver's
+    model = Model(m, _faces(m, 3), material_law(get_material("silicone").hyperfoam), [Dirichlet("bottom", (1,))])
+    # constant fields: interpolated exactly anywhere (the shape functions sum to 1)
+    sampler = stress_sampler(model, {n: np.full(model.nsdof, i + 1.0) for i, n in enumerate(STRESS_COMPONENTS)})
+    want = np.zeros((3, 3))
+    for i, (a, b) in enumerate(STRESS_COMPONENTS.values()):
+        want[a, b] = want[b, a] = i + 1.0
+    rng = np.random.default_rng(3)
+    sampler(rng.uniform(0, 1, (10, 3)))  # first-call set-up (the KD tree) outside the count
+    tracemalloc.start()
+    try:
+        sig = sampler(rng.uniform(0, 1, (6000, 3)))
+        kept, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert sig.shape == (6000, 3, 3) and np.allclose(sig, want, rtol=0, atol=1e-12)
+    assert kept < sig.nbytes + 2e6  # the result (0.4 MB), not the search's Jacobians (was 26 MB)
+    assert peak < 60e6  # one chunk of the search (was 100+ MB)
+
+
 # --- taxel averaging ---------------------------------------------------------------------------
 
 def _linear_sampler(points):

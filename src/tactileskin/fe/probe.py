@@ -17,6 +17,10 @@ from tactileskin.errors import ParameterError
 
 OUTSIDE_TOL = 1e-3           # reference units: 0.1 % of an element outside is the boundary
 _CANDIDATES = {2: 12, 3: 30}  # nearest elements (by centroid) tried per point
+# points located at once by stress_sampler: the search holds ~9 kB (affine) to ~160 kB (P2
+# geometry) per point in 3D (the 30 candidates' Newton arrays), so a chunk ~10-170 MB; a valid
+# sensor file of 19881 taxels of 16 x 16 points (5.1 M points) at once was killed at 20 GB
+CHUNK = 1024
 
 
 def _score(X: np.ndarray, simplex: bool) -> np.ndarray:
@@ -44,11 +48,20 @@ def locate(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     x = np.repeat(pts, k, axis=0).T[:, :, None]                  # (dim, n*k, 1)
     tind = cand.ravel()
     X = np.full(x.shape, 1.0 / (dim + 1))
-    for _ in range(12):  # Newton on the geometry map (one step when affine)
-        dX = np.einsum("ijkl,jkl->ikl", mapping.invDF(X, tind), x - mapping.F(X, tind))
-        X = X + dX
-        if np.max(np.abs(dX)) < 1e-13:
-            break
+    # scikit-fem's isoparametric mapping memoises every Jacobian it evaluates (its J, in
+    # mapping._cache): the Newton iterates of every point sampled stayed in memory (~27 kB a
+    # point on the 3D P2 meshes), so this call's entries are dropped after it
+    before = set(getattr(mapping, "_cache", {}))
+    try:
+        for _ in range(12):  # Newton on the geometry map (one step when affine)
+            dX = np.einsum("ijkl,jkl->ikl", mapping.invDF(X, tind), x - mapping.F(X, tind))
+            X = X + dX
+            if np.max(np.abs(dX)) < 1e-13:
+                break
+    finally:
+        memo = getattr(mapping, "_cache", None)
+        for h in set(memo or ()) - before:
+            del memo[h]
     simplex = "Tri" in type(mesh).__name__ or "Tet" in type(mesh).__name__
     score = _score(X[:, :, 0], simplex).reshape(len(pts), k)
     best = np.argmax(score, axis=1)
@@ -96,12 +109,14 @@ def stress_sampler(model, point_data: dict):
                                f"(has {sorted(point_data)})")
 
     def sample(points):
-        M = interpolation_matrix(model, points)
-        sig = np.zeros((M.shape[0], 3, 3))
-        for name, (i, j) in STRESS_COMPONENTS.items():
-            if keys[name] is not None:
-                v = M @ np.asarray(point_data[keys[name]], float)
-                sig[:, i, j] = sig[:, j, i] = v
+        points = np.atleast_2d(np.asarray(points, float))
+        sig = np.zeros((len(points), 3, 3))
+        for a in range(0, len(points), CHUNK):  # bounded memory (CHUNK)
+            M = interpolation_matrix(model, points[a:a + CHUNK])
+            for name, (i, j) in STRESS_COMPONENTS.items():
+                if keys[name] is not None:
+                    v = M @ np.asarray(point_data[keys[name]], float)
+                    sig[a:a + CHUNK, i, j] = sig[a:a + CHUNK, j, i] = v
         return sig
 
     return sample
