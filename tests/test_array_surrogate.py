@@ -221,6 +221,19 @@ def test_validation_refuses_a_text_too_large_to_mesh_before_any_solve(monkeypatc
         chart.validate_surrogate([1.0], "silicone", texts, chart.ChartConfig(), cache=None)
 
 
+@pytest.mark.parametrize("text", ["", "ab\ncd"])
+def test_validation_refuses_a_text_the_comparison_cannot_read_before_any_solve(monkeypatch, text):
+    # the comparison (surrogate.chart_shift) reads one line of cells: the empty text (the lone
+    # dot) and two lines were refused only after the solves (3.6 min for "" at t = 1 mm)
+    def refuse(*a, **k):
+        raise AssertionError("solving started")
+
+    monkeypatch.setattr(chart, "solve_cached", refuse)
+    cfg = chart.ChartConfig(mesh_size=2.0, refinement=2.0)  # coarse: both texts fit the mesh limit
+    with pytest.raises(ParameterError, match=r"validate text=.*one line of Braille cells"):
+        chart.validate_surrogate([1.0], "silicone", ["l", text], cfg, cache=None)
+
+
 def _heave(dx, dz):
     """A lone dot's surface deflection (mm, downward positive): 0.1 under the dot, heaving up
     (-0.01) at the neighbours' 2.3-2.5 mm, as on a thin bonded layer."""

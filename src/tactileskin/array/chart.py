@@ -804,9 +804,13 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
     mirrored. reference_mesh (mesh_size, refinement): solve the texts in full on that mesh
     (finer than the chart's, whose single dots the surrogates keep): the error of the chart's
     letters against a better reference; each row says its "reference_mesh"."""
-    from tactileskin.geometry.braille import dot_centres
+    from tactileskin.geometry.braille import check_text, dot_centres
 
     say = progress or (lambda msg: None)
+    for x in texts:  # surrogate.chart_shift's rule, refused after the solves before (minutes to hours)
+        cells = check_text(x)
+        if len(cells) != 1 or not cells[0]:
+            raise ParameterError("validate text", x, "one line of Braille cells, e.g. 'l' (not empty: that is the lone dot)")
     if cfg.skin == "fingertip":
         for x in texts:
             xs = np.sort(np.round(dot_centres(x, cfg.standard)[:, 0], 9))
