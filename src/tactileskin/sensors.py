@@ -51,6 +51,7 @@ log = logging.getLogger(__name__)
 
 KINDS = ("points", "line", "grid")
 MAX_SENSORS = 20000          # all layouts of a scene together
+MIN_PITCH = 0.01             # mm: a line's or grid's pitch, the finest mesh size (scene.MESH_SIZE)
 MAX_TAXEL_POINTS = 16        # Gauss points per direction
 # default Gauss points per direction: one per TAXEL_SPACING of the taxel's side, at least
 # MIN_TAXEL_POINTS. Three for every size read a 2 mm taxel on the bone of a 1 mm ridge 10.6 %
@@ -130,9 +131,13 @@ class SensorLayout:
             if len(s) != 2 or s[1] < s[0]:
                 raise ParameterError(f"{where} s", list(s), "[s0, s1] with s0 <= s1 (mm)")
             npitch = 1 if kind == "line" else (1, 2)
-            if len(pitch) not in np.atleast_1d(npitch) or min(pitch) <= 0:
+            if len(pitch) not in np.atleast_1d(npitch) or min(pitch) < MIN_PITCH:
+                # below the finest mesh size no sensor reads anything new: a file in metres
+                # (pitch 0.0005 for 0.5 mm) was solved and shown as ok
                 raise ParameterError(f"{where} pitch", list(pitch),
-                                     "one pitch > 0 (mm)" if kind == "line" else "[p] or [ps, pz], > 0 (mm)")
+                                     (f"one pitch >= {MIN_PITCH:g} mm" if kind == "line"
+                                      else f"[p] or [ps, pz], >= {MIN_PITCH:g} mm"),
+                                     hint="positions are in mm, not metres" if 0 < min(pitch, default=0) < MIN_PITCH else "")
             if kind == "line" and len(z) > 1:
                 raise ParameterError(f"{where} z", list(z), "one z (mm) for a line")
             if kind == "grid" and (len(z) != 2 or z[1] < z[0]):
