@@ -416,6 +416,43 @@ def test_validation_past_the_dot_height_is_plate_aware(monkeypatch, tmp_path):
     assert by["sum"]["max_abs_over_peak"] > 0.5  # three dots count the plate three times
 
 
+def test_validation_against_flagged_solves_is_not_counted(monkeypatch, tmp_path):
+    """A validation row judged against a full solve that quality flags (no contact, a coarse
+    mesh, ...) showed the surrogate "within 5 %" all the same, the letters marked trusted. Now
+    the row carries the solves' status, array.validity skips it, the table and the notes say so."""
+    from types import SimpleNamespace
+
+    from tactileskin.array import validity
+    from tactileskin.report.array_chart import suspect, validation_table
+
+    grid = np.linspace(-8, 8, 641)
+    lone = maps.on_grid(_gauss(), grid, grid)
+    full = maps.on_grid(lambda s, z: sum(_gauss(a, b)(s, z) for a, b in braille.dot_centres("l")), grid, grid)
+    flag = {"text": "l"}
+
+    def fake_solve(scenes, cache, on_event=None, workers=None):
+        status = lambda sc: "suspect: coarse_mesh" if sc.braille_text == flag["text"] else "ok"  # noqa: E731
+        return {sc: SimpleNamespace(scene=sc, path=tmp_path, summary={**_reaction(sc), "status": status(sc)})
+                for sc in scenes}
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "bone_map_of", lambda rec: lone)
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: full)
+    monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
+    cfg = chart.ChartConfig(skin="pad")
+    args = ("silicone", "pad", cfg.mesh_for(1.0), 1.0, 0.2)
+    for text, counted in (("l", False), ("", False), (None, True)):  # the full solve, the lone dot's, none
+        flag["text"] = text
+        rows = [r for r in chart.validate_surrogate([1.0], "silicone", ["l"], cfg, cache=None) if r["model"] == "sum"]
+        assert (rows[0]["solve_status"] == "ok") is counted
+        assert rows[0]["within_tolerance_taxel"]  # the sum is exact here: only the flag can refuse it
+        m = validity.measured(*args, validation=rows, extent=cfg.read_extent, taxel=cfg.min_taxel)
+        assert (validity.RUN_SOURCE in m["source"]) is counted, m  # beside the shipped measurements
+        ch = SimpleNamespace(notes=[], config=SimpleNamespace(sets=()))
+        assert any("not counted" in n and "coarse_mesh" in n for n in suspect(ch, rows)) is not counted
+        assert ("not counted (suspect solves)" in "\n".join(validation_table(rows, "t"))) is not counted
+
+
 @pytest.mark.slow
 def test_solve_cached_on_two_workers_matches_one_and_solves_a_repeated_scene_once(tmp_path):
     """The chart's batch solve: two worker processes give the records one process gives (same

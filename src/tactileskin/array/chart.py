@@ -838,6 +838,12 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                         cache, on_event=lambda oc: say(f"  {oc.status} {oc.case} ({oc.seconds:.0f} s)"),
                         workers=workers)
     for t, (dot, fulls, blank, shallow) in cases.items():
+        # a row judged against flagged solves does not show the surrogate (array.validity skips it)
+        shared = suspect_solves({sc: recs[sc] for sc in (dot, blank, shallow) if sc is not None})
+        solve_status = {}
+        for x, sc in zip(texts, fulls):
+            notes = shared + suspect_solves({sc: recs[sc]})
+            solve_status[x] = "suspect: " + "; ".join(notes) if notes else "ok"
         kernel = bone_map_of(recs[dot])
         sec = dot.section()
         refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
@@ -863,5 +869,5 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
                              "taxel_mm": float(cfg.min_taxel),
                              "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
-                             **err})
+                             "solve_status": solve_status[x], **err})
     return rows

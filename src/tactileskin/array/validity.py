@@ -91,7 +91,7 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
         key = "max_abs_over_peak_taxel" if rt > 0 else "max_abs_over_peak"  # taxel 0: pointwise
         if r.get("model", "sum") == model and r["material"] == material and _match(r["thickness_mm"], t) \
                 and _match(r.get("depth_mm", depth), depth) and key in r \
-                and _covers(r, extent) and _taxel_ok(rt, taxel):
+                and _covers(r, extent) and _taxel_ok(rt, taxel) and r.get("solve_status", "ok") == "ok":
             rows.append({"text": r["text"], "taxel_max_error": r[key],
                          "reference_mesh": r.get("reference_mesh"), "source": RUN_SOURCE})
     shipped = _shipped_dots()

@@ -184,7 +184,10 @@ def suspect(chart, validation=None, trust: dict | None = None) -> list[str]:
     material whose letters rest on a surrogate not shown within the tolerance."""
     if trust is None:
         trust = letters_trust(chart, validation) if "letters" in chart.config.sets else {}
-    return list(getattr(chart, "notes", None) or []) + _trust_notes(trust)
+    flagged = list(dict.fromkeys(
+        f"the validation of '{r['text']}' at t = {r['thickness_mm']:g} mm ({r['material']}) is not counted: "
+        f"{r['solve_status']}" for r in validation or () if r.get("solve_status", "ok") != "ok"))
+    return list(getattr(chart, "notes", None) or []) + flagged + _trust_notes(trust)
 
 
 def _trust_section(chart, trust: dict) -> list[str]:
@@ -242,11 +245,12 @@ def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
     out = [title, "", head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         ok = r.get("within_tolerance_taxel", r["within_tolerance"]) if taxel else r["within_tolerance"]
+        flagged = r.get("solve_status", "ok") != "ok"  # judged against flagged solves: not counted
         out.append("| " + (f"{r['mesh']} | " if mesh else "") + f"{r['material']} | {r['thickness_mm']:g} | "
                    f"{r.get('depth_mm', float('nan')):.3g} | {r['text']} | {r.get('model', 'sum')} | {r['rel_l2']:.1%} | "
                    f"{r['max_abs_over_peak']:.1%} | {r['peak_rel']:+.1%}"
                    + (f" | {r['max_abs_over_peak_taxel']:.1%} | {r['peak_rel_taxel']:+.1%}" if taxel else "")
-                   + f" | {'yes' if ok else 'no'} |")
+                   + f" | {'not counted (suspect solves)' if flagged else 'yes' if ok else 'no'} |")
     out += ["", "Models: sum = lone-dot responses added; interaction = their loads from the lone dot's "
             "surface deflection under depth control and its load-approach law, load ~ approach^p with p from "
             "a second lone-dot solve at 0.9 x the depth (surrogate.interaction_weights, load_exponent); "
