@@ -197,7 +197,7 @@ class ChartConfig:
         # checked here, before any solve (the classifiers would refuse them after hours of solves)
         if self.bits is not None and not (isinstance(self.bits, (int, np.integer)) and not isinstance(self.bits, bool)
                                           and 1 <= self.bits <= 32):
-            raise ParameterError("bits", self.bits, "an integer in [1, 32] or none")
+            raise ParameterError("bits", self.bits, "an integer in [1, 32] (None from Python: no quantisation)")
         # n_train >= 2: LDA needs more training readings than classes (two offsets per stimulus)
         for name, lo in (("n_train (--offsets)", 2), ("n_test (--offsets)", 1), ("template_grid", 1), ("seed", 0)):
             v = getattr(self, name.split()[0])

@@ -111,7 +111,7 @@ class Readout:
         _positive("noise_mpa", self.noise_mpa, allow_zero=True)
         _positive("noise_fs", self.noise_fs, allow_zero=True)
         if self.bits is not None and not (isinstance(self.bits, (int, np.integer)) and 1 <= self.bits <= 32):
-            raise ParameterError("bits", self.bits, "an integer in [1, 32] or none")
+            raise ParameterError("bits", self.bits, "an integer in [1, 32] (None from Python: no quantisation)")
 
     @property
     def sigma(self) -> float:
