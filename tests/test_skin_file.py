@@ -2,6 +2,7 @@
 built-in pad on the same mesh; a STEP solid is meshed with its bonded faces by a rule; the cache
 key follows the file's bytes; clear errors for missing groups, open solids, wrong units."""
 
+import re
 import shutil
 
 import numpy as np
@@ -419,6 +420,38 @@ def test_a_skin_placed_where_the_indenters_do_not_press_it_as_meant_is_refused(t
         Scene(skin="file", skin_file=str(mirrored), **kw)
     half = _gmsh_polygon(tmp_path / "half.msh", [(0, 0), (8, 0), (8, 2), (0, 2)], {"bonded": [0], "symmetry": [3]})
     assert Scene(skin="file", skin_file=str(half), **kw).section().top == pytest.approx(2.0)
+
+
+def test_the_indenter_starts_at_first_touch_on_a_skin_higher_off_its_axis(tmp_path, caplog):
+    """A STEP block whose top slopes from y = 2 (x = -2) to 2.04 (x = 2) is 0.02 mm higher at
+    x = 2 than on the axis (within the allowed 2 % of t, so it is solved). Indenters start at
+    the CAD point on the axis, y = 2.02: the flat plate started 0.02 mm inside the skin at x = 2
+    (10 % of a 0.2 mm press). It now starts at first touch: no contact point overlaps it before
+    the travel; a level block is not lifted."""
+    import logging
+
+    import build123d as bd
+    import numpy as np
+
+    from tactileskin.fe import model_for_scene
+
+    def block(path, y_right):
+        face = bd.Face(bd.Wire.make_polygon([(-2, 0, 0), (2, 0, 0), (2, y_right, 0), (-2, 2, 0)], close=True))
+        bd.export_step(bd.Solid.extrude(face, (0, 0, 4)).translate((0, 0, -2)), str(path))
+        return str(path)
+
+    kw = dict(skin="file", indenter="flat", depth=0.2, viscoelastic=False, mesh_size=1.0, refinement=1.0)
+    sc = Scene(skin_file=block(tmp_path / "sloped.step", 2.04), **kw)
+    assert sc.section().top == pytest.approx(2.02, abs=1e-6)
+    with caplog.at_level(logging.WARNING, logger="tactileskin.fe"):
+        model, _ = model_for_scene(sc)
+    g0, _ = model.contact.indenter.gap(model.surface.X.reshape(-1, 3))
+    assert -1e-3 * sc.indentation <= g0.min() <= 1e-9  # 1e-3 of the travel: the contact tolerance's cap
+    # (0.0188 mm at the contact points, which lie inside the facets of the block's edge x = 2)
+    assert re.search(r"stands 0\.01[89]\d* mm above its top point", caplog.text), caplog.text
+    model, _ = model_for_scene(Scene(skin_file=block(tmp_path / "level.step", 2.0), **kw))
+    assert model.contact.indenter.lowest_point == pytest.approx(2.0)  # not lifted
+    assert np.min(model.contact.indenter.gap(model.surface.X.reshape(-1, 3))[0]) == pytest.approx(0.0, abs=1e-9)
 
 
 def test_an_upside_down_or_off_centre_step_is_refused(tmp_path):

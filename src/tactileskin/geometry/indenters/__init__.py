@@ -60,11 +60,12 @@ def make_indenter(kind, *, y0: float | None = None, dim: int = 2, row: int | Non
     return cls.from_params(y0=y0, dim=dim, length=length, row=row, warn=warn, **kind_params)
 
 
-def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True) -> Indenter:
-    """The scene's indenter; its lowest point initially touches the skin top on x = 0."""
+def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True, lift: float = 0.0) -> Indenter:
+    """The scene's indenter; its lowest point initially touches the skin top on x = 0 (raised
+    by `lift` mm: fe.model_for_scene's start at first touch on a skin higher off the axis)."""
     # (no half-section warning for a skin that models its full width for such an indenter)
     warn = warn and not scene.skin_kind.full_width_if_asymmetric
-    return make_indenter(scene.indenter, y0=scene.section().top, dim=scene.dim, row=row,
+    return make_indenter(scene.indenter, y0=scene.section().top + lift, dim=scene.dim, row=row,
                          sample_length=scene.sample_length, warn=warn,
                          **scene_kind_params(scene))
 
