@@ -422,6 +422,15 @@ def test_a_skin_placed_where_the_indenters_do_not_press_it_as_meant_is_refused(t
     assert Scene(skin="file", skin_file=str(half), **kw).section().top == pytest.approx(2.0)
 
 
+def _sloped_block(path, y_right):
+    """A 4 x 4 mm STEP block on y = 0 whose top slopes from y = 2 (x = -2) to y_right (x = 2)."""
+    import build123d as bd
+
+    face = bd.Face(bd.Wire.make_polygon([(-2, 0, 0), (2, 0, 0), (2, y_right, 0), (-2, 2, 0)], close=True))
+    bd.export_step(bd.Solid.extrude(face, (0, 0, 4)).translate((0, 0, -2)), str(path))
+    return str(path)
+
+
 def test_the_indenter_starts_at_first_touch_on_a_skin_higher_off_its_axis(tmp_path, caplog):
     """A STEP block whose top slopes from y = 2 (x = -2) to 2.04 (x = 2) is 0.02 mm higher at
     x = 2 than on the axis (within the allowed 2 % of t, so it is solved). Indenters start at
@@ -430,20 +439,13 @@ def test_the_indenter_starts_at_first_touch_on_a_skin_higher_off_its_axis(tmp_pa
     the travel; a level block is not lifted."""
     import logging
 
-    import build123d as bd
-    import numpy as np
-
     from tactileskin.fe import model_for_scene
 
-    def block(path, y_right):
-        face = bd.Face(bd.Wire.make_polygon([(-2, 0, 0), (2, 0, 0), (2, y_right, 0), (-2, 2, 0)], close=True))
-        bd.export_step(bd.Solid.extrude(face, (0, 0, 4)).translate((0, 0, -2)), str(path))
-        return str(path)
-
+    block = _sloped_block
     kw = dict(skin="file", indenter="flat", depth=0.2, viscoelastic=False, mesh_size=1.0, refinement=1.0)
     sc = Scene(skin_file=block(tmp_path / "sloped.step", 2.04), **kw)
     assert sc.section().top == pytest.approx(2.02, abs=1e-6)
-    with caplog.at_level(logging.WARNING, logger="tactileskin.fe"):
+    with caplog.at_level(logging.WARNING):
         model, _ = model_for_scene(sc)
     g0, _ = model.contact.indenter.gap(model.surface.X.reshape(-1, 3))
     assert -1e-3 * sc.indentation <= g0.min() <= 1e-9  # 1e-3 of the travel: the contact tolerance's cap
@@ -452,6 +454,22 @@ def test_the_indenter_starts_at_first_touch_on_a_skin_higher_off_its_axis(tmp_pa
     model, _ = model_for_scene(Scene(skin_file=block(tmp_path / "level.step", 2.0), **kw))
     assert model.contact.indenter.lowest_point == pytest.approx(2.0)  # not lifted
     assert np.min(model.contact.indenter.gap(model.surface.X.reshape(-1, 3))[0]) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_an_exported_deck_starts_the_indenter_at_first_touch_as_the_solver(tmp_path):
+    """`export` writes what the solver solves: on the sloped block the solver starts the plate
+    at first touch, but the deck placed it at the CAD point on the axis (y0 = 2.02), 0.02 mm
+    inside the skin's nodes at x = 2 (10 % of a 0.2 mm press, as penetration at t = 0)."""
+    from tactileskin.mesh.deck import deck_text
+
+    sc = Scene(skin="file", skin_file=_sloped_block(tmp_path / "sloped.step", 2.04), indenter="flat", depth=0.2,
+               viscoelastic=False, mesh_size=1.0, refinement=1.0)
+    sm = build_mesh(sc)
+    deck = deck_text(sc, sm, "calculix")
+    y0 = float(re.search(r"lowest point at y0 = (\S+) mm", deck.text).group(1))
+    top = sm.mesh.p[1, np.unique(sm.mesh.facets[:, sm.boundaries["outer_surface"]])].max()
+    assert top == pytest.approx(2.04, abs=1e-6)
+    assert top - 1e-3 * sc.indentation <= y0 <= top + 1e-9  # was 2.02
 
 
 def test_an_upside_down_or_off_centre_step_is_refused(tmp_path):

@@ -104,6 +104,12 @@ def abaqus_cells(skinmesh) -> tuple[str, np.ndarray, np.ndarray]:
     return etype, pts, cells
 
 
+def contact_nodes(skinmesh) -> np.ndarray:
+    """(n, dim) positions of the vertices of the contact boundary (outer_surface)."""
+    mesh = skinmesh.mesh
+    return mesh.p[:, np.unique(mesh.facets[:, skinmesh.boundaries["outer_surface"]])].T
+
+
 def boundary_faces(skinmesh, cells: np.ndarray, etype: str, facets: np.ndarray) -> np.ndarray:
     """(n, 2) rows (cell index, Abaqus face number 1..) of the given boundary facets."""
     m = skinmesh.mesh
@@ -333,7 +339,7 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
     penalty (CalculiX contact slope, MPa/mm): default 10 K0 / h_fine (100 K0 / h made ccx 2.20
     diverge on the t = 3 polyurethane flat case); increments: the first
     time increment is T / increments (both solvers adapt it)."""
-    from tactileskin.geometry.indenters import indenter_for_scene
+    from tactileskin.geometry.indenters import at_first_touch, indenter_for_scene
     from tactileskin.materials import get_material
 
     if dialect not in DIALECTS:
@@ -349,7 +355,7 @@ def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | 
         return deck_text_3d(scene, skinmesh, penalty=penalty, increments=increments, viscoelastic=viscoelastic)
     mat = get_material(scene.material)
     visco = scene.viscoelastic if viscoelastic is None else bool(viscoelastic)
-    ind = indenter_for_scene(scene)
+    ind = at_first_touch(scene, indenter_for_scene(scene), contact_nodes(skinmesh))  # as fe.model_for_scene
     etype, pts, cells = abaqus_cells(skinmesh)
     n_nodes, n_cells = len(pts), len(cells)
     T, depth = scene.duration, scene.indentation

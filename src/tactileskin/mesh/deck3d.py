@@ -54,17 +54,17 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     size away from the Braille caps (default the skin's coarse size: a plane is exact at any
     size); cap_size: on the caps (default indenter3d's); penalty (MPa/mm): default
     PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
-    from tactileskin.geometry.indenters import indenter_for_scene
+    from tactileskin.geometry.indenters import at_first_touch, indenter_for_scene
     from tactileskin.materials import get_material
-    from tactileskin.mesh.deck import (Deck, _name, _num, abaqus_cells, indenter_mesh_lines, material_lines,
-                                        skin_mesh_lines)
+    from tactileskin.mesh.deck import (Deck, _name, _num, abaqus_cells, contact_nodes, indenter_mesh_lines,
+                                        material_lines, skin_mesh_lines)
     from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
 
     if skinmesh.dim != 3:
         raise ParameterError("mesh", f"{skinmesh.dim}D", "a 3D skin mesh for a 3D deck")
     mat = get_material(scene.material)
     visco = scene.viscoelastic if viscoelastic is None else bool(viscoelastic)
-    ind = indenter_for_scene(scene)
+    ind = at_first_touch(scene, indenter_for_scene(scene), contact_nodes(skinmesh))  # as fe.model_for_scene
     etype, pts, cells = abaqus_cells(skinmesh)
     n_nodes, n_cells = len(pts), len(cells)
     T, depth = scene.duration, scene.indentation

@@ -9,6 +9,8 @@ the CAD solids are built from. See docs/architecture.md, "geometry.indenters".
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from tactileskin import params
@@ -23,6 +25,8 @@ from tactileskin.geometry.indenters.cylinder import CurvedIndenter, CylinderInde
 from tactileskin.geometry.indenters.file import FileIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.flat import FlatIndenter  # noqa: E402,F401
 from tactileskin.geometry.indenters.sphere import SphereIndenter  # noqa: E402,F401
+
+log = logging.getLogger(__name__)
 
 PAPER_KINDS = tuple(k for k in KINDS if get_kind(k).paper)
 
@@ -68,6 +72,27 @@ def indenter_for_scene(scene, *, row: int | None = None, warn: bool = True, lift
     return make_indenter(scene.indenter, y0=scene.section().top + lift, dim=scene.dim, row=row,
                          sample_length=scene.sample_length, warn=warn,
                          **scene_kind_params(scene))
+
+
+# an initial overlap of the indenter and the skin below this fraction of the travel is left
+# (below the contact tolerance's own cap, fe.model.TOL_TRAVEL)
+START_OVERLAP = 1e-3
+
+
+def at_first_touch(scene, ind: Indenter, points) -> Indenter:
+    """`ind` (the scene's indenter_for_scene), or, where the skin's contact `points` (n, dim)
+    overlap it by more than START_OVERLAP of the travel, the same raised to first touch, with a
+    warning: a user's skin may stand higher off the indenters' axis than on it (skins.file.AXIS_GAP
+    allows 2 % of t), where a flat plate started inside it by that much. The solver
+    (fe.model_for_scene) and the decks (mesh.deck) start it alike. Built-in skins never overlap
+    (their top is the highest point under every indenter)."""
+    g0, _ = ind.gap(np.asarray(points, float).reshape(-1, scene.dim))
+    overlap = -float(np.min(g0)) if g0.size else 0.0
+    if not overlap > START_OVERLAP * scene.indentation:
+        return ind
+    log.warning("the skin's contact surface stands %.3g mm above its top point on the indenters' axis "
+                "where the indenter (%s) meets it: it starts there, at first touch", overlap, scene.indenter_label())
+    return indenter_for_scene(scene, lift=overlap, warn=False)  # warned already, if at all
 
 
 def indenter_symmetry(scene) -> tuple[bool, bool]:
