@@ -459,6 +459,31 @@ def test_lockup_of_a_soft_material_is_flagged_relative_to_its_modulus(tmp_path):
     assert f.code == "stress_range" and "mu0" in f.reason
 
 
+def test_braille_dots_pressed_less_than_their_patch_resolves_are_flagged():
+    # the t = 0.5 mm full cell on the fingertip: its dots, off the crown, touch after 0.069 of the
+    # 0.1 mm travel; at preview (dot patch 0.2 mm) the peak read 0.00691 MPa against the Richardson
+    # limit 0.00848 (-18 %), status ok
+    from tactileskin.fe import solve
+
+    cell = solve(Scene(thickness=0.5, indenter="braille", braille_text="\u283f", dim=3, mesh_size=1.6, refinement=8))
+    summ = cell.summary()
+    assert summ["mesh_sizes_mm"]["dot_indentation"] == pytest.approx(0.031, abs=0.002)
+    assert cell.peak < 0.85 * 0.00848
+    assert [f["code"] for f in summ["flags"]] == ["coarse_mesh"] and "Braille dots" in cell.status
+    # a centred dot touches at once: not judged (pressed 0.05 mm at t = 1, preview read -2.9 % from fine)
+    dot = solve(Scene(thickness=1, indenter="braille", dim=3, depth=0.05, mesh_size=1.6, refinement=8))
+    assert "dot_indentation" not in dot.summary()["mesh_sizes_mm"] and dot.status == "ok"
+    # nor a cell on the flat pad, whose dots all touch at the start (sampled first touch 5e-8 mm)
+    pad = solve(Scene(skin="pad", pad_width=10, pad_length=10, thickness=1, indenter="braille", braille_text="\u283f",
+                      dim=3, depth=0.05, mesh_size=1.6, refinement=8))
+    assert "dot_indentation" not in pad.summary()["mesh_sizes_mm"]
+    sizes = {"global": 1.6, "refined": 0.2, "preview_global": 1.6, "preview_refined": 0.2, "thickness": 1.0}
+    normal3 = {k: v for k, v in NORMAL.items() if k != "reaction_n_per_mm"} | {"reaction_n": 0.5}
+    assert quality.flags({**normal3, "mesh_sizes_mm": {**sizes, "dot_indentation": 0.131}}) == []  # t = 1 cell
+    assert [f.code for f in quality.flags({**normal3, "mesh_sizes_mm": {**sizes, "dot_indentation": 0.08}})] \
+        == ["coarse_mesh"]
+
+
 # --- elements through the skin -----------------------------------------------------------------
 
 def test_a_skin_thinner_than_the_presets_elements_is_flagged():

@@ -322,7 +322,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     Raises ParameterError before meshing if the indenter cannot reach the skin (no contact).
     progress: optional callable, given an IncrementInfo (increment, t, T, travel, Newton
     iterations) after each converged increment; nothing is printed either way."""
-    from tactileskin.geometry.indenters import indenter_symmetry, mirrored_x, require_contact
+    from tactileskin.geometry.indenters import (BrailleIndenter, first_contact_travel, indenter_symmetry,
+                                                mirrored_x, require_contact)
     from tactileskin.materials import get_material
     from tactileskin.materials.laws import nu0
 
@@ -395,6 +396,12 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     res.stats["order"] = int(scene.order)
     if sized and scene.skin != "file":
         res.stats["mesh_sizes_mm"] = _sizes_against_preview(scene)
+        touch = first_contact_travel(scene) if scene.dim == 3 and isinstance(ind, BrailleIndenter) else 0.0
+        if touch > 1e-3:  # as _start_near_first_touch: below it the dots touch at once (the pad: 5e-8)
+            # dots off a curved top's crown touch late (the t = 0.5 full cell: after 0.069 of 0.1 mm):
+            # quality judges how far the deepest-pressed one went in against the dot patch's size.
+            # A centred dot is not judged: pressed 0.05 mm (a quarter of preview's patch) it read -2.9 %
+            res.stats["mesh_sizes_mm"]["dot_indentation"] = max(0.0, travel - touch)
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)
