@@ -484,6 +484,23 @@ def test_braille_dots_pressed_less_than_their_patch_resolves_are_flagged():
         == ["coarse_mesh"]
 
 
+def test_a_3d_lockup_the_mesh_does_not_resolve_is_flagged():
+    # an R 2.5 sphere 0.6 mm into 1 mm silicone locks the law up (max |stress| ~50 mu0): on the
+    # fingertip the peak read 4.09 / 3.79 / 3.57 MPa at preview / default / fine, on this pad 4.32 /
+    # 3.83 (preview / default), status ok; 3D meshes resolve 0.4 mm (4.5 mu0: preview and default within 1 %)
+    from tactileskin.fe import solve
+
+    ball = Scene(skin="pad", pad_width=10, pad_length=10, dim=3, thickness=1.0, indenter="sphere",
+                 indenter_radius=2.5, depth=0.6, viscoelastic=False, mesh_size=1.6, refinement=8.0)  # preview
+    summ = solve(ball).summary()
+    assert summ["max_abs_stress_mpa"] > 30 * 0.09
+    assert [f["code"] for f in summ["flags"]] == ["stress_range"] and "in 3D" in summ["status"]
+    normal3 = {k: v for k, v in NORMAL.items() if k != "reaction_n_per_mm"} | {"reaction_n": 0.5}
+    assert quality.flags({**normal3, "max_abs_stress_mpa": 0.41, "material_mu0_mpa": 0.09}) == []  # 0.4 mm
+    # 2D meshes resolve it: 3 mm silicone at 40 % (57 mu0) moved 0.47 % from h = 1 to 0.5
+    assert quality.flags({**NORMAL, "max_abs_stress_mpa": 5.11, "material_mu0_mpa": 0.09}) == []
+
+
 # --- elements through the skin -----------------------------------------------------------------
 
 def test_a_skin_thinner_than_the_presets_elements_is_flagged():
