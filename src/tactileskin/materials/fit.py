@@ -306,12 +306,15 @@ def extrapolation_warnings(mat, lam, P, nu) -> list[str]:
     return out
 
 
-def _check_stable(law: str, mat, lam, nu) -> None:
-    """FitError unless the fitted law stiffens with stretch in uniaxial tension and compression
-    over the data's range and a margin (0.7 to 1.5 at least): a law whose stress falls with
-    stretch (a negative c01, a wrong-signed Ogden term) fits the points but has no stable
-    solution, and a solve with it would not converge."""
-    grid = np.linspace(min(0.7, float(lam.min())), max(1.5, float(lam.max())), 81)
+STABLE_RANGE = (0.7, 1.5)  # uniaxial stretches over which a law's stress must rise with stretch
+
+
+def unstable_stretch(mat, nu=None, lo: float = STABLE_RANGE[0], hi: float = STABLE_RANGE[1]) -> float | None:
+    """The uniaxial stretch in [lo, hi] (81 points) nearest 1 where `mat`'s nominal stress does not
+    rise with stretch or is not finite, or None: a law whose stress falls with stretch (a negative
+    c01, a wrong-signed Ogden term) has no stable solution there, and a solve with it does not
+    converge (3D) or converges to a wrong state (2D)."""
+    grid = np.linspace(lo, hi, 81)
     with np.errstate(all="ignore"):
         try:
             P, ok = uniaxial_nominal(mat, grid, nu)
@@ -319,8 +322,14 @@ def _check_stable(law: str, mat, lam, nu) -> None:
             P, ok = np.full(grid.shape, np.nan), np.zeros(grid.shape, bool)
     bad = ~(np.asarray(ok) & np.isfinite(P))
     bad[1:] |= np.diff(P) <= 0.0
-    if np.any(bad):
-        at = float(grid[int(np.argmax(bad))])
+    return float(grid[bad][np.argmin(np.abs(grid[bad] - 1.0))]) if np.any(bad) else None
+
+
+def _check_stable(law: str, mat, lam, nu) -> None:
+    """FitError unless the fitted law stiffens with stretch in uniaxial tension and compression
+    over the data's range and a margin (STABLE_RANGE at least)."""
+    at = unstable_stretch(mat, nu, min(STABLE_RANGE[0], float(lam.min())), max(STABLE_RANGE[1], float(lam.max())))
+    if at is not None:
         raise FitError(f"the fitted {law} law is not stable: its uniaxial stress does not rise with stretch "
                        f"at stretch {at:.3g} ({mat.to_dict() if hasattr(mat, 'to_dict') else mat}); "
                        "try another law or fewer terms")
