@@ -200,9 +200,10 @@ class ForceIncrement:
         if f < 0:  # below the target: deeper
             if d >= self.d_max * (1 - 1e-12):
                 goal = F if self.goal is None else self.goal
-                on_way = "" if abs(goal - F) <= 1e-9 * max(abs(goal), 1.0) else f" (on the way, at {F:.6g})"
+                unit = _unit(model)
+                on_way = "" if abs(goal - F) <= 1e-9 * max(abs(goal), 1.0) else f" (on the way, at {F:.6g} {unit})"
                 raise ConvergenceError(
-                    f"force {goal:.6g} not reached: the reaction is {f + F:.6g} at the largest travel "
+                    f"force {goal:.6g} {unit} not reached: the reaction is {f + F:.6g} {unit} at the largest travel "
                     f"{self.d_max:.6g} mm (0.6 x thickness){on_way}; the skin cannot carry this force "
                     "within its depth range", {"force": goal, "ramp_force": F, "reached": f + F, "travel_mm": d})
             x = max(x, d + 1e-6 * self.d_max)
