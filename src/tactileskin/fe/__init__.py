@@ -266,6 +266,9 @@ def _run_history(scene, model, section, program, options, progress, history: boo
 # a depth ramp starts at this fraction of the travel to first touch (the sampled contour's
 # first touch is within ~1e-5 mm of the true one; the margin keeps the start contact-free)
 START_BEFORE_TOUCH = 0.9
+# a first touch later than this travel (mm) is a late one (dots off a curved top's crown);
+# below it the indenter touches at once (the pad's samples as 5e-8)
+LATE_TOUCH = 1e-3
 
 
 def _start_near_first_touch(scene, model) -> None:
@@ -280,7 +283,7 @@ def _start_near_first_touch(scene, model) -> None:
     if scene.skin == "file" or not isinstance(getattr(model.contact, "indenter", None), BrailleIndenter):
         return
     touch = first_contact_travel(scene)
-    if touch <= 1e-3 or touch >= scene.indentation:
+    if touch <= LATE_TOUCH or touch >= scene.indentation:
         return
     model.t = START_BEFORE_TOUCH * touch / model.contact.rate
     model.d = model.travel(model.t)
@@ -397,7 +400,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     if sized and scene.skin != "file":
         res.stats["mesh_sizes_mm"] = _sizes_against_preview(scene)
         touch = first_contact_travel(scene) if scene.dim == 3 and isinstance(ind, BrailleIndenter) else 0.0
-        if touch > 1e-3:  # as _start_near_first_touch: below it the dots touch at once (the pad: 5e-8)
+        if touch > LATE_TOUCH:
             # dots off a curved top's crown touch late (the t = 0.5 full cell: after 0.069 of 0.1 mm):
             # quality judges how far the deepest-pressed one went in against the dot patch's size.
             # A centred dot is not judged: pressed 0.05 mm (a quarter of preview's patch) it read -2.9 %
