@@ -454,3 +454,38 @@ def test_a_read_only_result_folder_is_refused_before_the_solve(tmp_path, capsys,
     assert main(["solve", *CHEAP, "--out", str(d)]) == 2
     assert "permission denied" in _err(capsys) and calls == []  # was: solved, then refused
     assert {p.name: p.read_bytes() for p in d.iterdir()} == before
+
+
+@pytest.mark.parametrize("fail_at", ["writer", "record"])
+def test_a_failed_single_file_write_leaves_no_folder_it_created(tmp_path, capsys, monkeypatch, fail_at):
+    """`material fit -o new/sub/gel.toml` (as mesh, export, film calibrate) on a full disk left
+    the empty folders `new/sub` it had created (solve and film analyze removed theirs). Now a
+    failed write removes the folders it created, which hold only its bookkeeping; a folder that
+    was there stays, and so does the user's file."""
+    import numpy as np
+
+    lam = np.linspace(0.8, 1.5, 8)
+    (tmp_path / "t.csv").write_text("stretch,nominal_stress_mpa\n" + "".join(
+        f"{float(a)!r},{float(0.04 * (a - a ** -2))!r}\n" for a in lam))
+    real = ownership.atomic_write_json
+
+    def full_disk(path, obj):
+        raise fileio.OutputError(path, "no space left on the device")
+
+    def failing_writer(path, text):
+        raise fileio.OutputError(path, "no space left on the device")
+
+    if fail_at == "record":
+        monkeypatch.setattr(ownership, "atomic_write_json", full_disk)
+    else:
+        monkeypatch.setattr(fileio, "atomic_write_text", failing_writer)
+    out = tmp_path / "new" / "sub" / "gel.toml"
+    argv = ["material", "fit", str(tmp_path / "t.csv"), "-o", str(out), "--law", "neo_hookean"]
+    assert main(argv) == 2
+    assert "Traceback" not in _err(capsys)
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "kept").mkdir()
+    (tmp_path / "kept" / "mine.txt").write_text("user")
+    assert main(argv[:4] + [str(tmp_path / "kept" / "sub" / "gel.toml")] + argv[5:]) == 2
+    assert sorted(p.name for p in (tmp_path / "kept").iterdir()) == ["mine.txt"]
+    monkeypatch.setattr(ownership, "atomic_write_json", real)

@@ -90,15 +90,63 @@ def written_file(path) -> Iterator[Path]:
     that is there: a rerun replaces it. (Writing `path`, then `record_file`, left the new file
     unrecorded when the record's write failed: every rerun refused it as a user's file.)"""
     path = Path(path)
-    with atomic_path(path, suffix=path.suffix or ".tmp") as tmp:
-        yield path.with_name(tmp.name)  # as the user named the folder (mkstemp's is absolute)
-        with os_errors(path, own_name=False):
-            digest = file_sha256(tmp)
-        _set_entry(path, lambda old: entry_digests(old) + [digest])
+    new_dirs = _missing_dirs(path.parent)
+    try:
+        with atomic_path(path, suffix=path.suffix or ".tmp") as tmp:
+            yield path.with_name(tmp.name)  # as the user named the folder (mkstemp's is absolute)
+            with os_errors(path, own_name=False):
+                digest = file_sha256(tmp)
+            _set_entry(path, lambda old: entry_digests(old) + [digest])
+    except BaseException:
+        _remove_new_dirs(new_dirs)
+        raise
     try:  # in place; the [old, new] entry already covers it if this write fails
         _set_entry(path, lambda old: digest)
     except OutputError as e:
         log.warning("%s", e)
+
+
+def _missing_dirs(folder: Path) -> list[Path]:
+    """The folders of `folder`'s path that do not exist yet, deepest first."""
+    missing = []
+    for d in [folder, *folder.parents]:
+        if d.exists() or d.is_symlink():
+            break
+        missing.append(d)
+    return missing
+
+
+def _remove_new_dirs(dirs: list[Path]) -> None:
+    """After a failed write, remove the folders it created (deepest first) while they hold
+    nothing but the record of files and its lock, which no other writer holds: a failed
+    `mesh -o new/m.msh` left an empty `new`."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        fcntl = None
+    for d in dirs:
+        try:
+            names = {p.name for p in d.iterdir()}
+            if not names <= {OWNED_FILES, RECORD_LOCK} or any(
+                    (d / n).is_symlink() or not (d / n).is_file() for n in names):
+                return
+            if OWNED_FILES in names and any((d / k).exists() for k in read_record(d)):
+                return
+            if RECORD_LOCK in names:
+                fd = os.open(d / RECORD_LOCK, os.O_RDONLY)
+                try:  # a writer holding it is using the folder
+                    if fcntl is not None:
+                        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    for n in names:
+                        (d / n).unlink()
+                finally:
+                    os.close(fd)
+            else:
+                for n in names:
+                    (d / n).unlink()
+            d.rmdir()
+        except OSError:
+            return
 
 
 # The record is replaced by a rename, so it cannot be locked itself: a lock file beside it,
