@@ -235,6 +235,28 @@ def test_core_clearance_is_checked():
     molds.MoldParams.from_params(core_clearance=0.0).check(sec)
 
 
+def test_sprue_position_is_checked(tmp_path, monkeypatch):
+    """pour_inset keeps the sprue inside the sample and 1 mm of mold from the vent at the other
+    end (20 mm sample, vent at z = 8: at most 20 - 2 - 2.75 - 1 = 14.25 mm); a molds.toml
+    without it (copied before it existed) names the key to add."""
+    import shutil
+
+    from tactileskin import params
+
+    sec = FT.section(1.0)
+    molds.MoldParams.from_params(pour_inset=14.25).check(sec)
+    for bad in (1.9, 14.3):
+        with pytest.raises(ParameterError, match=r"molds\.pour\.pour_inset=.*valid: \[2, 14\.25\] mm"):
+            molds.MoldParams.from_params(pour_inset=bad).check(sec)
+    for f in params.geometry_dir().glob("*.toml"):
+        shutil.copy(f, tmp_path / f.name)
+    old = (tmp_path / "molds.toml").read_text()
+    (tmp_path / "molds.toml").write_text("\n".join(ln for ln in old.splitlines() if not ln.startswith("pour_inset")))
+    monkeypatch.setenv("TACTILESKIN_GEOMETRY", str(tmp_path))
+    with pytest.raises(ParameterError, match=r"molds\.pour\.pour_inset.*add `pour_inset = 3\.0` under \[pour\]"):
+        molds.MoldParams.from_params()
+
+
 @pytest.mark.parametrize("t", THICKNESSES)
 def test_mold_halves_core_and_pins_fit(builds, t):
     build = builds(t)
@@ -250,17 +272,21 @@ def test_mold_halves_core_and_pins_fit(builds, t):
     (lx0, ly0, lz0, lx1, ly1, lz1), (ux0, uy0, uz0, ux1, uy1, uz1) = lower.bounding_box(), upper.bounding_box()
     assert uy0 == pytest.approx(0.0, abs=1e-9) and ly0 < -FT.height  # split plane y = 0
     assert ly1 == pytest.approx(mp.pin_height, abs=1e-6)              # pins protrude above it
-    # sprue (z = 0) and vents (near the ends) open the roof onto the cavity on x = 0: a thin
-    # vertical probe from the contour's ridge through the roof meets no mold material there,
-    # but does beside the sprue and over the end wall
-    zv = FT.sample_length / 2 - mp.vent_inset
+    # the sprue (pour_inset from the z < 0 end) and the vent (near the other end) open the roof
+    # onto the cavity on x = 0: a thin vertical probe from the contour's ridge through the roof
+    # meets no mold material there, but does beside them, over the end walls, and over the
+    # middle of the ridge, where the indenters press (the sprue was at z = 0: its trimmed gate
+    # lay under the Braille dot and the sphere)
+    zv, zs = FT.sample_length / 2 - mp.vent_inset, -FT.sample_length / 2 + mp.pour_inset
+    assert zs + 0.5 * mp.pour_diameter < -3.1  # clear of a centred Braille cell's dots (|z| <= 3.06)
 
     def probe(z):
         r = 0.1
         return (upper ^ _box([-r, FT.height + 1e-3, z - r], [r, uy1 + 1.0, z + r])).volume()
 
-    assert [probe(z) for z in (0.0, zv, -zv)] == [0.0, 0.0, 0.0]
-    assert all(probe(z) > 0.1 for z in (mp.pour_diameter, zv + mp.vent_diameter, FT.sample_length / 2 + mp.wall / 2))
+    assert [probe(z) for z in (zs, zv)] == [0.0, 0.0]
+    assert all(probe(z) > 0.1 for z in (0.0, zs + mp.pour_diameter, zv - mp.vent_diameter,
+                                        FT.sample_length / 2 + mp.wall / 2, -FT.sample_length / 2 - mp.wall / 2))
 
 
 def test_indenter_working_faces_lie_on_the_analytic_surface(builds):

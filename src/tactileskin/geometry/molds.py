@@ -20,8 +20,10 @@ Layout (dimensions in data/geometry/molds.toml, frame as in solids.py):
 - Split plane y = 0, the contour's widest section: neither half has an undercut, and the
   lower half releases the cast skin together with its base.
 - Four alignment pins on the lower half's split face, in clearance holes in the upper half.
-- A sprue at the middle of the skin's ridge (x = 0, z = 0) and an air vent near each end,
-  both through the upper half's roof.
+- A sprue on the skin's ridge (x = 0) near the z < 0 end (`pour_inset` from it) and an air
+  vent near the other end, both through the upper half's roof: the skin fills from one end
+  and its air leaves at the other, and the gate's mark stays off the middle of the sample,
+  where the indenters press (a sprue at z = 0 left it under the Braille dot and the sphere).
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ class MoldParams:
     pin_depth_clearance: float
     pin_flange: float
     pour_diameter: float
+    pour_inset: float
     vent_diameter: float
     vent_inset: float
     core_clearance: float
@@ -60,12 +63,17 @@ class MoldParams:
         kw = dict(wall=p["block"]["wall"], pin_diameter=p["pins"]["diameter"], pin_height=p["pins"]["height"],
                   pin_clearance=p["pins"]["clearance"], pin_depth_clearance=p["pins"]["depth_clearance"],
                   pin_flange=p["pins"]["flange"], pour_diameter=p["pour"]["pour_diameter"],
+                  pour_inset=p["pour"].get("pour_inset"),
                   vent_diameter=p["pour"]["vent_diameter"], vent_inset=p["pour"]["vent_inset"])
         core = p.get("core", {})
         if "clearance" not in core and "core_clearance" not in overrides:
             raise ParameterError("molds.core.clearance", None, ">= 0 mm in molds.toml",
                                  "add `[core] clearance = 0.2` (the gap around the printed core)")
         kw["core_clearance"] = core.get("clearance")
+        if kw["pour_inset"] is None and "pour_inset" not in overrides:  # a molds.toml from before it
+            raise ParameterError("molds.pour.pour_inset", None, ">= 0 mm in molds.toml",
+                                 "add `pour_inset = 3.0` under [pour] (the fingertip sprue's distance "
+                                 "from the sample's z < 0 end)")
         kw.update(overrides)
         from tactileskin import validate
 
@@ -87,7 +95,7 @@ class MoldParams:
         for name in ("wall", "pin_diameter", "pin_height", "pour_diameter", "vent_diameter", "pin_flange"):
             if not getattr(self, name) > 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), "> 0 mm")
-        for name in ("pin_clearance", "pin_depth_clearance", "vent_inset"):
+        for name in ("pin_clearance", "pin_depth_clearance", "vent_inset", "pour_inset"):
             if not getattr(self, name) >= 0.0:
                 raise ParameterError(f"molds.{name}", getattr(self, name), ">= 0 mm")
         if not 0.0 <= self.core_clearance <= 0.5 * self.wall:
@@ -108,6 +116,17 @@ class MoldParams:
                                  f"[{0.5 * self.vent_diameter:g}, {half_l:g}] mm")
         if self.pour_diameter >= 2.0 * ft.half_width:
             raise ParameterError("molds.pour.pour_diameter", self.pour_diameter, f"< {2 * ft.half_width:g} mm")
+        # the sprue inside the sample, 1 mm of mold from the vent at the other end
+        zv = half_l - self.vent_inset
+        hi = zv - 0.5 * (self.pour_diameter + self.vent_diameter) - 1.0 + half_l
+        if not 0.5 * self.pour_diameter <= self.pour_inset <= hi:
+            raise ParameterError("molds.pour.pour_inset", self.pour_inset,
+                                 f"[{0.5 * self.pour_diameter:g}, {hi:g}] mm (the sprue inside the "
+                                 f"{ft.sample_length:g} mm sample, 1 mm of mold from the vent at z = {zv:g})")
+
+    def sprue_z(self, sample_length: float) -> float:
+        """z of the fingertip mold's sprue: `pour_inset` from the sample's z < 0 end."""
+        return -0.5 * sample_length + self.pour_inset
 
 
 @dataclass(frozen=True)
@@ -202,12 +221,12 @@ def skin_mold(sec: Section, mp: MoldParams | None = None) -> tuple[bd.Solid, bd.
             cavity = _single(cavity.fuse(core_seat(sec, mp.core_clearance)).clean())
         pins = [vertical_cylinder(x, z, 0.0, mp.pin_height, mp.pin_diameter) for x, z in lay.pins]
         lower = box(-A, A, lay.floor, 0.0, -Z, Z).cut(cavity).fuse(*pins).clean()
-        # the upper half: pin holes, a sprue at the ridge's middle and a vent near each end;
-        # the holes start at the split plane (inside the cavity) so they open into it
+        # the upper half: pin holes, a sprue near one end of the ridge and a vent near the
+        # other; the holes start at the split plane (inside the cavity) so they open into it
         holes = [vertical_cylinder(x, z, 0.0, mp.pin_height + mp.pin_depth_clearance,
                                     mp.pin_diameter + mp.pin_clearance) for x, z in lay.pins]
         zv = 0.5 * ft.sample_length - mp.vent_inset
-        holes += [vertical_cylinder(0.0, 0.0, 0.0, lay.roof + 1.0, mp.pour_diameter)]
-        holes += [vertical_cylinder(0.0, s * zv, 0.0, lay.roof + 1.0, mp.vent_diameter) for s in (-1, 1)]
+        holes += [vertical_cylinder(0.0, mp.sprue_z(ft.sample_length), 0.0, lay.roof + 1.0, mp.pour_diameter)]
+        holes += [vertical_cylinder(0.0, zv, 0.0, lay.roof + 1.0, mp.vent_diameter)]
         upper = box(-A, A, 0.0, lay.roof, -Z, Z).cut(cavity, *holes).clean()
     return check_solid(lower, "mold lower half", **p), check_solid(upper, "mold upper half", **p)

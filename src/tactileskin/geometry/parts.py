@@ -108,7 +108,7 @@ def build_parts(thickness: float | None = None, *, indenters="all", braille_text
         mp = dict(fp, **{k: getattr(mold_params, k) for k in ("wall", "pin_diameter", "pour_diameter", "vent_diameter",
                                                           "core_clearance")})
         parts.append(Part("mold_lower", "casting mold, lower half (holds the base, pins)", lower, mp))
-        parts.append(Part("mold_upper", "casting mold, upper half (sprue, vents)", upper, mp))
+        parts.append(Part("mold_upper", "casting mold, upper half (sprue near one end, vent near the other)", upper, mp))
     log.info("fingertip parts in %.2f s", time.perf_counter() - t0)
     for kind, ind in inds:
         t1 = time.perf_counter()
