@@ -6,7 +6,7 @@ reading (a 5 mm band in a 9 mm crop reads 5/9 of its pressure), so without a box
 the band:
 
 1. activated pixels: pressure above the calibration's lower clip (lighter pixels read as
-   unactivated film); a 3 x 3 opening drops isolated noise pixels;
+   unactivated film); a 3 x 3 opening drops isolated noise pixels (none left: the scan is blank);
 2. connected regions (4-neighbour), each weighted by its summed pressure; the heaviest is
    the strip. If another region weighs at least half as much, the choice is ambiguous and
    we refuse (the user gives --box-px / --box-mm);
@@ -38,15 +38,19 @@ RULE = ("auto: heaviest connected activated region (pressure above the lower cli
         "along it the region's extent + 1 mm each side")
 
 
+def pressed(pmap: np.ndarray, p_lo: float) -> np.ndarray:
+    """The activated pixels (pressure above p_lo) that a 3 x 3 block of activated pixels holds
+    (a 3 x 3 opening): a press darkens an area; isolated pixels and 1-2 px lines are scan noise,
+    dust or scratches."""
+    return ndimage.binary_opening(pmap > p_lo, structure=np.ones((3, 3), bool))
+
+
 def find_strip(pmap: np.ndarray, p_lo: float, px_per_mm: float) -> tuple[int, int, int, int]:
     """Box (c0, r0, c1, r1), half-open, of the strip in a pressure map whose strip runs
     along axis 1 (columns). Raises ParameterError if nothing or several strips qualify."""
-    active = pmap > p_lo
-    if not active.any():  # a blank scan: the caller reports it for the whole image
+    active = pressed(pmap, p_lo)
+    if not active.any():  # a blank scan (or noise and dust only): the caller reports it for the whole image
         return 0, 0, pmap.shape[1], pmap.shape[0]
-    opened = ndimage.binary_opening(active, structure=np.ones((3, 3), bool))
-    if opened.any():
-        active = opened
     labels, n = ndimage.label(active)
     weight = np.asarray(ndimage.sum(pmap - p_lo, labels, index=np.arange(1, n + 1)), float)
     order = np.argsort(weight)[::-1]
