@@ -7,14 +7,15 @@ import numpy as np
 
 from tactileskin.cli import main
 from tactileskin.film import paper_eq8
+from tactileskin.film.calibration import Calibration
 from tactileskin.film.synthetic import gaussian_profile, mirrored, render_scan, save_scan
 
 S = np.linspace(0, 6, 121)
 
 
-def _sim_dir(path, status="ok"):
+def _sim_dir(path, status="ok", peak=1.2):
     path.mkdir(parents=True)
-    np.savetxt(path / "profile.csv", np.column_stack([S, gaussian_profile(1.2, 1.0)(S)]), delimiter=",",
+    np.savetxt(path / "profile.csv", np.column_stack([S, gaussian_profile(peak, 1.0)(S)]), delimiter=",",
                header="s_mm,pressure_mpa", comments="", fmt="%.10g")
     (path / "summary.json").write_text(json.dumps({"status": status}))
     return path
@@ -97,3 +98,28 @@ def test_an_inverted_scan_is_said_to_look_inverted(tmp_path, capsys):
     assert len(warnings) == 1 and "looks inverted" in warnings[0] and "widen the region" not in warnings[0]
     # the same scan the right way round is not
     assert main(["film", "analyze", str(save_scan(img, tmp_path / "scan.png")), "--out", str(tmp_path / "ok")]) == 0
+
+
+def test_a_film_in_another_unit_than_mpa_is_a_suspect_comparison(tmp_path, capsys):
+    # a calibration in kPa: the film read 400 kPa against the simulation's 0.4 MPa, -99.9 %, 'ok'
+    eq8 = paper_eq8()
+    kpa = Calibration(name="kpa", model="linear", params=tuple(1000 * v for v in eq8.params),
+                      gs_range=eq8.gs_range, p_range=tuple(1000 * v for v in eq8.p_range), unit="kPa")
+    kpa.save(tmp_path / "kpa.json")
+    scan = save_scan(render_scan(mirrored(S, gaussian_profile(0.4, 1.0)(S)), paper_eq8(), length_mm=14,
+                                 background_gs=245), tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "-c", str(tmp_path / "kpa.json"), "--out", str(tmp_path / "film")]) == 0
+    _sim_dir(tmp_path / "sim")
+    capsys.readouterr()
+    assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o",
+                 str(tmp_path / "cmp")]) == 3
+    assert "warning: units: the film reads in kPa, the simulation in MPa" in capsys.readouterr().err
+    doc = json.loads((tmp_path / "cmp" / "comparison.json").read_text())
+    assert doc["status"] == "suspect" and doc["percent_diff"]["peak"] < -99
+    # the paper's MPa/mm (Eq. 8) is compared as MPa, as the paper does: no warning for it
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film8")]) == 0
+    _sim_dir(tmp_path / "sim4", peak=0.4)
+    assert main(["film", "compare", str(tmp_path / "film8"), str(tmp_path / "sim4"), "-o",
+                 str(tmp_path / "cmp8")]) == 0
+    doc = json.loads((tmp_path / "cmp8" / "comparison.json").read_text())
+    assert doc["status"] == "ok" and abs(doc["percent_diff"]["peak"]) < 1

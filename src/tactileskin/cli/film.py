@@ -144,7 +144,7 @@ def compare(film_dir, sim_dir, out):
     if status != "ok":  # comparison.json carries it too (sim_meta, status, warnings)
         click.echo(f"warning: the simulated result is {status}", err=True)
     for w in comp.warnings:  # the comparison's own about the simulation (an asymmetric fold)
-        if w.startswith("simulation: ") and w != f"simulation: {status}":
+        if (w.startswith("simulation: ") and w != f"simulation: {status}") or w.startswith("units: "):
             click.echo(f"warning: {w}", err=True)
     for w in comp.film_warnings:  # the film's own (summary.json): the comparison inherits them
         click.echo(f"warning: the film profile is suspect: {w}", err=True)

@@ -10,7 +10,8 @@ Percent difference (paper Sec. V-B): 100 (sim - film) / film, signed; the paper 
 magnitudes (e.g. 231 %), and values above 200 % rule out the symmetric |a-b|/mean(a,b)
 form, so the measurement is the reference. Units: the film reads in its calibration's unit
 (MPa, or MPa/mm for paper_eq8); numbers are compared directly with the simulation's MPa as
-the paper does (see calibration module docstring).
+the paper does (see calibration module docstring); a film in any other unit makes the
+comparison suspect (SAME_AS_MPA).
 """
 
 from __future__ import annotations
@@ -34,6 +35,9 @@ from tactileskin.film.scan import (ASYMMETRY, COMPARE_NAMES, FilmProfile, fold_p
 log = logging.getLogger(__name__)
 
 METRICS = ("peak", "span_mm", "auc")
+# film units whose numbers are compared with the simulation's MPa as they are: MPa, and the
+# paper's MPa/mm (Eq. 8, read as MPa as the paper does); any other (kPa, psi) is not comparable
+SAME_AS_MPA = ("MPa", "MPa/mm")
 
 
 def read_profile_csv(path, s_col: str, p_col: str) -> tuple[np.ndarray, np.ndarray]:
@@ -153,8 +157,8 @@ class Comparison:
             "percent_diff": self.percent_diff,
             "percent_diff_definition": "100 * (sim - film) / film, film folded onto s >= 0",
             "film_unit": self.film_unit, "sim_unit": "MPa",
-            "unit_note": ("numbers compared directly, as the paper does"
-                          if self.film_unit != "MPa" else "same unit"),
+            "unit_note": ("same unit" if self.film_unit == "MPa" else "numbers compared directly, as the paper does"
+                          if self.film_unit in SAME_AS_MPA else "unlike units: peak and area not comparable"),
             "film_asymmetry": self.asymmetry, "sim_asymmetry": self.sim_asymmetry,
             "sim_meta": self.sim_meta,
         }
@@ -232,6 +236,10 @@ def compare(film, sim) -> Comparison:
     warnings = [f"film: {w}" for w in film_warnings]
     if not isinstance(film, FilmProfile) and (changed := changed_since_written(film)):
         warnings.append(f"film: {', '.join(changed)} changed since `film analyze` wrote it (damaged or edited)")
+    if unit not in SAME_AS_MPA:  # 218 kPa against 0.22 MPa read -99.9 %, status ok
+        warnings.append(f"units: the film reads in {unit}, the simulation in MPa: the peak and area differences "
+                        "compare unlike units (only MPa and the paper's MPa/mm are compared as they are); "
+                        "calibrate in MPa (`film calibrate` does)")
     status = str(smeta.get("status", "ok"))
     if status != "ok":
         warnings.append(f"simulation: {status}")
