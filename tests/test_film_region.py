@@ -9,7 +9,7 @@ import pytest
 
 from tactileskin.cli import main
 from tactileskin.errors import ParameterError
-from tactileskin.film import analyze_scan
+from tactileskin.film import analyze_scan, paper_eq8
 from tactileskin.film.calibration import Calibration
 from tactileskin.film.synthetic import gaussian_profile, mirrored, render_scan, save_scan
 
@@ -74,6 +74,20 @@ def test_all_film_scan_and_axis_y():
     fx, fy = analyze_scan(img, TRUE), analyze_scan(img.T.copy(), TRUE, axis="y")
     assert fy.box_px == (fx.box_px[1], fx.box_px[0], fx.box_px[3], fx.box_px[2])
     assert fy.pressure == pytest.approx(fx.pressure, abs=1e-12)
+
+
+def test_scan_noise_keeps_every_row_of_a_sharp_strip():
+    # 0.1 MPa/mm under Eq. 8 (23.5 GS) with 3 GS noise: a row dipping below 90 % of the (noisy)
+    # largest broke the 90 % run, so the 'edges' read wide and 3-20 of the 40 rows were kept; the
+    # span (6.44 mm) was off by up to 1.14 mm (now 0.28; 0.24 with the strip's own rows)
+    truth = 2 * 1.5 * np.sqrt(2 * np.log(10))
+    for seed in range(10):
+        img = render_scan(gaussian_profile(0.1, 1.5), paper_eq8(), length_mm=30, width_mm=5,
+                          background_gs=245, noise_gs=3.0, seed=seed)
+        fp = analyze_scan(img, paper_eq8())
+        r0, r1 = fp.box_px[1::2]
+        assert STRIP[0] <= r0 and r1 <= STRIP[1] and r1 - r0 >= 36, (seed, r0, r1)  # 90 % of the rows
+        assert fp.metrics["span_mm"] == pytest.approx(truth, abs=0.35), seed  # 2.8 px: noise on the tails
 
 
 def test_a_small_dark_mark_does_not_capture_the_region():
