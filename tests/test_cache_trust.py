@@ -171,6 +171,49 @@ def test_key_follows_the_code_that_computes(tmp_path, monkeypatch):
     assert cache_key(sc) == k
 
 
+def test_stale_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
+    """Python takes a .pyc while it names its source's mtime (whole seconds) and size: a same-size
+    edit with the time stamp set back (touch -d, cp -p) or within the second the .pyc was compiled
+    in runs the old code. Its results took the new source's key and were reused as the new code's
+    once the .pyc was refreshed (a results.py printing 10 digits stood for one printing 12)."""
+    import importlib.util
+    import os
+    import py_compile
+
+    from tactileskin.cache import code_digest
+
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    mod = pkg / "rtol.py"
+    mod.write_text("RTOL = 1e-8\n")
+    st = mod.stat()
+    pyc = importlib.util.cache_from_source(str(mod))
+
+    def compile_pyc():
+        py_compile.compile(str(mod), cfile=pyc, doraise=True,
+                           invalidation_mode=py_compile.PycInvalidationMode.TIMESTAMP)
+
+    compile_pyc()
+    mod.write_text("RTOL = 1e-6\n")                    # same size, time stamp set back
+    os.utime(mod, ns=(st.st_atime_ns, st.st_mtime_ns))
+    spec = importlib.util.spec_from_file_location("rtol_stale", mod)
+    ran = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ran)
+    assert ran.RTOL == 1e-8                            # the premise: Python runs the old code
+    code_digest.cache_clear()
+    with caplog.at_level(logging.WARNING, logger="tactileskin.cache"):
+        stale = code_digest(pkg)
+    os.remove(pyc)                                     # refreshed: the file's own code runs
+    code_digest.cache_clear()
+    fresh = code_digest(pkg)
+    assert stale != fresh                              # the old code's results are not the new code's
+    assert "rtol.py" in caplog.text and "earlier version" in caplog.text
+    compile_pyc()                                      # a .pyc that matches its source changes nothing
+    code_digest.cache_clear()
+    assert code_digest(pkg) == fresh
+    code_digest.cache_clear()
+
+
 def test_edited_material_file_is_recomputed(tmp_path):
     mat = _material_file(tmp_path / "pu.toml")
     sc = Scene(material=str(mat), indenter="curved", **COARSE)

@@ -14,7 +14,8 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's
   own source and data files (but the shipped molds.toml) and the versions of the libraries that mesh and solve (gmsh,
   scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
-  tactileskin, a changed mesher) is never reused.
+  tactileskin, a changed mesher) is never reused; a .pyc Python runs instead of its edited source
+  (same size and time stamp) adds its code (`_stale_bytecode`).
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
 time stamp, so an edit within the same second is not missed.
@@ -95,8 +96,9 @@ SOLVER_LIBRARIES = ("gmsh", "scikit-fem", "numpy", "scipy", "numba", "mkl", "mes
 def code_digest(root: Path | None = None) -> str:
     """SHA-256 of the code that produces a result: the names and bytes of every .py, .json and
     .toml file of the package (`root`, default the installed package's folder; sorted by path)
-    and the installed versions of SOLVER_LIBRARIES. Computed once per process: it is the
-    code this process imported and runs (~100 files, a few ms)."""
+    and the installed versions of SOLVER_LIBRARIES; plus the code of any .pyc Python runs in place
+    of its source (_stale_bytecode). Computed once per process: it is the code this process
+    imported and runs (~130 files, ~20 ms)."""
     from importlib import metadata
 
     root = Path(__file__).resolve().parent if root is None else Path(root)
@@ -110,6 +112,8 @@ def code_digest(root: Path | None = None) -> str:
         for p in paths:
             data = p.read_bytes()
             h.update(p.relative_to(root).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
+            if p.suffix == ".py" and (old := _stale_bytecode(p, data)) is not None:
+                h.update(b"stale bytecode\0" + old)  # results of the code that runs, not of the file
     except OSError as e:  # an unreadable install: the version alone names the code
         log.warning("package files not readable (%s); cache keys use the version %s only", e, __version__)
         h.update(b"unreadable")
@@ -120,6 +124,44 @@ def code_digest(root: Path | None = None) -> str:
             v = "-"
         h.update(f"{name}={v}\0".encode())
     return h.hexdigest()
+
+
+def _stale_bytecode(p: Path, source: bytes) -> bytes | None:
+    """The body of p's .pyc when Python runs it instead of p's code, else None. Python takes a
+    time-stamp .pyc while it names the source's mtime in whole seconds and its size, so a same-size
+    edit within the second the .pyc was compiled in, or with the time stamp set back (touch -d,
+    cp -p), still runs the old code. Compiled (~3 ms) and compared only when p changed after the
+    .pyc was written (their ctimes, which no tool sets back): other .pyc files cost a 16-byte read."""
+    import importlib.util
+    import marshal
+    import types
+    import warnings
+
+    try:
+        with open(importlib.util.cache_from_source(str(p)), "rb") as fh:
+            head, written, st = fh.read(16), os.fstat(fh.fileno()).st_ctime_ns, p.stat()
+            if (len(head) < 16 or head[:4] != importlib.util.MAGIC_NUMBER or head[4:8] != bytes(4)
+                    or int.from_bytes(head[8:12], "little") != int(st.st_mtime) & 0xFFFFFFFF
+                    or int.from_bytes(head[12:16], "little") != st.st_size & 0xFFFFFFFF
+                    or st.st_ctime_ns < written):
+                return None  # none, not one Python takes, or compiled after p's last change
+            body = fh.read()
+        code = marshal.loads(body)
+    except (OSError, NotImplementedError, ValueError, EOFError, TypeError):
+        return None  # no .pyc Python can run
+    if not isinstance(code, types.CodeType):
+        return None  # Python refuses it (ImportError)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the source's own SyntaxWarnings: Python shows them itself
+            if code == compile(source, code.co_filename, "exec", dont_inherit=True):
+                return None
+    except (SyntaxError, ValueError):
+        pass  # the source does not compile: the .pyc's code is all the more not the source's
+    log.warning("Python runs %s, compiled from an earlier version of %s (changed within the second it "
+                "was compiled in, or its time stamp set back): results are cached as that code's; delete "
+                "the .pyc to run the file's code", importlib.util.cache_from_source(str(p)), p)
+    return body
 
 
 def cache_key(scene: Scene) -> str:
