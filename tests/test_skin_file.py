@@ -483,3 +483,14 @@ def test_an_upside_down_or_off_centre_step_is_refused(tmp_path):
     bd.export_step(corner, str(tmp_path / "corner.step"))
     with pytest.raises(ParameterError, match=r"skin_file.*axis x = 0.*x in \[0, 8\]"):
         Scene(skin="file", skin_file=str(tmp_path / "corner.step"))
+
+
+def test_the_reports_run_settings_give_a_msh_skins_own_mesh_not_sizes_it_never_used(tmp_path):
+    # a .msh is solved on its own mesh; the report stated the 2D default preset's 0.5 mm / 3
+    # (refined 0.167 mm) for it, sizes the solve never used
+    from tactileskin.report.markdown import run_settings
+
+    f = _gmsh_block(tmp_path / "skin.msh", dim=2, t=2.0)
+    text = "\n".join(run_settings([Scene(skin="file", skin_file=str(f), indenter="flat", mesh_size=0.5, refinement=3.0)]))
+    assert "| 2D | flat | skin.msh's mesh | – | – | – | P2 |" in text
+    assert "| 0.5 | 3 |" not in text

@@ -507,6 +507,18 @@ def params_changed() -> bool:
     return bool(params.geometry_changes())
 
 
+def _own_mesh(scene) -> str:
+    """'NAME.msh's mesh' for a scene whose skin is a .msh file (solved on the file's mesh as it
+    is: --quality and the mesh sizes do not apply), else ''."""
+    from pathlib import Path
+
+    from tactileskin.mesh.skinfile import MSH_SUFFIXES
+
+    if scene.skin != "file" or not scene.skin_file or Path(str(scene.skin_file)).suffix.lower() not in MSH_SUFFIXES:
+        return ""
+    return f"{Path(str(scene.skin_file)).name}'s mesh"
+
+
 def run_settings(scenes) -> list[str]:
     """The section stating what produced the numbers: version, mesh presets and sizes, model
     and solver settings (the solver's defaults: a sweep does not change them)."""
@@ -523,10 +535,14 @@ def run_settings(scenes) -> list[str]:
                 "order | formulation | viscoelastic | rate (mm/s) | cases |", "|---|---|---|---|---|---|---|---|---|---|---|"]
         groups = defaultdict(int)
         for sc in scenes:
-            groups[(sc.dim, sc.indenter.value, quality_name(sc), sc.mesh_size, sc.refinement, sc.order,
-                    sc.formulation.value, sc.viscoelastic, sc.rate)] += 1
+            # a .msh skin is solved on its own mesh: the scene's sizes were never used, so they
+            # are not stated as the ones the numbers came from
+            own = _own_mesh(sc)
+            groups[(sc.dim, sc.indenter.value, own or quality_name(sc), None if own else sc.mesh_size,
+                    None if own else sc.refinement, sc.order, sc.formulation.value, sc.viscoelastic, sc.rate)] += 1
         for (dim, ind, q, h, ref, order, form, visco, rate), n in sorted(groups.items(), key=str):
-            out.append(f"| {dim}D | {ind} | {q} | {h:g} | {ref:g} | {h / ref:.3g} | P{order} | {form} | "
+            sizes = "– | – | –" if h is None else f"{h:g} | {ref:g} | {h / ref:.3g}"
+            out.append(f"| {dim}D | {ind} | {q} | {sizes} | P{order} | {form} | "
                        f"{'yes' if visco else 'no'} | {rate:g} | {n} |")
         out.append("")
     note = geometry_note()
