@@ -176,3 +176,17 @@ def test_help_states_the_valid_ranges_from_the_validation_constants(cmd):
         from tactileskin.scene import IndenterKind
 
         assert "Indenters: " + ", ".join(k.value for k in IndenterKind) in text and "cylinder" in text
+
+
+@pytest.mark.parametrize("cmd", ["solve", "mesh"])
+def test_help_states_the_default_indenter_and_dim_and_what_a_skin_file_fixes(cmd):
+    # `-i` said only "Indenter kind." and `--dim` gave no default, so a user had to guess both; a
+    # .msh skin silently ignored --quality / --mesh-size and a STEP's bonded-face rule had no hint
+    from click.testing import CliRunner
+
+    from tactileskin.cli import cli
+
+    text = " ".join(CliRunner().invoke(cli, [cmd, "--help"]).output.split())
+    assert f"Indenter kind. Default {Scene().indenter.value}." in text
+    assert f"3D slab. Default {Scene().dim}" in text
+    assert "solved on its own mesh" in text and "skin_bonded" in text

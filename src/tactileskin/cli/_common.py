@@ -142,7 +142,8 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         opt("--indenter", "-i", default=None,
             type=str if grid else click.Choice([k.value for k in IndenterKind]),
             help=lambda: (f"Indenters: {', '.join(k.value for k in IndenterKind)}{names}. "
-                          f"Default {h.default('indenter', grid)}.") if grid else "Indenter kind."),
+                          f"Default {h.default('indenter', grid)}.") if grid
+            else f"Indenter kind. Default {h.default('indenter')}."),
         click.option("--braille-text", type=str, default=None, multiple=grid,
                      help="Text for a Braille indenter" + (" (repeatable)." if grid else ".")),
         click.option("--braille-standard", type=str, default=None, help="Braille standard name."),
@@ -155,7 +156,7 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         opt("--depth", type=str if grid else float, default=None,
             help=lambda: f"Indentation depth (mm){many}, {h.depth()}; default {h.depth_default()}."),
         click.option("--dim", type=click.Choice(["2", "3"]), default=None,
-                     help="2D plane-strain section or 3D slab."),
+                     help="2D plane-strain section or 3D slab. Default 2 (a dome or a 3D skin file: 3)."),
         click.option("--quality", type=click.Choice(QUALITIES), default=None,
                      help="Mesh preset of the scene's dimension (data/presets.json; "
                           "docs/speed_vs_error.md). Default: the `default` sizes."),
@@ -167,7 +168,9 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         click.option("--skin", type=str, default=None,
                      help="Skin geometry: fingertip (default), pad, dome (rounded 3D tip) or file."),
         click.option("--skin-file", type=str, default=None,
-                     help="File skin: a gmsh .msh with named groups or a STEP solid (mm); implies --skin file."),
+                     help="File skin: a gmsh .msh with named groups (solved on its own mesh: --quality and "
+                          "the mesh sizes do not apply) or a STEP solid (mm; its bonded faces: skin_bonded in "
+                          "a --scene file, default 'normal:-y'); implies --skin file."),
         opt("--pad-width", type=float, default=None,
             help=lambda: f"Pad: x extent of the whole pad (mm), {h.pad_size()}. Default {h.pad('WIDTH')}."),
         opt("--pad-length", type=float, default=None,
