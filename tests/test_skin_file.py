@@ -494,3 +494,20 @@ def test_the_reports_run_settings_give_a_msh_skins_own_mesh_not_sizes_it_never_u
     text = "\n".join(run_settings([Scene(skin="file", skin_file=str(f), indenter="flat", mesh_size=0.5, refinement=3.0)]))
     assert "| 2D | flat | skin.msh's mesh | – | – | – | P2 |" in text
     assert "| 0.5 | 3 |" not in text
+
+
+def test_a_step_skins_thickness_is_read_on_its_curved_bonded_face_not_on_the_chords(tmp_path):
+    # a fingertip-like shell (a half tube, outer R 8, inner R 6: t = 2 mm) bonded on its inner
+    # face: the coarse mesh's chords of that face read t = 2.06084 mm, and `-t 2` was refused
+    import build123d as bd
+
+    tube = bd.Cylinder(8, 8) - bd.Cylinder(6, 8)
+    shell = tube - bd.Box(20, 10, 20, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER))
+    path = tmp_path / "shell.step"
+    bd.export_step(shell, str(path))
+    sc = Scene(skin="file", skin_file=str(path), skin_bonded="normal:-y:89.99")
+    assert sc.thickness == pytest.approx(2.0, abs=1e-9)
+    assert Scene(skin="file", skin_file=str(path), skin_bonded="normal:-y:89.99", thickness=2.0).thickness == 2.0
+    # bonded on the flat strips at y = 0 alone (the default rule), the nearest bonded point is
+    # their inner edge x = 6: t = hypot(6, 8), on an edge, not on the strips' plane (8)
+    assert Scene(skin="file", skin_file=str(path)).thickness == pytest.approx(10.0, abs=1e-9)

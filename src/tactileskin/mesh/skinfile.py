@@ -316,8 +316,11 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
         centre = (0.0, hi[1], 0.0) if centre is None else centre
         radius = 0.2 * size if radius is None else radius
 
+        bonded_tags = []
+
         def classify(mesh, faces):
             hits = classify_by_rule(mesh, faces, bonded, size)
+            bonded_tags.extend(hits)
             if not hits:
                 kind = parse_rule(bonded)[0]
                 raise ParameterError("skin_bonded", bonded or DEFAULT_RULE,
@@ -333,7 +336,37 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
                              "every face of the solid matched it")
     quality["wall_s"] = time.perf_counter() - t0
     check_quality(quality, {"coarse": mesh_size})
-    return SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality)
+    sm = SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality)
+    sm.bonded_faces = tuple(bonded_tags)  # CAD face tags (the same on a re-import): distance_to_faces
+    return sm
+
+
+def distance_to_faces(path, point, faces) -> float | None:
+    """Distance (mm) from `point` to the CAD faces `faces` of a STEP solid (their interiors,
+    edges and corners), or None if no projection lands on them. The meshed facets are chords:
+    on a curved bonded face (a fingertip's bone, R 6 mm) their distance read the thickness
+    2.06 mm for a 2.00 mm skin."""
+    p = np.asarray(point, float)
+    best = None
+    with _gmsh.session("skinstep-distance", {"skin_file": str(path)}) as gmsh:
+        _import_step(gmsh, Path(path))
+        curves = set()
+        for f in faces:
+            xyz, uv = gmsh.model.getClosestPoint(2, f, p)
+            if gmsh.model.isInside(2, f, uv, parametric=True) > 0:
+                d = float(np.linalg.norm(np.asarray(xyz) - p))
+                best = d if best is None else min(best, d)
+            curves.update(abs(c) for _, c in gmsh.model.getBoundary([(2, f)], oriented=False))
+        for c in curves:  # a nearest point on a face's edge (its projection falls off the trim)
+            xyz, u = gmsh.model.getClosestPoint(1, c, p)
+            lo, hi = gmsh.model.getParametrizationBounds(1, c)
+            if lo[0] <= u[0] <= hi[0]:
+                d = float(np.linalg.norm(np.asarray(xyz) - p))
+                best = d if best is None else min(best, d)
+            for _, v in gmsh.model.getBoundary([(1, c)], oriented=False):
+                d = float(np.linalg.norm(np.asarray(gmsh.model.getValue(0, v, [])) - p))
+                best = d if best is None else min(best, d)
+    return best
 
 
 def refine_top(path, top) -> tuple[np.ndarray, np.ndarray | None]:

@@ -181,6 +181,9 @@ def _analyse(kind: str, path: str, digest: str, bonded, outer) -> FileGeometry:
         # the CAD point there, not the highest node's refinement (0.34 mm off it on a sphere cap,
         # t 0.5 % short; 3.2 mm along a crown's top line)
         t = _distance_to_facets(on_axis, sm.mesh, sm.boundaries["bone_interface"])
+        # the facets are chords of the CAD: read t on the bonded faces themselves
+        cad = skinfile.distance_to_faces(path, on_axis, sm.bonded_faces)
+        t = t if cad is None else cad
         return FileGeometry(**{**g.__dict__, "top_point": tuple(float(c) for c in on_axis), "thickness": t})
     check_placement(g, path, kind, bonded, outer)
     return g
