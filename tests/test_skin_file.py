@@ -511,3 +511,14 @@ def test_a_step_skins_thickness_is_read_on_its_curved_bonded_face_not_on_the_cho
     # bonded on the flat strips at y = 0 alone (the default rule), the nearest bonded point is
     # their inner edge x = 6: t = hypot(6, 8), on an edge, not on the strips' plane (8)
     assert Scene(skin="file", skin_file=str(path)).thickness == pytest.approx(10.0, abs=1e-9)
+
+
+def test_asking_2d_of_a_step_skin_says_how_to_get_a_2d_section(tmp_path, capsys):
+    # "the file skin is 3D" named no way to a 2D solve of one's own skin: a 2D .msh of its section
+    from tactileskin.cli import main
+
+    path = _step_block(tmp_path / "block.step")
+    assert main(["solve", "--skin-file", str(path), "--dim", "2", "-o", str(tmp_path / "out")]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "dim=2" in err and "2D .msh of its section" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()

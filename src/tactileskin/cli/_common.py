@@ -228,8 +228,11 @@ def check_dim_kept(requested, scene) -> None:
     from tactileskin.errors import ParameterError
 
     if requested is not None and int(requested) != scene.dim:
+        # a 3D file skin's 2D section needs a file of its own: say which
+        hint = ("; for 2D give a 2D .msh of its section (triangles in a plane z = const, with named "
+                "physical groups)" if scene.skin == "file" else "")
         raise ParameterError("dim", int(requested), f"{scene.dim} with skin = {scene.skin}",
-                             f"the {scene.skin} skin is {scene.dim}D")
+                             f"the {scene.skin} skin is {scene.dim}D{hint}")
 
 
 def has_2d_section(scene) -> bool:
