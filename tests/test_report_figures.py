@@ -273,3 +273,21 @@ def test_profiles_figure_labels_s_by_what_it_is_on_the_figures_skins(tmp_path, m
     assert fig.axes[0].get_xlabel() == "distance along bone s (mm)"
     assert "along the bone" in fig._suptitle.get_text()
     figures._plt().close("all")
+
+
+def test_run_settings_say_elastic_for_a_material_without_prony_terms(tmp_path):
+    """A fitted material has no Prony terms, so its scenes are solved elastic although
+    `viscoelastic` defaults to True: the run settings read "yes". They now say no, and why."""
+    from tactileskin.cli import main
+
+    lam = np.linspace(0.8, 1.5, 8)
+    (tmp_path / "t.csv").write_text("stretch,nominal_stress_mpa\n" + "".join(
+        f"{float(a)!r},{float(0.04 * (a - a ** -2))!r}\n" for a in lam))
+    gel = tmp_path / "gel.toml"
+    assert main(["material", "fit", str(tmp_path / "t.csv"), "-o", str(gel), "--law", "neo_hookean"]) == 0
+    fitted, paper = Scene(thickness=1.0, material=str(gel)), Scene(thickness=1.0)
+    assert fitted.viscoelastic and paper.viscoelastic
+    text = "\n".join(run_settings([fitted, paper, paper.replace(viscoelastic=False)]))
+    rows = [ln for ln in text.splitlines() if ln.startswith("| 2D |")]
+    cells = sorted(ln.split(" | ")[-3] for ln in rows)
+    assert cells == ["no", "no (the material has no Prony terms)", "yes"], rows

@@ -11,6 +11,7 @@ from collections import defaultdict
 
 from tactileskin import quality
 from tactileskin.discrimination import THRESHOLD, discriminate
+from tactileskin.errors import TactileSkinError
 
 # What the paper states (Sec. V), with where it says it.
 PAPER_PEAK_1MM_FLAT = {"silicone": 0.5, "polyurethane": 0.8}   # MPa/mm, Fig. 11 / Sec. V-B
@@ -539,11 +540,10 @@ def run_settings(scenes) -> list[str]:
             # are not stated as the ones the numbers came from
             own = _own_mesh(sc)
             groups[(sc.dim, sc.indenter.value, own or quality_name(sc), None if own else sc.mesh_size,
-                    None if own else sc.refinement, sc.order, sc.formulation.value, sc.viscoelastic, sc.rate)] += 1
+                    None if own else sc.refinement, sc.order, sc.formulation.value, _visco(sc), sc.rate)] += 1
         for (dim, ind, q, h, ref, order, form, visco, rate), n in sorted(groups.items(), key=str):
             sizes = "– | – | –" if h is None else f"{h:g} | {ref:g} | {h / ref:.3g}"
-            out.append(f"| {dim}D | {ind} | {q} | {sizes} | P{order} | {form} | "
-                       f"{'yes' if visco else 'no'} | {rate:g} | {n} |")
+            out.append(f"| {dim}D | {ind} | {q} | {sizes} | P{order} | {form} | {visco} | {rate:g} | {n} |")
         out.append("")
     note = geometry_note()
     if note:
@@ -552,6 +552,20 @@ def run_settings(scenes) -> list[str]:
     out += [f"Solver settings (fe.solver.SolverOptions): {opts}; where None, by model dimension: "
             f"easy_iterations {EASY_ITERATIONS}, short_step {SHORT_STEP}.", ""]
     return out
+
+
+def _visco(sc) -> str:
+    """The run-settings cell: whether the Prony series was applied (a material without Prony
+    terms, as a fitted one, is solved elastic whatever the scene asks: it read "yes")."""
+    if not sc.viscoelastic:
+        return "no"
+    from tactileskin.materials import get_material
+
+    try:
+        terms = get_material(sc.material).prony.n_terms
+    except TactileSkinError:
+        return "yes"
+    return "yes" if terms else "no (the material has no Prony terms)"
 
 
 def build_report(rows, records, failures, figures, renders, wall_s: float, scenes=None) -> str:
