@@ -195,8 +195,10 @@ def test_a_strip_read_along_the_wrong_axis_is_flagged():
     assert len(wrong.warnings) == 1 and "try --axis y" in wrong.warnings[0]
     assert wrong.metrics["peak"] < 0.95 * right.metrics["peak"]
     assert analyze_scan(np.ascontiguousarray(img.T), axis="y").warnings == []
-    # a box the user gives is analysed as given
-    assert analyze_scan(np.ascontiguousarray(img.T), axis="x", box_px=(24, 0, 48, 160)).warnings == []
+    # a box the user gives is analysed as given (no axis check), but this one holds the press's 20 rows and
+    # 140 of white film, which dilute it 84 %: said, with the box on those rows
+    boxed = analyze_scan(np.ascontiguousarray(img.T), axis="x", box_px=(24, 0, 48, 160)).warnings
+    assert len(boxed) == 1 and "140 of the region's 160 rows" in boxed[0] and "--box-px 24 70 48 90" in boxed[0]
 
 
 def test_the_band_brackets_the_profile_of_a_box_with_white_margins():
@@ -209,6 +211,28 @@ def test_the_band_brackets_the_profile_of_a_box_with_white_margins():
     img = render_scan(gaussian_profile(0.4, 1.0), cal, background_gs=245.0)
     fp = analyze_scan(img, cal, box_px=(0, 0, img.shape[1], img.shape[0]))
     assert np.all(fp.band_lo <= fp.pressure + 1e-12) and np.all(fp.band_hi >= fp.pressure - 1e-12)
+
+
+@pytest.mark.parametrize("box, peak, flagged", [
+    ((0, 16, 160, 56), 0.4744, False),   # the strip's 40 rows: blurred edge rows read 0.6 of it, kept
+    ((0, 24, 160, 48), 0.4908, False),   # inside the strip
+    ((0, 14, 160, 58), 0.4388, True),    # 2 white rows each side: 9 % of the rows, -7.5 %
+    ((0, 12, 160, 60), 0.4023, True),    # a 6 mm box: -15 %
+    ((0, 8, 160, 64), 0.3448, True),     # 7 mm: -27 %
+    ((0, 0, 160, 72), 0.2682, True)])    # 9 mm: -43 %
+def test_a_box_wider_than_the_strip_is_flagged(box, peak, flagged):
+    # the white rows of a box wider than the 5 mm strip (rows 16-55) are averaged into its profile: a
+    # 0.5 peak read 0.357 in a 7 mm box and 0.278 in a 9 mm box, no warning, exit 0. Rows below half
+    # the strongest row's mean lowering it > 5 % (scan.DILUTION) are named, with the box on the strip
+    img = _scan(gaussian_profile(P0, W))
+    fp = analyze_scan(img, box_px=box)
+    assert fp.metrics["peak"] == pytest.approx(peak, abs=5e-4)
+    assert len(fp.warnings) == int(flagged), fp.warnings
+    if flagged:
+        assert "below 50% of its strongest one" in fp.warnings[0] and "--box-px 0 16 160 56" in fp.warnings[0]
+    # the same scan transposed, read along y: the box's columns are named, the box on the strip is in x
+    ty = analyze_scan(img.T.copy(), box_px=(box[1], box[0], box[3], box[2]), axis="y").warnings
+    assert len(ty) == int(flagged) and (not flagged or "--box-px 16 0 56 160" in ty[0])
 
 
 @pytest.mark.parametrize("angle, flagged", [(0, False), (3, False), (10, True)])
