@@ -421,6 +421,43 @@ def _diluted(pmap: np.ndarray, box, axis: str) -> str:
             f"reading; narrow the box to the strip's {lines}: --box-px {' '.join(str(int(v)) for v in fix)}")
 
 
+# A press that is not uniform across the strip (a round one: a sphere, a Braille dot) has rows that read
+# 50-100 % of its middle row, and their mean is read as the profile: a Gaussian spot's 0.5 peak read 0.41
+# (its 3D section's centre line reads the 0.5), status ok. Flagged when the outer half of the strip's
+# rows (STRIP_ROWS; by distance from their middle) reads below this share of the inner half: a contrast
+# of two means of many rows, so row noise does not trigger it. Under 3 GS noise and 0-2 px blur (5 seeds,
+# 0.05-0.9 MPa/mm) strips 5-10 mm wide read >= 0.904 (in a box exactly on them; found automatically
+# >= 0.919), round spots with >= 4 rows (Gaussian sd 0.5-3 mm, Hertzian a 0.75-3 mm, 0.1-0.9 MPa/mm)
+# <= 0.838: the threshold is midway. A narrow strip's blurred edge rows fall off too (2 mm in a box on it
+# under >= 1 px blur: its mean 7-13 % below its middle rows; found automatically, its edges are dropped)
+ROUND = 0.87
+
+
+def _not_uniform(pmap: np.ndarray, box, axis: str) -> str:
+    """The warning for a strip whose rows' mean pressure falls off from its middle (ROUND), naming
+    the shortfall of their mean against the middle quarter's and a box on those rows, else ""."""
+    rows = pmap.mean(axis=1)
+    idx = np.flatnonzero(rows >= STRIP_ROWS * rows.max())
+    if idx.size < 4:  # a row or three: read as the centre line already
+        return ""
+    order = idx[np.argsort(np.abs(idx - 0.5 * (idx[0] + idx[-1])), kind="stable")]
+    half = idx.size // 2
+    ratio = float(rows[order[half:]].mean() / rows[order[:half]].mean())
+    if ratio >= ROUND:
+        return ""
+    mid = np.sort(order[:max(idx.size // 4, 1)])
+    short = 1.0 - float(rows[idx].mean() / rows[mid].mean())
+    x0, y0, x1, y1 = box
+    a, b = int(mid[0]), int(mid[-1])
+    across, off, lines = ("y", y0, "rows") if axis == "x" else ("x", x0, "columns")
+    fix = (x0, y0 + a, x1, y0 + b + 1) if axis == "x" else (x0 + a, y0, x0 + b + 1, y1)
+    return (f"the pressure is not uniform across the strip: the outer half of its {idx.size} {lines} ({across} "
+            f"{idx[0] + off}-{idx[-1] + off} px) reads {ratio:.0%} of the inner half, as a round press (a sphere, a "
+            f"dot) or a narrow strip's blurred edges, not a line uniform along its length; the profile, their mean, "
+            f"reads {short:.0%} below its middle {lines}' (a section's centre line): for the centre line read a box "
+            f"on those, --box-px {' '.join(str(int(v)) for v in fix)}")
+
+
 def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: float = PX_PER_MM,
                  box_px=None, box_mm=None, axis: str = "x", centre="peak") -> FilmProfile:
     """Scan (path or (H, W) grayscale array) -> FilmProfile.
@@ -536,6 +573,10 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     if diluted:
         warnings.append(diluted)
         log.warning("%s", diluted)
+    round_ = _not_uniform(pmap, box, axis) if not wrong_axis and not inverted else ""
+    if round_:
+        warnings.append(round_)
+        log.warning("%s", round_)
     sd = pmap.std(axis=0)
     x_mm = (start + np.arange(region.shape[1]) + 0.5) / px_per_mm   # pixel centres
     if centre == "peak":
