@@ -303,6 +303,29 @@ def test_a_force_no_trial_travel_meets_names_the_force(mesh):
     assert "stalled at" in str(e.value) and "smaller target" in str(e.value)
 
 
+def test_a_stall_far_from_the_laws_stiffening_does_not_blame_the_force_step(mesh, monkeypatch):
+    import tactileskin.fe.loading as fl
+    from tactileskin.fe import solve
+
+    real = fl.run_program
+
+    def stalling(model, program, opts=None, *, on_segment=None, **kw):
+        # a gentle press commits (0.01 N/mm: far below the law's stiffening), then the ramp
+        # stalls as a gel of mu0 2e-6 MPa did (Newton failed a 1.3 um step at 0.08 mm)
+        real(model, [Segment("force", 0.01, time=0.2)], opts, **kw)
+        raise ConvergenceError("no convergence at t = 1e-5 s: force control: reaction not within 1e-9 "
+                               "of 0.011 after 16 trial travels")
+
+    monkeypatch.setattr(fl, "run_program", stalling)
+    with pytest.raises(ParameterError, match="force") as e:
+        solve(BASE.replace(force=1.0), mesh=mesh)
+    msg = str(e.value)
+    # it said "a smaller target may converge": a smaller force stalls at the same travel
+    assert e.value.name == "force" and "smaller target" not in msg
+    assert "0.01 of the 1 N/mm asked" in msg and "of the 1.2 mm allowed" in msg
+    assert "solve with depth (up to 1.2 mm)" in msg and "not stiffening" in msg
+
+
 def test_a_stall_in_a_depth_segment_after_a_force_ramp_is_not_called_a_force_lock_up(mesh):
     from tactileskin.fe import _force_controlled, solve
     from tactileskin.fe.solver import SolverOptions

@@ -221,16 +221,31 @@ def _run_history(scene, model, section, program, options, progress, history: boo
         # cap (1000 N/mm on a 1 mm skin: 2000 increments, 88 s, "more than 2000 increments");
         # or no travel of an increment met its force (10000 N/mm on 1 mm silicone stalled at
         # 9.6 N/mm, "after 16 trial travels", the parameter unnamed)
+        from tactileskin.materials import get_material
+        from tactileskin.quality import MAX_STRESS_OVER_MU0_3D
+
         unit = force_unit(scene.dim)
-        stalled = (f"the solve stalled at {last['reaction']:.4g} {unit}, travel {last['d']:.4g} mm, "
+        target = scene.force if scene.force is not None else max(forced)
+        stress, mu0 = worst.get("max_abs_stress_mpa", float("nan")), float(get_material(scene.material).law.mu0)
+        stalled = (f"the solve stalled at {last['reaction']:.4g} {unit} ({last['reaction'] / target:.2g} of the "
+                   f"{target:.4g} {unit} asked), travel {last['d']:.4g} mm of the {scene.max_travel:.3g} mm allowed, "
                    f"with the material law at J = {worst.get('min_J', float('nan')):.3g} and "
-                   f"|stress| up to {worst.get('max_abs_stress_mpa', float('nan')):.3g} MPa")
-        raise ParameterError("force", scene.force if scene.force is not None else max(forced),
+                   f"|stress| up to {stress:.3g} MPa ({stress / mu0:.2g} mu0)")
+        if lock_up:
+            hint = stalled
+        elif stress <= MAX_STRESS_OVER_MU0_3D * mu0:
+            # a stall where the law is not stiffening is no force step's fault: a gel of mu0 2e-6 MPa
+            # stalled at 6.2e-7 N, 0.08 mm, 0.64 mu0 (Newton failed a 1.3 um step) asked for 1e-3 N,
+            # and said a smaller target may converge; a depth ramp to 0.6 mm gives it 4.1e-5 N, below
+            # the smallest force allowed
+            hint = (f"{stalled}: the law is not stiffening there; solve with depth (up to "
+                    f"{scene.max_travel:.3g} mm) instead to see the force this skin carries")
+        else:
+            hint = f"{stalled}; a smaller target may converge (its ramp takes smaller force steps)"
+        raise ParameterError("force", target,
                              f"a force the skin carries within its travel (at most "
                              f"{scene.max_travel:.3g} mm = 0.6 x thickness)" if lock_up else
-                             "a force this solve reaches",
-                             stalled if lock_up else f"{stalled}; a smaller target may converge (its "
-                             "ramp takes smaller force steps)") from None
+                             "a force this solve reaches", hint) from None
     if not best:  # every ramp ended below zero force: report the final state
         on_segment(0, program[0], ev)
     res = best["result"]
