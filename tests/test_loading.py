@@ -326,6 +326,31 @@ def test_a_stall_far_from_the_laws_stiffening_does_not_blame_the_force_step(mesh
     assert "solve with depth (up to 1.2 mm)" in msg and "not stiffening" in msg
 
 
+def test_an_increment_whose_target_is_out_of_reach_below_a_failed_trial_is_cut_back_early(mesh, monkeypatch):
+    import tactileskin.fe.loading as fl
+    from tactileskin.fe import model_for_scene
+    from tactileskin.fe.solver import SolverOptions, Stats, _Failure
+
+    real = fl._solve_increment
+
+    def solve_increment(model, *a, **k):
+        # Newton fails from the unloaded state beyond 0.3 mm, as a 3D sphere's first increment did
+        if model.travel_fixed >= 0.3:
+            raise _Failure("Newton did not converge", {})
+        return real(model, *a, **k)
+
+    monkeypatch.setattr(fl, "_solve_increment", solve_increment)
+    model, _ = model_for_scene(BASE, mesh)
+    stats = Stats()
+    inc = fl.ForceIncrement(lambda t: 5.0, d_max=1.2, d_guess=lambda F: 0.05)
+    with pytest.raises(_Failure, match="out of reach") as e:
+        inc(model, model.u.copy(), 0.1, 0.1, SolverOptions(), stats)
+    # ~0.14 N/mm at 0.3 mm of the 5 asked: the bisection crept up to the failed 0.3 mm over all
+    # 16 trials (7 such increments were half of a 3D 1000 N run); now 6
+    assert stats.force_trials <= 8 and e.value.diag["failed_mm"] == pytest.approx(0.3)
+    assert 0.0 < e.value.diag["reached"] < 5.0 and model.travel_fixed is None
+
+
 def test_a_stall_in_a_depth_segment_after_a_force_ramp_is_not_called_a_force_lock_up(mesh):
     from tactileskin.fe import _force_controlled, solve
     from tactileskin.fe.solver import SolverOptions
