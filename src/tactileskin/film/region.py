@@ -14,10 +14,10 @@ the band:
    is at least half the largest row mean (the half-maximum of a blurred edge sits on the
    edge itself), less the rows the scanner blurred into the white beside it: each edge's
    width from 10 % to 90 % of that maximum (to the outermost 90 % row: noise dips rows
-   inside) is measured, and rows closer than half that width inward of the 90 % row are
-   dropped (for a Gaussian blur of sd b this keeps rows
-   >= 2.6 b inside the edge, which read within 0.5 % of the band). A sharp edge loses
-   nothing;
+   inside; 90 % at most the run's median: weak strips' rows scatter ~10 %) is measured,
+   and rows closer than half that width inward of the 90 % row are dropped (for a Gaussian
+   blur of sd b this keeps rows >= 2.6 b inside the edge, which read within 0.5 % of the
+   band). A sharp edge loses nothing;
 4. along the strip: the region's extent plus 1 mm on each side (clipped to the image), so
    the profile shows its return to zero; what lies beyond read as unactivated film.
 """
@@ -35,7 +35,8 @@ EDGE = (0.1, 0.9)   # an edge's width: from 10 % to 90 % of the largest row mean
 PAD_MM = 1.0        # along-strip margin kept around the activated region
 RULE = ("auto: heaviest connected activated region (pressure above the lower clip, 3x3 "
         "opening); across the strip the rows at >= 50 % of the largest row-mean pressure, "
-        "less the blurred edge rows (half the 10-90 % edge width inward of the outermost 90 % row); "
+        "less the blurred edge rows (half the 10-90 % edge width inward of the outermost 90 % row, "
+        "90 % at most the run's median); "
         "along it the region's extent + 1 mm each side")
 
 
@@ -82,8 +83,11 @@ def find_strip(pmap: np.ndarray, p_lo: float, px_per_mm: float) -> tuple[int, in
     a10, b10 = run(EDGE[0])
     # the outermost 90 % rows of the half-maximum run, not a contiguous run from the largest: noise
     # dips rows inside a strip below 90 % of its largest, and the run's 'edges' read wide (3 GS of
-    # noise on a sharp 40-row strip kept 3 of its rows); the same rows for a noise-free strip
-    inner = np.flatnonzero(row_mean[a:b + 1] >= EDGE[1] * top) + a
+    # noise on a sharp 40-row strip kept 3 of its rows); the same rows for a noise-free strip. At
+    # most the run's median: where row noise is ~10 % of the top (a weak narrow ridge) few rows
+    # reach 90 % of the noisiest one, and their spread read as wide edges (3 of 40 rows kept)
+    level = min(EDGE[1] * top, float(np.median(row_mean[a:b + 1])))
+    inner = np.flatnonzero(row_mean[a:b + 1] >= level) + a
     a90, b90 = int(inner[0]), int(inner[-1])
     # drop the blurred edge rows: inward of the 90 % row by half the 10-90 % edge width
     core = a90 + -(-(a90 - a10) // 2), b90 - -(-(b10 - b90) // 2)
