@@ -341,6 +341,29 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
     return sm
 
 
+def bonded_plane(path, bonded=None) -> float:
+    """y (mm) of the one plane y = const, facing -y, that holds a STEP skin's bonded faces (the
+    rule `bonded` picks them, as the solver does): the open top of a mold that casts the skin
+    face down (geometry.file_parts). ParameterError naming `skin_bonded` when they are curved
+    or at several heights (a fingertip's bone), or face another way."""
+    path = Path(path)
+    sm = mesh_step(path, bonded=bonded, mesh_size=None, order=1)  # coarse: its vertices lie on the CAD
+    m, f = sm.mesh, sm.boundaries["bone_interface"]
+    size = float(np.max(np.ptp(m.p, axis=1)))
+    y = m.p[1, np.unique(m.facets[:, f])]
+    off = float(np.degrees(np.arccos(np.clip(-outward_normals(m, f)[:, 1], -1.0, 1.0))).max())
+    if np.ptp(y) > 1e-6 * size or off > 1e-3:
+        lo, hi = (round(float(v), 9) + 0.0 for v in (y.min(), y.max()))  # no "-1.959e-15" for 0
+        raise ParameterError("skin_bonded", bonded or DEFAULT_RULE,
+                             "bonded faces in one plane y = const facing -y for a mold (the skin cast face down on "
+                             "a flat board)",
+                             f"{path.name}'s bonded faces span y in [{lo:.4g}, {hi:.4g}] mm"
+                             + (f", normals up to {off:.3g} degrees off -y" if off > 1e-3 else "")
+                             + ": a curved or stepped bonded surface (a fingertip's bone) "
+                             "needs a core in the mold, which `build` makes for the built-in fingertip and dome only")
+    return float(np.mean(y))
+
+
 def distance_to_faces(path, point, faces) -> float | None:
     """Distance (mm) from `point` to the CAD faces `faces` of a STEP solid (their interiors,
     edges and corners), or None if no projection lands on them. The meshed facets are chords:

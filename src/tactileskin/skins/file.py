@@ -323,9 +323,14 @@ class FileSkin(Skin):
         return sm
 
     @classmethod
-    def build_parts(cls, thickness, *, molds=True, **params):
-        raise ParameterError("skin", "file", "a built-in skin (fingertip, pad, dome)",
-                             "a user's file skin is its own CAD: no parts to build")
+    def build_parts(cls, thickness, *, molds=True, skin_file=None, skin_bonded=None, **_):
+        """The STEP skin as read and its casting mold (geometry.file_parts): for a skin bonded on
+        one flat face; `thickness` is the file's (measured)."""
+        from tactileskin.geometry.file_parts import build_file_parts
+
+        if not skin_file:
+            raise ParameterError("skin_file", skin_file, "a STEP file of the skin", "skin = 'file' needs it")
+        return build_file_parts(skin_file, skin_bonded, molds=molds)
 
     @classmethod
     def label(cls, scene) -> str:

@@ -1,0 +1,146 @@
+"""Printable parts of a user's STEP skin (skins.file): the skin as read and its two-part casting
+mold, made as the pad's (pad_parts.py) for a skin bonded on one flat face.
+
+Frame the file's (the solver's): contact face up (+y), its bonded faces (the rule `skin_bonded`
+picks, mesh.skinfile.bonded_plane) all in one plane y = y_b, facing -y. The mold casts the skin
+face down:
+- lower part: a block around the skin, `wall` beyond it, minus the skin: a pocket open at the
+  split plane y = y_b (its floor is the skin's contact face); four alignment pins on the split
+  face at the corners of the skin's footprint, as the pad's;
+- upper part (lid): a plate over y < y_b with the pin holes, an air vent `vent_inset` from each
+  end of the bonded face along the line x = 0 (as the pad's) and the sprue beside the z < 0
+  vent with 1 mm of mold between them: off the middle, where the indenters press (the pad's
+  sprue is at its centre). The sensor board, if it is to be bonded while curing, replaces the
+  lid. Every hole must open wholly onto the bonded plane. Sizes from data/geometry/molds.toml.
+Not checked: undercuts (a skin wider below its top than at its bonded face is held by the
+pocket; a soft one may still come out).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import build123d as bd
+
+from tactileskin.errors import ParameterError
+from tactileskin.geometry.molds import MoldParams, vertical_cylinder
+from tactileskin.geometry.parts import Part
+from tactileskin.geometry.solids import box, check_solid, occ_guard
+
+NO_MOLDS = "or build without molds (--no-molds)"
+
+
+def read_skin(path) -> bd.Solid:
+    """The one solid of a STEP skin file (CadError if it is not one valid solid)."""
+    p = dict(skin_file=str(path))
+    with occ_guard("reading the skin's STEP", **p):
+        shape = bd.import_step(str(path))
+    return check_solid(shape, f"the skin in {Path(str(path)).name}", **p)
+
+
+def _bonded_faces(skin: bd.Solid, y_b: float, tol: float) -> list[bd.Face]:
+    """The skin's faces in the plane y = y_b (the pocket's opening, which the lid closes)."""
+    out = []
+    for f in skin.faces():
+        bb = f.bounding_box()
+        if f.geom_type == bd.GeomType.PLANE and abs(bb.min.Y - y_b) <= tol and abs(bb.max.Y - y_b) <= tol:
+            out.append(f)
+    return out
+
+
+def _overhang(faces: list[bd.Face], x: float, z: float, y_b: float, diameter: float) -> float:
+    """Area (mm^2) of the hole's disc at (x, z) that lies off the bonded faces."""
+    disc = bd.Face(bd.Wire([bd.Edge.make_circle(0.5 * diameter, plane=bd.Plane((x, y_b, z), x_dir=(1, 0, 0),
+                                                                                 z_dir=(0, -1, 0)))]))
+    on = sum(g.area for f in faces for g in disc.intersect(f).faces()) if faces else 0.0
+    return max(0.0, disc.area - on)
+
+
+def hole_positions(faces: list[bd.Face], y_b: float, lo_z: float, hi_z: float, mp: MoldParams, path):
+    """((x, z) of the sprue, [(x, z) of the two vents]) on the line x = 0 of the bonded faces:
+    the vents `vent_inset` from its ends, the sprue 1 mm of mold beyond the z < 0 vent."""
+    line = bd.Edge.make_line((0.0, y_b, lo_z - 1.0), (0.0, y_b, hi_z + 1.0))
+    zs = []
+    for f in faces:
+        for e in f.intersect(line) or ():
+            zs += [e.bounding_box().min.Z, e.bounding_box().max.Z]
+    rs, rv = 0.5 * mp.pour_diameter, 0.5 * mp.vent_diameter
+    need = 2.0 * (mp.vent_inset + rv + 1.0 + rs)  # as the pad's: 11.5 mm with molds.toml's sizes
+    name = Path(str(path)).name
+    if not zs or max(zs) - min(zs) < need:
+        got = f"{max(zs) - min(zs):.4g} mm long there" if zs else "not crossed by it"
+        raise ParameterError("skin_file", str(path), f"a skin whose bonded face runs >= {need:g} mm along z on "
+                             "x = 0 for the mold's sprue and two vents (molds.toml [pour])",
+                             f"{name}'s is {got}; {NO_MOLDS}")
+    z0, z1 = min(zs), max(zs)
+    vents = [(0.0, z0 + mp.vent_inset), (0.0, z1 - mp.vent_inset)]
+    sprue = (0.0, vents[0][1] + rv + 1.0 + rs)
+    for what, (x, z), d in [("sprue", sprue, mp.pour_diameter)] + [("vent", v, mp.vent_diameter) for v in vents]:
+        off = _overhang(faces, x, z, y_b, d)
+        if off > 1e-6 * d * d:
+            raise ParameterError("skin_file", str(path), "a bonded face under the whole of the mold's sprue and vents "
+                                 "(on x = 0)", f"{name}'s leaves {off:.3g} mm^2 of the {d:g} mm {what} at "
+                                 f"z = {z:.4g} mm off it, over the mold's wall; {NO_MOLDS}")
+    return sprue, vents
+
+
+def file_mold(skin: bd.Solid, y_b: float, path, mp: MoldParams | None = None):
+    """(lower part with the pocket and pins, lid with sprue and vents) of the skin `skin`, bonded
+    on the plane y = y_b."""
+    mp = mp or MoldParams.from_params()
+    bb = skin.bounding_box()
+    size = max(bb.size.X, bb.size.Y, bb.size.Z)
+    tol = 1e-6 * size
+    name = Path(str(path)).name
+    if bb.min.Y < y_b - tol:
+        raise ParameterError("skin_file", str(path), "a skin above its bonded plane (the mold's split plane)",
+                             f"{name} reaches y = {bb.min.Y:.4g} mm, below its bonded faces at y = {y_b:.4g} mm")
+    hole = mp.pin_diameter + mp.pin_clearance
+    xp = (bb.min.X - mp.wall - 0.5 * hole, bb.max.X + mp.wall + 0.5 * hole)  # `wall` from the pocket
+    x0, x1 = xp[0] - 0.5 * hole - mp.pin_flange, xp[1] + 0.5 * hole + mp.pin_flange
+    z0, z1 = bb.min.Z - mp.wall, bb.max.Z + mp.wall
+    lid = max(mp.wall, mp.pin_height + mp.pin_depth_clearance + 1.0)  # the pin holes stay blind
+    pins = [(x, z) for x in xp for z in (bb.min.Z, bb.max.Z)]
+    p = dict(skin_file=name, bonded_y=y_b, wall=mp.wall)
+    with occ_guard("building the skin's mold", **p):
+        pin_solids = [vertical_cylinder(x, z, y_b - mp.pin_height, y_b, mp.pin_diameter) for x, z in pins]
+        lower = box(x0, x1, y_b, bb.max.Y + mp.wall, z0, z1).cut(skin)
+        pieces = len(lower.solids())
+    if pieces != 1:
+        # the skin closes a room under it onto the bonded plane (a hollow over a core): the
+        # block there is a loose core, which this two-part mold cannot hold
+        raise ParameterError("skin_file", str(path), "a skin whose mold pocket is one piece (open only at the "
+                             "bonded plane)", f"{name} encloses {pieces - 1} room(s) under it down to its "
+                             f"bonded plane y = {y_b:.4g} mm, which would be loose core(s) of the mold")
+    sprue, vents = hole_positions(_bonded_faces(skin, y_b, tol), y_b, bb.min.Z, bb.max.Z, mp, path)
+    with occ_guard("building the skin's mold", **p):
+        lower = lower.fuse(*pin_solids).clean()
+        holes = [vertical_cylinder(x, z, y_b - (mp.pin_height + mp.pin_depth_clearance), y_b, hole) for x, z in pins]
+        holes += [vertical_cylinder(*sprue, y_b - lid - 1.0, y_b, mp.pour_diameter)]
+        holes += [vertical_cylinder(x, z, y_b - lid - 1.0, y_b, mp.vent_diameter) for x, z in vents]
+        upper = box(x0, x1, y_b - lid, y_b, z0, z1).cut(*holes).clean()
+    return check_solid(lower, "skin mold lower part", **p), check_solid(upper, "skin mold lid", **p)
+
+
+def build_file_parts(path, bonded=None, *, molds: bool = True) -> list[Part]:
+    """The skin of a STEP file and (molds=True) its mold parts. ParameterError for a .msh (no
+    CAD) and for bonded faces not in one plane facing -y (mesh.skinfile.bonded_plane)."""
+    from tactileskin.mesh import skinfile
+
+    kind = skinfile.file_kind(path)
+    if kind != "step":
+        raise ParameterError("skin_file", str(path), "a STEP (.step/.stp) skin solid for `build`",
+                             "a .msh is a mesh, not CAD: export the skin's solid as STEP from its CAD")
+    skinfile.parse_rule(bonded)  # a bad rule fails before any CAD work
+    rule = bonded or skinfile.DEFAULT_RULE
+    fp = dict(skin="file", skin_file=str(path), skin_sha256=skinfile.file_digest(path), skin_bonded=rule)
+    y_b = skinfile.bonded_plane(path, bonded) if molds else None
+    skin = read_skin(path)
+    parts = [Part("skin", f"your skin ({Path(str(path)).name}; cast in the mold)", skin, fp)]
+    if molds:
+        lower, upper = file_mold(skin, y_b, path)
+        fp = dict(fp, bonded_y=y_b)
+        parts.append(Part("mold_lower", "skin mold, lower part (pocket = the skin, cast face down; pins)", lower, fp))
+        parts.append(Part("mold_upper", "skin mold, lid over the bonded face (sprue, vents; or the sensor board)",
+                          upper, fp))
+    return parts

@@ -1,0 +1,110 @@
+"""`build` of a user's STEP skin (skins.file, geometry.file_parts): the skin and a two-part mold
+cast face down, as the pad's, for a skin bonded on one flat face; refusals for the rest."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("build123d")
+
+import build123d as bd  # noqa: E402
+import manifold3d  # noqa: E402
+import trimesh  # noqa: E402
+
+from tactileskin.errors import ParameterError  # noqa: E402
+from tactileskin.geometry.export import export_parts  # noqa: E402
+from tactileskin.geometry.molds import MoldParams  # noqa: E402
+from tactileskin.geometry.solids import check_solid  # noqa: E402
+from tactileskin.skins import get  # noqa: E402
+
+W, H, L, R = 12.0, 4.0, 16.0, 16.0  # block x, y, z (mm) and the dome's sphere radius
+
+
+def _base():
+    return bd.Box(W, H, L, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+
+
+def _dome_step(path, shape=None):
+    """A block x in [-6, 6], y in [0, 4], z in [-8, 8] under a sphere of radius 16 whose top is
+    the block's top centre (4 mm there, 0.49 mm at the corners), bonded on y = 0."""
+    bd.export_step((shape if shape is not None else _base()) & bd.Pos(0, H - R, 0) * bd.Sphere(R), str(path))
+    return path
+
+
+def _solid(mesh: trimesh.Trimesh) -> manifold3d.Manifold:
+    m = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=np.asarray(mesh.vertices, np.float64),
+                                              tri_verts=np.asarray(mesh.faces, np.uint64)))
+    assert m.status() == manifold3d.Error.NoError
+    return m
+
+
+def test_a_domed_step_skins_mold_is_closed_and_its_cavity_is_the_skin(tmp_path):
+    path = _dome_step(tmp_path / "dome.step")
+    parts = get("file").build_parts(H, skin_file=str(path))
+    out = tmp_path / "out"
+    manifest = export_parts(parts, out)
+    assert [e["name"] for e in manifest["parts"]] == ["skin", "mold_lower", "mold_upper"]
+    for e in manifest["parts"]:
+        assert e["watertight"] and e["is_volume"], e["name"]
+        step = check_solid(bd.import_step(str(out / e["step"])), e["name"])  # the STEP re-reads as the part
+        assert step.volume == pytest.approx(e["cad_volume_mm3"], rel=1e-6)
+    assert manifest["parts"][1]["parameters"]["bonded_y"] == pytest.approx(0.0, abs=1e-9)
+    mesh = {e["name"]: trimesh.load(str(out / e["stl"]), force="mesh") for e in manifest["parts"]}
+    skin, lower, upper = (_solid(mesh[n]) for n in ("skin", "mold_lower", "mold_upper"))
+    # the assembled mold's void over the skin's footprint (the sprue and vents end at the split
+    # plane, the box's face) is the skin: same volume and same shape, to 0.5 % as the built-in molds
+    box = _solid(trimesh.creation.box(bounds=[[-W / 2, 0.0, -L / 2], [W / 2, H, L / 2]]))
+    cavity = box - lower - upper
+    assert cavity.volume() == pytest.approx(skin.volume(), rel=5e-3)
+    assert (cavity - skin).volume() + (skin - cavity).volume() < 5e-3 * skin.volume()
+    # the lid: its plate minus four blind pin holes and three separate through holes, the vents
+    # 2 mm from the bonded face's ends (z = -6, 6) and the sprue 1 mm of mold beyond the z < 0
+    # one (z = -2.25): off the middle
+    mp = MoldParams.from_params()
+    lid = parts[2].shape
+    b = lid.bounding_box().size
+    pins = 4 * math.pi * (0.5 * (mp.pin_diameter + mp.pin_clearance)) ** 2 * (mp.pin_height + mp.pin_depth_clearance)
+    holes = b.Y * math.pi * 0.25 * (mp.pour_diameter ** 2 + 2 * mp.vent_diameter ** 2)
+    assert lid.volume == pytest.approx(b.X * b.Y * b.Z - pins - holes, rel=1e-6)
+    for z, d in ((-2.25, mp.pour_diameter), (-6.0, mp.vent_diameter), (6.0, mp.vent_diameter)):
+        assert not lid.is_inside(bd.Vector(0.0, -1.0, z))  # a hole there
+        assert lid.is_inside(bd.Vector(0.0, -1.0, z + 0.5 * d + 0.1))  # and mold beside it
+    assert lid.is_inside(bd.Vector(0.0, -1.0, 0.0))  # none under the middle
+
+
+def _tube_shell(length=L):
+    """A fingertip-like half tube (outer R 8, inner R 6) on y >= 0: its inner face is curved."""
+    tube = bd.Cylinder(8, length) - bd.Cylinder(6, length)
+    return tube - bd.Box(20, 10, 2 * length, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER))
+
+
+@pytest.mark.parametrize("case, bonded, words", [
+    ("curved", "normal:-y:89.99", ["skin_bonded", "one plane", "span y in [0, 6]", "curved or stepped", "needs a core"]),
+    ("stepped", None, ["skin_bonded", "one plane", "span y in [0, 1]"]),
+    ("stepped", "plane:y=1", ["skin_file", "reaches y = 0", "below its bonded faces at y = 1"]),
+    ("recess", "plane:y=0", ["skin_file", "encloses 1 room", "loose core"]),
+    ("short", None, ["skin_file", ">= 11.5 mm along z", "10 mm long there", "--no-molds"]),
+    ("msh", None, ["skin_file", "STEP", "a .msh is a mesh, not CAD"]),
+])
+def test_a_skin_the_mold_cannot_cast_is_refused(tmp_path, case, bonded, words):
+    path = tmp_path / ("skin.msh" if case == "msh" else f"{case}.step")
+    if case == "msh":
+        path.write_text("not read", encoding="utf-8")
+    elif case == "curved":
+        bd.export_step(_tube_shell(), str(path))
+    elif case == "stepped":  # bottom faces at y = 0 (x < 0) and y = 1 (x > 0)
+        _dome_step(path, _base() - bd.Box(W / 2, 1.0, L, align=(bd.Align.MIN, bd.Align.MIN, bd.Align.CENTER)))
+    elif case == "recess":  # a pocket in the bottom: the block would fill it, loose
+        _dome_step(path, _base() - bd.Box(6.0, 2.0, 10.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)))
+    else:
+        _dome_step(path, bd.Box(W, H, 10.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)))
+    with pytest.raises(ParameterError) as e:
+        get("file").build_parts(H, skin_file=str(path), skin_bonded=bonded)
+    msg = " ".join(str(e.value).split())
+    assert all(w in msg for w in words), msg
+    if case != "msh":  # without the mold, the skin alone is printed
+        assert [p.name for p in get("file").build_parts(H, skin_file=str(path), skin_bonded=bonded,
+                                                        molds=False)] == ["skin"]
