@@ -108,3 +108,76 @@ def test_a_skin_the_mold_cannot_cast_is_refused(tmp_path, case, bonded, words):
     if case != "msh":  # without the mold, the skin alone is printed
         assert [p.name for p in get("file").build_parts(H, skin_file=str(path), skin_bonded=bonded,
                                                         molds=False)] == ["skin"]
+
+
+def _manifest(out):
+    import json
+
+    return json.loads((out / "manifest.json").read_text())
+
+
+def test_build_skin_file_writes_the_skin_its_mold_and_indenters_for_it(tmp_path, capsys):
+    from tactileskin.cli import main
+
+    path = _dome_step(tmp_path / "dome.step")
+    out = tmp_path / "out"
+    assert main(["build", "--skin-file", str(path), "--indenter", "flat", "--out", str(out)]) == 0
+    m = _manifest(out)
+    parts = {e["name"]: e for e in m["parts"]}
+    assert list(parts) == ["skin", "mold_lower", "mold_upper", "indenter_flat"]
+    assert all(e["is_volume"] and (out / e["stl"]).is_file() and (out / e["step"]).is_file() for e in m["parts"])
+    assert m["parameters"]["skin"] == "file" and m["parameters"]["skin_bonded"] == "normal:-y"
+    assert m["parameters"]["thickness"] == pytest.approx(H, abs=1e-9)  # measured from the file
+    flat = parts["indenter_flat"]  # on the skin's top, as wide and as long as the skin
+    assert flat["bbox_min"][1] == pytest.approx(H, abs=1e-6)
+    assert flat["bbox_max"][0] - flat["bbox_min"][0] >= W - 1e-6
+    assert flat["bbox_max"][2] - flat["bbox_min"][2] == pytest.approx(L, abs=1e-6)
+    # a scene file names the skin and its bonded-face rule; the rebuild replaces the build in place
+    scene = tmp_path / "scene.toml"
+    scene.write_text('skin_file = "dome.step"\nskin_bonded = "plane:y=0"\nindenter = "flat"\n', encoding="utf-8")
+    assert main(["build", "--scene", str(scene), "--indenter", "none", "--out", str(out)]) == 2  # one or the other
+    assert main(["build", "--scene", str(scene), "--no-molds", "--out", str(out)]) == 0
+    m = _manifest(out)
+    assert [e["name"] for e in m["parts"]] == ["skin", "indenter_flat"]
+    assert m["parameters"]["skin_bonded"] == "plane:y=0"
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "indenter_flat.step", "indenter_flat.stl", "manifest.json", "skin.step", "skin.stl"]
+    assert "Traceback" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("case, argv, words", [
+    ("curved", [], ["skin_bonded='normal:-y:89.99'", "one plane y = const", "curved or stepped"]),
+    ("msh", [], ["skin_file=", "a .msh is a mesh, not CAD"]),
+    ("scene-msh", [], ["skin_file=", "a .msh is a mesh, not CAD"]),
+    ("dome", ["-t", "3.5"], ["thickness=3.5", "4 mm (measured from"]),
+    ("dome", ["--skin", "pad"], ["--skin-file is the skin"]),
+])
+def test_build_refuses_a_skin_file_it_cannot_mold_in_one_line(tmp_path, capsys, case, argv, words):
+    from tactileskin.cli import main
+
+    if case == "curved":  # its bonded rule comes from a scene file
+        bd.export_step(_tube_shell(), str(tmp_path / "shell.step"))
+        scene = tmp_path / "scene.toml"
+        scene.write_text('skin_file = "shell.step"\nskin_bonded = "normal:-y:89.99"\n', encoding="utf-8")
+        source = ["--scene", str(scene)]
+    elif case == "msh":
+        (tmp_path / "skin.msh").write_text("not read", encoding="utf-8")
+        source = ["--skin-file", str(tmp_path / "skin.msh")]
+    elif case == "scene-msh":  # a valid one (a scene file's skin is read as the scene is checked)
+        from tactileskin.mesh import build_mesh
+        from tactileskin.scene import Scene
+
+        build_mesh(Scene(skin="pad", pad_width=4.0, pad_length=4.0, thickness=1.0, mesh_size=1.0,
+                         refinement=1.0)).write(tmp_path / "pad.msh")
+        scene = tmp_path / "scene.toml"
+        scene.write_text('skin_file = "pad.msh"\n', encoding="utf-8")
+        source = ["--scene", str(scene)]
+    else:
+        source = ["--skin-file", str(_dome_step(tmp_path / "dome.step"))]
+    out = tmp_path / "out"
+    assert main(["build", *source, *argv, "--out", str(out)]) == 2
+    cap = capsys.readouterr()
+    err = " ".join(cap.err.split())
+    assert "error" in err.lower() and all(w in err for w in words), err
+    assert "Traceback" not in cap.err + cap.out
+    assert not out.exists()  # nothing written

@@ -1,4 +1,5 @@
-"""`tactileskin build`: printable STL/STEP of the fingertip, its casting mold and the indenters."""
+"""`tactileskin build`: printable STL/STEP of the fingertip (or a pad, a dome, a user's STEP skin),
+its casting mold and the indenters."""
 
 from __future__ import annotations
 
@@ -9,28 +10,31 @@ import click
 
 
 GEOMETRY_OPTIONS = ("thickness", "indenter", "indenter_radius", "indenter_axis", "braille_text", "braille_standard",
-                    "skin", "pad_width", "pad_length", "dome_length", "dome_tip")
+                    "skin", "pad_width", "pad_length", "dome_length", "dome_tip", "skin_file")
 
 
 def _scene_options(path: str) -> dict:
     """build's geometry options from a scene (or one-case sweep) TOML: the skin that `solve
     --scene` solves, its fingertip overrides included (`build` had no option for them and printed
-    the default 20 mm, 8 mm fingertip for a scene that solves a 30 mm, 9 mm one)."""
+    the default 20 mm, 8 mm fingertip for a scene that solves a 30 mm, 9 mm one); a STEP skin
+    file with its `skin_bonded` rule."""
     from tactileskin import scenefile
     from tactileskin.errors import ParameterError
     from tactileskin.scene import Scene
 
     sc = Scene.from_dict(scenefile.single_scene_fields(scenefile.read(path), "build"))
     if sc.skin == "file":
-        raise ParameterError("skin_file", str(sc.skin_file), "a built-in skin (fingertip, pad, dome) for `build`",
-                             "a skin file is your own CAD: print it from there")
+        from tactileskin.mesh.skinfile import require_step
+
+        require_step(sc.skin_file)  # a .msh has no CAD to make a mold of
     kind = sc.indenter.value
     if kind == "file":
         raise ParameterError("indenter_file", str(sc.indenter_file), "a built-in indenter for `build`",
                              "a file indenter is your own CAD: print it from there")
     opts = dict(thickness=sc.thickness, indenter=kind, skin=sc.skin, braille_text="",
                 braille_standard="standard_american", indenter_radius=None, indenter_axis=None,
-                pad_width=None, pad_length=None, dome_length=None, dome_tip=None, fingertip=dict(sc.fingertip))
+                pad_width=None, pad_length=None, dome_length=None, dome_tip=None, fingertip=dict(sc.fingertip),
+                skin_file=None, skin_bonded=None)
     if kind == "braille":
         opts.update(braille_text=sc.braille_text, braille_standard=sc.braille_standard)
     if kind in ("sphere", "cylinder"):
@@ -39,6 +43,8 @@ def _scene_options(path: str) -> dict:
         opts.update(pad_width=sc.pad_width, pad_length=sc.pad_length)
     if sc.skin == "dome":
         opts.update(dome_length=sc.dome_length, dome_tip=sc.dome_tip)
+    if sc.skin == "file":
+        opts.update(skin_file=sc.skin_file, skin_bonded=sc.skin_bonded)
     return opts
 
 
@@ -64,6 +70,10 @@ def _scene_options(path: str) -> dict:
 @click.option("--skin", type=click.Choice(["fingertip", "pad", "dome"]), default="fingertip", show_default=True,
               help="Skin geometry: the paper's fingertip, a flat pad (--pad-width, --pad-length) or a "
                    "finger with a rounded tip (--dome-length, --dome-tip).")
+@click.option("--skin-file", type=str, default=None,
+              help="Your own skin: a STEP solid (mm) bonded on one flat face y = const facing -y (the faces "
+                   "skin_bonded picks, in a --scene file; default 'normal:-y'); builds it and a two-part mold "
+                   "cast face down, as the pad's; implies --skin file (a .msh has no CAD: refused).")
 @click.option("--pad-width", type=float, default=None, help="Pad: x extent (mm); default 20.")
 @click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm); default 20.")
 @click.option("--dome-length", type=float, default=None, help="Dome: finger length before the dome (mm); default 10.")
@@ -71,7 +81,7 @@ def _scene_options(path: str) -> dict:
               help="Dome: semi-axis of the dome along the finger (mm); default the section's half width.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
             pad_width=None, pad_length=None, dome_length=None, dome_tip=None, indenter_radius=None,
-            indenter_axis=None, scene_file=None):
+            indenter_axis=None, scene_file=None, skin_file=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -99,6 +109,13 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         indenter_radius, indenter_axis = opts["indenter_radius"], opts["indenter_axis"]
         pad_width, pad_length, dome_length, dome_tip = (opts[k] for k in ("pad_width", "pad_length", "dome_length",
                                                                            "dome_tip"))
+        skin_file, skin_bonded = opts["skin_file"], opts["skin_bonded"]
+    else:
+        skin_bonded = None
+        if skin_file is not None:
+            if click.get_current_context().get_parameter_source("skin") == click.core.ParameterSource.COMMANDLINE:
+                raise click.UsageError("--skin-file is the skin: leave out --skin")
+            skin = "file"
     t = default_thickness() if thickness is None else thickness
     pad = {}
     if skin != "pad" and (pad_width is not None or pad_length is not None):
@@ -110,6 +127,15 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
 
         sc = Scene(skin="pad", thickness=t, pad_width=pad_width, pad_length=pad_length)  # validates
         pad = dict(pad_width=sc.pad_width, pad_length=sc.pad_length)
+    elif skin == "file":
+        from tactileskin.mesh.skinfile import DEFAULT_RULE, require_step
+        from tactileskin.scene import Scene
+
+        require_step(skin_file)  # a .msh: no CAD, before gmsh reads it
+        given = {} if thickness is None else {"thickness": thickness}  # the file fixes t: another is refused
+        sc = Scene(skin="file", skin_file=skin_file, skin_bonded=skin_bonded, **given)  # validates, measures t
+        t = sc.thickness
+        pad = dict(skin_file=str(sc.skin_file), skin_bonded=sc.skin_bonded or DEFAULT_RULE)
     elif skin == "dome":
         from tactileskin.scene import Scene
 

@@ -127,10 +127,7 @@ def build_file_parts(path, bonded=None, *, molds: bool = True) -> list[Part]:
     CAD) and for bonded faces not in one plane facing -y (mesh.skinfile.bonded_plane)."""
     from tactileskin.mesh import skinfile
 
-    kind = skinfile.file_kind(path)
-    if kind != "step":
-        raise ParameterError("skin_file", str(path), "a STEP (.step/.stp) skin solid for `build`",
-                             "a .msh is a mesh, not CAD: export the skin's solid as STEP from its CAD")
+    skinfile.require_step(path)
     skinfile.parse_rule(bonded)  # a bad rule fails before any CAD work
     rule = bonded or skinfile.DEFAULT_RULE
     fp = dict(skin="file", skin_file=str(path), skin_sha256=skinfile.file_digest(path), skin_bonded=rule)

@@ -67,6 +67,14 @@ def file_kind(path) -> str:
     raise ParameterError("skin_file", str(path), _VALID_FILE, f"unknown suffix {suffix!r}")
 
 
+def require_step(path) -> None:
+    """ParameterError unless `path` names a STEP file: `build` makes parts and a mold of a skin's
+    CAD solid, which a .msh does not hold."""
+    if file_kind(path) != "step":
+        raise ParameterError("skin_file", str(path), "a STEP (.step/.stp) skin solid for `build`",
+                             "a .msh is a mesh, not CAD: export the skin's solid as STEP from its CAD")
+
+
 def _names(value) -> tuple[str, ...]:
     if value is None:
         return ()
