@@ -381,3 +381,47 @@ def test_a_line_whose_pitch_misses_its_end_says_so(caplog):
     with caplog.at_level(logging.WARNING, logger="tactileskin.sensors"):
         sensors.layouts([{"name": "exact", "kind": "line", "s": [0, 2], "pitch": 0.5, "depth": 1.0}])[0].positions()
     assert not caplog.records
+
+
+def test_points_are_located_alike_by_the_affine_first_search(monkeypatch):
+    """locate ranks a point's candidate elements by their affine coordinates and runs Newton
+    on the AFFINE_FIRST best (a 3D point took ~0.4 ms with Newton on all 30; 0.07 ms now,
+    benchmarks/sensor_sampling.py), and tries EXPAND x as many elements for a point outside
+    all of them: on a graded mesh the element holding a point near a vertex of small elements
+    can rank past the 30 nearest centroids, and such a point inside the skin was refused as off
+    it (64 of 20000 points here, and some in no other element). Every point inside an element, and every boundary node of
+    the curved outer surface, interpolates the coordinates exactly (P2 geometry), alike with
+    Newton on all candidates; a point off the skin is still refused."""
+    from tactileskin.fe import model_for_scene
+    from tactileskin.fe import probe
+    from tactileskin.planner import with_quality
+    from tactileskin.scene import Scene
+
+    model, _ = model_for_scene(with_quality(Scene(skin="pad", pad_width=10, pad_length=10, thickness=1.0,
+                                                  indenter="sphere", indenter_radius=2.5, dim=3,
+                                                  viscoelastic=False), "preview"))
+    rng = np.random.default_rng(0)
+    el = rng.integers(0, model.mesh.t.shape[1], 20000)
+    b = rng.dirichlet(np.full(4, 0.3), 20000).T  # near the elements' vertices and edges
+    inside = model.basis.mapping.F(b[1:][:, :, None], el)[:, :, 0].T
+    probe.locate(model, inside[:1])  # builds the centroid tree
+    _, near = model._probe_tree.query(inside, k=probe._CANDIDATES[3])
+    far = ~np.any(near == el[:, None], axis=1)  # their own element is not among the 30 nearest
+    assert far.sum() > 10
+    bn = model.mesh.doflocs[:, model.mesh.boundary_nodes()].T
+    pts = np.vstack([inside[far], inside[:500], bn[rng.integers(0, len(bn), 300)]])
+    monkeypatch.setattr(probe, "EXPANSIONS", 0)  # the 30 nearest only, as before
+    with pytest.raises(ParameterError, match="inside the meshed skin"):
+        probe.locate(model, pts)
+    monkeypatch.undo()
+    got = {}
+    for first in (probe.AFFINE_FIRST, 10 ** 6):  # the second: Newton on every candidate
+        monkeypatch.setattr(probe, "AFFINE_FIRST", first)
+        M = probe.interpolation_matrix(model, pts)
+        got[first] = np.stack([M @ model.mesh.doflocs[i] for i in range(3)], axis=1)
+        assert np.abs(got[first] - pts).max() < 1e-12
+    assert np.abs(got[probe.AFFINE_FIRST] - got[10 ** 6]).max() < 1e-12
+    monkeypatch.undo()
+    top = model.mesh.doflocs[:, np.argmax(model.mesh.doflocs[1])]
+    with pytest.raises(ParameterError, match="inside the meshed skin"):
+        probe.locate(model, (top + [0.0, 0.05, 0.0])[None, :])

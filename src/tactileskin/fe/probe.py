@@ -17,6 +17,8 @@ from tactileskin.errors import ParameterError
 
 OUTSIDE_TOL = 1e-3           # reference units: 0.1 % of an element outside is the boundary
 _CANDIDATES = {2: 12, 3: 30}  # nearest elements (by centroid) tried per point
+AFFINE_FIRST = 4              # of them, those Newton tries first (best affine coordinates)
+EXPAND, EXPANSIONS = 4, 2     # a point outside all its candidates: EXPAND x as many, twice
 # points located at once by stress_sampler: the search holds ~9 kB (affine) to ~160 kB (P2
 # geometry) per point in 3D (the 30 candidates' Newton arrays), so a chunk ~10-170 MB; a valid
 # sensor file of 19881 taxels of 16 x 16 points (5.1 M points) at once was killed at 20 GB
@@ -30,22 +32,24 @@ def _score(X: np.ndarray, simplex: bool) -> np.ndarray:
     return np.minimum(X.min(axis=0), 1.0 - X.max(axis=0))
 
 
-def locate(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(cells (n,), reference coordinates (dim, n)) of reference-configuration points (n, dim)."""
-    from scipy.spatial import cKDTree
+def _affine(model) -> tuple[np.ndarray, np.ndarray]:
+    """(first vertex (n_el, dim), inverse of the vertex-edge matrix (n_el, dim, dim)) of each
+    simplex: its affine map, exact for straight-sided elements (all but the curved boundary's)."""
+    aff = getattr(model, "_probe_affine", None)
+    if aff is None:
+        mesh = model.mesh
+        v = mesh.p[:, mesh.t].transpose(2, 1, 0)                  # (n_el, dim + 1, dim)
+        A = (v[:, 1:, :] - v[:, :1, :]).transpose(0, 2, 1)        # columns: the edges from vertex 0
+        aff = model._probe_affine = (v[:, 0, :], np.linalg.inv(A))
+    return aff
 
-    mesh, mapping = model.mesh, model.basis.mapping
-    dim = mesh.dim()
-    pts = np.atleast_2d(np.asarray(points, float))
-    if pts.shape[1] != dim:
-        raise ParameterError("probe points", f"shape {pts.shape}", f"(n, {dim})")
-    tree = getattr(model, "_probe_tree", None)
-    if tree is None:
-        tree = model._probe_tree = cKDTree(mesh.p[:, mesh.t].mean(axis=1).T)
-    k = min(_CANDIDATES[dim], mesh.t.shape[1])
-    _, cand = tree.query(pts, k=k)
-    cand = cand.reshape(len(pts), k)
-    x = np.repeat(pts, k, axis=0).T[:, :, None]                  # (dim, n*k, 1)
+
+def _newton(model, pts: np.ndarray, cand: np.ndarray, simplex: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(reference coordinates (dim, n*m), scores (n, m)) of points (n, dim) in their candidate
+    elements cand (n, m), by Newton on the (isoparametric) geometry map."""
+    mapping, dim = model.basis.mapping, pts.shape[1]
+    n, m = cand.shape
+    x = np.repeat(pts, m, axis=0).T[:, :, None]                  # (dim, n*m, 1)
     tind = cand.ravel()
     X = np.full(x.shape, 1.0 / (dim + 1))
     # scikit-fem's isoparametric mapping memoises every Jacobian it evaluates (its J, in
@@ -62,19 +66,69 @@ def locate(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         memo = getattr(mapping, "_cache", None)
         for h in set(memo or ()) - before:
             del memo[h]
+    return X[:, :, 0], _score(X[:, :, 0], simplex).reshape(n, m)
+
+
+def locate(model, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(cells (n,), reference coordinates (dim, n)) of reference-configuration points (n, dim).
+    A point's candidates are its nearest elements by centroid (_CANDIDATES); on simplices they
+    are ranked by their affine coordinates (exact for straight-sided elements) and Newton runs
+    on the AFFINE_FIRST best, then, for a point none of them holds, on all of them. A point
+    still outside every candidate is searched again among EXPAND x as many: on a graded mesh the
+    element holding a point near a vertex of small elements can rank past the first 30 (a point
+    inside the default 3D Braille mesh ranked 31st and was refused as off the skin)."""
+    from scipy.spatial import cKDTree
+
+    mesh = model.mesh
+    dim, n_el = mesh.dim(), mesh.t.shape[1]
+    pts = np.atleast_2d(np.asarray(points, float))
+    if pts.shape[1] != dim:
+        raise ParameterError("probe points", f"shape {pts.shape}", f"(n, {dim})")
+    tree = getattr(model, "_probe_tree", None)
+    if tree is None:
+        tree = model._probe_tree = cKDTree(mesh.p[:, mesh.t].mean(axis=1).T)
     simplex = "Tri" in type(mesh).__name__ or "Tet" in type(mesh).__name__
-    score = _score(X[:, :, 0], simplex).reshape(len(pts), k)
-    best = np.argmax(score, axis=1)
-    rows = np.arange(len(pts))
-    bad = score[rows, best] < -OUTSIDE_TOL
+    n = len(pts)
+    cells, Xb, sb = np.zeros(n, int), np.zeros((dim, n)), np.full(n, -np.inf)
+
+    def keep(idx, cand, X, score):  # the better of each point's best so far and its best here
+        best = np.argmax(score, axis=1)
+        r = np.arange(len(idx))
+        better = score[r, best] > sb[idx]
+        j = idx[better]
+        cells[j] = cand[r, best][better]
+        Xb[:, j] = X[:, r * cand.shape[1] + best][:, better]
+        sb[j] = score[r, best][better]
+
+    todo, k = np.arange(n), min(_CANDIDATES[dim], n_el)
+    for level in range(EXPANSIONS + 1):
+        _, cand = tree.query(pts[todo], k=k)
+        cand = cand.reshape(todo.size, k)
+        rest = todo
+        if simplex and k > AFFINE_FIRST:
+            v0, Ainv = _affine(model)
+            Xa = np.einsum("nkij,nkj->ink", Ainv[cand], pts[todo, None, :] - v0[cand])   # (dim, n, k)
+            first = np.argsort(-_score(Xa.reshape(dim, -1), True).reshape(todo.size, k), axis=1)[:, :AFFINE_FIRST]
+            short = np.take_along_axis(cand, first, axis=1)
+            keep(todo, short, *_newton(model, pts[todo], short, simplex))
+            # in none of them (a curved element, round-off): all the first candidates; the
+            # further ones only by their affine ranks (a point off the skin costs little)
+            rest = np.flatnonzero(sb[todo] < 0.0) if level == 0 else np.zeros(0, int)
+            cand, rest = cand[rest], todo[rest]
+        if rest.size:
+            keep(rest, cand, *_newton(model, pts[rest], cand, simplex))
+        todo = todo[sb[todo] < -OUTSIDE_TOL]
+        if not todo.size or k == n_el:
+            break
+        k = min(EXPAND * k, n_el)
+    bad = sb < -OUTSIDE_TOL
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
         raise ParameterError("sample point", tuple(float(v) for v in pts[i]),
                              "inside the meshed skin (mesh box " + ", ".join(
                                  f"[{a:.4g}, {b:.4g}]" for a, b in zip(lo, hi)) + " mm)")
-    pick = rows * k + best
-    return cand[rows, best], X[:, pick, 0]
+    return cells, Xb
 
 
 def interpolation_matrix(model, points: np.ndarray):
