@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from tactileskin import cache
+from tactileskin import cache, sensors
 from tactileskin.errors import MeshError, ParameterError
 from tactileskin.fe import solve
 from tactileskin.mesh import build_mesh
@@ -122,8 +122,14 @@ def test_gmsh_written_block_maps_common_names_and_elevates_order(tmp_path):
         Scene(skin="file", skin_file=str(path), skin_outer="contact")
     with pytest.raises(ParameterError, match="thickness.*measured"):
         Scene(skin="file", skin_file=str(path), thickness=1.5)
-    with pytest.raises(ParameterError, match="sensors.*none with skin = file"):
-        Scene(skin="file", skin_file=str(path), sensors=[{"kind": "points", "s": [0.5], "depth": 0.5}])
+    # sensors (they were refused): a grid at depth 0.5 over the half model x >= 0 and its mirror
+    # image, on the file's z extent [-2, 2]
+    grid = {"name": "g", "kind": "grid", "s": [-1.0, 1.0], "z": [-2.0, 2.0], "pitch": [1.0, 2.0], "depth": 0.5}
+    sites = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[grid]))
+    assert np.allclose(sites.xyz[:, 1], 1.5) and np.allclose(sites.normal, [0.0, 1.0, 0.0])
+    assert sorted(set(sites.xyz[:, 0])) == [-1.0, 0.0, 1.0] and sorted(set(sites.xyz[:, 2])) == [-2.0, 0.0, 2.0]
+    with pytest.raises(ParameterError, match=r"'g' s, z=\(0.0, 2.5\) .*z in \[-2, 2\] mm.*sensor g-2: no skin"):
+        Scene(skin="file", skin_file=str(path), sensors=[{**grid, "s": [0.0, 1.0], "z": [0.5, 2.5]}])
 
 
 def test_no_bonded_group_wrong_units_and_mixed_cells(tmp_path):

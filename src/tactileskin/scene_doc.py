@@ -33,7 +33,9 @@ FIELDS: dict[str, tuple[str, str, str]] = {
                   "height, max_fraction_of_min_radius, nail_angle_deg, sample_length, thickness_min",
                   "fingertip geometry"),
     "sensors": ("mm", "[[sensors]] layouts: kind points / line / grid (3D), s along the bone, depth "
-                "below the surface or height above the bone, pitch, taxel (inside the skin)",
+                "below the surface or height above the bone, pitch, taxel (inside the skin); pad: s = x, "
+                "depth along -y; file: s = x - x_top, depth straight down (-y) from the contact surface "
+                "at (x, z), height straight up (+y) from the bonded surface there",
                 "where stresses are read (sensors.csv); () = none"),
     "indenter_radius": ("mm", "(0.1, 1000]; sphere and cylinder only", "indenter radius"),
     "indenter_axis": ("-", "'z' (along the finger, 2D-exact) or 'x' (3D); cylinder only", "cylinder axis"),

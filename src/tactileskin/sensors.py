@@ -9,6 +9,9 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
   at s is one line from the surface to the bone); or height above the bone, = t - depth.
   depth 0 is the outer surface, depth t (height 0) the bonded (bone) surface;
 - z (mm, 3D only): along the finger; the slab spans [-L/2, L/2] (L = fingertip sample_length).
+A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top,
+its depth straight down from the contact surface at (x, z) and its height straight up from the
+bonded surface there (skins.file.FileCoordinates).
 
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
@@ -302,6 +305,8 @@ class FlatCoordinates:
     """A flat layer: s = x in [-half_width, half_width], depth below y = top. For blocks
     and pads (the tests' homogeneous block)."""
 
+    straight = True  # taxel_s: s is arc length on every depth surface
+
     def __init__(self, top: float, thickness: float, half_width: float):
         self.top, self.thickness, self.s_max = float(top), float(thickness), float(half_width)
 
@@ -377,6 +382,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
     """Sites of the layouts in the skin coordinates `coords`; a sensor (or a taxel's edge)
     outside the skin is a ParameterError naming the layout and the valid range."""
     t, smax = coords.thickness, coords.s_max
+    local = getattr(coords, "local", False)  # skins.file.FileCoordinates: checks its own points
     ids, names, S, Z, D, layout_of = [], [], [], [], [], []
     for lay in lays:
         where = f"sensor layout {lay.name!r}"
@@ -385,13 +391,27 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
                                  "along z: a grid is a line)")
         if dim == 2 and lay.z and any(v != 0 for v in lay.z):
             raise ParameterError(f"{where} z", list(lay.z), "omitted in 2D (plane strain)")
+        s, z = lay.positions()
+        h = 0.5 * lay.taxel
+        n0 = len(ids)
+        ids += [f"{lay.name}-{i}" for i in range(len(s))]
+        names += [lay.name] * len(s)
+        layout_of.append((lay, n0, len(s)))
+        if local:  # a user's skin: the surface, the bonded face and the skin's extent vary
+            if dim == 2:
+                z = np.zeros_like(z)
+            if h:  # the taxel's edges (in 3D its corners) are in the skin
+                ox = np.array([-1.0, 1.0] if dim == 2 else [-1.0, 1.0, -1.0, 1.0])
+                oz = np.zeros(2) if dim == 2 else np.array([-1.0, -1.0, 1.0, 1.0])
+                coords.depths(where, lay, (s[:, None] + h * ox).ravel(), (z[:, None] + h * oz).ravel(),
+                              np.repeat(np.arange(len(s)), len(ox)), what=" +- taxel/2")
+            S.append(s), Z.append(z), D.append(coords.depths(where, lay, s, z, np.arange(len(s))))
+            continue
         d = lay.depth_in(t)
         if lay.depth is not None:
             _check_range(where, "depth", d, 0.0, t)
         else:
             _check_range(where, "height", lay.height, 0.0, t)
-        s, z = lay.positions()
-        h = 0.5 * lay.taxel
         lim = coords.s_limit(d) if hasattr(coords, "s_limit") else smax
         _check_range(where, "s", s, -lim, lim,
                      note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
@@ -401,14 +421,11 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
                          note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
         if dim == 3 and z_range is not None:
             _check_range(where, "z" + (" +- taxel/2" if h else ""), np.concatenate([z - h, z + h]), *z_range)
-        n0 = len(ids)
-        ids += [f"{lay.name}-{i}" for i in range(len(s))]
-        names += [lay.name] * len(s)
-        S.append(s), Z.append(z), D.append(np.full(len(s), d)), layout_of.append((lay, n0, len(s)))
+        S.append(s), Z.append(z), D.append(np.full(len(s), d))
     s, z, depth = np.concatenate(S), np.concatenate(Z), np.concatenate(D)
     if dim == 2:
         z = np.zeros_like(z)
-    xy, n2, t2d, _ = coords.frame(s, depth)
+    xy, n2, t2d, _ = coords.frame(s, depth, z) if local else coords.frame(s, depth)
     xyz = np.column_stack([xy, z])
     normal = np.column_stack([n2, np.zeros(len(s))])
     t1 = np.column_stack([t2d, np.zeros(len(s))])
@@ -433,8 +450,12 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         k = len(gs)
         rows = slice(i0, i0 + cnt)
         ss = taxel_s(coords, s[rows], float(depth[i0]), gs, lay.taxel).ravel()
-        pq, _, _, _ = coords.frame(ss, np.repeat(depth[rows], k))
         zz = (z[rows, None] + 0.5 * lay.taxel * gz[None, :]).ravel() if dim == 3 else np.zeros(len(ss))
+        if local:  # each point at the layout's depth (or height) at its own (x, z)
+            dq = coords.depths(f"sensor layout {lay.name!r}", lay, ss, zz, np.repeat(np.arange(cnt), k))
+            pq = coords.frame(ss, dq, zz)[0]
+        else:
+            pq, _, _, _ = coords.frame(ss, np.repeat(depth[rows], k))
         samples[rows, :k] = np.column_stack([pq, zz]).reshape(cnt, k, 3)
         weights[rows, :k] = np.broadcast_to(wq / wq.sum(), (cnt, k))
         weights[rows, k:] = 0.0
@@ -450,7 +471,7 @@ def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 17) -> np.n
     sc = np.atleast_1d(np.asarray(s_centre, float))
     g = np.asarray(g, float)
     half = 0.5 * float(side)
-    if isinstance(coords, FlatCoordinates):  # s is arc length on every depth surface
+    if getattr(coords, "straight", False):  # s is arc length on every depth surface
         return sc[:, None] + half * g[None, :]
     _, _, _, j0 = coords.frame(sc, np.full(sc.shape, depth))
     out = np.empty((sc.size, g.size))

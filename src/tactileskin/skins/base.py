@@ -11,7 +11,8 @@ A skin is a class (no instances: every answer is a function of the Scene) with
   of the outer surface), `contact_radius(indenter)`, `outer_length_to_x(x)`,
   `min_radius_of_curvature`);
 - `sample_length(scene)`: the z extent of the 3D model (and the indenter plates);
-- `coordinates(scene)`: the sensor coordinates (`frame(s, depth)`, `thickness`, `s_max`);
+- `coordinates(scene)`: the sensor coordinates (`frame(s, depth)`, `thickness`, `s_max`; a
+  `local` one, skins.file's, also `depths(...)` and `frame(s, depth, z)`: see sensors.resolve);
 - `fixed_boundaries`: the boundary names held fixed (bonded to rigid parts). Every skin mesh
   names `bone_interface` (the bonded surface: the pressure path), `outer_surface` (contact),
   `symmetry` (x = 0) and, in 3D, `end_front` / `end_back` (z = +-L/2; `end_back` is z = 0

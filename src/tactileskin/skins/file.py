@@ -15,7 +15,10 @@ value given is refused), the top point (highest point of the outer surface, near
 x = z = 0 among equals; of a STEP, the CAD surface's point on that axis), where indenters start (y0 = its y; indenters stay centred on
 x = z = 0; `check_placement` refuses a skin upside down, off the axis or highest off it). s
 along the bonded surface is x - x_top (signed), the section plane of a 3D
-profile z = 0. Sensor layouts are refused on a file skin (its sensor frames are undefined).
+profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth straight down (-y)
+from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
+first face under the contact surface), normal +y; both surfaces read on the analysed mesh's
+boundary facets (a STEP's analysis mesh: chords of its faces).
 The model is the half x >= 0 only when the file names a `symmetry` group.
 """
 
@@ -32,6 +35,7 @@ from tactileskin.skins.base import Skin
 from tactileskin.skins.registry import register
 
 DEFAULT_THICKNESS = 3.0  # Scene's default: taken as "not given"
+_TOL = 1e-9  # mm: a sensor on a range's end is inside (sensors._TOL)
 
 
 @dataclass(frozen=True)
@@ -48,9 +52,15 @@ class FileGeometry:
     groups: tuple = ()
     z_symmetric: bool = False  # 3D: the file names a `symmetry_z` group (half model z >= 0)
     axis_y: float | None = None  # y of the outer surface on the indenters' axis (None: it misses it)
+    facets: np.ndarray | None = None  # (n, dim, dim): the boundary facets' vertices (sensor columns)
+    facet_kind: np.ndarray | None = None  # (n,): OUTER, BONDED or 0 (another boundary)
 
 
 AXIS_GAP = 0.02  # of t: how far the outer surface on the axis may lie below the top point
+OUTER, BONDED = 1, 2  # FileGeometry.facet_kind
+# the bonded surfaces held fixed: the fingertip's nail and the dome's bone under its tip, as
+# `tactileskin mesh` writes them, where the file has them
+FIXED = ("bone_interface", "nail_edge", "bone_tip")
 
 
 def _axis_height(mesh, facets, size: float):
@@ -112,11 +122,16 @@ def measure(skinmesh, groups=()) -> FileGeometry:
         top = np.zeros(pts.shape[1])
         top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
+    every = m.boundary_facets()
+    kind = np.zeros(len(every), int)
+    kind[np.isin(every, b["outer_surface"])] = OUTER
+    kind[np.isin(every, np.concatenate([b[n] for n in FIXED if n in b]))] = BONDED
     return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
                         lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
                         symmetric="symmetry" in b, groups=tuple(groups),
                         z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
-                        axis_y=_axis_height(m, b["outer_surface"], size))
+                        axis_y=_axis_height(m, b["outer_surface"], size),
+                        facets=m.p[:, m.facets[:, every]].T.copy(), facet_kind=kind)
 
 
 def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
@@ -190,6 +205,16 @@ def _analyse(kind: str, path: str, digest: str, bonded, outer) -> FileGeometry:
 
 
 def geometry(scene) -> FileGeometry:
+    return _analyse(*_key(scene))
+
+
+@functools.lru_cache(maxsize=16)
+def _coordinates(*key) -> "FileCoordinates":
+    return FileCoordinates(_analyse(*key))
+
+
+def _key(scene) -> tuple:
+    """The memo key of a scene's skin file: (kind, resolved path, digest, bonded, outer)."""
     from tactileskin.mesh import skinfile
 
     path = scene.skin_file
@@ -202,7 +227,7 @@ def geometry(scene) -> FileGeometry:
         if scene.skin_outer is not None:
             raise ParameterError("skin_outer", scene.skin_outer, "not set for a STEP file",
                                  "every face that is not bonded is the outer surface")
-    return _analyse(kind, str(Path(path).resolve()), digest, scene.skin_bonded, scene.skin_outer)
+    return kind, str(Path(path).resolve()), digest, scene.skin_bonded, scene.skin_outer
 
 
 @dataclass(frozen=True)
@@ -254,14 +279,193 @@ class FileSection:
         raise ParameterError("skin", "file", "a built-in skin", "a file skin has no section area")
 
 
+class FileCoordinates:
+    """Sensor coordinates of a file skin (the `coordinates` duck type of sensors.resolve): s =
+    x - x_top, z as given (3D); depth straight down (-y) from the contact surface at (x, z),
+    height straight up (+y) from the bonded surface there; normal +y, tangents +x (and +z).
+    The sensor's column is the vertical line through (x, z): its top must be the contact
+    surface and the point must lie above the first boundary under it (which, for a height,
+    must be bonded); the heights are read on the mesh's straight boundary facets (a STEP's
+    analysis mesh: chords of its faces). A half model (`symmetry`, `symmetry_z`) answers for
+    its mirror image by reflection, as the solver's sampler does."""
+
+    straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
+    local = True     # sensors.resolve: depth, thickness and extent vary with (x, z): self.depths
+
+    def __init__(self, geo: FileGeometry):
+        self.geo, self.dim = geo, geo.dim
+        self.thickness = float(geo.thickness)
+        self.x_top = float(geo.top_point[0])
+        lat = [0] if geo.dim == 2 else [0, 2]
+        size = float(np.max(np.subtract(geo.hi, geo.lo)))
+        self.tol = 1e-7 * size  # mm: heights this close are one surface (a shared vertex)
+        ext = [(-geo.hi[k] if half else geo.lo[k], geo.hi[k]) for k, half in
+               zip(lat, (geo.symmetric, geo.z_symmetric))]
+        self.s_range = (ext[0][0] - self.x_top, ext[0][1] - self.x_top)
+        self.s_max = float(max(abs(v) for v in self.s_range))
+        self.z_range = ext[1] if geo.dim == 3 else (0.0, 0.0)
+        F = np.asarray(geo.facets, float)
+        L = F[:, :, lat]                                    # (n, nv, k): the facets seen from above
+        if geo.dim == 2:
+            area = np.abs(L[:, 1, 0] - L[:, 0, 0])
+        else:
+            area = 0.5 * np.abs((L[:, 1, 0] - L[:, 0, 0]) * (L[:, 2, 1] - L[:, 0, 1])
+                                - (L[:, 2, 0] - L[:, 0, 0]) * (L[:, 1, 1] - L[:, 0, 1]))
+        # a vertical facet (a side, a symmetry plane) holds no height of its own: its edges
+        # are its neighbours' (a sensor on a side's line reads the top and bottom facets)
+        keep = area > 1e-9 * size ** (geo.dim - 1)
+        self._L, self._y, self._kind = L[keep], F[keep][:, :, 1], np.asarray(geo.facet_kind)[keep]
+        # a uniform grid over the facets' bounding boxes (seen from above) finds each point's few
+        # candidate facets
+        lo, hi = self._L.min(axis=(0, 1)), self._L.max(axis=(0, 1))
+        span = np.maximum(hi - lo, 1e-12)
+        ncell = np.clip((span / max(np.median(self._L.max(axis=1) - self._L.min(axis=1)), 1e-12)).astype(int),
+                        1, 4096 if geo.dim == 2 else 256)
+        self._lo, self._cell, self._ncell = lo, span / ncell, ncell
+        i0 = self._cell_index(self._L.min(axis=1))
+        i1 = self._cell_index(self._L.max(axis=1))
+        cells, owner = [], []
+        for f, (a, b) in enumerate(zip(i0, i1)):
+            grid = np.meshgrid(*(np.arange(a[k], b[k] + 1) for k in range(len(a))), indexing="ij")
+            flat = np.ravel_multi_index([g.ravel() for g in grid], tuple(ncell))
+            cells.append(flat)
+            owner.append(np.full(flat.size, f))
+        cells, owner = np.concatenate(cells), np.concatenate(owner)
+        order = np.argsort(cells, kind="stable")
+        self._owner = owner[order]
+        self._start = np.searchsorted(cells[order], np.arange(int(np.prod(ncell)) + 1))
+
+    def _cell_index(self, q):
+        return np.clip(np.floor((q - self._lo) / self._cell).astype(int), 0, self._ncell - 1)
+
+    def column(self, s, z=None) -> dict:
+        """Heights (mm, NaN where none) on the vertical line through each (s, z): `top` (the
+        highest boundary), `outer` (the highest contact surface), `floor` (the first boundary
+        under the top) and `bonded` (whether that floor is a bonded surface)."""
+        s = np.atleast_1d(np.asarray(s, float))
+        x = self.x_top + s
+        if self.geo.symmetric:
+            x = np.abs(x)
+        q = x[:, None]
+        if self.dim == 3:
+            z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape)
+            q = np.column_stack([x, np.abs(z) if self.geo.z_symmetric else z])
+        n = len(q)
+        top, outer, floor, bond = (np.full(n, -np.inf) for _ in range(4))
+        lo, hi = self._lo - self.tol, self._lo + self._cell * self._ncell + self.tol
+        inside = np.all((q >= lo) & (q <= hi), axis=1)
+        for a in range(0, n, 4096):  # bounded memory: a few candidate facets per point
+            rows = np.flatnonzero(inside[a:a + 4096]) + a
+            if not rows.size:
+                continue
+            c = np.ravel_multi_index(tuple(self._cell_index(q[rows]).T), tuple(self._ncell))
+            cnt = self._start[c + 1] - self._start[c]
+            pt = np.repeat(rows, cnt)
+            off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+            f = self._owner[np.repeat(self._start[c], cnt) + off]
+            hit, y = self._cross(q[pt], f)
+            pt, f, y = pt[hit], f[hit], y[hit]
+            np.maximum.at(top, pt, y)
+            out = self._kind[f] == OUTER
+            np.maximum.at(outer, pt[out], y[out])
+            below = y < top[pt] - self.tol
+            np.maximum.at(floor, pt[below], y[below])
+            bonded = below & (self._kind[f] == BONDED)
+            np.maximum.at(bond, pt[bonded], y[bonded])
+        nan = lambda v: np.where(np.isfinite(v), v, np.nan)  # noqa: E731
+        return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
+                "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
+
+    def _cross(self, q, f):
+        """(hit, y) of the vertical lines through the points q (m, k) and the facets f (m,)."""
+        L, Y = self._L[f], self._y[f]
+        tol = 1e-9
+        if self.dim == 2:
+            a, b = L[:, 0, 0], L[:, 1, 0]
+            u = (q[:, 0] - a) / (b - a)
+            hit = (u >= -tol) & (u <= 1 + tol)
+            u = np.clip(u, 0.0, 1.0)
+            return hit, Y[:, 0] + u * (Y[:, 1] - Y[:, 0])
+        a, b, c = L[:, 0], L[:, 1], L[:, 2]
+        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        p = q - a
+        l1 = (p[:, 0] * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * p[:, 1]) / det
+        l2 = ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det
+        hit = (l1 >= -tol) & (l2 >= -tol) & (l1 + l2 <= 1 + tol)
+        return hit, Y[:, 0] + l1 * (Y[:, 1] - Y[:, 0]) + l2 * (Y[:, 2] - Y[:, 0])
+
+    def depths(self, where: str, lay, s, z, idx, what: str = "") -> np.ndarray:
+        """The depth below the contact surface of each point (s, z) of the layout `lay` (its
+        depth, or the height over the bonded surface there); a point outside the skin is a
+        ParameterError naming the layout, the sensor (`idx`: its index in the layout) and the
+        valid range there."""
+        s = np.atleast_1d(np.asarray(s, float))
+        z = np.broadcast_to(np.asarray(z, float), s.shape)
+        col = self.column(s, z if self.dim == 3 else None)
+        t = col["top"] - col["floor"]
+
+        def at(i):
+            return f"s = {s[i]:.6g}" + (f", z = {z[i]:.6g}" if self.dim == 3 else "") + " mm"
+
+        def sensor(i):
+            return f"sensor {lay.name}-{int(np.atleast_1d(idx)[i])}" + (f" (taxel edge at {at(i)})" if what else "")
+
+        def first(bad):
+            return int(np.flatnonzero(bad)[0])
+
+        over = np.isfinite(col["top"]) & np.isfinite(col["floor"])
+        if not over.all():
+            i = first(~over)
+            where_s = "s" + (", z" if self.dim == 3 else "")
+            value = float(s[i]) if self.dim == 2 else (float(s[i]), float(z[i]))
+            z_text = f", z in [{self.z_range[0]:.6g}, {self.z_range[1]:.6g}]" if self.dim == 3 else ""
+            raise ParameterError(f"{where} {where_s}{what}", value,
+                                 f"over the skin (it spans s in [{self.s_range[0]:.6g}, {self.s_range[1]:.6g}]"
+                                 f"{z_text} mm)", f"{sensor(i)}: no skin under it")
+        up = col["outer"] >= col["top"] - self.tol
+        if not up.all():
+            i = first(~up)
+            raise ParameterError(f"{where} s{what}", float(s[i]), "under the contact surface",
+                                 f"{sensor(i)}: at {at(i)} the skin's top is not its contact surface "
+                                 "(skin_outer)")
+        if lay.depth is not None:
+            d = np.full(len(s), float(lay.depth))
+            bad = (d < -_TOL) | (d > t + _TOL)
+            if bad.any():
+                i = first(bad)
+                raise ParameterError(f"{where} depth", float(d[i]), f"[0, {t[i]:.6g}] mm at {at(i)} (the skin's "
+                                     "thickness under its contact surface there)", sensor(i))
+            return d
+        h = float(lay.height)
+        if not col["bonded"].all():
+            i = first(~col["bonded"])
+            raise ParameterError(f"{where} height", h, "a depth instead where no bonded surface is under the "
+                                 "sensor", f"{sensor(i)}: at {at(i)} the face under the contact surface is "
+                                 "not bonded")
+        bad = (h < -_TOL) | (h > t + _TOL)
+        if bad.any():
+            i = first(bad)
+            raise ParameterError(f"{where} height", h, f"[0, {t[i]:.6g}] mm at {at(i)} (the skin's thickness "
+                                 "over its bonded surface there)", sensor(i))
+        return t - h
+
+    def frame(self, s, depth, z=None):
+        """(xy (n, 2), normal +y, tangent +x, area element 1) at depth below the contact
+        surface over (s, z)."""
+        s = np.atleast_1d(np.asarray(s, float))
+        depth = np.broadcast_to(np.asarray(depth, float), s.shape)
+        y = self.column(s, z)["top"] - depth
+        n = len(s)
+        return (np.column_stack([self.x_top + s, y]), np.tile([0.0, 1.0], (n, 1)), np.tile([1.0, 0.0], (n, 1)),
+                np.ones(n))
+
+
 @register
 class FileSkin(Skin):
     name = "file"
     order = 3
     scene_params = ("skin_file", "skin_bonded", "skin_outer")
-    # the other bonded surfaces `tactileskin mesh` writes (the fingertip's nail, the dome's bone
-    # under its tip) are held fixed too where the file has them
-    fixed_boundaries = ("bone_interface", "nail_edge", "bone_tip")
+    fixed_boundaries = FIXED
     fixes_thickness = True
     s_axis = "s = x - x_top along the bonded surface"
 
@@ -274,9 +478,6 @@ class FileSkin(Skin):
         if t != DEFAULT_THICKNESS and abs(t - geo.thickness) > 1e-6 * max(1.0, geo.thickness):
             raise ParameterError("thickness", t, f"{geo.thickness:.6g} mm (measured from {scene.skin_file}) or left out",
                                  "the file fixes it")
-        if scene.sensors:
-            raise ParameterError("sensors", f"{len(scene.sensors)} layout(s)", "none with skin = file",
-                                 "a user's skin has no sensor coordinates (s and depth) yet")
         return {"thickness": geo.thickness, "dim": geo.dim, "skin_file": str(scene.skin_file)}
 
     @classmethod
@@ -291,9 +492,8 @@ class FileSkin(Skin):
         return float(2.0 * max(abs(geo.lo[2]), abs(geo.hi[2])))
 
     @classmethod
-    def coordinates(cls, scene):
-        raise ParameterError("sensors", "a layout", "none with skin = file",
-                             "a user's skin has no sensor coordinates (s and depth) yet")
+    def coordinates(cls, scene) -> FileCoordinates:
+        return _coordinates(*_key(scene))
 
     @classmethod
     def cache_content(cls, scene) -> dict:

@@ -1,0 +1,180 @@
+"""Sensor layouts inside a user's file skin (skins.file.FileCoordinates): s = x - x_top, depth
+straight down from the contact surface at (x, z), height straight up from the bonded surface
+there, normal +y. The pad's own mesh read back as a file skin reads what the pad reads; the
+coordinates follow a skin that is not a flat layer; a sensor outside the skin is refused."""
+
+import numpy as np
+import pytest
+from test_skin_file import PAD, _gmsh_polygon
+
+from tactileskin import sensors
+from tactileskin.errors import ParameterError
+from tactileskin.fe import solve
+from tactileskin.mesh import build_mesh
+from tactileskin.scene import Scene
+
+LAYOUTS = [{"name": "mid", "kind": "line", "s": [-4.0, 4.0], "pitch": [0.5], "depth": 1.0},
+           {"name": "bone", "kind": "points", "s": [0.0, 1.0, 3.9], "height": 0.0, "taxel": 0.2},
+           {"name": "chip", "kind": "points", "s": [-1.0, 2.5], "height": 0.5, "taxel": 1.0}]
+
+
+def test_the_pads_mesh_as_a_file_skin_reads_the_pads_sensors(tmp_path):
+    """Same mesh, same layouts -> the same sites (exactly: the file's top y = 2 and its facets
+    are the pad's) and the same readings to 1e-9 of the largest (the solves agree to 1e-10,
+    test_msh_of_the_pad_mesh_solves_like_the_pad; measured 1e-15), in the same sensors.csv
+    columns; s < 0 is the mirror half of both (a `symmetry` group)."""
+    pad = Scene(**PAD, sensors=LAYOUTS)
+    sm = build_mesh(pad)
+    path = sm.write(tmp_path / "pad.msh")
+    user = Scene(skin="file", skin_file=str(path), indenter="flat", depth_fraction=0.03, viscoelastic=False,
+                 sensors=LAYOUTS)
+    a, b = sensors.sites_for(pad), sensors.sites_for(user)
+    assert b.ids == a.ids and np.array_equal(b.s, a.s)
+    for name in ("xyz", "depth", "normal", "t1", "t2", "samples", "weights"):
+        assert np.allclose(getattr(b, name), getattr(a, name), rtol=0, atol=1e-12), name
+    ra, rb = solve(pad, mesh=sm).sensors, solve(user, mesh=build_mesh(user)).sensors
+    assert rb.to_csv().splitlines()[0] == ra.to_csv().splitlines()[0]
+    for name in ("pressure", "sigma_nn", "tau_1", "tau_2"):
+        va, vb = getattr(ra, name), getattr(rb, name)
+        assert np.allclose(vb, va, rtol=0, atol=1e-9 * np.abs(va).max() + 1e-15), name
+    assert ra.pressure.max() > 0.01 and np.abs(ra.tau_1).max() > 1e-3  # a press was read
+
+
+def _tent(tmp_path):
+    """A whole 2D skin: its top rises from y = 1.6 at x = +-4 to 2 on the axis; its bonded base
+    is y = 0 for x < 0 and y = 0.5 for 0 < x < 3, with a free lip under 3 < x < 4."""
+    pts = [(-4, 0), (0, 0), (0, 0.5), (3, 0.5), (4, 0.5), (4, 1.6), (0, 2), (-4, 1.6)]
+    return _gmsh_polygon(tmp_path / "tent.msh", pts, {"bonded": [0, 2], "step": [1], "lip": [3],
+                                                      "sides": [4, 7], "outer_surface": [5, 6]}, h=0.5)
+
+
+def test_depth_and_height_follow_the_skin_at_each_x(tmp_path):
+    """Depth is measured from the contact surface over the sensor, height from the bonded
+    surface under it, not from the top point's thickness (1.5 here): at s = 2 the top is at
+    y = 1.8 and the base at 0.5, at s = -2 at 1.8 and 0; a taxel's points follow the surface."""
+    path = str(_tent(tmp_path))
+    lays = [{"name": "d", "kind": "points", "s": [2.0, -2.0, 3.5], "depth": 0.5},
+            {"name": "h", "kind": "points", "s": [2.0, -2.0], "height": 0.25},
+            {"name": "deep", "kind": "points", "s": [-2.0], "depth": 1.7},  # deeper than t = 1.5
+            {"name": "tx", "kind": "points", "s": [2.0], "depth": 0.5, "taxel": 2.0, "taxel_points": 3}]
+    sc = Scene(skin="file", skin_file=path, indenter="flat", sensors=lays)
+    assert sc.thickness == pytest.approx(1.5)
+    st = sensors.sites_for(sc)
+    y = dict(zip(st.ids, st.xyz[:, 1]))
+    assert (y["d-0"], y["d-1"], y["d-2"]) == (pytest.approx(1.3), pytest.approx(1.3), pytest.approx(1.15))
+    assert (y["h-0"], y["h-1"]) == (pytest.approx(0.75), pytest.approx(0.25))
+    assert y["deep-0"] == pytest.approx(0.1)
+    depth = dict(zip(st.ids, st.depth))
+    assert (depth["h-0"], depth["h-1"]) == (pytest.approx(1.05), pytest.approx(1.55))
+    assert np.allclose(st.normal, [0.0, 1.0, 0.0]) and np.allclose(st.t1, [1.0, 0.0, 0.0])
+    g = np.polynomial.legendre.leggauss(3)[0]
+    i = st.ids.index("tx-0")
+    assert np.allclose(st.samples[i, :3, 0], 2.0 + g)  # the side along x
+    assert np.allclose(st.samples[i, :3, 1], 2.0 - 0.1 * (2.0 + g) - 0.5)  # 0.5 under the slope
+
+
+@pytest.mark.parametrize("layout,match", [
+    ({"s": [2.0], "depth": 1.4}, r"'x' depth=1.4 .*\[0, 1.3\] mm at s = 2 mm.*sensor x-0"),
+    ({"s": [-2.0], "depth": -0.1}, r"'x' depth=-0.1 .*\[0, 1.8\] mm at s = -2 mm"),      # above the surface
+    ({"s": [0.0, 2.0], "height": 1.4}, r"'x' height=1.4 .*\[0, 1.3\] mm at s = 2 mm.*sensor x-1"),
+    ({"s": [-2.0], "height": -0.2}, r"'x' height=-0.2 .*\[0, 1.8\] mm"),                 # below the bonded face
+    ({"s": [3.5], "height": 0.2}, r"'x' height=0.2 .*a depth instead.*sensor x-0: at s = 3.5 mm.*not bonded"),
+    ({"s": [1.0, 4.5], "depth": 0.5}, r"'x' s=4.5 .*s in \[-4, 4\] mm.*sensor x-1: no skin under it"),
+    ({"s": [3.8], "depth": 0.5, "taxel": 1.0}, r"'x' s \+- taxel/2=4.3 .*sensor x-0 \(taxel edge at s = 4.3 mm\)"),
+])
+def test_a_sensor_outside_a_file_skin_names_the_layout_and_the_sensor(tmp_path, layout, match):
+    with pytest.raises(ParameterError, match=match):
+        Scene(skin="file", skin_file=str(_tent(tmp_path)), indenter="flat", sensors=[{"name": "x", **layout}])
+
+
+def test_a_file_skins_sensors_enter_the_cache_key_and_its_path_does_not(tmp_path):
+    import shutil
+
+    from tactileskin.cache import cache_key
+
+    path = _tent(tmp_path)
+    lay = {"name": "d", "kind": "points", "s": [2.0], "depth": 0.5}
+    keys = {cache_key(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=s))
+            for s in ([], [lay], [{**lay, "depth": 0.6}], [{**lay, "height": 0.5, "depth": None}])}
+    assert len(keys) == 4
+    moved = shutil.copy(path, tmp_path / "moved.msh")
+    assert (cache_key(Scene(skin="file", skin_file=str(moved), indenter="flat", sensors=[lay]))
+            == cache_key(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=[lay])))
+
+
+def test_the_cli_refuses_a_sensor_outside_a_file_skin_in_one_line(tmp_path, capsys):
+    from tactileskin.cli import main
+
+    (tmp_path / "s.toml").write_text('[[sensors]]\nname = "deep"\ns = [2.0]\ndepth = 1.4\n')
+    rc = main(["solve", "--skin-file", str(_tent(tmp_path)), "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
+               "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "sensor layout 'deep' depth=1.4" in err and "deep-0" in err
+    assert not (tmp_path / "o").exists()
+
+
+LAYOUTS_3D = [{"name": "mid", "kind": "line", "s": [-1.0, 1.0], "pitch": [0.5], "depth": 0.5},
+              {"name": "g", "kind": "grid", "s": [-1.0, 1.0], "z": [-1.0, 1.0], "pitch": [1.0], "height": 0.5,
+               "taxel": 0.5, "taxel_points": 3},
+              {"name": "p", "kind": "points", "s": [0.0, 0.5], "z": [-0.5, 1.0], "height": 0.0}]
+
+
+def test_the_3d_quarter_pads_mesh_as_a_file_skin_reads_the_pads_sensors(tmp_path):
+    """The z-symmetric quarter of the 3D pad written as .msh: the same sites (z < 0 and s < 0
+    read by reflection in both) and the same readings to 1e-9 of the largest (the solves
+    agree to 1e-8 of the reaction, test_3d_quarter_pad_written_as_msh_solves_like_the_pad;
+    measured 1e-13)."""
+    kw = dict(indenter="sphere", indenter_radius=2.5, depth=0.2, viscoelastic=False, sensors=LAYOUTS_3D)
+    pad = Scene(skin="pad", pad_width=6.0, pad_length=6.0, thickness=2.0, dim=3, mesh_size=1.0, refinement=3.0, **kw)
+    sm = build_mesh(pad)
+    user = Scene(skin="file", skin_file=str(sm.write(tmp_path / "quarter.msh")), **kw)
+    a, b = sensors.sites_for(pad), sensors.sites_for(user)
+    for name in ("xyz", "depth", "normal", "t1", "t2", "samples", "weights"):
+        assert np.allclose(getattr(b, name), getattr(a, name), rtol=0, atol=1e-12), name
+    ra, rb = solve(pad, mesh=sm).sensors, solve(user, mesh=build_mesh(user)).sensors
+    for name in ("pressure", "sigma_nn", "tau_1", "tau_2"):
+        va, vb = getattr(ra, name), getattr(rb, name)
+        assert np.allclose(vb, va, rtol=0, atol=1e-9 * np.abs(va).max()), name
+    assert np.abs(ra.tau_2).max() > 1e-3  # off the plane z = 0 the shear along z is read
+
+
+def test_a_step_block_reads_the_sensors_of_the_3d_pad(tmp_path):
+    """A STEP block 4 x 2 x 4 mm (a full model: its analysis mesh's facets give the heights)
+    has the pad's sites exactly, and under a flat plate reads what the built-in pad of that
+    size (its quarter) reads, to 5 % of the largest |sigma_nn|: different tetrahedral meshes
+    (h = 0.5: reactions 3.5e-4 apart), whose point stresses carry the element's O(h^2) error
+    (measured up to 2.7 %, at the bonded point 1 mm from the base's edge; the largest pressure
+    difference on an 8 mm block was 11.4 % at h = 1 and 2.7 % at h = 0.5)."""
+    import build123d as bd
+
+    path = tmp_path / "block.step"
+    bd.export_step(bd.Box(4.0, 2.0, 4.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)), str(path))
+    kw = dict(indenter="flat", depth_fraction=0.03, viscoelastic=False, mesh_size=0.5, refinement=1.0,
+              sensors=LAYOUTS_3D)
+    user = Scene(skin="file", skin_file=str(path), **kw)
+    pad = Scene(skin="pad", pad_width=4.0, pad_length=4.0, thickness=2.0, dim=3, **kw)
+    a, b = sensors.sites_for(pad), sensors.sites_for(user)
+    for name in ("xyz", "depth", "normal", "t1", "t2", "samples", "weights"):
+        assert np.allclose(getattr(b, name), getattr(a, name), rtol=0, atol=1e-9), name
+    ra, rb = solve(pad).sensors, solve(user).sensors
+    assert rb.to_csv().splitlines()[0] == ra.to_csv().splitlines()[0]
+    tol = 0.05 * np.abs(ra.sigma_nn).max()
+    for name in ("pressure", "sigma_nn", "tau_1", "tau_2"):
+        assert np.allclose(getattr(rb, name), getattr(ra, name), rtol=0, atol=tol), name
+    assert np.ptp(ra.pressure) > 2 * tol  # the readings vary by more than the tolerance
+
+
+def test_a_curved_step_skins_sensors_follow_its_surface(tmp_path):
+    """On a sphere cap (R 6, 2 mm over a flat base) a grid at depth 0 lies on the cap's
+    surface, within the sag of the analysis mesh's chords under it (measured 0.006-0.039 mm:
+    size / 8 = 1 mm facets)."""
+    import build123d as bd
+
+    path = tmp_path / "cap.step"
+    base = bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    bd.export_step(bd.Pos(0, -4.0, 0) * bd.Sphere(6.0) & base, str(path))
+    lay = {"name": "c", "kind": "grid", "s": [-3.0, 3.0], "z": [-3.0, 3.0], "pitch": [1.0], "depth": 0.0}
+    x, y, z = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[lay])).xyz.T
+    sag = -4.0 + np.sqrt(36.0 - x ** 2 - z ** 2) - y
+    assert sag.min() >= 0.0 and sag.max() < 0.05
