@@ -178,3 +178,56 @@ def test_a_curved_step_skins_sensors_follow_its_surface(tmp_path):
     x, y, z = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[lay])).xyz.T
     sag = -4.0 + np.sqrt(36.0 - x ** 2 - z ** 2) - y
     assert sag.min() >= 0.0 and sag.max() < 0.05
+
+
+def _distance_to_polyline(points, poly):
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    out = []
+    for p in points:
+        u = np.clip(np.sum((p - a) * ab, axis=1) / np.sum(ab * ab, axis=1), 0.0, 1.0)
+        out.append(np.min(np.linalg.norm(a + u[:, None] * ab - p, axis=1)))
+    return np.array(out)
+
+
+def test_sensors_on_a_curved_p2_msh_lie_on_its_curved_faces(tmp_path):
+    """The fingertip's own P2 mesh (curved faces) read back as a file skin: sensors on its bone
+    (height 0) and its surface (depth 0) lie on the mesh's quadratic faces, within 3e-5 mm of the
+    fingertip's analytic curves. On the straight chords between the nodes they were 4.8e-3 and
+    9.5e-3 mm off, the bone's inside the bone: the solve ran and then failed reading them
+    ("sample point ... inside the meshed skin")."""
+    ft = Scene(skin="fingertip", thickness=3.0, indenter="flat", depth_fraction=0.05, viscoelastic=False,
+               mesh_size=0.8, refinement=2.0)
+    lays = [{"name": "bone", "kind": "line", "s": [-4.5, 4.5], "pitch": [0.25], "height": 0.0},
+            {"name": "top", "kind": "line", "s": [-7.0, 7.0], "pitch": [0.25], "depth": 0.0}]
+    user = Scene(skin="file", skin_file=str(build_mesh(ft).write(tmp_path / "ft.msh")), indenter="flat",
+                 depth_fraction=0.05, viscoelastic=False, sensors=lays)
+    st = sensors.sites_for(user)
+    sec = ft.section()
+    xy = np.abs(st.xyz[:, :2])  # the analytic half x >= 0
+    on_bone = np.array([n == "bone" for n in st.layout])
+    assert _distance_to_polyline(xy[on_bone], sec.point_at_s(np.linspace(0, sec.interface_length, 20001))).max() < 3e-5
+    assert _distance_to_polyline(xy[~on_bone], sec.outer_points(20001)).max() < 3e-5
+    res = solve(user)
+    assert res.sensors.pressure.size == on_bone.size and np.abs(res.sensors.sigma_nn).max() > 0
+
+
+def test_sensors_on_a_curved_3d_p2_msh_lie_on_its_curved_faces(tmp_path):
+    """The dome's P2 mesh (an elliptic cylinder a = 8, b = 7 over its bone a = 6, b = 5 for
+    z < 0) as a file skin: grids on its surface (depth 0) and bone (height 0) lie on the mesh's
+    quadratic faces, 2.0e-4 / 4.8e-4 mm off the analytic ellipses on these h = 2 cells (their
+    quadratic interpolation). On the straight chords they were 0.063 / 0.051 mm off and the
+    solve failed reading them ("sample point ... inside the meshed skin")."""
+    dome = Scene(skin="dome", thickness=2.0, mesh_size=2.0, refinement=1.0, indenter="flat", depth_fraction=0.05,
+                 viscoelastic=False)
+    lays = [{"name": "top", "kind": "grid", "s": [0.0, 4.0], "z": [-6.0, -1.0], "pitch": [1.0], "depth": 0.0},
+            {"name": "bone", "kind": "grid", "s": [0.0, 3.0], "z": [-6.0, -1.0], "pitch": [1.0], "height": 0.0}]
+    user = Scene(skin="file", skin_file=str(build_mesh(dome).write(tmp_path / "dome.msh")), indenter="flat",
+                 depth_fraction=0.05, viscoelastic=False, sensors=lays)
+    st = sensors.sites_for(user)
+    th = np.linspace(0.0, np.pi / 2, 20001)
+    on_bone = np.array([n == "bone" for n in st.layout])
+    for pick, (a, b) in ((~on_bone, (8.0, 7.0)), (on_bone, (6.0, 5.0))):
+        ellipse = np.column_stack([a * np.cos(th), b * np.sin(th)])
+        assert _distance_to_polyline(st.xyz[pick, :2], ellipse).max() < 1e-3
+    assert solve(user).sensors.pressure.size == on_bone.size

@@ -18,7 +18,7 @@ along the bonded surface is x - x_top (signed), the section plane of a 3D
 profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth straight down (-y)
 from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
 first face under the contact surface), normal +y; both surfaces read on the analysed mesh's
-boundary facets (a STEP's analysis mesh: chords of its faces).
+boundary facets (quadratic on a P2 .msh, as the solver's; a STEP's analysis mesh: chords).
 The model is the half x >= 0 only when the file names a `symmetry` group.
 """
 
@@ -52,7 +52,9 @@ class FileGeometry:
     groups: tuple = ()
     z_symmetric: bool = False  # 3D: the file names a `symmetry_z` group (half model z >= 0)
     axis_y: float | None = None  # y of the outer surface on the indenters' axis (None: it misses it)
-    facets: np.ndarray | None = None  # (n, dim, dim): the boundary facets' vertices (sensor columns)
+    # (n, nn, dim): the boundary facets' nodes (sensor columns): their dim vertices, then on a P2
+    # mesh the mid-edge nodes (2D: 1; 3D: ab, bc, ca), which curve them as the solver's mesh
+    facets: np.ndarray | None = None
     facet_kind: np.ndarray | None = None  # (n,): OUTER, BONDED or 0 (another boundary)
 
 
@@ -123,6 +125,19 @@ def measure(skinmesh, groups=()) -> FileGeometry:
         top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
     every = m.boundary_facets()
+    nodes = m.facets[:, every]
+    if m.doflocs.shape[1] > m.nvertices:  # P2: the curved facets' mid-edge nodes (skfem's order)
+        if skinmesh.dim == 2:
+            nodes = np.vstack([nodes, m.nvertices + every])
+        else:
+            e = m.f2e[:, every]
+            ends = np.sort(m.edges[:, e], axis=0)                   # (2, 3, n)
+            mids = []
+            for i, j in ((0, 1), (1, 2), (2, 0)):
+                pair = np.sort(nodes[[i, j]], axis=0)[:, None, :]
+                k = np.argmax(np.all(ends == pair, axis=0), axis=0)
+                mids.append(m.nvertices + e[k, np.arange(len(every))])
+            nodes = np.vstack([nodes, mids])
     kind = np.zeros(len(every), int)
     kind[np.isin(every, b["outer_surface"])] = OUTER
     kind[np.isin(every, np.concatenate([b[n] for n in FIXED if n in b]))] = BONDED
@@ -131,7 +146,7 @@ def measure(skinmesh, groups=()) -> FileGeometry:
                         symmetric="symmetry" in b, groups=tuple(groups),
                         z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
                         axis_y=_axis_height(m, b["outer_surface"], size),
-                        facets=m.p[:, m.facets[:, every]].T.copy(), facet_kind=kind)
+                        facets=m.doflocs[:, nodes].T.copy(), facet_kind=kind)
 
 
 def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
@@ -285,8 +300,10 @@ class FileCoordinates:
     height straight up (+y) from the bonded surface there; normal +y, tangents +x (and +z).
     The sensor's column is the vertical line through (x, z): its top must be the contact
     surface and the point must lie above the first boundary under it (which, for a height,
-    must be bonded); the heights are read on the mesh's straight boundary facets (a STEP's
-    analysis mesh: chords of its faces). A half model (`symmetry`, `symmetry_z`) answers for
+    must be bonded); the heights are read on the mesh's boundary facets, quadratic on a P2
+    mesh as the solver's (on their chords a bone sensor of the fingertip's own mesh lay inside
+    the bone, and the solve failed reading it), a STEP's on its P1 analysis mesh (chords of its
+    faces). A half model (`symmetry`, `symmetry_z`) answers for
     its mirror image by reflection, as the solver's sampler does."""
 
     straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
@@ -305,7 +322,7 @@ class FileCoordinates:
         self.s_max = float(max(abs(v) for v in self.s_range))
         self.z_range = ext[1] if geo.dim == 3 else (0.0, 0.0)
         F = np.asarray(geo.facets, float)
-        L = F[:, :, lat]                                    # (n, nv, k): the facets seen from above
+        L = F[:, :, lat]                                    # (n, nn, k): the facets seen from above
         if geo.dim == 2:
             area = np.abs(L[:, 1, 0] - L[:, 0, 0])
         else:
@@ -315,15 +332,23 @@ class FileCoordinates:
         # are its neighbours' (a sensor on a side's line reads the top and bottom facets)
         keep = area > 1e-9 * size ** (geo.dim - 1)
         self._L, self._y, self._kind = L[keep], F[keep][:, :, 1], np.asarray(geo.facet_kind)[keep]
+        self._curved = F.shape[1] > geo.dim
+        box = self._L
+        if self._curved:  # a quadratic edge lies in the hull of its ends and 2 mid - (a + b) / 2
+            v = self._L[:, :geo.dim]
+            ends = [(0, 1)] if geo.dim == 2 else [(0, 1), (1, 2), (2, 0)]
+            ctrl = [2.0 * self._L[:, geo.dim + i] - 0.5 * (v[:, a] + v[:, b]) for i, (a, b) in enumerate(ends)]
+            box = np.concatenate([self._L, np.stack(ctrl, axis=1)], axis=1)
         # a uniform grid over the facets' bounding boxes (seen from above) finds each point's few
         # candidate facets
-        lo, hi = self._L.min(axis=(0, 1)), self._L.max(axis=(0, 1))
+        lo, hi = box.min(axis=(0, 1)), box.max(axis=(0, 1))
         span = np.maximum(hi - lo, 1e-12)
-        ncell = np.clip((span / max(np.median(self._L.max(axis=1) - self._L.min(axis=1)), 1e-12)).astype(int),
+        ncell = np.clip((span / max(np.median(box.max(axis=1) - box.min(axis=1)), 1e-12)).astype(int),
                         1, 4096 if geo.dim == 2 else 256)
         self._lo, self._cell, self._ncell = lo, span / ncell, ncell
-        i0 = self._cell_index(self._L.min(axis=1))
-        i1 = self._cell_index(self._L.max(axis=1))
+        self._size = size
+        i0 = self._cell_index(box.min(axis=1))
+        i1 = self._cell_index(box.max(axis=1))
         cells, owner = [], []
         for f, (a, b) in enumerate(zip(i0, i1)):
             grid = np.meshgrid(*(np.arange(a[k], b[k] + 1) for k in range(len(a))), indexing="ij")
@@ -363,8 +388,9 @@ class FileCoordinates:
             pt = np.repeat(rows, cnt)
             off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
             f = self._owner[np.repeat(self._start[c], cnt) + off]
-            hit, y = self._cross(q[pt], f)
-            pt, f, y = pt[hit], f[hit], y[hit]
+            found = self._cross_curved(q[pt], f) if self._curved else [self._cross(q[pt], f)]
+            y = np.concatenate([yy[hit] for hit, yy in found])
+            pt, f = (np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f))
             np.maximum.at(top, pt, y)
             out = self._kind[f] == OUTER
             np.maximum.at(outer, pt[out], y[out])
@@ -393,6 +419,55 @@ class FileCoordinates:
         l2 = ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det
         hit = (l1 >= -tol) & (l2 >= -tol) & (l1 + l2 <= 1 + tol)
         return hit, Y[:, 0] + l1 * (Y[:, 1] - Y[:, 0]) + l2 * (Y[:, 2] - Y[:, 0])
+
+    def _cross_curved(self, q, f) -> list:
+        """[(hit, y), ...] of the vertical lines through q (m, k) and the quadratic facets f (m,):
+        2D both roots of x(u) = q on the edge (one that turns back in x is crossed twice), 3D
+        Newton on the triangle's (u, v) from the straight facet's answer."""
+        L, Y = self._L[f], self._y[f]
+        tol = 1e-9
+        if self.dim == 2:
+            x0, x1, xm = L[:, 0, 0], L[:, 1, 0], L[:, 2, 0]
+            b, a, c = -3.0 * x0 - x1 + 4.0 * xm, 2.0 * x0 + 2.0 * x1 - 4.0 * xm, x0 - q[:, 0]
+            lin = np.abs(a) <= 1e-9 * np.maximum(np.abs(b), 1e-300)
+            disc = b * b - 4.0 * a * c
+            root = np.sqrt(np.maximum(disc, 0.0))
+            # the stable pair of roots (no cancellation); a straight edge has the one root -c / b
+            qq = -0.5 * (b + np.where(b >= 0, root, -root))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r1 = np.where(lin, -c / np.where(b == 0, 1.0, b), qq / np.where(a == 0, 1.0, a))
+                r2 = np.where(lin | (qq == 0), np.nan, c / np.where(qq == 0, 1.0, qq))
+            out = []
+            for u, ok in ((r1, disc >= 0), (r2, (disc >= 0) & ~lin)):
+                hit = ok & np.isfinite(u) & (u >= -tol) & (u <= 1 + tol)
+                u = np.clip(np.nan_to_num(u), 0.0, 1.0)
+                y = Y[:, 0] * (1 - u) * (1 - 2 * u) + Y[:, 1] * u * (2 * u - 1) + Y[:, 2] * 4 * u * (1 - u)
+                out.append((hit, y))
+            return out
+        a, b, c = L[:, 0], L[:, 1], L[:, 2]  # the straight facet's (u, v) start Newton
+        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        p = q - a
+        u = (p[:, 0] * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * p[:, 1]) / det
+        v = ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det
+
+        def shape(u, v):
+            w = 1.0 - u - v
+            N = np.stack([w * (2 * w - 1), u * (2 * u - 1), v * (2 * v - 1), 4 * w * u, 4 * u * v, 4 * v * w], 1)
+            du = np.stack([1 - 4 * w, 4 * u - 1, 0 * u, 4 * (w - u), 4 * v, -4 * v], 1)
+            dv = np.stack([1 - 4 * w, 0 * u, 4 * v - 1, -4 * u, 4 * u, 4 * (w - v)], 1)
+            return N, du, dv
+
+        for _ in range(8):
+            N, du, dv = shape(u, v)
+            r = np.einsum("ni,nik->nk", N, L) - q
+            Ju, Jv = np.einsum("ni,nik->nk", du, L), np.einsum("ni,nik->nk", dv, L)
+            J = Ju[:, 0] * Jv[:, 1] - Jv[:, 0] * Ju[:, 1]
+            J = np.where(np.abs(J) > 1e-300, J, 1e-300)
+            u, v = u - (Jv[:, 1] * r[:, 0] - Jv[:, 0] * r[:, 1]) / J, v - (Ju[:, 0] * r[:, 1] - Ju[:, 1] * r[:, 0]) / J
+        N, _, _ = shape(u, v)
+        close = np.linalg.norm(np.einsum("ni,nik->nk", N, L) - q, axis=1) <= 1e-9 * self._size
+        hit = close & (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol)
+        return [(hit, np.einsum("ni,ni->n", N, Y))]
 
     def depths(self, where: str, lay, s, z, idx, what: str = "") -> np.ndarray:
         """The depth below the contact surface of each point (s, z) of the layout `lay` (its
