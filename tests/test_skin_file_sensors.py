@@ -231,3 +231,25 @@ def test_sensors_on_a_curved_3d_p2_msh_lie_on_its_curved_faces(tmp_path):
         ellipse = np.column_stack([a * np.cos(th), b * np.sin(th)])
         assert _distance_to_polyline(st.xyz[pick, :2], ellipse).max() < 1e-3
     assert solve(user).sensors.pressure.size == on_bone.size
+
+
+def test_a_step_skins_sensors_are_read_on_its_solved_curved_faces(tmp_path):
+    """A half tube (outer R 8, inner R 6, bonded on the inner face) from STEP: its scene's sites
+    lie on the coarse analysis mesh's chords, a bone line (height 0) 0.011-0.077 mm inside the
+    bone; the solve ran and then failed reading it ("sample point ... inside the meshed skin").
+    The sensors are now placed on the solved mesh's faces, curved onto the CAD (within 2e-4 mm
+    of R 6 and R 8 on these h = 2 cells) and checked before the solve."""
+    import build123d as bd
+
+    tube = bd.Cylinder(8, 8) - bd.Cylinder(6, 8)
+    path = tmp_path / "shell.step"
+    bd.export_step(tube - bd.Box(20, 10, 20, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER)), str(path))
+    lays = [{"name": "bone", "kind": "line", "s": [-4.0, 4.0], "pitch": [0.5], "z": [0.0], "height": 0.0},
+            {"name": "top", "kind": "line", "s": [-5.0, 5.0], "pitch": [0.5], "z": [1.0], "depth": 0.0}]
+    sc = Scene(skin="file", skin_file=str(path), skin_bonded="normal:-y:89.99", sensors=lays, indenter="sphere",
+               indenter_radius=3.0, depth=0.1, viscoelastic=False, mesh_size=2.0, refinement=1.0)
+    on_bone = np.array([n == "bone" for n in sensors.sites_for(sc).layout])
+    read = solve(sc).sensors
+    r = np.hypot(read.xyz[:, 0], read.xyz[:, 1])
+    assert np.abs(r[on_bone] - 6.0).max() < 2e-4 and np.abs(r[~on_bone] - 8.0).max() < 2e-4
+    assert np.abs(read.sigma_nn).max() > 0

@@ -501,12 +501,13 @@ def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 17) -> np.n
     return out
 
 
-def sites_for(scene, z_range=None) -> Sites:
-    """Sites of a scene's layouts (validated against its skin; z_range: the 3D slab's z)."""
+def sites_for(scene, z_range=None, coords=None) -> Sites:
+    """Sites of a scene's layouts (validated against its skin; z_range: the 3D slab's z; coords:
+    other coordinates than the scene's, e.g. skin_kind.mesh_coordinates)."""
     if z_range is None and scene.dim == 3:
         L = scene.sample_length
         z_range = (-0.5 * L, 0.5 * L)
-    return resolve(scene.sensors, coordinates_for(scene), scene.dim, z_range)
+    return resolve(scene.sensors, coordinates_for(scene) if coords is None else coords, scene.dim, z_range)
 
 
 # --- sampling and readings ----------------------------------------------------------------------

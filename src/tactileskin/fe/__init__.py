@@ -149,14 +149,14 @@ def blas_threads():
     return threadpool_limits(limits=1)
 
 
-def read_sensors(scene, model, result, *, z_symmetric: bool = False):
-    """The readings (sensors.SensorReadings) of the scene's sensor layouts from a result's
-    nodal stress fields, interpolated inside the elements (fe.probe); the modelled half (x >= 0,
-    and z >= 0 for a z-symmetric slab) answers for its mirror image."""
+def read_sensors(scene, model, result, *, z_symmetric: bool = False, sites=None):
+    """The readings (sensors.SensorReadings) of the scene's sensor layouts (or of `sites`)
+    from a result's nodal stress fields, interpolated inside the elements (fe.probe); the
+    modelled half (x >= 0, and z >= 0 for a z-symmetric slab) answers for its mirror image."""
     from tactileskin import sensors
     from tactileskin.fe.probe import stress_sampler
 
-    sites = sensors.sites_for(scene)
+    sites = sensors.sites_for(scene) if sites is None else sites
     # a whole model (no x = 0 line: a full-width pad under an x-asymmetric indenter) has x < 0
     # itself; mirroring there would read the other side's stress
     sampler = sensors.symmetric_sampler(stress_sampler(model, result.fields["point_data"]),
@@ -358,6 +358,13 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     t1 = time.perf_counter()
     model, sm = model_for_scene(scene, mesh)
     section = scene.section()
+    sites = None
+    if scene.sensors:
+        from tactileskin import sensors
+
+        # placed on the mesh solved (a file skin's faces; the built-in skins' are analytic) and
+        # checked before the solve: a sensor off that mesh failed only after it
+        sites = sensors.sites_for(scene, coords=scene.skin_kind.mesh_coordinates(scene, sm))
     t_setup = time.perf_counter() - t1
 
     def record(model, ev):
@@ -377,7 +384,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     if res is None:
         res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
     if scene.sensors:
-        res.sensors = read_sensors(scene, model, res, z_symmetric=bool(getattr(sm, "z_symmetric", False)))
+        res.sensors = read_sensors(scene, model, res, z_symmetric=bool(getattr(sm, "z_symmetric", False)),
+                                   sites=sites)
     stats.wall_s = time.perf_counter() - t0
     res.stats["wall_s"] = stats.wall_s
     res.stats["phases_s"] = phases(model, mesh=t_mesh, setup=t_setup,

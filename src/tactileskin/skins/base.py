@@ -13,6 +13,7 @@ A skin is a class (no instances: every answer is a function of the Scene) with
 - `sample_length(scene)`: the z extent of the 3D model (and the indenter plates);
 - `coordinates(scene)`: the sensor coordinates (`frame(s, depth)`, `thickness`, `s_max`; a
   `local` one, skins.file's, also `depths(...)` and `frame(s, depth, z)`: see sensors.resolve);
+  `mesh_coordinates(scene, skinmesh)`: those on the mesh solved (where the sensors are read);
 - `fixed_boundaries`: the boundary names held fixed (bonded to rigid parts). Every skin mesh
   names `bone_interface` (the bonded surface: the pressure path), `outer_surface` (contact),
   `symmetry` (x = 0) and, in 3D, `end_front` / `end_back` (z = +-L/2; `end_back` is z = 0
@@ -89,6 +90,12 @@ class Skin:
     @classmethod
     def coordinates(cls, scene):
         raise NotImplementedError
+
+    @classmethod
+    def mesh_coordinates(cls, scene, skinmesh):
+        """The sensor coordinates on the mesh solved (the built-in skins' are analytic: the
+        scene's)."""
+        return cls.coordinates(scene)
 
     @classmethod
     def build_mesh(cls, scene, *, cell: str = "tri", **overrides):

@@ -104,6 +104,29 @@ def _distance_to_facets(point, mesh, facets) -> float:
     return float(np.min(np.linalg.norm(closest - p, axis=1)))
 
 
+def boundary_facets(skinmesh) -> tuple[np.ndarray, np.ndarray]:
+    """(nodes (n, nn, dim), kind (n,)) of a skin mesh's boundary facets (FileGeometry.facets)."""
+    m, b = skinmesh.mesh, skinmesh.boundaries
+    every = m.boundary_facets()
+    nodes = m.facets[:, every]
+    if m.doflocs.shape[1] > m.nvertices:  # P2: the curved facets' mid-edge nodes (skfem's order)
+        if skinmesh.dim == 2:
+            nodes = np.vstack([nodes, m.nvertices + every])
+        else:
+            e = m.f2e[:, every]
+            ends = np.sort(m.edges[:, e], axis=0)                   # (2, 3, n)
+            mids = []
+            for i, j in ((0, 1), (1, 2), (2, 0)):
+                pair = np.sort(nodes[[i, j]], axis=0)[:, None, :]
+                k = np.argmax(np.all(ends == pair, axis=0), axis=0)
+                mids.append(m.nvertices + e[k, np.arange(len(every))])
+            nodes = np.vstack([nodes, mids])
+    kind = np.zeros(len(every), int)
+    kind[np.isin(every, b["outer_surface"])] = OUTER
+    kind[np.isin(every, np.concatenate([b[n] for n in FIXED if n in b]))] = BONDED
+    return m.doflocs[:, nodes].T.copy(), kind
+
+
 def measure(skinmesh, groups=()) -> FileGeometry:
     """The FileGeometry of a loaded skin mesh."""
     m, b = skinmesh.mesh, skinmesh.boundaries
@@ -124,29 +147,13 @@ def measure(skinmesh, groups=()) -> FileGeometry:
         top = np.zeros(pts.shape[1])
         top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
-    every = m.boundary_facets()
-    nodes = m.facets[:, every]
-    if m.doflocs.shape[1] > m.nvertices:  # P2: the curved facets' mid-edge nodes (skfem's order)
-        if skinmesh.dim == 2:
-            nodes = np.vstack([nodes, m.nvertices + every])
-        else:
-            e = m.f2e[:, every]
-            ends = np.sort(m.edges[:, e], axis=0)                   # (2, 3, n)
-            mids = []
-            for i, j in ((0, 1), (1, 2), (2, 0)):
-                pair = np.sort(nodes[[i, j]], axis=0)[:, None, :]
-                k = np.argmax(np.all(ends == pair, axis=0), axis=0)
-                mids.append(m.nvertices + e[k, np.arange(len(every))])
-            nodes = np.vstack([nodes, mids])
-    kind = np.zeros(len(every), int)
-    kind[np.isin(every, b["outer_surface"])] = OUTER
-    kind[np.isin(every, np.concatenate([b[n] for n in FIXED if n in b]))] = BONDED
+    facets, kind = boundary_facets(skinmesh)
     return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
                         lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
                         symmetric="symmetry" in b, groups=tuple(groups),
                         z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
                         axis_y=_axis_height(m, b["outer_surface"], size),
-                        facets=m.doflocs[:, nodes].T.copy(), facet_kind=kind)
+                        facets=facets, facet_kind=kind)
 
 
 def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
@@ -303,7 +310,8 @@ class FileCoordinates:
     must be bonded); the heights are read on the mesh's boundary facets, quadratic on a P2
     mesh as the solver's (on their chords a bone sensor of the fingertip's own mesh lay inside
     the bone, and the solve failed reading it), a STEP's on its P1 analysis mesh (chords of its
-    faces). A half model (`symmetry`, `symmetry_z`) answers for
+    faces) for the scene's check and on the mesh solved for the readings (mesh_coordinates). A
+    half model (`symmetry`, `symmetry_z`) answers for
     its mirror image by reflection, as the solver's sampler does."""
 
     straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
@@ -569,6 +577,17 @@ class FileSkin(Skin):
     @classmethod
     def coordinates(cls, scene) -> FileCoordinates:
         return _coordinates(*_key(scene))
+
+    @classmethod
+    def mesh_coordinates(cls, scene, skinmesh) -> FileCoordinates:
+        """The sensor coordinates on the mesh solved: a STEP's analysis mesh is coarse and
+        straight, its solve mesh curved onto the CAD (bone sensors of a half tube's R 6 bonded
+        face lay up to 0.077 mm inside the bone on the chords and the solve failed reading
+        them); a .msh's is its own mesh (the same faces)."""
+        import dataclasses
+
+        facets, kind = boundary_facets(skinmesh)
+        return FileCoordinates(dataclasses.replace(geometry(scene), facets=facets, facet_kind=kind))
 
     @classmethod
     def cache_content(cls, scene) -> dict:
