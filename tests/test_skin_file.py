@@ -528,3 +528,43 @@ def test_asking_2d_of_a_step_skin_says_how_to_get_a_2d_section(tmp_path, capsys)
     err = " ".join(capsys.readouterr().err.split())
     assert "dim=2" in err and "2D .msh of its section" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_p2_msh_whose_curved_top_has_no_vertex_on_the_axis_is_taken(tmp_path):
+    """A 2D skin under an R 20 arc crowned at y = 2, meshed by gmsh at order 2 with 9 elements
+    on the arc: no vertex on the axis, the middle element's mid-edge node at the crown. The
+    placement check read the contact surface's vertices only (highest 1.995 mm) against the
+    skin's nodes (2.0) and refused it as upside down. Its nodes now include the mid-edge ones:
+    top and thickness 2.0 (the P1 mesh of the same arc is its chords: 1.995)."""
+    import gmsh
+
+    def arc_skin(path, order):
+        gmsh.initialize(interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            occ = gmsh.model.occ
+            R, half = 20.0, 4.0
+            yc = 2.0 - R
+            ye = yc + np.sqrt(R * R - half * half)
+            p = [occ.addPoint(x, y, 0) for x, y in ((-half, 0), (half, 0), (half, ye), (-half, ye))]
+            c = occ.addPoint(0, yc, 0)
+            lines = [occ.addLine(p[0], p[1]), occ.addLine(p[1], p[2]), occ.addCircleArc(p[2], c, p[3]),
+                     occ.addLine(p[3], p[0])]
+            occ.addPlaneSurface([occ.addCurveLoop(lines)])
+            occ.synchronize()
+            for name, k in (("bonded", [0]), ("outer_surface", [2]), ("sides", [1, 3])):
+                gmsh.model.addPhysicalGroup(1, [lines[i] for i in k], name=name)
+            gmsh.model.addPhysicalGroup(2, [1], name="skin")
+            gmsh.model.mesh.setTransfiniteCurve(lines[2], 10)
+            gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+            gmsh.model.mesh.generate(2)
+            gmsh.model.mesh.setOrder(order)
+            gmsh.write(str(path))
+        finally:
+            gmsh.finalize()
+        return str(path)
+
+    p2 = Scene(skin="file", skin_file=arc_skin(tmp_path / "p2.msh", 2), indenter="flat", depth=0.2)
+    assert p2.section().top == pytest.approx(2.0, abs=1e-9) and p2.thickness == pytest.approx(2.0, abs=1e-9)
+    p1 = Scene(skin="file", skin_file=arc_skin(tmp_path / "p1.msh", 1), indenter="flat", depth=0.2)
+    assert p1.thickness == pytest.approx(20.0 * np.cos(np.arcsin(4.0 / 20.0) / 9.0) - 18.0, abs=1e-9)  # the chord

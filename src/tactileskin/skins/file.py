@@ -131,8 +131,11 @@ def measure(skinmesh, groups=()) -> FileGeometry:
     """The FileGeometry of a loaded skin mesh."""
     m, b = skinmesh.mesh, skinmesh.boundaries
     X = m.doflocs
-    nodes = np.unique(m.facets[:, b["outer_surface"]])
-    pts = m.p[:, nodes].T
+    facets, kind = boundary_facets(skinmesh)
+    # the contact surface's nodes, a P2 mesh's mid-edge ones too: a curved top with no vertex on
+    # the axis has its highest node there, and its vertices alone (1.995 mm under a 2 mm crown)
+    # read it as lower than the skin, "upside down"
+    pts = np.unique(facets[kind == OUTER].reshape(-1, skinmesh.dim), axis=0)
     lo, hi = X.min(axis=1), X.max(axis=1)
     size = float(np.max(hi - lo))
     ymax = pts[:, 1].max()
@@ -147,7 +150,6 @@ def measure(skinmesh, groups=()) -> FileGeometry:
         top = np.zeros(pts.shape[1])
         top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
-    facets, kind = boundary_facets(skinmesh)
     return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
                         lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
                         symmetric="symmetry" in b, groups=tuple(groups),
