@@ -5,6 +5,8 @@ No CalculiX needed (benchmarks/calculix_compare3d.py runs ccx)."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,7 @@ from tactileskin.errors import ParameterError
 from tactileskin.geometry.indenters import indenter_for_scene
 from tactileskin.mesh import build_mesh
 from tactileskin.mesh.deck import FACES, _num, deck_text, parse_deck, undefined_names
-from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
+from tactileskin.mesh.indenter3d import CHORD_TOL, cap_rise, curved_cap, indenter_face, max_chord_error, wedge_cells
 from tactileskin.scene import Scene
 from mesh_probe import c3d10_grad
 
@@ -146,8 +148,10 @@ def test_bad_requests_raise_typed_errors(braille):
     with pytest.raises(ParameterError, match="penalty"):
         deck_text(sc, sm, "calculix", penalty=-1.0)
     ind = indenter_for_scene(Scene(indenter="sphere", indenter_radius=2.0, dim=3))
-    with pytest.raises(ParameterError, match="indenter"):
+    with pytest.raises(ParameterError, match="reach"):  # how far up to mesh it: the travel
         indenter_face(ind, (0, 1, 0, 1), 0.5)
+    with pytest.raises(ParameterError, match="indenter"):
+        indenter_face(SimpleNamespace(kind="file"), (0, 1, 0, 1), 0.5)
     with pytest.raises(ParameterError, match="box"):
         indenter_face(indenter_for_scene(sc), (1, 0, 0, 1), 0.5)
 
@@ -228,3 +232,81 @@ def test_default_penalty_is_forty_k0_over_h(braille):
     p = parse_deck(deck.text)
     slope = next(rows for kw, _, rows in p["blocks"] if kw == "SURFACE BEHAVIOR")
     assert float(slope[0][0]) == pytest.approx(deck.info["penalty_mpa_per_mm"])
+
+
+def _on_cap(cap, P):
+    return np.hypot(P[:, 0], P[:, 2]) < cap.a - 1e-9 if cap.axis is None else \
+        np.abs(P[:, 0 if cap.axis == "z" else 2]) < cap.a - 1e-9
+
+
+@pytest.mark.parametrize("kw", [dict(indenter="sphere", indenter_radius=2.5),
+                                dict(indenter="curved"),
+                                dict(indenter="cylinder", indenter_radius=3.0, indenter_axis="x")])
+def test_sphere_and_cylinder_faces_lie_on_the_exact_surface(kw):
+    """Nodes on the exact surface; facets within CHORD_TOL x the travel of it by the solver's
+    own gap (chords lie inside a convex indenter: g in [-tol, 0]); the rim a line of nodes
+    and no facet across it; past it the flat flange, twice the travel above the lowest point."""
+    sc = Scene(thickness=1.0, skin="pad", depth=0.2, dim=3, **kw)
+    ind = indenter_for_scene(sc)
+    box = (-1.0, 8.0, -1.0, 11.0)  # a quarter pad's footprint
+    face = indenter_face(ind, box, 1.6, reach=sc.reach)
+    cap, tol = curved_cap(ind, sc.reach), CHORD_TOL * sc.reach
+    assert cap_rise(ind, sc.reach) == pytest.approx(0.4) and tol == pytest.approx(1e-3)
+    X = face.points
+    on = _on_cap(cap, X)
+    assert on.sum() > 100
+    z0, z1 = ind.face_box()[2:]  # a cylinder along z is uniform past its printed ends
+    assert np.allclose(X[on, 1], ind.surface_y(X[on, 0], np.clip(X[on, 2], z0, z1)), atol=1e-12, rtol=0)
+    assert np.allclose(X[~on, 1], ind.y0 + 0.4, atol=1e-12, rtol=0)  # the flange
+    assert X[:, 1].min() == pytest.approx(ind.y0, abs=1e-12)  # a node (a line) where it first touches
+    W = np.array([(1, 1, 1), (2, 1, 1), (1, 2, 1), (1, 1, 2)], float) / np.array([[3.0], [4], [4], [4]])
+    P = np.einsum("wk,tkd->twd", W, X[face.tris]).reshape(-1, 3)
+    g, _ = ind.gap(P[_on_cap(cap, P)])
+    assert g.max() <= 1e-12 and -tol <= g.min() < -0.1 * tol
+    assert 0.1 * tol < max_chord_error(face, ind) <= tol
+    across = np.hypot(X[:, 0], X[:, 2]) if cap.axis is None else np.abs(X[:, 0 if cap.axis == "z" else 2])
+    assert np.sum(np.isclose(across, cap.a, atol=1e-9)) >= 24  # the rim (the kink) is a line of nodes
+    at = across[face.tris]
+    assert not np.any((at.min(1) < cap.a - 1e-9) & (at.max(1) > cap.a + 1e-9))
+    n = np.cross(*(X[face.tris[:, k]] - X[face.tris[:, 0]] for k in (1, 2)))
+    assert np.all(n[:, 1] < 0.0)  # facing the skin
+    # the tolerance sets the size: facets twice as large are off by more than it
+    coarse = indenter_face(ind, box, 1.6, h_dot=2.0 * face_cap_size(face, cap), reach=sc.reach)
+    assert max_chord_error(coarse, ind) > tol
+
+
+def face_cap_size(face, cap):
+    """Median edge length (plan) of the facets inside the cap."""
+    X = face.points
+    t = face.tris[np.all(_on_cap(cap, X)[face.tris], axis=1)]
+    e = np.linalg.norm(X[t[:, [1, 2, 0]]][:, :, [0, 2]] - X[t][:, :, [0, 2]], axis=2)
+    return float(np.median(e))
+
+
+def test_sphere_deck_on_a_pad():
+    """A sphere (R 2.5, 0.2 mm) on a quarter pad: counts, sets, supports, the face's wedges on
+    the sphere at the pole (the ccx run: benchmarks/results/calculix_compare3d.md)."""
+    sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="sphere", indenter_radius=2.5,
+               depth=0.2, dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0)
+    sm = build_mesh(sc)
+    deck = deck_text(sc, sm, "calculix")
+    p = parse_deck(deck.text)
+    assert undefined_names(p) == []
+    ids, X = _elements(p, "C3D10")
+    assert len(ids) == deck.n_skin_cells == sm.mesh.nelements
+    ids, X = _elements(p, "C3D6")
+    assert len(ids) == deck.info["indenter_cells"] > 1000
+    assert len(p["nodes"]) == deck.n_skin_nodes + deck.info["indenter_nodes"]
+    assert {"indenter_nodes", "bone_interface", "outer_surface", "symmetry", "end_back"} <= set(p["nsets"])
+    assert {"indenter_face", "outer_surface_faces"} <= set(p["surfaces"])
+    bc = [b for b in p["blocks"] if b[0] == "BOUNDARY" and "AMPLITUDE" not in b[1]]
+    assert {tuple(r) for b in bc for r in b[2]} == {
+        ("bone_interface", "1", "3"), ("symmetry", "1", "1"), ("end_back", "3", "3"),
+        ("indenter_nodes", "1", "1"), ("indenter_nodes", "3", "3")}
+    assert deck.info["force_factor"] == 4.0 and 0.0 < deck.info["face_chord_error_mm"] <= 1e-3
+    b = X[:, :3].reshape(-1, 3)
+    pole = np.hypot(b[:, 0], b[:, 2]) < 1.0
+    ind = indenter_for_scene(sc)
+    assert pole.sum() > 100 and np.allclose(b[pole, 1], ind.surface_y(b[pole, 0], b[pole, 2]), atol=1e-12, rtol=0)
+    assert b[:, 1].min() == pytest.approx(ind.y0, abs=1e-12)  # a node at the pole: it touches the pad's top
+    assert "a flat flange beyond" in deck.text

@@ -9,10 +9,12 @@
 - supports: the skin's bonded boundaries fixed in x, y, z (fingertip: bone_interface and
   nail_edge), u_x = 0 on the symmetry plane x = 0 of a half model, u_z = 0 on end_back when
   the mesh is z-symmetric (the plane z = 0); end_front (and a non-symmetric end_back) free;
-- the indenter: its working face triangulated on the kind's exact surface
-  (mesh.indenter3d), thickened into C3D6 wedges whose nodes are all moved by the travel
-  (a rigid translation without *RIGID BODY, as the 2D CalculiX deck does); the face
-  extends 1 mm past the skin on every side, like the solver's unbounded analytic indenter;
+- the indenter (flat, braille, sphere, cylinder, curved): its working face triangulated on
+  the kind's exact surface (mesh.indenter3d; a sphere or cylinder up to twice the travel
+  above its lowest point, a flat flange beyond, where the skin cannot reach), thickened
+  into C3D6 wedges whose nodes are all moved by the travel (a rigid translation without
+  *RIGID BODY, as the 2D CalculiX deck does); the face extends 1 mm past the skin on every
+  side, like the solver's unbounded analytic indenter;
 - frictionless surface-to-surface contact, skin outer surface slave, indenter face master,
   linear penalty `penalty` MPa/mm (default 40 K0 / h_fine: at 2D's 10 K0 / h ccx let the t = 1 mm
   plate penetrate 3.5 % of the travel and read 5.6 % low in bone pressure; 40 and 160 converged
@@ -51,14 +53,14 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
                  face_size: float | None = None, cap_size: float | None = None,
                  viscoelastic: bool | None = None):
     """The CalculiX deck of a 3D scene on its mesh (a deck.Deck). face_size: indenter facet
-    size away from the Braille caps (default the skin's coarse size: a plane is exact at any
-    size); cap_size: on the caps (default indenter3d's); penalty (MPa/mm): default
-    PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
+    size away from the Braille caps or a sphere's or cylinder's cap (default the skin's coarse
+    size: a plane is exact at any size); cap_size: on the caps (default indenter3d's);
+    penalty (MPa/mm): default PENALTY_FACTOR K0 / h_fine; increments: as deck.deck_text."""
     from tactileskin.geometry.indenters import at_first_touch, indenter_for_scene
     from tactileskin.materials import get_material
     from tactileskin.mesh.deck import (Deck, _name, _num, abaqus_cells, contact_nodes, indenter_mesh_lines,
                                         material_lines, skin_mesh_lines)
-    from tactileskin.mesh.indenter3d import indenter_face, max_chord_error, wedge_cells
+    from tactileskin.mesh.indenter3d import cap_rise, indenter_face, max_chord_error, wedge_cells
 
     if skinmesh.dim != 3:
         raise ParameterError("mesh", f"{skinmesh.dim}D", "a 3D skin mesh for a 3D deck")
@@ -75,7 +77,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
         penalty = PENALTY_FACTOR * max(hf.K0, hf.mu0) / h_fine
     if not (isinstance(penalty, (int, float)) and np.isfinite(penalty) and penalty > 0):
         raise ParameterError("penalty", penalty, "a positive contact stiffness (MPa/mm)")
-    face = indenter_face(ind, footprint(skinmesh), h_face, cap_size)
+    face = indenter_face(ind, footprint(skinmesh), h_face, cap_size, reach=scene.reach)
     ipts, icells = wedge_cells(face, WEDGE_HEIGHT)
     halved, zsym = bool(skinmesh.halved), bool(getattr(skinmesh, "z_symmetric", False))
 
@@ -92,6 +94,9 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, moves by -"
       + _num(depth) + " mm over " + _num(T) + " s; C3D6 wedges, face S1 on the working face,\n"
       "** all nodes prescribed (a rigid translation)\n")
+    if face.caps:
+        w("** the face is the exact surface up to " + _num(cap_rise(ind, scene.reach)) + " mm above its lowest point "
+          "(at most twice the travel), a flat flange beyond\n")
     indenter_mesh_lines(fh, ref, n_ind, icells, n_cells, "C3D6")
     w("*MATERIAL, NAME=indenter_rigid\n*ELASTIC\n1e6, 0.3\n")
     w("*SOLID SECTION, ELSET=indenter, MATERIAL=indenter_rigid\n")
