@@ -121,9 +121,14 @@ def even_fit_peak(s: np.ndarray, p: np.ndarray, window: float) -> float:
     return float(np.linalg.lstsq(A, p[near], rcond=None)[0][0])
 
 
-def make_scene(kind: str, thickness: float, quality: str, mesh: str | None = None):
+def make_scene(kind: str, thickness: float, quality: str, mesh: str | None = None, skin: str | None = None):
+    """kind: an indenter kind, "sphere-R2.5" / "cylinder-R3" with its radius; skin: default the Scene's."""
+    kind, _, radius = kind.partition("-R")
+    extra = {"indenter_radius": float(radius)} if radius else {}
+    if skin:
+        extra["skin"] = skin
     scene = with_quality(Scene(thickness=thickness, material="polyurethane", indenter=kind, dim=3,
-                               viscoelastic=False), quality)
+                               viscoelastic=False, **extra), quality)
     if mesh:
         size, _, ref = mesh.partition("/")
         scene = scene.replace(mesh_size=float(size), refinement=float(ref or scene.refinement))
@@ -293,7 +298,8 @@ def markdown(rows: list[dict], cmd: str, refs: list[dict] = ()) -> str:
     for r in rows:
         c = r["ccx"]
         cap = (f" (cap facets {r['cap_size_mm']:g} mm, " if r.get("cap_size_mm") else " (") + \
-            f"face <= {r['face_chord_um']:.1f} um off the dot)" if "braille" in r["scene"] else ""
+            f"face <= {r['face_chord_um']:.1f} um off the dot)" if "braille" in r["scene"] else \
+            f" (face <= {r['face_chord_um']:.1f} um off the surface)" if r["face_chord_um"] > 1e-6 else ""
         L.append(f"| {r['scene']} | {r['mesh']}, {r['cells']} cells, {r['dofs']} dofs | CalculiX{cap}, penalty "
                  f"{r['penalty']:.0f} MPa/mm ({r['penalty_factor']:g} K0/h), penetration "
                  f"{c['penetration_mm'] * 1e3:.2f} um = {100 * c['penetration_mm'] / r['depth']:.2f} % of the travel "
@@ -360,7 +366,8 @@ def plot(rows: list[dict], path: Path) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--case", nargs="+", default=["braille:1", "flat:1"],
-                    help="indenter:thickness[:SIZE/REFINEMENT]")
+                    help="indenter:thickness[:SIZE/REFINEMENT]; indenter sphere-R2.5 etc. with its radius")
+    ap.add_argument("--skin", default=None, help="skin kind (default the Scene's: fingertip)")
     ap.add_argument("--cached", action="store_true",
                     help="solve nothing: tabulate the cases and penalties raw_calculix3d/ holds")
     ap.add_argument("--quality", default="preview")
@@ -383,13 +390,13 @@ def main(argv=None) -> int:
     for case in a.case:
         parts = case.split(":")
         kind, t, mesh = parts[0], (parts[1:2] or ["1"])[0], (parts[2:3] or [""])[0]
-        rows += compare(make_scene(kind, float(t), a.quality, mesh or a.mesh), a.penalty_factor, a.fresh,
+        rows += compare(make_scene(kind, float(t), a.quality, mesh or a.mesh, a.skin), a.penalty_factor, a.fresh,
                         a.timeout, a.cached, a.cap_size)
         for m in a.reference:  # KIND:SIZE/REF for one indenter, SIZE/REF for every case
             k, _, m = m.rpartition(":")
-            if k in ("", kind) and not any(r["scene"] == make_scene(kind, float(t), a.quality, m).label()
-                                           and r["mesh"] == m for r in refs) and not (a.cached and not _ref_path(make_scene(kind, float(t), a.quality, m)).exists()):
-                refs.append(reference(make_scene(kind, float(t), a.quality, m), a.fresh))
+            if k in ("", kind) and not any(r["scene"] == make_scene(kind, float(t), a.quality, m, a.skin).label()
+                                           and r["mesh"] == m for r in refs) and not (a.cached and not _ref_path(make_scene(kind, float(t), a.quality, m, a.skin)).exists()):
+                refs.append(reference(make_scene(kind, float(t), a.quality, m, a.skin), a.fresh))
     if not rows:
         print("no results: nothing solved and nothing in raw_calculix3d/ for these cases", file=sys.stderr)
         return 1
