@@ -75,6 +75,29 @@ def test_a_domed_step_skins_mold_is_closed_and_its_cavity_is_the_skin(tmp_path):
     assert lid.is_inside(bd.Vector(0.0, -1.0, 0.0))  # none under the middle
 
 
+def test_a_bonded_face_split_in_several_faces_gets_its_mold(tmp_path):
+    """A block whose bonded face is two coplanar faces (a CAD export's split face; here split at
+    z = -2.25, through the sprue): the z = -6 vent's disc misses the z > -2.25 face, which
+    was a traceback ("'NoneType' object has no attribute 'faces'"); the sprue's straddles both
+    and lies wholly on the bonded plane."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+
+    a = bd.Pos(0, 0, -2.25) * bd.Box(W, H, L / 2 - 2.25, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.MAX))
+    b = bd.Pos(0, 0, -2.25) * bd.Box(W, H, L / 2 + 2.25, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.MIN))
+    op = BRepAlgoAPI_Fuse(a.wrapped, b.wrapped)
+    op.Build()  # OCP's fuse keeps the two bottom faces (build123d's would merge them)
+    skin = bd.Shape.cast(op.Shape()).solids()[0]
+    assert len([f for f in skin.faces() if f.bounding_box().max.Y < 1e-9]) == 2
+    path = tmp_path / "split.step"
+    bd.export_step(skin, str(path))
+    parts = get("file").build_parts(H, skin_file=str(path))
+    assert [p.name for p in parts] == ["skin", "mold_lower", "mold_upper"]
+    lid = parts[2].shape
+    for z in (-2.25, -6.0, 6.0):
+        assert not lid.is_inside(bd.Vector(0.0, -1.0, z))  # the sprue and the vents
+    assert lid.is_inside(bd.Vector(0.0, -1.0, 0.0))
+
+
 def _tube_shell(length=L):
     """A fingertip-like half tube (outer R 8, inner R 6) on y >= 0: its inner face is curved."""
     tube = bd.Cylinder(8, length) - bd.Cylinder(6, length)

@@ -52,7 +52,10 @@ def _overhang(faces: list[bd.Face], x: float, z: float, y_b: float, diameter: fl
     """Area (mm^2) of the hole's disc at (x, z) that lies off the bonded faces."""
     disc = bd.Face(bd.Wire([bd.Edge.make_circle(0.5 * diameter, plane=bd.Plane((x, y_b, z), x_dir=(1, 0, 0),
                                                                                  z_dir=(0, -1, 0)))]))
-    on = sum(g.area for f in faces for g in disc.intersect(f).faces()) if faces else 0.0
+    on = 0.0
+    for f in faces:  # a bonded face split in several (as CAD exports often are) the disc may miss
+        common = disc.intersect(f)
+        on += sum(g.area for g in common.faces()) if common is not None else 0.0
     return max(0.0, disc.area - on)
 
 
