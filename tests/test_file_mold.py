@@ -155,6 +155,11 @@ def test_build_skin_file_writes_the_skin_its_mold_and_indenters_for_it(tmp_path,
     assert flat["bbox_min"][1] == pytest.approx(H, abs=1e-6)
     assert flat["bbox_max"][0] - flat["bbox_min"][0] >= W - 1e-6
     assert flat["bbox_max"][2] - flat["bbox_min"][2] == pytest.approx(L, abs=1e-6)
+    # its own output as the skin: the rebuild replaced its input, and the manifest named bytes gone
+    before = (out / "skin.step").read_bytes()
+    capsys.readouterr()
+    assert main(["build", "--skin-file", str(out / "skin.step"), "--out", str(out)]) == 2
+    assert "--skin-file" in capsys.readouterr().err and (out / "skin.step").read_bytes() == before
     # a scene file names the skin and its bonded-face rule; the rebuild replaces the build in place
     scene = tmp_path / "scene.toml"
     scene.write_text('skin_file = "dome.step"\nskin_bonded = "plane:y=0"\nindenter = "flat"\n', encoding="utf-8")

@@ -91,6 +91,7 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
     from rich.table import Table
 
     from tactileskin.cli._console import new_console
+    from tactileskin.errors import ParameterError
     from tactileskin.geometry.fingertip import Fingertip
     from tactileskin.geometry.parts import default_thickness, resolve_indenters
 
@@ -132,6 +133,11 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
         from tactileskin.scene import Scene
 
         require_step(skin_file)  # a .msh: no CAD, before gmsh reads it
+        if Path(skin_file).resolve().parent == Path(out_dir).resolve():
+            # the build writes skin.step (and its record) there: a rebuild over its own output would
+            # replace its input, and the manifest name bytes that are gone
+            raise ParameterError("--skin-file", str(skin_file), "a STEP outside --out",
+                                 f"the build writes into {out_dir}: copy the file out of it first")
         given = {} if thickness is None else {"thickness": thickness}  # the file fixes t: another is refused
         sc = Scene(skin="file", skin_file=skin_file, skin_bonded=skin_bonded, **given)  # validates, measures t
         t = sc.thickness
