@@ -189,4 +189,4 @@ def test_help_states_the_default_indenter_and_dim_and_what_a_skin_file_fixes(cmd
     text = " ".join(CliRunner().invoke(cli, [cmd, "--help"]).output.split())
     assert f"Indenter kind. Default {Scene().indenter.value}." in text
     assert f"3D slab. Default {Scene().dim}" in text
-    assert "solved on its own mesh" in text and "skin_bonded" in text
+    assert "solved on its own mesh" in text and "--skin-bonded" in text and "'normal:-y'" in text

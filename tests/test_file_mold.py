@@ -209,3 +209,30 @@ def test_build_refuses_a_skin_file_it_cannot_mold_in_one_line(tmp_path, capsys, 
     assert "error" in err.lower() and all(w in err for w in words), err
     assert "Traceback" not in cap.err + cap.out
     assert not out.exists()  # nothing written
+
+
+def test_the_bonded_face_rule_is_an_option_of_the_commands(tmp_path, capsys):
+    """The STEP's bonded-face rule could only be set in a scene file: a new user's half tube,
+    bonded on its curved inner face, was meshed bonded on its two end strips (64 mm^2, t = 10).
+    `--skin-bonded` now sets it on mesh / solve / sweep / export and on build: normal:-y:89.9
+    bonds the inner face (366 mm^2, t = 2); a rule without a skin file, or a bad rule, is one line."""
+    from tactileskin.cli import main
+
+    bd.export_step(_tube_shell(), str(tmp_path / "tube.step"))
+    step = str(tmp_path / "tube.step")
+    area = {}
+    for rule in (None, "normal:-y:89.9"):
+        argv = ["mesh", "--skin-file", step, "--mesh-size", "2", "--out", str(tmp_path / f"m{len(area)}.msh")]
+        assert main(argv + (["--skin-bonded", rule] if rule else [])) == 0
+        out = capsys.readouterr().out
+        area[rule] = float(out.split("bonded boundary measure (mm^2)")[1].split("│")[1])
+    assert area[None] == pytest.approx(64.0, rel=1e-3) and area["normal:-y:89.9"] == pytest.approx(365.6, rel=1e-2)
+    assert main(["solve", "--skin-bonded", "bonded", "-t", "1", "--out", str(tmp_path / "o")]) == 2
+    assert main(["mesh", "--skin-file", step, "--skin-bonded", "normal:-q", "--out", str(tmp_path / "x.msh")]) == 2
+    err = capsys.readouterr().err
+    assert "skin_bonded='bonded'" in err and "only with skin = file" in err and "skin_bonded='normal:-q'" in err
+    assert "Traceback" not in err and not (tmp_path / "o").exists()
+    assert main(["build", "--skin-bonded", "plane:y=0", "--out", str(tmp_path / "b")]) == 2
+    # build takes it too: the inner face is curved, so the mold is refused naming the rule given
+    assert main(["build", "--skin-file", step, "--skin-bonded", "normal:-y:89.9", "--out", str(tmp_path / "b")]) == 2
+    assert "skin_bonded='normal:-y:89.9'" in capsys.readouterr().err and not (tmp_path / "b").exists()

@@ -14,7 +14,8 @@ QUALITIES = ("preview", "default", "fine")
 # ones of the commands that solve. `grid=True` (sweep): the axis options take lists.
 SCENE_KEYS = ("scene_file", "thickness", "material", "indenter", "braille_text", "braille_standard",
               "indenter_radius", "indenter_axis", "indenter_file", "skin", "pad_width", "pad_length",
-              "skin_file", "depth", "dim", "quality", "mesh_size", "refinement", "order")
+              "skin_file", "skin_bonded", "skin_outer", "depth", "dim", "quality", "mesh_size", "refinement",
+              "order")
 PHYSICS_KEYS = ("rate", "force", "force_rate", "formulation", "elastic")
 
 
@@ -169,8 +170,15 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
                      help="Skin geometry: fingertip (default), pad, dome (rounded 3D tip) or file."),
         click.option("--skin-file", type=str, default=None,
                      help="File skin: a gmsh .msh with named groups (solved on its own mesh: --quality and "
-                          "the mesh sizes do not apply) or a STEP solid (mm; its bonded faces: skin_bonded in "
-                          "a --scene file, default 'normal:-y'); implies --skin file."),
+                          "the mesh sizes do not apply) or a STEP solid (mm; its bonded faces: --skin-bonded, "
+                          "default 'normal:-y'); implies --skin file."),
+        opt("--skin-bonded", type=str, default=None,
+            help=lambda: "File skin's bonded surface: a .msh's physical group name(s), comma-separated (default "
+                         "bone_interface/bonded/board/...), or a STEP's face rule, " + _rule_forms() +
+                         " (default 'normal:-y': outward normals within 10 degrees of -y)."),
+        click.option("--skin-outer", type=str, default=None,
+                     help="File skin (.msh): the contact surface's physical group name(s), comma-separated "
+                          "(default outer_surface/..., or the rest of the boundary)."),
         opt("--pad-width", type=float, default=None,
             help=lambda: f"Pad: x extent of the whole pad (mm), {h.pad_size()}. Default {h.pad('WIDTH')}."),
         opt("--pad-length", type=float, default=None,
@@ -205,11 +213,18 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
     return wrapper
 
 
+def _rule_forms() -> str:
+    from tactileskin.mesh.skinfile import RULE_FORMS
+
+    return RULE_FORMS
+
+
 def _field_changes(opts: dict) -> dict:
     """Scene-field changes of the single-valued options (None: not given)."""
     ch = {k: opts.get(k) for k in ("thickness", "material", "indenter", "braille_text", "braille_standard",
                                     "indenter_radius", "indenter_axis", "indenter_file",
-                                    "skin", "pad_width", "pad_length", "skin_file", "depth", "rate",
+                                    "skin", "pad_width", "pad_length", "skin_file", "skin_bonded", "skin_outer",
+                                    "depth", "rate",
                                     "force", "force_rate", "formulation")}
     if ch.get("skin_file") is not None and ch.get("skin") is None:
         ch["skin"] = "file"

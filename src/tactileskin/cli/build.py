@@ -8,9 +8,12 @@ from pathlib import Path
 
 import click
 
+from tactileskin.cli._common import _RangeHelpOption, _rule_forms
+
 
 GEOMETRY_OPTIONS = ("thickness", "indenter", "indenter_radius", "indenter_axis", "braille_text", "braille_standard",
-                    "skin", "pad_width", "pad_length", "dome_length", "dome_tip", "skin_file")
+                    "skin", "pad_width", "pad_length", "dome_length", "dome_tip", "skin_file",
+                    "skin_bonded")
 
 
 def _scene_options(path: str) -> dict:
@@ -72,8 +75,11 @@ def _scene_options(path: str) -> dict:
                    "finger with a rounded tip (--dome-length, --dome-tip).")
 @click.option("--skin-file", type=str, default=None,
               help="Your own skin: a STEP solid (mm) bonded on one flat face y = const facing -y (the faces "
-                   "skin_bonded picks, in a --scene file; default 'normal:-y'); builds it and a two-part mold "
+                   "--skin-bonded picks; default 'normal:-y'); builds it and a two-part mold "
                    "cast face down, as the pad's; implies --skin file (a .msh has no CAD: refused).")
+@click.option("--skin-bonded", type=str, default=None, cls=_RangeHelpOption,
+              help=lambda: "With --skin-file: the rule picking its bonded faces, " + _rule_forms()
+              + "; default 'normal:-y' (within 10 degrees).")
 @click.option("--pad-width", type=float, default=None, help="Pad: x extent (mm); default 20.")
 @click.option("--pad-length", type=float, default=None, help="Pad: z extent (mm); default 20.")
 @click.option("--dome-length", type=float, default=None, help="Dome: finger length before the dome (mm); default 10.")
@@ -81,7 +87,7 @@ def _scene_options(path: str) -> dict:
               help="Dome: semi-axis of the dome along the finger (mm); default the section's half width.")
 def command(thickness, out_dir, indenter, braille_text, braille_standard, no_molds, skin="fingertip",
             pad_width=None, pad_length=None, dome_length=None, dome_tip=None, indenter_radius=None,
-            indenter_axis=None, scene_file=None, skin_file=None):
+            indenter_axis=None, scene_file=None, skin_file=None, skin_bonded=None):
     """Build the fingertip skin, rigid base, casting mold and indenters into OUT.
 
     Writes binary STL + STEP per part and OUT/manifest.json (file, volume, bounding box,
@@ -112,7 +118,8 @@ def command(thickness, out_dir, indenter, braille_text, braille_standard, no_mol
                                                                            "dome_tip"))
         skin_file, skin_bonded = opts["skin_file"], opts["skin_bonded"]
     else:
-        skin_bonded = None
+        if skin_bonded is not None and skin_file is None:
+            raise click.UsageError("--skin-bonded needs --skin-file")
         if skin_file is not None:
             if click.get_current_context().get_parameter_source("skin") == click.core.ParameterSource.COMMANDLINE:
                 raise click.UsageError("--skin-file is the skin: leave out --skin")
