@@ -291,3 +291,16 @@ def test_run_settings_say_elastic_for_a_material_without_prony_terms(tmp_path):
     rows = [ln for ln in text.splitlines() if ln.startswith("| 2D |")]
     cells = sorted(ln.split(" | ")[-3] for ln in rows)
     assert cells == ["no", "no (the material has no Prony terms)", "yes"], rows
+
+
+def test_bar_figures_of_three_materials_show_no_empty_fourth_panel(tmp_path, monkeypatch):
+    """Three materials on a 2 x 2 grid: the spare panel was hidden per row (row[3:], always
+    empty), so Figs. 11-13 showed a fourth, empty panel with a 0-1 axis beside the third."""
+    rows = [dict(status="ok", material=m, thickness_mm=t, indenter=ind, braille_text="",
+                 peak_mpa=0.1, span_mm=1.0, auc_mpa_mm=0.1)
+            for m in ("gel.toml", "polyurethane", "silicone") for t in (1.0, 3.0) for ind in ("flat", "curved")]
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak", tmp_path)
+    shown = [ax.get_title() for ax in got["fig11_peak"].axes if ax.get_visible()]
+    assert shown == ["gel.toml", "polyurethane", "silicone"]

@@ -185,9 +185,8 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     width = float(np.clip(1.2 + 0.22 * len(thick) * max(len(series), 1), 3.6, 7.5))  # per panel
     fig, axes = plt.subplots(nrows, cols, figsize=(width * cols, 3.2 * nrows + 0.5), squeeze=False,
                              sharey=True, constrained_layout=True)
-    for row in axes:
-        for ax in row[len(mats):]:
-            ax.set_visible(False)
+    for ax in axes.flat[len(mats):]:  # the panels past the last material (per row, none was: 3 on 2 x 2)
+        ax.set_visible(False)
     w = 0.8 / max(len(series), 1)
     for k, m in enumerate(mats):
         ax = axes[k // cols][k % cols]
