@@ -230,3 +230,17 @@ def test_contact_csv_gives_each_contact_points_position(tmp_path):
     rows = list(csv.DictReader(open(out / "contact.csv", encoding="utf-8")))
     assert list(rows[0]) == ["x_mm", "y_mm", "z_mm", "contact_pressure_mpa"]
     assert [(float(x["z_mm"]), float(x["contact_pressure_mpa"])) for x in rows] == [(0.0, 0.3), (0.5, 0.2), (0.2, 0.1)]
+
+
+def test_sweep_dataframe_has_the_columns_of_results_csv_and_parquet(tmp_path):
+    """The DataFrame dropped the columns no case filled: without a failed case or force
+    control it had 22 of results.csv's 25 (no error, target_force_n_per_mm, target_force_n),
+    so `df.error` raised where the files had the column."""
+    pd = pytest.importorskip("pandas")
+    out = tmp_path / "sw"
+    df = ts.sweep({"thickness": [1.0], "material": "silicone", "indenter": ["flat"]}, quality="preview",
+                  out=out, serial=True, report=False)
+    with open(out / "results.csv", newline="") as fh:
+        header = next(csv.reader(fh))
+    assert list(df.columns) == header == list(pd.read_parquet(out / "results.parquet").columns)
+    assert df.error.isna().all() and df.target_force_n_per_mm.isna().all() and df.target_force_n.dtype == float

@@ -183,9 +183,9 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
             records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, Path(out), report)
     from tactileskin.report.outputs import RESULT_COLUMNS
 
-    metrics = pd.DataFrame(rows)
-    cols = [c for c in RESULT_COLUMNS + ["dim", "variant"] if c in metrics.columns]
-    metrics = metrics[cols]
+    # the columns of results.csv / .parquet, all of them: a column no row filled (error when
+    # none failed, the target forces without force control) was missing from the DataFrame
+    metrics = pd.DataFrame(rows).reindex(columns=RESULT_COLUMNS + ["dim", "variant"])
     for c in ("target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
               "reaction_n", "min_J",
               "max_abs_stress_mpa", "wall_s"):
