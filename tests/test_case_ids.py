@@ -58,6 +58,9 @@ def test_material_files_are_named_by_their_file(tmp_path):
     scenes = [Scene(material=str(tmp_path / d / "soft.toml")) for d in ("a", "b")]
     ids = case_ids(scenes)
     assert ids == ["t3-soft-flat-2d-@a", "t3-soft-flat-2d-@b"]
+    # `solve` (its title, the Result's repr) names the case as the sweep does: it read
+    # 't3-/tmp/.../a/soft.toml-flat-2d' for the sweep's 't3-soft-flat-2d'
+    assert case_ids(scenes[:1]) == [scenes[0].label()] == ["t3-soft-flat-2d"]
 
 
 def test_two_depth_sweep_writes_two_rows_profiles_and_bars(tmp_path, capsys, monkeypatch):

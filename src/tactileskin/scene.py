@@ -420,8 +420,15 @@ class Scene:
         """The indenter as case ids, tables and figures name it (braille[text], sphere-R2.5, ...)."""
         return self.indenter_kind.label(self)
 
+    def material_tag(self) -> str:
+        """The material as labels and case ids name it: a material file by its name ('gel' for
+        /data/gel.toml), as a skin file is named."""
+        return Path(self.material).stem if self.material.endswith(".toml") else self.material
+
     def label(self) -> str:
-        return f"{self.skin_kind.label(self)}t{self.thickness:g}-{self.material}-{self.indenter_label()}-{self.dim}d"
+        # the sweep's case id of the same scene (sweep.case_ids): `solve` named a material
+        # file by its path ('t1-gel.toml-curved-2d' for the sweep's 't1-gel-curved-2d')
+        return f"{self.skin_kind.label(self)}t{self.thickness:g}-{self.material_tag()}-{self.indenter_label()}-{self.dim}d"
 
     def to_toml(self, path: str | Path) -> None:
         import tomli_w

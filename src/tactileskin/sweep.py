@@ -248,12 +248,8 @@ def load_spec(path: str | Path) -> dict:
 
 # --- case ids -----------------------------------------------------------------------------
 
-def _material_tag(material: str) -> str:
-    return Path(material).stem if material.endswith(".toml") else material
-
-
 def _base_id(sc: Scene) -> str:
-    return f"t{sc.thickness:g}-{_material_tag(sc.material)}-{sc.indenter_label()}-{sc.dim}d"
+    return f"t{sc.thickness:g}-{sc.material_tag()}-{sc.indenter_label()}-{sc.dim}d"
 
 
 # Fields outside the base id that change a result, with the suffix naming each value.
