@@ -244,3 +244,25 @@ def test_sweep_dataframe_has_the_columns_of_results_csv_and_parquet(tmp_path):
         header = next(csv.reader(fh))
     assert list(df.columns) == header == list(pd.read_parquet(out / "results.parquet").columns)
     assert df.error.isna().all() and df.target_force_n_per_mm.isna().all() and df.target_force_n.dtype == float
+
+
+def test_results_parquet_types_a_column_no_case_filled_as_the_dataframe_does(tmp_path):
+    """results.parquet wrote the columns no row filled (a 2D sweep's reaction_n, the target
+    forces without force control, error) as type null, read back as object columns of None,
+    where ts.sweep's DataFrame has float64 (and a 3D sweep's file double): the files of a 2D
+    and a 3D sweep did not share a schema."""
+    pa = pytest.importorskip("pyarrow")
+    import pyarrow.parquet as pq
+
+    from tactileskin.report.outputs import RESULT_COLUMNS, _write_parquet
+
+    cols = RESULT_COLUMNS + ["dim", "variant"]
+    row = dict(case="t1-silicone-flat-2d", key="k", status="ok", thickness_mm=1.0, material="silicone",
+               indenter="flat", braille_text="", depth_mm=0.2, rate_mm_s=1.0, peak_mpa=0.3, span_mm=2.0,
+               auc_mpa_mm=0.4, reaction_n_per_mm=0.5, reaction_n=None, min_J=0.99, max_abs_stress_mpa=0.3,
+               dofs=2060, increments=4, newton_iterations=20, wall_s=1.0, dim=2, variant="")
+    _write_parquet(tmp_path / "r.parquet", cols, [row])
+    schema = pq.read_schema(tmp_path / "r.parquet")
+    for c in ("reaction_n", "target_force_n_per_mm", "target_force_n", "peak_mpa", "reaction_n_per_mm"):
+        assert schema.field(c).type == pa.float64(), c
+    assert schema.field("error").type == pa.string() and schema.field("dofs").type == pa.int64()

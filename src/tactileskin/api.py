@@ -181,16 +181,13 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
             # as the command (cli.sweep): an edited report.md is refused now, not after every case
             staging.check_replaceable(Path(out), SWEEP_ALWAYS_WRITTEN)
             records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, Path(out), report)
-    from tactileskin.report.outputs import RESULT_COLUMNS
+    from tactileskin.report.outputs import FLOAT_COLUMNS, RESULT_COLUMNS
 
     # the columns of results.csv / .parquet, all of them: a column no row filled (error when
     # none failed, the target forces without force control) was missing from the DataFrame
     metrics = pd.DataFrame(rows).reindex(columns=RESULT_COLUMNS + ["dim", "variant"])
-    for c in ("target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
-              "reaction_n", "min_J",
-              "max_abs_stress_mpa", "wall_s"):
-        if c in metrics.columns:  # a value a case has not (a 2D case's reaction_n, a failed case): NaN
-            metrics[c] = pd.to_numeric(metrics[c], errors="coerce").astype(float)
+    for c in FLOAT_COLUMNS:  # a value a case has not (a 2D case's reaction_n, a failed case): NaN
+        metrics[c] = pd.to_numeric(metrics[c], errors="coerce").astype(float)
     if not profiles:
         return metrics
     prof = pd.DataFrame(profile_rows(records), columns=["case", "s_mm", "pressure_mpa"])

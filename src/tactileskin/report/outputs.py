@@ -19,6 +19,10 @@ RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter
                   "depth_mm", "rate_mm_s", "target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "reaction_n",
                   "min_J", "max_abs_stress_mpa",
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
+# the columns that hold numbers (MPa, mm, N, s) whether or not a row has one: a 2D sweep's
+# reaction_n, the target forces without force control, a failed case's metrics
+FLOAT_COLUMNS = ("target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
+                 "reaction_n", "min_J", "max_abs_stress_mpa", "wall_s")
 
 
 def collect(outcomes, cache):
@@ -74,7 +78,10 @@ def _write_parquet(path: Path, columns: list[str], rows) -> None:
     from tactileskin.fileio import atomic_path, os_errors
 
     data = {c: [r[i] if isinstance(r, tuple) else r.get(c) for r in rows] for i, c in enumerate(columns)}
-    table = pa.table(data)
+    # typed as the DataFrame of ts.sweep: a column no row filled was written as type null
+    # (pandas: object of None), one a row filled as double
+    types = {**dict.fromkeys(FLOAT_COLUMNS + ("s_mm", "pressure_mpa"), pa.float64()), "error": pa.string()}
+    table = pa.table({c: pa.array(v, type=types.get(c)) for c, v in data.items()})
     with atomic_path(path) as tmp, os_errors(path):
         pq.write_table(table, tmp)
 
