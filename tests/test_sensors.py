@@ -425,3 +425,30 @@ def test_points_are_located_alike_by_the_affine_first_search(monkeypatch):
     top = model.mesh.doflocs[:, np.argmax(model.mesh.doflocs[1])]
     with pytest.raises(ParameterError, match="inside the meshed skin"):
         probe.locate(model, (top + [0.0, 0.05, 0.0])[None, :])
+
+
+def test_a_sweep_marks_a_suspect_cases_sensor_readings(tmp_path):
+    """The sweep's sensors.csv listed a suspect case's readings (t = 1 curved pressed 1e-3 mm:
+    one contact point, bone sensor 1.25e-4 MPa) exactly like an ok case's: it had no status,
+    while results.csv said suspect. Each row now carries its case's status, as results.csv."""
+    import csv
+
+    from tactileskin import quality
+    from tactileskin.report.outputs import _write_sensors
+    from tactileskin.sweep import CaseRecord
+
+    head = "sensor_id,layout,x_mm,y_mm,z_mm,s_mm,depth_mm,pressure_mpa,sigma_nn_mpa,tau_1_mpa,tau_2_mpa,taxel_points\n"
+    ok = dict(peak_mpa=0.22, reaction_n_per_mm=0.27, contact_points=20)
+    recs = []
+    for name, summary in (("ok", ok), ("none", dict(ok, peak_mpa=0.0, reaction_n_per_mm=0.0, contact_points=0))):
+        d = tmp_path / name
+        d.mkdir()
+        (d / "sensors.csv").write_text(head + "bone-0,bone,0,6,0,0,1,0.1,-0.1,0,0,1\n")
+        rec = CaseRecord(Scene(**COARSE), np.zeros(2), np.zeros(2), summary, d)
+        rec.case = name
+        recs.append(rec)
+    _write_sensors(tmp_path / "sensors.csv", recs)
+    rows = list(csv.DictReader(open(tmp_path / "sensors.csv", encoding="utf-8")))
+    assert [r["status"] for r in rows] == [quality.status(r.summary) for r in recs]
+    assert rows[0]["status"] == "ok" and rows[1]["status"].startswith("suspect: no contact")
+    assert rows[1]["pressure_mpa"] == "0.1"  # the readings themselves unchanged

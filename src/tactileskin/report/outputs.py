@@ -112,7 +112,7 @@ def write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool = T
 
 def _write_sensors(path: Path, records) -> None:
     """sensors.csv of the sweep: every case's sensor readings (the cache entry's sensors.csv)
-    with the case id in front; not written when no case has sensors."""
+    with the case id and its status (results.csv's) in front; not written when no case has sensors."""
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     header = None
@@ -125,11 +125,13 @@ def _write_sensors(path: Path, records) -> None:
             continue
         if header is None:
             header = rows[0]
-            w.writerow(["case"] + header)
+            w.writerow(["case", "status"] + header)
         elif rows[0] != header:  # one writer (sensors.SensorReadings) made every file
             log.warning("sensors.csv of %s has other columns; left out of the sweep's sensors.csv", rec.case)
             continue
-        w.writerows([rec.case] + r for r in rows[1:])
+        # a suspect case's readings were listed like an ok case's: its status on every row
+        status = quality.status(rec.summary)
+        w.writerows([rec.case, status] + r for r in rows[1:])
     if header is not None:
         atomic_write_text(path, out.getvalue())
 
