@@ -304,3 +304,21 @@ def test_bar_figures_of_three_materials_show_no_empty_fourth_panel(tmp_path, mon
     figures.metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak", tmp_path)
     shown = [ax.get_title() for ax in got["fig11_peak"].axes if ax.get_visible()]
     assert shown == ["gel.toml", "polyurethane", "silicone"]
+
+
+def test_a_figure_saved_twice_has_the_same_bytes(tmp_path):
+    """A cached rerun gave byte-identical CSVs but new SVG / PDF figures: matplotlib stamps
+    them with the date and salts the SVG's ids with a random hash. Saved alike now."""
+    from tactileskin.report import figures
+
+    plt = figures._plt()  # the figures' own settings (SVG text as text)
+    got = []
+    for k in range(2):
+        fig, ax = plt.subplots()
+        ax.plot([0, 1], [0, 2])
+        ax.set_title("P (MPa)")
+        out = tmp_path / str(k)
+        out.mkdir()
+        got.append({p.name: p.read_bytes() for p in figures._save(fig, out, figures.DESIGN_STEMS[0])})
+    assert sorted(got[0]) == ["metrics_vs_thickness.pdf", "metrics_vs_thickness.png", "metrics_vs_thickness.svg"]
+    assert got[0] == got[1]

@@ -58,6 +58,17 @@ def _fit_width(fig) -> None:
         fig.set_figwidth(need + 0.3)
 
 
+def save_reproducibly(fig, buf, fmt: str, dpi: int) -> None:
+    """fig.savefig into `buf`, the same bytes for the same figure: matplotlib stamps SVG and PDF
+    with the date and salts SVG ids with a random hash, so a rerun's figures differed from the
+    cached run's while its CSVs were byte-identical."""
+    import matplotlib
+
+    meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}.get(fmt)
+    with matplotlib.rc_context({"svg.hashsalt": "tactileskin"}):
+        fig.savefig(buf, format=fmt, dpi=dpi, **({"metadata": meta} if meta else {}))
+
+
 def _save(fig, out: Path, stem: str) -> list[Path]:
     paths = []
     try:
@@ -66,7 +77,7 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
             buf = io.BytesIO()
             # every figure has constrained layout, which already keeps its labels inside; a
             # "tight" bounding box would draw each figure once more per format (~45 % of savefig)
-            fig.savefig(buf, format=ext, dpi=150)
+            save_reproducibly(fig, buf, ext, 150)
             atomic_write_bytes(p, buf.getvalue())
             paths.append(p)
     finally:  # a failed write (full disk) too: a notebook's pyplot keeps no figure of ours

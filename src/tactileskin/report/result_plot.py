@@ -76,7 +76,9 @@ def plot_result(result, path=None, *, ax=None):
         mx.set_title("bone pressure P(s, z); dashed: section plane", loc="left", fontsize="medium")
         fig.colorbar(im, ax=mx, label="P (MPa)")
     if path is not None:
+        from tactileskin.report.figures import save_reproducibly
+
         buf = io.BytesIO()
-        fig.savefig(buf, format=fmt, dpi=150)
+        save_reproducibly(fig, buf, fmt, 150)
         atomic_write_bytes(path, buf.getvalue())
     return fig, axes
