@@ -130,3 +130,18 @@ def test_a_braille_text_is_only_taken_by_the_braille_indenter():
         Scene(indenter="flat", braille_text="a")
     s = Scene(indenter="braille", braille_text="a").replace(indenter="flat")
     assert s.braille_text == "" and s.key() == Scene(indenter="flat").key()
+
+
+def test_a_field_given_twice_in_a_scene_file_is_named_with_its_value(tmp_path):
+    """A field given both at the top level and in [scene], or beside its [sweep] list, read
+    "scene field thickness='s.toml' is invalid": the file's name as the field's value."""
+    from tactileskin import scenefile
+
+    p = tmp_path / "s.toml"
+    p.write_text("[scene]\nthickness = 1.0\n[sweep]\nthicknesses = [1, 3]\n")
+    with pytest.raises(ParameterError, match=r"^thickness=1\.0 is invalid; valid: either thickness or "
+                                             r"sweep\.thicknesses, not both \(.*s\.toml gives both\)"):
+        scenefile.read(p)
+    p.write_text("thickness = 2.0\n[scene]\nthickness = 3.0\n")
+    with pytest.raises(ParameterError, match=r"^thickness=2\.0 is invalid; valid: given once .*gives it twice"):
+        scenefile.read(p)

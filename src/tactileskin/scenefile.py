@@ -98,7 +98,8 @@ def read(path: str | Path | None) -> SceneFile:
     scene_tab = validate.table(data.get("scene", {}), "[scene]")
     both = sorted(set(top) & set(scene_tab))
     if both:
-        raise ParameterError(f"scene field {both[0]}", str(path), "given once (top level or [scene], not both)")
+        raise ParameterError(both[0], top[both[0]], "given once in the scene file (top level or [scene], not both)",
+                             f"{path} gives it twice")
     fields = resolve_paths({**top, **scene_tab}, path)
     quality = fields.pop("quality", None)
     if quality is not None:
@@ -108,7 +109,7 @@ def read(path: str | Path | None) -> SceneFile:
     axes = resolve_paths(sweep_lists(data["sweep"]), path) if "sweep" in data else {}
     for f, ax in AXES.items():
         if f in fields and ax in axes:
-            raise ParameterError(f"scene field {f}", str(path), f"either {f} or sweep.{ax}, not both")
+            raise ParameterError(f, fields[f], f"either {f} or sweep.{ax}, not both", f"{path} gives both")
     if not fields and quality is None and not axes:  # surely a mistake: it would run the default scene
         raise ParameterError("scene file", str(path), "a TOML file with at least one setting",
                              "it sets nothing; leave out --scene for the default scene")
