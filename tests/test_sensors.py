@@ -452,3 +452,21 @@ def test_a_sweep_marks_a_suspect_cases_sensor_readings(tmp_path):
     assert [r["status"] for r in rows] == [quality.status(r.summary) for r in recs]
     assert rows[0]["status"] == "ok" and rows[1]["status"].startswith("suspect: no contact")
     assert rows[1]["pressure_mpa"] == "0.1"  # the readings themselves unchanged
+
+
+def test_the_sweep_report_names_sensors_csv_when_cases_have_sensors(tmp_path):
+    """report.md never mentioned sensors.csv, which the sweep writes beside it for the cases
+    with sensor layouts; it now names it (and says nothing without sensors)."""
+    from tactileskin.report.markdown import build_report
+    from tactileskin.sweep import CaseRecord
+
+    lays = [dict(name="bone", kind="points", s=[0.0, 1.0], height=0.0)]
+    summary = dict(peak_mpa=0.22, span_mm=2.0, auc_mpa_mm=0.3, reaction_n_per_mm=0.27, contact_points=20)
+    texts = []
+    for sensors in (lays, None):
+        rec = CaseRecord(Scene(**COARSE, sensors=sensors or []), np.zeros(2), np.zeros(2), summary, tmp_path)
+        rec.case = "t3-silicone-curved-2d"
+        row = dict(case=rec.case, thickness_mm=3.0, material="silicone", indenter="curved", depth_mm=0.6,
+                   status="ok", **summary)
+        texts.append(build_report([row], [rec], [], [], [], 1.0))
+    assert "`sensors.csv` (one row per case and sensor" in texts[0] and "sensors.csv" not in texts[1]

@@ -603,6 +603,10 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                    f"{r.get('increments', '')} | {r.get('newton_iterations', '')} | {_fmt(r.get('wall_s'), 2)} | "
                    f"{'**suspect**' if k == 'suspect' else 'ok'} |")
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
+    with_sensors = [r.case for r in records if r.scene.sensors]
+    if with_sensors:
+        out += [f"Sensor readings of the {len(with_sensors)} case{'s' if len(with_sensors) > 1 else ''} with "
+                "sensor layouts: `sensors.csv` (one row per case and sensor, with the case's status).", ""]
     two_models = has_3d_braille(rows)
     if two_models:
         out += braille_comparison(records, rows) + [""]
