@@ -463,8 +463,8 @@ def test_the_sweep_report_names_sensors_csv_when_cases_have_sensors(tmp_path):
     lays = [dict(name="bone", kind="points", s=[0.0, 1.0], height=0.0)]
     summary = dict(peak_mpa=0.22, span_mm=2.0, auc_mpa_mm=0.3, reaction_n_per_mm=0.27, contact_points=20)
     texts = []
-    for sensors in (lays, None):
-        rec = CaseRecord(Scene(**COARSE, sensors=sensors or []), np.zeros(2), np.zeros(2), summary, tmp_path)
+    for lay in (lays, None):
+        rec = CaseRecord(Scene(**COARSE, sensors=lay or []), np.zeros(2), np.zeros(2), summary, tmp_path)
         rec.case = "t3-silicone-curved-2d"
         row = dict(case=rec.case, thickness_mm=3.0, material="silicone", indenter="curved", depth_mm=0.6,
                    status="ok", **summary)
