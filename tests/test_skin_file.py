@@ -213,11 +213,12 @@ def test_step_block_bonded_by_rule(tmp_path):
                mesh_size=1.0, refinement=1.0)
     assert sc.dim == 3 and sc.thickness == pytest.approx(2.0, abs=1e-9)
     assert sc.section().top == pytest.approx(2.0, abs=1e-9)
-    sm = build_mesh(sc)
+    # whole: the symmetric block under the sphere is otherwise cut to its quarter (test_step_symmetry)
+    sm = build_mesh(sc, use_symmetry=False)
     assert sm.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-9)  # the face y = 0
     assert sm.boundary_measure("outer_surface") == pytest.approx(16.0 + 4 * 8.0, rel=1e-9)
     assert "symmetry" not in sm.boundaries  # a full model
-    plane = build_mesh(sc.replace(skin_bonded="plane:y=0"))
+    plane = build_mesh(sc.replace(skin_bonded="plane:y=0"), use_symmetry=False)
     assert plane.boundary_measure("bone_interface") == pytest.approx(16.0, rel=1e-9)
     with pytest.raises(ParameterError, match="skin_bonded.*no face matches"):
         Scene(skin="file", skin_file=str(path), skin_bonded="plane:y=-1")
@@ -260,7 +261,8 @@ def test_step_block_solves_like_the_pad_block(tmp_path):
     path = tmp_path / "block.step"
     bd.export_step(bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)), str(path))
     kw = dict(indenter="flat", depth_fraction=0.03, viscoelastic=False, mesh_size=1.0, refinement=1.0)
-    full = solve(Scene(skin="file", skin_file=str(path), **kw))
+    user = Scene(skin="file", skin_file=str(path), **kw)
+    full = solve(user, mesh=build_mesh(user, use_symmetry=False))  # not cut to its quarter: the whole model
     quarter = solve(Scene(skin="pad", pad_width=8.0, pad_length=8.0, thickness=2.0, dim=3, **kw))
     assert quarter.stats["dofs"] < 0.5 * full.stats["dofs"]  # it was the quarter
     assert full.reaction == pytest.approx(quarter.reaction, rel=1e-3)

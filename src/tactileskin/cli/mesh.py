@@ -50,6 +50,10 @@ def command(out, cell, scene_opts):
         table.add_row("min / mean SICN (shape)", f"{q['min_sicn']:.3f} / {q['mean_sicn']:.3f}")
     table.add_row("min scaled Jacobian (curved)", f"{q['min_scaled_jacobian']:.3f}")
     if scene.skin_kind.fixes_thickness:  # a user's file: no CAD section to compare with
+        # the measures below are the model's: a symmetric STEP is cut to its half or quarter
+        table.add_row("model", {(True, True): "quarter (x >= 0, z >= 0)", (True, False): "half (x >= 0)",
+                                (False, True): "half (z >= 0)", (False, False): "whole"}[
+                                    (sm.halved, bool(sm.z_symmetric))])
         table.add_row("bonded boundary measure (mm^%d)" % (sm.dim - 1), f"{sm.boundary_measure('bone_interface'):.6g}")
     else:
         # 3D: over the bonded surface's own z extent (a dome's bone_interface ends where its

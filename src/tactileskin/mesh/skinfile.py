@@ -17,7 +17,10 @@ curved onto the CAD (size `mesh_size`, `mesh_size / refinement` in a ball around
 point where indenters start). Each CAD face is one group; a face is bonded when every
 facet satisfies the rule `skin_bonded`: "normal:-y" (outward normal within 10 degrees of
 -y; "normal:+x:5" for another axis and tolerance) or "plane:y=0" (every vertex on that plane
-within 1e-6 of the part size); every other face is `outer_surface`.
+within 1e-6 of the part size); every other face is `outer_surface`. A STEP solid that is its own
+mirror image about x = 0 (z = 0) (`step_symmetry`) is meshed as its half x >= 0 (z >= 0) where
+the caller asks (`mesh_step(halve=...)`: skins.file, for an indenter symmetric the same way):
+the cut faces are `symmetry` (`symmetry_z`, held as `end_back`), as in a .msh half.
 
 Units: a part whose bounding box is smaller than 0.1 mm or larger than 1 m is refused (a
 file in metres or micrometres).
@@ -26,6 +29,7 @@ file in metres or micrometres).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import logging
 import re
@@ -46,6 +50,13 @@ BONDED_NAMES = ("bone_interface", "bonded", "board", "bone", "base", "fixed")
 OUTER_NAMES = ("outer_surface", "outer", "contact", "skin_surface", "top")
 SIZE_RANGE = (0.1, 1000.0)  # mm: the largest bounding-box side of a plausible skin
 DEFAULT_RULE = "normal:-y"
+# a STEP solid is mirror-symmetric about x = 0 (z = 0) when the volume of its symmetric
+# difference with its mirror image is below this fraction of its volume: an exact mirror image
+# leaves none (0.0 measured on domed blocks), while a side face 1e-5 mm off its mirror place on
+# a 20 mm pad leaves 1e-6 (2 x 1e-5 / 20): far below the cells (>= 0.05 mm) and print
+# tolerances, far above OCC's 1e-7 mm modelling precision; a 12 mm domed block moved 0.001 mm
+# along x (2.4e-4) already stays whole
+SYMMETRY_TOL = 1e-6
 RULE_FORMS = "'normal:-y' (optionally ':TOL_DEG'), 'normal:+x', ... or 'plane:y=0' (x, y or z)"
 _VALID_FILE = "a gmsh .msh with named physical groups or a STEP (.step/.stp) of the skin solid, in mm"
 
@@ -307,19 +318,75 @@ def _import_step(gmsh, path: Path) -> None:
     check_units(path, *np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2))
 
 
+def step_symmetry(path, bonded=None) -> tuple[bool, bool]:
+    """(about x = 0, about z = 0): a STEP skin solid is its own mirror image about the plane
+    (symmetric difference below SYMMETRY_TOL of its volume) and so are its bonded faces (the
+    rule `bonded` picks mirror images of bonded faces unless it names that axis: 'normal:+x',
+    'plane:x=1' bond one side only). Cached by the file's bytes."""
+    kind, a, _ = parse_rule(bonded)
+    axis = int(np.argmax(np.abs(a))) if kind == "normal" else a
+    solid = _solid_symmetry(str(Path(path).resolve()), file_digest(path))
+    return solid[0] and axis != 0, solid[1] and axis != 2
+
+
+@functools.lru_cache(maxsize=16)
+def _solid_symmetry(path: str, digest: str) -> tuple[bool, bool]:
+    out = []
+    with _gmsh.session("skinstep-symmetry", {"skin_file": path}) as gmsh:
+        _import_step(gmsh, Path(path))
+        occ = gmsh.model.occ
+        vol = gmsh.model.getEntities(3)
+        v = occ.getMass(*vol[0])
+        for plane in ((1, 0, 0, 0), (0, 0, 1, 0)):
+            image = occ.copy(vol)
+            occ.mirror(image, *plane)
+            try:  # |A - B| = |B - A| (equal volumes): the symmetric difference is twice it
+                rest, _ = occ.cut(vol, image, removeObject=False, removeTool=True)
+            except Exception as e:  # OCC failed on the boolean: model it whole, as it is
+                logger.warning("STEP skin %s: no symmetry test about the plane %s (OCC: %s): meshed whole",
+                               Path(path).name, "xz"[plane[2]], e)
+                out.append(False)
+                continue
+            diff = 2.0 * sum(occ.getMass(*e) for e in rest if e[0] == 3)
+            occ.remove(rest, recursive=True)
+            out.append(diff <= SYMMETRY_TOL * v)
+            logger.info("STEP skin %s: symmetric difference with its mirror image about %s = 0: %.3g of its "
+                        "volume (symmetric below %g)", Path(path).name, "xz"[plane[2]], diff / v, SYMMETRY_TOL)
+    return out[0], out[1]
+
+
+def _keep_half(gmsh, halve, lo, hi) -> None:
+    """Cut the model's one volume to x >= 0 (halve[0]) and z >= 0 (halve[1])."""
+    occ = gmsh.model.occ
+    pad = 1.0 + float(np.max(hi - lo))
+    a = [0.0 if halve[0] else lo[0] - pad, lo[1] - pad, 0.0 if halve[1] else lo[2] - pad]
+    box = occ.addBox(*a, *(hi + pad - np.array(a)))
+    out, _ = occ.intersect(gmsh.model.getEntities(3), [(3, box)])
+    occ.synchronize()
+    if len([e for e in out if e[0] == 3]) != 1:
+        raise MeshError(f"cutting the STEP skin at {' and '.join(n for n, h in zip(('x = 0', 'z = 0'), halve) if h)}"
+                        f" left {len(out)} volumes, not one")
+
+
 def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float = 1.0, order: int = 2,
-              centre=None, radius: float | None = None) -> SkinMesh:
+              centre=None, radius: float | None = None, halve=(False, False)) -> SkinMesh:
     """Mesh a STEP skin solid (module docstring); `centre`, `radius`: the fine ball (default
     around the top of the bounding box on x = z = 0, a fifth of the part's size); mesh_size
-    None: an eighth of the part's size."""
+    None: an eighth of the part's size. halve: (x, z) mesh the part x >= 0 (z >= 0) only, its
+    cut faces `symmetry` (`end_back`, z_symmetric): for a solid that `step_symmetry` finds
+    symmetric (the caller's check); sizes default from the whole solid."""
     path = Path(path)
     parse_rule(bonded)  # a bad rule fails before any CAD work
-    params = {"skin_file": str(path), "mesh_size": mesh_size, "refinement": refinement, "order": order}
+    halve = (bool(halve[0]), bool(halve[1]))
+    params = {"skin_file": str(path), "mesh_size": mesh_size, "refinement": refinement, "order": order,
+              "halve": halve}
     t0 = time.perf_counter()
     with _gmsh.session("skinstep", params) as gmsh:
         _import_step(gmsh, path)
         lo, hi = np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2)
         size = float(np.max(hi - lo))
+        if any(halve):
+            _keep_half(gmsh, halve, lo, hi)
         mesh_size = size / 8.0 if mesh_size is None else mesh_size
         centre = (0.0, hi[1], 0.0) if centre is None else centre
         radius = 0.2 * size if radius is None else radius
@@ -327,14 +394,18 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
         bonded_tags = []
 
         def classify(mesh, faces):
-            hits = classify_by_rule(mesh, faces, bonded, size)
+            # the cut faces (every vertex on the plane) first: the rule picks among the skin's own
+            cut = {name: [f for f in faces if np.all(np.abs(mesh.p[k, mesh.facets[:, faces[f]]]) <= 1e-9 * size)]
+                   for name, k, h in (("symmetry", 0, halve[0]), ("end_back", 2, halve[1])) if h}
+            own = {f: v for f, v in faces.items() if not any(f in c for c in cut.values())}
+            hits = classify_by_rule(mesh, own, bonded, size)
             bonded_tags.extend(hits)
             if not hits:
                 kind = parse_rule(bonded)[0]
                 raise ParameterError("skin_bonded", bonded or DEFAULT_RULE,
                                      f"a rule that some of the {len(faces)} faces of {path.name} satisfy ({RULE_FORMS})",
                                      f"no face matches the {kind} rule")
-            return {"bone_interface": hits, "outer_surface": [f for f in faces if f not in hits]}
+            return {"bone_interface": hits, "outer_surface": [f for f in own if f not in hits], **cut}
 
         mesh, boundaries, quality = mesh_occ(gmsh, f"STEP skin {path.name}", mesh_size=mesh_size,
                                              fine=mesh_size / refinement, centre=centre, radius=radius,
@@ -344,8 +415,12 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
                              "every face of the solid matched it")
     quality["wall_s"] = time.perf_counter() - t0
     check_quality(quality, {"coarse": mesh_size})
-    sm = SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality)
-    sm.bonded_faces = tuple(bonded_tags)  # CAD face tags (the same on a re-import): distance_to_faces
+    for name, h in (("symmetry", halve[0]), ("end_back", halve[1])):
+        if h and name not in boundaries:
+            raise MeshError(f"cutting the STEP skin {path.name} left no face on its symmetry plane ({name})")
+    sm = SkinMesh(mesh=mesh, boundaries=boundaries, dim=3, quality=quality, z_symmetric=halve[1])
+    # CAD face tags (the same on a re-import of the whole solid, not of a cut one): distance_to_faces
+    sm.bonded_faces = None if any(halve) else tuple(bonded_tags)
     return sm
 
 

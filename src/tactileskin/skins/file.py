@@ -19,7 +19,10 @@ profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth str
 from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
 first face under the contact surface), normal +y; both surfaces read on the analysed mesh's
 boundary facets (quadratic on a P2 .msh, as the solver's; a STEP's analysis mesh: chords).
-The model is the half x >= 0 only when the file names a `symmetry` group.
+The model is the half x >= 0 when a .msh names a `symmetry` group, or when a STEP solid and its
+bonded faces are mirror-symmetric about x = 0 (mesh.skinfile.step_symmetry) and so is the
+indenter (geometry.indenters.indenter_symmetry): the solid is cut there; likewise z = 0 (3D).
+The geometry checks above read the whole solid.
 """
 
 from __future__ import annotations
@@ -598,7 +601,22 @@ class FileSkin(Skin):
         return {"skin_file": file_digest(scene.skin_file)}
 
     @classmethod
-    def build_mesh(cls, scene, *, cell: str = "tri", mesh_size=None, refinement=None, order=None, **_):
+    def step_halves(cls, scene) -> tuple[bool, bool]:
+        """(x, z): cut a STEP skin at x = 0 (z = 0), where it and the scene's indenter are both
+        mirror-symmetric about the plane (the indenter's test first: it costs no CAD work)."""
+        from tactileskin.geometry.indenters import indenter_symmetry
+        from tactileskin.mesh import skinfile
+
+        ind = indenter_symmetry(scene)
+        if not any(ind):
+            return False, False
+        solid = skinfile.step_symmetry(scene.skin_file, scene.skin_bonded)
+        return ind[0] and solid[0], ind[1] and solid[1]
+
+    @classmethod
+    def build_mesh(cls, scene, *, cell: str = "tri", mesh_size=None, refinement=None, order=None,
+                   use_symmetry: bool = True, **_):
+        """use_symmetry=False: a STEP skin whole even where it and the indenter are symmetric."""
         from tactileskin.mesh import skinfile
 
         if cell != "tri":
@@ -613,7 +631,8 @@ class FileSkin(Skin):
             r = scene.refinement if refinement is None else refinement
             sm = skinfile.mesh_step(scene.skin_file, bonded=scene.skin_bonded, mesh_size=h, refinement=r,
                                     order=order, centre=geo.top_point,
-                                    radius=max(2.0 * geo.thickness, 3.0 * h / r))
+                                    radius=max(2.0 * geo.thickness, 3.0 * h / r),
+                                    halve=cls.step_halves(scene) if use_symmetry else (False, False))
         sm.section = FileSection(geo)
         sm.length = cls.sample_length(scene) if sm.dim == 3 else None
         return sm

@@ -1,0 +1,90 @@
+"""A STEP skin that is its own mirror image about x = 0 and z = 0 is cut there and solved as its
+quarter (mesh.skinfile.step_symmetry, mesh_step(halve=...)) where the indenter is symmetric the
+same way, as a .msh quarter is; an almost symmetric skin or an asymmetric indenter keeps the
+whole model."""
+
+import math
+
+import pytest
+
+pytest.importorskip("build123d")
+
+import build123d as bd  # noqa: E402
+
+from tactileskin.fe import solve  # noqa: E402
+from tactileskin.mesh import build_mesh  # noqa: E402
+from tactileskin.mesh.skinfile import step_symmetry  # noqa: E402
+from tactileskin.scene import Scene  # noqa: E402
+
+W, H, R = 8.0, 2.0, 12.0  # block x and z, thickness on the axis, the dome's sphere radius (mm)
+
+
+def _dome(path, dx=0.0):
+    """A block x, z in [-4, 4] (moved dx along x), y in [0, 2] under a sphere of radius 12 whose
+    top is on the axis (2 mm there, 0.67 mm at the corners), bonded on y = 0."""
+    base = bd.Pos(dx, 0, 0) * bd.Box(W, H, W, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    bd.export_step(base & bd.Pos(0, H - R, 0) * bd.Sphere(R), str(path))
+    return str(path)
+
+
+KW = dict(skin="file", viscoelastic=False, mesh_size=1.0, refinement=2.0)
+
+
+def test_a_symmetric_domed_step_is_solved_as_its_quarter_like_the_whole(tmp_path):
+    """The quarter (cut at x = 0 and z = 0) and the whole block under a sphere agree within their
+    meshes' differences: the two meshes differ (the quarter has nodes on the axis planes, where
+    the peak and the z = 0 profile are read; the whole model's cells cross them), and the whole
+    model alone moves by 3.1 % (reaction), 6.7 % (peak) and 1.3 % (span) between h = 0.9, 1.0 and
+    1.1 mm; the quarter reads 2.2 %, 2.8 % and 3.7 % above it at h = 1 (TOL)."""
+    sc = Scene(skin_file=_dome(tmp_path / "dome.step"), indenter="sphere", indenter_radius=1.5, depth=0.1, **KW)
+    quarter, whole = build_mesh(sc), build_mesh(sc, use_symmetry=False)
+    assert quarter.halved and quarter.z_symmetric and not whole.halved and not whole.z_symmetric
+    assert {"symmetry", "end_back"} <= set(quarter.boundaries) and "symmetry_z" not in quarter.boundaries
+    # the cut faces are the symmetry planes, not bonded or contact faces: a quarter of each
+    assert quarter.measure() == pytest.approx(whole.measure() / 4.0, rel=1e-6)
+    assert quarter.boundary_measure("bone_interface") == pytest.approx(W * W / 4.0, rel=1e-9)
+    # each cut face is the dome's section z in [0, 4] under y = H - R + sqrt(R^2 - z^2), 7.0955 mm^2
+    # (the P2 faces curved onto the CAD: 1e-4)
+    cut = 0.5 * W / 2 * math.sqrt(R**2 - (W / 2) ** 2) + 0.5 * R**2 * math.asin(W / 2 / R) + (H - R) * W / 2
+    assert quarter.boundary_measure("symmetry") == pytest.approx(cut, rel=1e-4)
+    assert quarter.boundary_measure("end_back") == pytest.approx(cut, rel=1e-4)
+    a, b = solve(sc, mesh=quarter), solve(sc, mesh=whole)
+    assert a.stats["dofs"] < 0.4 * b.stats["dofs"]
+    assert a.status == b.status == "ok" and a.sides == 1 and b.sides == 2
+    TOL = 0.05
+    assert a.reaction == pytest.approx(b.reaction, rel=TOL)
+    assert a.peak == pytest.approx(b.peak, rel=TOL)
+    assert a.span == pytest.approx(b.span, rel=TOL)
+
+
+def test_an_almost_symmetric_step_stays_whole_on_that_axis(tmp_path):
+    """A block moved 0.001 mm along x (its symmetric difference with its mirror image about x = 0
+    is 2.4e-4 of its volume, above SYMMETRY_TOL = 1e-6) is halved in z only; a bonded-face rule
+    naming an axis bonds one side only: no cut across it."""
+    exact, off = _dome(tmp_path / "exact.step"), _dome(tmp_path / "off.step", dx=0.001)
+    assert step_symmetry(exact) == (True, True)
+    assert step_symmetry(off) == (False, True)
+    assert step_symmetry(exact, "normal:-z") == (True, False)
+    assert step_symmetry(exact, "plane:x=0") == (False, True)
+    sm = build_mesh(Scene(skin_file=off, indenter="sphere", indenter_radius=1.5, depth=0.1, **KW))
+    assert not sm.halved and sm.z_symmetric and "symmetry" not in sm.boundaries
+
+
+def test_an_asymmetric_indenter_keeps_the_whole_step(tmp_path):
+    """Braille ⠑ (dots at (-1.17, 1.17) and (1.17, -1.17) mm: symmetric about neither plane) on
+    the symmetric block: the whole model, as before the cut existed."""
+    sc = Scene(skin_file=_dome(tmp_path / "dome.step"), indenter="braille", braille_text="⠑", depth=0.3, **KW)
+    sm = build_mesh(sc)
+    assert not sm.halved and not sm.z_symmetric
+    assert sm.boundary_measure("bone_interface") == pytest.approx(W * W, rel=1e-9)
+
+
+def test_the_mesh_command_says_a_step_skin_is_modelled_as_its_quarter(tmp_path, capsys):
+    """Its bonded measure is the quarter's (16 of the block's 64 mm^2): the table says so."""
+    from tactileskin.cli import main
+
+    path = _dome(tmp_path / "dome.step")
+    assert main(["mesh", "--skin-file", path, "-i", "sphere", "--indenter-radius", "1.5", "--mesh-size", "1"]) == 0
+    out = " ".join(capsys.readouterr().out.split())  # the table wraps at the terminal's width
+    assert "model │ quarter (x >= 0, z >= 0) │" in out
+    assert "bonded boundary measure (mm^2) │ 16 │" in out
