@@ -592,7 +592,11 @@ class FileSkin(Skin):
         import dataclasses
 
         facets, kind = boundary_facets(skinmesh)
-        return FileCoordinates(dataclasses.replace(geometry(scene), facets=facets, facet_kind=kind))
+        # the halves of the model solved: a symmetric STEP is cut at x = 0 / z = 0 for its solve
+        # only, so its sensors on the other side read their mirror images there
+        return FileCoordinates(dataclasses.replace(geometry(scene), facets=facets, facet_kind=kind,
+                                                   symmetric=bool(skinmesh.halved),
+                                                   z_symmetric=bool(getattr(skinmesh, "z_symmetric", False))))
 
     @classmethod
     def cache_content(cls, scene) -> dict:
