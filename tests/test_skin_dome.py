@@ -27,8 +27,6 @@ def test_scene_fields():
         Scene(skin="dome", dome_tip=1.0)
     with pytest.raises(ParameterError, match="dome_length.*only with skin = dome"):
         Scene(dome_length=5.0)
-    with pytest.raises(ParameterError, match="sensors.*none with skin = dome"):
-        Scene(skin="dome", sensors=[{"kind": "points", "s": [0.5], "depth": 0.5}])
 
 
 def test_parts_are_valid_solids_with_the_analytic_volume():
@@ -221,3 +219,117 @@ def test_the_default_dome_molds_step_files_reread_as_their_solids(tmp_path):
         back = bd.import_step(tmp_path / f"{name}.step")
         assert len(back.solids()) == 1 and back.is_valid, name
         assert cad_volume(back) == pytest.approx(cad_volume(solid), rel=1e-6), name
+
+
+def test_dome_sensor_sites_stand_on_vertical_lines_through_the_exact_surfaces():
+    """The dome's sensors use the file skin's convention (skins.dome.DomeCoordinates; every
+    layout was refused): s = x, z as given, depth straight down from the outer surface at
+    (x, z), height straight up from the bone there, normal +y, tangents x and z. The scene
+    places them on the exact surfaces: the ellipse (a, b) / bone (a - t, b - t) for z <= 0, the
+    half ellipsoids of semi-axis c / c - t along z on the tip (z > 0), where the vertical line
+    is not the surface's normal (the skin there is thicker than t along it)."""
+    from tactileskin import sensors
+    from tactileskin.mesh.dome import outer_level
+
+    t, c = 2.0, 8.0
+    lays = [{"name": "bone", "kind": "grid", "s": [-3.0, 4.0], "z": [-9.0, 3.0], "pitch": [1.0], "height": 0.0},
+            {"name": "top", "kind": "grid", "s": [0.0, 4.0], "z": [-4.0, 6.0], "pitch": [1.0], "depth": 0.0},
+            {"name": "mid", "kind": "points", "s": [0.0, 3.0, 3.0], "z": [-2.0, -2.0, 4.0], "height": 0.5},
+            {"name": "side", "kind": "points", "s": [7.5], "z": [-2.0], "depth": 1.0}]
+    sc = Scene(skin="dome", thickness=t, dome_tip=c, sensors=lays)
+    st = sensors.sites_for(sc)
+    x, y, z = st.xyz.T
+    of = np.array(st.layout)
+    assert np.allclose(x, st.s) and np.allclose(z, st.z)  # s = x; the half x < 0 by reflection
+    p = np.vstack([np.abs(x), y, z])
+    assert np.abs(outer_level(p[:, of == "bone"], A - t, B - t, c - t)).max() < 1e-12
+    assert np.abs(outer_level(p[:, of == "top"], A, B, c)).max() < 1e-12
+    # 0.5 mm straight up from the bone: at (0, -2) t - 0.5 under the pulp; at (3, 4), on the
+    # tip, the bone's cap is at y = 5 sqrt(1 - (3/6)^2 - (4/6)^2) = 2.764, the surface at
+    # 7 sqrt(1 - (3/8)^2 - (4/8)^2) = 5.464: the sensor 2.200 mm below it
+    i = {k: n for n, k in enumerate(st.ids)}
+    bone = 5.0 * math.sqrt(1 - 0.25 - 4 / 9)
+    assert y[i["mid-0"]] == pytest.approx(B - t + 0.5) and y[i["mid-2"]] == pytest.approx(bone + 0.5)
+    assert st.depth[i["mid-2"]] == pytest.approx(7.0 * math.sqrt(1 - 9 / 64 - 0.25) - bone - 0.5)
+    # over the flank (x > a - t: no bone under it) a depth is taken, along -y from the surface
+    assert y[i["side-0"]] == pytest.approx(B * math.sqrt(1 - (7.5 / A) ** 2) - 1.0)
+    assert np.allclose(st.normal, [0, 1, 0]) and np.allclose(st.t1, [1, 0, 0]) and np.allclose(st.t2, [0, 0, 1])
+
+
+@pytest.mark.parametrize("layout,match", [
+    # no bone under the line: the flank (x > a - t) and the last t of the tip (z > c - t)
+    ({"s": [6.5], "z": [-2.0], "height": 0.0}, r"'x' height=0.0 .*a depth instead.*x-0: at s = 6.5, z = -2 mm"),
+    ({"s": [0.0], "z": [7.0], "height": 0.2}, r"'x' height=0.2 .*a depth instead.*at s = 0, z = 7 mm"),
+    ({"s": [0.0, 3.0], "z": [-1.0], "depth": 2.1}, r"'x' depth=2.1 .*\[0, 2\] mm at s = 0, z = -1 mm.*x-0"),
+    ({"s": [1.0], "z": [8.5], "depth": 0.1}, r"'x' s, z=\(1.0, 8.5\) .*z in \[-10, 8\] mm.*x-0: no skin"),
+    ({"s": [1.0], "z": [-10.5], "depth": 0.1}, r"'x' s, z=\(1.0, -10.5\)"),
+    ({"s": [8.2], "depth": 0.1}, r"'x' s, z=\(8.2, 0.0\) .*s in \[-8, 8\]"),
+    ({"s": [0.0], "z": [-9.8], "depth": 0.5, "taxel": 1.0}, r"taxel/2.*taxel edge at s = -0.5, z = -10.3 mm"),
+])
+def test_a_sensor_outside_the_dome_is_refused_naming_the_layout(layout, match):
+    with pytest.raises(ParameterError, match=match):
+        Scene(skin="dome", thickness=2.0, sensors=[{"name": "x", **layout}])
+
+
+def test_a_dome_bone_sensor_reads_the_bone_map_there():
+    """A sensor at height 0 under a sphere on the pulp (half on the tip) reads the bone map's
+    pressure at that point: placed on the solved mesh's curved bone (within 1e-3 mm of the
+    exact surface at h = 2: 1.1e-4 measured here, 4.8e-4 in test_skin_file_sensors), the same
+    nodal field
+    (fe.output._fit_on_path fits the stresses and the pressure at the bone's nodes alike)
+    interpolated in the element there. The sensors stand at the map's own grid points (s on
+    the exact bone ellipse -> x), so the only difference is that position: 5e-4 mm times the
+    map's largest slope dP/ds (measured 1.4e-7 MPa of 0.025, the tolerance 8e-6)."""
+    from tactileskin.fe import solve
+
+    kw = dict(skin="dome", thickness=2.0, indenter="sphere", indenter_radius=3.0, depth=0.3,
+              viscoelastic=False, mesh_size=2.0, refinement=2.0)
+    plain = Scene(**kw)
+    sm = build_mesh(plain)
+    bm = solve(plain, mesh=sm).bone_map
+    sec = plain.section()
+    i = np.flatnonzero(bm.s <= 4.0)
+    rows = [len(bm.z) - 1, len(bm.z) - 5, len(bm.z) // 2]  # z = 0 (the profile), near it, mid-finger
+    x = sec.point_at_s(bm.s[i])[:, 0]
+    lays = [{"name": f"r{j}", "kind": "points", "s": x.tolist(), "z": [float(bm.z[j])], "height": 0.0}
+            for j in rows] + [{"name": "tip", "kind": "line", "s": [0.0, 4.0], "z": [3.0], "pitch": [1.0],
+                               "height": 0.0}]
+    res = solve(Scene(**kw, sensors=lays), mesh=sm)
+    assert np.array_equal(res.bone_map.pressure, bm.pressure)  # the same solve
+    assert np.array_equal(res.pressure, bm.row(0.0))            # whose profile is the map's z = 0 row
+    for j in rows:
+        read = res.sensors.select(f"r{j}")
+        slope = np.abs(np.diff(bm.pressure[j]) / np.diff(bm.s)).max()
+        assert np.allclose(read.pressure, bm.pressure[j, i], rtol=0, atol=5e-4 * slope + 1e-12), bm.z[j]
+    assert res.sensors.select(f"r{rows[0]}").pressure.max() > 0.01  # the press reached the bone
+    # on the mesh's bone: the ellipse for z <= 0, the ellipsoid's cap (bone_tip) on the tip
+    from tactileskin.mesh.dome import outer_level
+
+    x, y, z = res.sensors.xyz.T
+    ax = np.array([A - 2.0, B - 2.0, 6.0])[:, None]
+    grad = 2.0 * np.vstack([x, y, np.maximum(z, 0.0)]) / ax ** 2
+    # the distance to the exact bone, to first order: |level| / |grad level|
+    dist = np.abs(outer_level(np.vstack([x, y, z]), *ax[:, 0])) / np.linalg.norm(grad, axis=0)
+    assert dist.max() < 1e-3 and (z > 0).sum() == 5
+
+
+def test_the_dome_sensor_layouts_enter_the_cache_key():
+    from tactileskin.cache import cache_key
+
+    lay = {"name": "d", "kind": "points", "s": [1.0], "z": [-2.0], "depth": 0.5}
+    keys = {cache_key(Scene(skin="dome", thickness=2.0, sensors=s))
+            for s in ([], [lay], [{**lay, "depth": 0.6}], [{**lay, "z": [3.0]}],
+                      [{**lay, "depth": None, "height": 0.5}])}
+    assert len(keys) == 5
+
+
+def test_the_cli_refuses_a_sensor_outside_the_dome_in_one_line(tmp_path, capsys):
+    from tactileskin.cli import main
+
+    (tmp_path / "s.toml").write_text('[[sensors]]\nname = "tipbone"\ns = [0.0]\nz = [7.0]\nheight = 0.0\n')
+    rc = main(["solve", "--skin", "dome", "-t", "2", "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
+               "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "sensor layout 'tipbone' height=0" in err and "tipbone-0" in err and "z = 7 mm" in err
+    assert not (tmp_path / "o").exists()

@@ -10,8 +10,18 @@ the bone map's surface), `bone_tip` (the bone under the dome, fixed), `outer_sur
 Indenters start on the pulp line (x = 0, y = b), centred on z = 0 where the dome begins: a
 sphere or a Braille dot there presses half on the finger and half on the dome. s is the arc
 length along the bone's ellipse (a - t, b - t) from its top, by the angle of (x, y) (so it
-also parametrises the bone under the dome); the 3D profile's section plane is z = 0. Sensor
-layouts are refused (no sensor frames yet).
+also parametrises the bone under the dome); the 3D profile's section plane is z = 0.
+
+Sensors (`DomeCoordinates`): a user's file skin's vertical columns (skins.file.FileCoordinates),
+not the fingertip's normals: s = x, z as given (z in [-dome_length, dome_tip]), depth straight
+down (-y) from the outer surface at (x, z), height straight up (+y) from the bone there, normal
++y, tangents x and z. The bone is the outer body shrunk by t per semi-axis, not its offset (no
+common normal from the surface to the bone), and on the tip the surface normal leaves the plane
+z = const, where sensors.resolve keeps its frames; a vertical line is one answer everywhere. On
+the tip (z > 0) the line meets the bone's cap (`bone_tip`, bonded) while |x| < (a - t) sqrt(1 -
+(z / (c - t))^2); past it (the flanks, the last t of the tip) no bone is under it: a height is
+refused there and a depth runs through to the skin's underside. The scene checks the layouts on
+the exact surfaces, the solve places them on the mesh it solves (mesh_coordinates).
 """
 
 from __future__ import annotations
@@ -24,6 +34,7 @@ import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
 from tactileskin.skins.base import Skin
+from tactileskin.skins.file import FileCoordinates, FileGeometry, boundary_facets
 from tactileskin.skins.registry import register
 
 DEFAULT_LENGTH = 10.0
@@ -169,7 +180,7 @@ class DomeSkin(Skin):
                                  f"section's {a:g} / {b:g} mm thins the skin between pulp and tip")
         return {"thickness": t,
                 "dome_length": check_range("dome_length", length, *LENGTH, unit="mm"),
-                "dome_tip": c, "dim": _dim3(scene), "sensors": _no_sensors(scene)}
+                "dome_tip": c, "dim": _dim3(scene)}
 
     @classmethod
     def section(cls, scene) -> DomeSection:
@@ -181,8 +192,21 @@ class DomeSkin(Skin):
         return 2.0 * max(float(scene.dome_length), float(scene.dome_tip)) + 2.0
 
     @classmethod
-    def coordinates(cls, scene):
-        raise ParameterError("sensors", "a layout", "none with skin = dome", "the dome skin has no sensor frames yet")
+    def coordinates(cls, scene) -> "DomeCoordinates":
+        return DomeCoordinates(cls.section(scene))
+
+    @classmethod
+    def mesh_coordinates(cls, scene, skinmesh):
+        """The file skin's coordinates on the mesh solved: its P2 faces lie up to ~5e-4 mm off
+        the exact surfaces (h = 2), so a bone sensor placed on the exact bone could lie inside
+        the meshed bone and fail to be read."""
+        sec = cls.section(scene)
+        facets, kind = boundary_facets(skinmesh)
+        X = skinmesh.mesh.doflocs
+        geo = FileGeometry(dim=3, top_point=(0.0, sec.b, 0.0), thickness=sec.thickness,
+                           lo=tuple(X.min(axis=1).tolist()), hi=tuple(X.max(axis=1).tolist()),
+                           outer_xy=np.zeros((0, 2)), symmetric=True, facets=facets, facet_kind=kind)
+        return FileCoordinates(geo)
 
     @classmethod
     def build_mesh(cls, scene, *, cell: str = "tri", mesh_size=None, refinement=None, order=None, **_):
@@ -210,8 +234,32 @@ def _dim3(scene) -> int:
     return 3  # a rounded tip is 3D (Scene's default dim 2 becomes 3)
 
 
-def _no_sensors(scene):
-    if scene.sensors:
-        raise ParameterError("sensors", f"{len(scene.sensors)} layout(s)", "none with skin = dome",
-                             "the dome skin has no sensor frames yet")
-    return scene.sensors
+class DomeCoordinates(FileCoordinates):
+    """The dome's sensor coordinates for the scene's check (FileCoordinates' vertical columns,
+    read on the exact surfaces instead of a mesh's faces): the line through (x, z) meets the
+    outer body's upper surface (the contact surface) at y = b sqrt(k - (x/a)^2), k = 1 -
+    (max(z, 0)/c)^2, then the bone's (bonded) where it passes over the bone, else the skin's
+    underside (the outer surface's lower half)."""
+
+    def __init__(self, sec: DomeSection):
+        self.sec, self.dim = sec, 3
+        self.thickness = float(sec.thickness)
+        self.x_top = 0.0
+        self.tol = 1e-7 * max(sec.a, sec.b, sec.c, sec.length)  # FileCoordinates.tol
+        self.s_range = (-sec.a, sec.a)
+        self.s_max = float(sec.a)
+        self.z_range = (-sec.length, sec.c)
+
+    def column(self, s, z=None) -> dict:
+        sec, t = self.sec, self.sec.thickness
+        x = np.abs(np.atleast_1d(np.asarray(s, float)))  # the half model answers for x < 0
+        z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), x.shape)
+        zt = np.maximum(z, 0.0)
+        out = 1.0 - (zt / sec.c) ** 2 - (x / sec.a) ** 2
+        bone = 1.0 - (zt / (sec.c - t)) ** 2 - (x / (sec.a - t)) ** 2
+        top = sec.b * np.sqrt(np.maximum(out, 0.0))
+        on = (z >= -sec.length - self.tol) & (z <= sec.c + self.tol) & (top > self.tol)
+        bonded = on & (bone >= 0.0)
+        floor = np.where(bonded, (sec.b - t) * np.sqrt(np.maximum(bone, 0.0)), -top)
+        top, floor = np.where(on, top, np.nan), np.where(on, floor, np.nan)
+        return {"top": top, "outer": top, "floor": floor, "bonded": bonded}
