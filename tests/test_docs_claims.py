@@ -155,3 +155,23 @@ def test_hard_cases_p1_note_says_the_scene_is_refused():
           formulation="displacement")
     doc = _text("docs/hard_cases.md")
     assert "*Resolved:* `Scene` refuses `order=1` with the mixed formulation" in doc
+
+
+def test_readme_dome_sensor_numbers_are_the_dome_coordinates():
+    """The README's dome sentence said layouts were not taken; it now gives the sensors' s = x
+    against the profile's bone arc length, and the skin's thickness along a vertical line,
+    which the dome's own coordinates must reproduce."""
+    import numpy as np
+
+    from tactileskin.scene import Scene
+    from tactileskin.sensors import coordinates_for
+
+    sc = Scene(skin="dome", thickness=2.0)
+    sec, col = sc.section(), coordinates_for(sc).column(np.array([0.0, 1.0, 3.0]), np.zeros(3))
+    s3 = sec.s_of_point([[3.0, (sec.b - 2.0) * np.sqrt(1 - (3.0 / (sec.a - 2.0)) ** 2)]])[0]
+    thick = col["top"] - col["floor"]
+    tip = coordinates_for(sc).column(np.zeros(1), np.array([sec.c - 2.0]))
+    readme = _text("README.md")
+    assert f"x = 3 mm is s = {s3:.2f} mm at t = 2" in readme and thick[0] == 2.0
+    assert f"({thick[1]:.3f} mm at x = 1, {thick[2]:.3f} at x = 3, t = 2)" in readme
+    assert f"thicker than t ({tip['top'][0] - tip['floor'][0]:.1f} mm on the axis at z = c - t, t = 2)" in readme
