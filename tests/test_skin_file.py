@@ -226,6 +226,19 @@ def test_step_block_bonded_by_rule(tmp_path):
         Scene(skin="file", skin_file=str(path), skin_bonded="bottom")
 
 
+@pytest.mark.parametrize("rule", ["normal:-y:.", "normal:-y:1.2.3"])
+def test_a_bonded_rule_with_a_malformed_tolerance_is_one_line(tmp_path, capsys, rule):
+    """The rule's tolerance took any digits and dots: '--skin-bonded normal:-y:1.2.3' ended in
+    float()'s ValueError traceback (exit 1); it is refused naming skin_bonded and the range."""
+    from tactileskin.cli import main
+
+    path = _step_block(tmp_path / "block.step")
+    assert main(["mesh", "--skin-file", str(path), "--skin-bonded", rule, "--out", str(tmp_path / "m.msh")]) == 2
+    err = capsys.readouterr().err
+    assert f"skin_bonded={rule!r}" in err and "(0, 90) degrees" in err and "Traceback" not in err
+    assert not (tmp_path / "m.msh").exists()
+
+
 def test_open_step_is_refused(tmp_path):
     path = _step_block(tmp_path / "open.step", open_=True)
     with pytest.raises(ParameterError, match="skin_file.*one closed solid.*not closed"):

@@ -226,7 +226,10 @@ def parse_rule(rule):
     if m:
         v = np.zeros(3)
         v["xyz".index(m.group(2))] = -1.0 if m.group(1) == "-" else 1.0
-        tol = float(m.group(3)) if m.group(3) else 10.0
+        try:
+            tol = float(m.group(3)) if m.group(3) else 10.0
+        except ValueError:  # '.', '1.2.3' (digits and dots): refused below as out of range, no traceback
+            tol = float("nan")
         if not 0.0 < tol < 90.0:
             raise ParameterError("skin_bonded", rule, "a tolerance in (0, 90) degrees")
         return "normal", v, tol
