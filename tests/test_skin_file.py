@@ -321,7 +321,7 @@ def test_a_scene_files_skin_file_implies_the_file_skin_as_the_option_does(tmp_pa
     assert Scene.from_toml(tmp_path / "s.toml").skin == "file"
 
 
-def _gmsh_polygon(path, pts, groups, h=0.5):
+def _gmsh_polygon(path, pts, groups, h=0.5, order=1):
     """A 2D polygon skin; `groups`: {name: [edge indices]} (edge k runs from pts[k] to pts[k+1])."""
     import gmsh
 
@@ -338,6 +338,7 @@ def _gmsh_polygon(path, pts, groups, h=0.5):
         gmsh.model.addPhysicalGroup(2, [1], name="skin")
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
         gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(order)
         gmsh.write(str(path))
     finally:
         gmsh.finalize()
@@ -545,41 +546,58 @@ def test_asking_2d_of_a_step_skin_says_how_to_get_a_2d_section(tmp_path, capsys)
     assert not (tmp_path / "out").exists()
 
 
+def _arc_skin(path, order, R=20.0, half=4.0, top=2.0, n=10):
+    """A 2D skin x in [-half, half] under an arc of radius R crowned at y = top, bonded on y = 0,
+    meshed by gmsh at `order` with n - 1 elements on the arc (an odd count: no vertex on the axis)."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        yc = top - R
+        ye = yc + np.sqrt(R * R - half * half)
+        p = [occ.addPoint(x, y, 0) for x, y in ((-half, 0), (half, 0), (half, ye), (-half, ye))]
+        c = occ.addPoint(0, yc, 0)
+        lines = [occ.addLine(p[0], p[1]), occ.addLine(p[1], p[2]), occ.addCircleArc(p[2], c, p[3]),
+                 occ.addLine(p[3], p[0])]
+        occ.addPlaneSurface([occ.addCurveLoop(lines)])
+        occ.synchronize()
+        for name, k in (("bonded", [0]), ("outer_surface", [2]), ("sides", [1, 3])):
+            gmsh.model.addPhysicalGroup(1, [lines[i] for i in k], name=name)
+        gmsh.model.addPhysicalGroup(2, [1], name="skin")
+        gmsh.model.mesh.setTransfiniteCurve(lines[2], n)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(order)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return str(path)
+
+
 def test_a_p2_msh_whose_curved_top_has_no_vertex_on_the_axis_is_taken(tmp_path):
     """A 2D skin under an R 20 arc crowned at y = 2, meshed by gmsh at order 2 with 9 elements
     on the arc: no vertex on the axis, the middle element's mid-edge node at the crown. The
     placement check read the contact surface's vertices only (highest 1.995 mm) against the
     skin's nodes (2.0) and refused it as upside down. Its nodes now include the mid-edge ones:
     top and thickness 2.0 (the P1 mesh of the same arc is its chords: 1.995)."""
-    import gmsh
-
-    def arc_skin(path, order):
-        gmsh.initialize(interruptible=False)
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            occ = gmsh.model.occ
-            R, half = 20.0, 4.0
-            yc = 2.0 - R
-            ye = yc + np.sqrt(R * R - half * half)
-            p = [occ.addPoint(x, y, 0) for x, y in ((-half, 0), (half, 0), (half, ye), (-half, ye))]
-            c = occ.addPoint(0, yc, 0)
-            lines = [occ.addLine(p[0], p[1]), occ.addLine(p[1], p[2]), occ.addCircleArc(p[2], c, p[3]),
-                     occ.addLine(p[3], p[0])]
-            occ.addPlaneSurface([occ.addCurveLoop(lines)])
-            occ.synchronize()
-            for name, k in (("bonded", [0]), ("outer_surface", [2]), ("sides", [1, 3])):
-                gmsh.model.addPhysicalGroup(1, [lines[i] for i in k], name=name)
-            gmsh.model.addPhysicalGroup(2, [1], name="skin")
-            gmsh.model.mesh.setTransfiniteCurve(lines[2], 10)
-            gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
-            gmsh.model.mesh.generate(2)
-            gmsh.model.mesh.setOrder(order)
-            gmsh.write(str(path))
-        finally:
-            gmsh.finalize()
-        return str(path)
-
-    p2 = Scene(skin="file", skin_file=arc_skin(tmp_path / "p2.msh", 2), indenter="flat", depth=0.2)
+    p2 = Scene(skin="file", skin_file=_arc_skin(tmp_path / "p2.msh", 2), indenter="flat", depth=0.2)
     assert p2.section().top == pytest.approx(2.0, abs=1e-9) and p2.thickness == pytest.approx(2.0, abs=1e-9)
-    p1 = Scene(skin="file", skin_file=arc_skin(tmp_path / "p1.msh", 1), indenter="flat", depth=0.2)
+    p1 = Scene(skin="file", skin_file=_arc_skin(tmp_path / "p1.msh", 1), indenter="flat", depth=0.2)
     assert p1.thickness == pytest.approx(20.0 * np.cos(np.arcsin(4.0 / 20.0) / 9.0) - 18.0, abs=1e-9)  # the chord
+
+
+def test_a_p2_msh_whose_crown_node_is_on_the_axis_is_not_highest_off_it(tmp_path):
+    """An R 5 crown at t = 0.5 with 5 elements on the arc: its middle element's mid-edge node is
+    the top, on the axis. The axis height was read on the straight chords, the sag (0.017 mm,
+    3.4 % of t) under that node, and the skin refused as highest off the axis (at x = 9e-16); it
+    is read on the curved facets, as the solver's surface and the top are: 0.5 there."""
+    sc = Scene(skin="file", skin_file=_arc_skin(tmp_path / "p2.msh", 2, R=5.0, half=2.0, top=0.5, n=6),
+               indenter="flat", depth=0.05)
+    assert sc.thickness == pytest.approx(0.5, abs=1e-9) and sc.section().top == pytest.approx(0.5, abs=1e-9)
+    # a skin really highest off its axis is refused all the same on a P2 mesh
+    off = _gmsh_polygon(tmp_path / "tilt.msh", [(-4.0, 0.0), (4.0, 0.0), (4.0, 2.0), (-4.0, 1.5)],
+                        {"bonded": [0], "sides": [1, 3], "outer_surface": [2]}, order=2)
+    with pytest.raises(ParameterError, match="highest on the indenters' axis"):
+        Scene(skin="file", skin_file=str(off), indenter="flat", depth=0.05)

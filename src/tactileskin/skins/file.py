@@ -153,12 +153,33 @@ def measure(skinmesh, groups=()) -> FileGeometry:
         top = np.zeros(pts.shape[1])
         top[1] = ymax
     t = _distance_to_facets(top, m, b["bone_interface"])
-    return FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
-                        lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
-                        symmetric="symmetry" in b, groups=tuple(groups),
-                        z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
-                        axis_y=_axis_height(m, b["outer_surface"], size),
-                        facets=facets, facet_kind=kind)
+    geo = FileGeometry(dim=skinmesh.dim, top_point=tuple(float(c) for c in top), thickness=t,
+                       lo=tuple(lo.tolist()), hi=tuple(hi.tolist()), outer_xy=pts[:, :2].copy(),
+                       symmetric="symmetry" in b, groups=tuple(groups),
+                       z_symmetric=bool(getattr(skinmesh, "z_symmetric", False)),
+                       axis_y=_axis_height(m, b["outer_surface"], size),
+                       facets=facets, facet_kind=kind)
+    if facets.shape[1] > skinmesh.dim:
+        # P2: the top is read on the nodes, so the axis height is read on the curved facets (the
+        # solver's surface), not their chords: a crown's mid-edge node on the axis lay the chord's
+        # sag (0.017 mm, t = 0.5) above them and was refused as highest off the axis
+        geo = FileGeometry(**{**geo.__dict__, "axis_y": _curved_axis_height(geo)})
+    return geo
+
+
+def _curved_axis_height(geo: FileGeometry) -> float | None:
+    """Highest y where the axis x = 0 (z = 0) crosses the quadratic contact facets (the chords'
+    answer, geo.axis_y, where it meets none of them: a line on a model's edge, within rounding)."""
+    lat = [0] if geo.dim == 2 else [0, 2]
+    L = geo.facets[:, :, lat]
+    lo, hi = L.min(axis=1), L.max(axis=1)
+    pad = hi - lo  # a quadratic facet lies within its nodes' box widened by its size
+    near = (geo.facet_kind == OUTER) & np.all((lo - pad <= 0.0) & (hi + pad >= 0.0), axis=1)
+    if not near.any():
+        return geo.axis_y
+    sub = FileGeometry(**{**geo.__dict__, "facets": geo.facets[near], "facet_kind": geo.facet_kind[near]})
+    y = FileCoordinates(sub).column(np.array([-geo.top_point[0]]), 0.0)["outer"][0]
+    return geo.axis_y if np.isnan(y) else float(y)
 
 
 def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
