@@ -300,6 +300,24 @@ def test_chart_letters_on_the_pad_and_the_paper_set_on_the_fingertip(monkeypatch
     assert why["status"] == "exceeds" and why["error"] > 0.3
 
 
+def test_chart_progress_names_the_material_thickness_and_noise_of_each_accuracy(monkeypatch):
+    """The progress printed 'letters pitch 0.5 mm: 1.00, 1.00' once per thickness: which
+    thickness (and material) each line was, and that the numbers are accuracies per noise level,
+    was not said."""
+    _fake_solver(monkeypatch, [])
+    monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: _heave)
+    cfg = chart.ChartConfig(thicknesses=(1.0, 2.0), sets=("letters",), pitches=(0.5,), noise_fs=(0.01, 0.05),
+                            letters="ab", n_train=2, n_test=2, template_grid=1)
+    said = []
+    ch = chart.compute(cfg, cache=None, progress=said.append)
+    lines = said[said.index("  silicone, t = 1 mm, letters: accuracy at noise 0.01, 0.05 x full scale"):]
+    a = {t: ", ".join(f"{ch.accuracy('silicone', t, 'letters', 0.5, n):.2f}" for n in (0.01, 0.05)) for t in (1.0, 2.0)}
+    assert lines == ["  silicone, t = 1 mm, letters: accuracy at noise 0.01, 0.05 x full scale",
+                     f"    pitch 0.5 mm: {a[1.0]}",
+                     "  silicone, t = 2 mm, letters: accuracy at noise 0.01, 0.05 x full scale",
+                     f"    pitch 0.5 mm: {a[2.0]}"]
+
+
 def test_shapes_set_adds_a_3d_sphere_on_the_fingertip_and_tells_four_distinct_maps_apart(monkeypatch):
     """The shapes set: the paper's three and a sphere solved in 3D on the fingertip (radius and
     mesh preset from the config, the chart's depth cap); distinct maps are told apart by a fine

@@ -662,6 +662,10 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
                 fs = max(float(m.pressure.max()) for m in maps_.values())
+                # which thickness and what the numbers are: the pitch lines came once per thickness
+                # and material ("letters pitch 1 mm: 1.00, 0.98"), naming neither, nor the noise
+                say(f"  {material}, t = {t:g} mm, {set_}: accuracy at noise "
+                    + ", ".join(f"{n:g}" for n in cfg.noise_fs) + " x full scale")
                 for pitch in cfg.pitches:
                     spec = cfg.spec(pitch)
                     rng = np.random.default_rng([cfg.seed, int(t * 1000), int(pitch * 1000), SETS.index(set_)])
@@ -677,7 +681,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
                                                    noise_fs=float(noise), noise_mpa=float(ro.sigma),
                                                    full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
                                                    chance=ev.chance, n_test=ev.n_test))
-                    say(f"  {set_} pitch {pitch:g} mm: " + ", ".join(
+                    say(f"    pitch {pitch:g} mm: " + ", ".join(
                         f"{chart.accuracy(material, t, set_, pitch, n):.2f}" for n in cfg.noise_fs))
     chart.seconds = time.perf_counter() - t0
     return chart
