@@ -52,3 +52,23 @@ def test_the_chart_figure_of_a_suspect_chart_says_so(tmp_path, monkeypatch):
                         lambda fig, out, stem: titles.append(fig._suptitle.get_text()) or _plt().close(fig) or [])
     array_chart.write_outputs(ch, tmp_path)
     assert len(titles) == 1 and "SUSPECT parts of the chart: 1 note in array_chart.md" in titles[0], titles
+
+
+def test_the_accuracy_table_gives_the_noise_in_mpa_and_the_taxels_of_each_pitch():
+    """The table's 'noise' column held fractions of a full scale the report never gave (it
+    differs per thickness, so equal fractions are unequal noise), the pitches had no taxel
+    count and the bold cells no legend."""
+    ch = Chart(ChartConfig(thicknesses=(1.0, 2.0), pitches=(0.5, 2.5), noise_fs=(0.05,), sets=("paper",)))
+    ch.labels["paper"] = ["flat", "curved", "braille"]
+    for t, fs in ((1.0, 0.04), (2.0, 0.03)):
+        for p in (0.5, 2.5):
+            ch.rows.append(dict(material="silicone", thickness_mm=t, set="paper", pitch_mm=p, taxel_mm=0.8 * p,
+                                noise_fs=0.05, noise_mpa=0.05 * fs, full_scale_mpa=fs, bits=12, method="template",
+                                accuracy=0.96 if p == 0.5 else 0.9, chance=1 / 3, n_test=16))
+    lines = markdown(ch).splitlines()
+    # 8 mm window: floor(8 / 0.5) + 1 = 17 and floor(8 / 2.5) + 1 = 4 taxels a side
+    assert "| t (mm) | noise (x full scale) | noise (MPa) | 0.5 mm (17 x 17) | 2.5 mm (4 x 4) |" in lines
+    assert "| 1 | 0.05 | 0.002 | **0.96** | 0.90 |" in lines
+    assert "| 2 | 0.05 | 0.0015 | **0.96** | 0.90 |" in lines
+    legend = next(ln for ln in lines if ln.startswith("Accuracy (template)"))
+    assert "**bold** at >= 0.95" in legend and "taxel centre to centre" in legend and "in MPa" in legend

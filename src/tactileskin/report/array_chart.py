@@ -131,15 +131,25 @@ def markdown(chart, validation=None, method: str = "template") -> str:
               "Depth: 20 % of t" + _cap_text(cfg) + ".", ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
+            # the noise also in MPa and the taxels a pitch takes: a header "noise" with fractions
+            # of a full scale the report never gave (it differs per thickness: 0.042 MPa at t = 1,
+            # 0.032 at t = 2 for the letters) and pitches without their channel count
             lines += [f"### {material}: {set_title(set_, cfg)} (chance {1 / len(chart.labels[set_]):.2f})", "",
-                      "| t (mm) | noise | " + " | ".join(f"{p:g} mm" for p in cfg.pitches) + " |",
-                      "|---|---|" + "---|" * len(cfg.pitches)]
+                      "| t (mm) | noise (x full scale) | noise (MPa) | "
+                      + " | ".join(f"{p:g} mm ({cfg.spec(p).n} x {cfg.spec(p).n})" for p in cfg.pitches) + " |",
+                      "|---|---|---|" + "---|" * len(cfg.pitches)]
             for t in cfg.thicknesses:
                 mark = " †" if set_ == "letters" and trust[(material, t)]["status"] not in TRUSTED else ""
                 for n in cfg.noise_fs:
-                    lines.append(f"| {t:g}{mark} | {n:g} | " + " | ".join(
+                    lines.append(f"| {t:g}{mark} | {n:g} | {_noise_mpa(chart, material, t, set_, n)} | " + " | ".join(
                         _cell(chart.accuracy(material, t, set_, p, n, method)) for p in cfg.pitches) + " |")
             lines.append("")
+    if chart.rows:
+        lines += [f"Accuracy ({method}): the fraction of test readings told right; **bold** at >= {GOOD:g}. Columns: the "
+                  f"array pitch (taxel centre to centre, mm) and its taxels (n x n: n = floor({cfg.window:g} / pitch) + 1 "
+                  f"over the {cfg.window:g} mm window), each taxel a square of {cfg.taxel_fraction:g} x the pitch "
+                  "averaging the pressure on the sensor plane over it. Noise: Gaussian, its std as a fraction of the set's "
+                  "full scale (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv) and in MPa.", ""]
     if "letters" in cfg.sets:
         lines += _trust_section(chart, trust)
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
@@ -263,6 +273,14 @@ def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
             "half side + the coarsest pitch's offset and half taxel, around the cell's centre; "
             "ChartConfig.read_extent) where the row gives it; within 5 % judges the taxel errors where given.", ""]
     return out
+
+
+def _noise_mpa(chart, material, t, set_, noise) -> str:
+    """The noise std in MPa of the rows of (material, t, set_, noise) (their set's full scale)."""
+    for r in chart.rows:
+        if (r["material"], r["thickness_mm"], r["set"], r["noise_fs"]) == (material, t, set_, noise):
+            return f"{r['noise_mpa']:.3g}"
+    return "-"
 
 
 def _cell(a: float) -> str:
