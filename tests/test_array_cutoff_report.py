@@ -72,3 +72,20 @@ def test_the_accuracy_table_gives_the_noise_in_mpa_and_the_taxels_of_each_pitch(
     assert "| 2 | 0.05 | 0.0015 | **0.96** | 0.90 |" in lines
     legend = next(ln for ln in lines if ln.startswith("Accuracy (template)"))
     assert "**bold** at >= 0.95" in legend and "taxel centre to centre" in legend and "in MPa" in legend
+
+
+def test_the_conditions_name_only_the_sets_computed_and_where_the_sensors_sit():
+    """A letters-only chart read 'Skin: letters on the pad, the paper and shapes sets on the
+    fingertip' and described the flat and curved profiles it had not computed."""
+    def head(sets):
+        ch = Chart(ChartConfig(thicknesses=(1.0,), pitches=(0.75,), noise_fs=(0.01,), sets=sets))
+        ch.labels.update({s: ["a", "b"] for s in sets})
+        return next(ln for ln in markdown(ch).splitlines() if ln.startswith("Skin:"))
+
+    letters = head(("letters",))
+    assert letters.startswith("Skin: letters on the pad. Sensor plane: the bonded surface, t below the contact surface")
+    assert "fingertip" not in letters and "flat and curved" not in letters
+    assert head(("paper",)).startswith("Skin: the paper set on the fingertip.")
+    both = head(("letters", "paper", "shapes"))
+    assert both.startswith("Skin: letters on the pad, the paper and shapes sets on the fingertip.")
+    assert "flat and curved: 2D bone profiles extruded along z" in both

@@ -83,6 +83,16 @@ def _meshes(cfg) -> str:
     return ", ".join(f"{m[0]:g} / {m[1]:g} at t = {', '.join(f'{t:g}' for t in ts)} mm" for m, ts in by.items())
 
 
+def _skins(cfg) -> str:
+    """Which skin each of the chart's sets is on: a letters-only chart read 'letters on the pad,
+    the paper and shapes sets on the fingertip' (sets it had not computed)."""
+    out = [f"letters on the {cfg.skin}"] if "letters" in cfg.sets else []
+    others = [s for s in ("paper", "shapes") if s in cfg.sets]
+    if others:
+        out.append(f"the {' and '.join(others)} set{'s' if len(others) > 1 else ''} on the fingertip")
+    return ", ".join(out)
+
+
 def _cap_text(cfg) -> str:
     """The depth cap's sentence: it keeps the Braille plate off only below the dot height (a
     cap of 0.55 mm read 'below the dot height, so the plate never touches' while the notes
@@ -106,9 +116,10 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
     notes = suspect(chart, validation, trust)
     lines = ["## Sensor-array design chart", "", *(["**Suspect:** " + n for n in notes] + [""] if notes else []),
-             f"Skin: letters on the {cfg.skin}, the paper and shapes sets on the fingertip. Sensor plane: the bonded surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
-             f"(mesh {_meshes(cfg)}); flat and curved: 2D bone profiles extruded "
-             f"along z" + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
+             f"Skin: {_skins(cfg)}. Sensor plane: the bonded surface, t below the contact surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
+             f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D bone profiles extruded along z"
+                                         if {"paper", "shapes"} & set(cfg.sets) else "")
+             + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
              + f". Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
              f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
              f"a fraction of full scale; stimuli at random sub-pitch offsets ({cfg.n_test} test and "
