@@ -89,3 +89,19 @@ def test_the_conditions_name_only_the_sets_computed_and_where_the_sensors_sit():
     both = head(("letters", "paper", "shapes"))
     assert both.startswith("Skin: letters on the pad, the paper and shapes sets on the fingertip.")
     assert "flat and curved: 2D bone profiles extruded along z" in both
+
+
+def test_the_filter_table_names_its_half_space_column_and_reads_the_nyquist_pitch():
+    """The last column was 'half-space at depth t (mm)' (of what?), 'the paper's rule' was not
+    given, and nothing said that a pitch past the Nyquist pitch can still tell the stimuli apart
+    (t = 2 mm silicone: Nyquist 1.30 mm, letters 1.00 at 1.5 mm)."""
+    ch = _one_row_chart(1.0)
+    ch.cutoffs.append({"material": "silicone", "thickness_mm": 1.0, "skin": "pad", "depth_mm": 0.2,
+                       "peak_mpa": 0.04, "kc_rad_per_mm": 4.51, "nyquist_pitch_mm": 0.70,
+                       "halfspace_nyquist_pitch_mm": 0.81})
+    md = " ".join(markdown(ch).split())
+    assert "| Nyquist pitch (mm) | half-space Nyquist pitch at depth t (mm) |" in md
+    assert "| silicone | 1 | 0.2 | pad | 0.0400 | 4.51 | 0.70 | 0.81 |" in md
+    assert "not a limit on telling known stimuli apart" in md
+    assert "The paper's rule (half the 1.5 mm span of the Braille pressure at t = 1) gives 0.75 mm" in md
+    assert "travel into the skin from first touch" in md

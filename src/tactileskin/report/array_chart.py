@@ -127,7 +127,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"{cfg.template_grid}x{cfg.template_grid} offsets; `lda` in the CSV). "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
-             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space at depth t (mm) |",
+             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth t (mm) |",
              "|---|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
         kc, ny = c["kc_rad_per_mm"], c["nyquist_pitch_mm"]
@@ -138,8 +138,9 @@ def markdown(chart, validation=None, method: str = "template") -> str:
         lines.append(f"| {c['material']} | {c['thickness_mm']:g} | {c.get('depth_mm', float('nan')):.3g} | {c.get('skin', 'fingertip')} | "
                      f"{c['peak_mpa']:.4f} | {kc_s} | {ny_s} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
-              "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c. The paper's rule gives 0.75 mm at t = 1. "
-              "Depth: 20 % of t" + _cap_text(cfg) + ".", ""]
+              "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c: the coarsest pitch that samples the map without aliasing, not a limit on telling known stimuli apart (the accuracy tables below say that). The paper's rule (half the 1.5 mm span of the Braille pressure at t = 1) gives 0.75 mm at t = 1. "
+              "Depth (each stimulus's travel into the skin from first touch: depth control, not force): 20 % of t"
+              + _cap_text(cfg) + ".", ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
             # the noise also in MPa and the taxels a pitch takes: a header "noise" with fractions
