@@ -318,6 +318,24 @@ def test_chart_progress_names_the_material_thickness_and_noise_of_each_accuracy(
                      f"    pitch 0.5 mm: {a[2.0]}"]
 
 
+def test_compute_takes_a_cache_folder_as_ts_sweep_does(monkeypatch, tmp_path):
+    """compute(cfg, "cache") failed with "AttributeError: 'str' object has no attribute 'key'"
+    (a traceback from the solver's cache lookup); it takes a folder path, a ResultCache, or
+    None (the default cache folder), and refuses anything else by name."""
+    import tactileskin.sweep as sweep_mod
+    from tactileskin.cache import ResultCache
+
+    seen = []
+    monkeypatch.setattr(sweep_mod, "run_sweep", lambda scenes, cache, **kw: seen.append(cache) or [])
+    monkeypatch.setenv("TACTILESKIN_CACHE", str(tmp_path / "default"))
+    for given, root in ((str(tmp_path / "c"), tmp_path / "c"), (tmp_path / "p", tmp_path / "p"),
+                        (ResultCache(tmp_path / "r"), tmp_path / "r"), (None, tmp_path / "default")):
+        assert chart.solve_cached([], given) == {}
+        assert isinstance(seen[-1], ResultCache) and seen[-1].root == root
+    with pytest.raises(ParameterError, match="cache=.3.* is invalid; valid: a folder path"):
+        chart.compute(chart.ChartConfig(sets=("letters",), thicknesses=(1.0,), pitches=(1.0,)), 3)
+
+
 def test_shapes_set_adds_a_3d_sphere_on_the_fingertip_and_tells_four_distinct_maps_apart(monkeypatch):
     """The shapes set: the paper's three and a sphere solved in 3D on the fingertip (radius and
     mesh preset from the config, the chart's depth cap); distinct maps are told apart by a fine

@@ -346,6 +346,22 @@ def blank_map(scene, record, like: BoneMap) -> BoneMap:
     return extruded(record.s, record.pressure, like.z)
 
 
+def result_cache(cache):
+    """The ResultCache of `cache`: one as given, a folder path (str or os.PathLike), or None for
+    api.default_cache_dir(), as ts.sweep takes it (a path failed with "AttributeError: 'str'
+    object has no attribute 'key'")."""
+    from tactileskin import validate
+    from tactileskin.cache import ResultCache
+
+    if isinstance(cache, ResultCache):
+        return cache
+    if cache is None:
+        from tactileskin.api import default_cache_dir
+
+        return ResultCache(default_cache_dir())
+    return ResultCache(validate.path(cache, "cache", "a folder path (str or os.PathLike), a ResultCache or None"))
+
+
 def solve_cached(scenes, cache, on_event=None, workers: int | None = None) -> dict:
     """{scene: cache record} through the sweep's cache, the uncached cases on a local Dask
     cluster of `workers` processes (None: one per core; 1: in this process). Every solve
@@ -353,6 +369,7 @@ def solve_cached(scenes, cache, on_event=None, workers: int | None = None) -> di
     one material took 553 s one at a time. A failed case raises TactileSkinError naming it."""
     from tactileskin.sweep import run_sweep
 
+    cache = result_cache(cache)
     scenes = list(dict.fromkeys(scenes))
     out = {}
     serial = workers == 1 or len(scenes) == 1
@@ -567,9 +584,10 @@ def letter_scenes(cfg: ChartConfig, material: str, t: float, full: bool = False)
     return {c: dot_scene(t, material, cfg, c) for c in cfg.letters}
 
 
-def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = None,
+def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None = None,
             workers: int | None = None, validation=None) -> Chart:
-    """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`,
+    """The chart of `cfg`; solves (single dots in 3D, flat and curved in 2D) through `cache`
+    (a folder path, a ResultCache, or None: api.default_cache_dir(); result_cache),
     all of them first, in one batch on `workers` processes (solve_cached). `validation`: this
     run's validate_surrogate rows, which judge the letters' surrogate together with the
     project's measurements (fallback_reason, array.validity.measured)."""
@@ -577,6 +595,7 @@ def compute(cfg: ChartConfig, cache, progress: Callable[[str], None] | None = No
     from tactileskin.array.validity import finer_mesh_reason
 
     say = progress or (lambda msg: None)
+    cache = result_cache(cache)  # a wrong one refused before the scenes are planned
     t0 = time.perf_counter()
     chart = Chart(cfg)
     cases = {(m, t): _chart_scenes(cfg, m, t) for m in cfg.materials for t in cfg.thicknesses}
