@@ -72,6 +72,8 @@ def test_the_accuracy_table_gives_the_noise_in_mpa_and_the_taxels_of_each_pitch(
     assert "| 2 | 0.05 | 0.0015 | **0.96** | 0.90 |" in lines
     legend = next(ln for ln in lines if ln.startswith("Accuracy (template)"))
     assert "**bold** at >= 0.95" in legend and "taxel centre to centre" in legend and "in MPa" in legend
+    # the offsets' draw, not the readings' count, limits how sure a cell near 0.95 is
+    assert "one draw of 16 random offsets, shared by all stimuli" in legend and "another `--seed`" in legend
 
 
 def test_the_conditions_name_only_the_sets_computed_and_where_the_sensors_sit():

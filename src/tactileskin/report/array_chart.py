@@ -161,7 +161,13 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                   f"array pitch (taxel centre to centre, mm) and its taxels (n x n: n = floor({cfg.window:g} / pitch) + 1 "
                   f"over the {cfg.window:g} mm window), each taxel a square of {cfg.taxel_fraction:g} x the pitch "
                   "averaging the pressure on the sensor plane over it. Noise: Gaussian, its std as a fraction of the set's "
-                  "full scale (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv) and in MPa.", ""]
+                  "full scale (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv) and in MPa. "
+                  # the readings share one draw of offsets: at a coarse pitch the draw moves the
+                  # accuracy by 4-5x the binomial std over the readings (README: seeds 0-5 at 2.5 mm)
+                  f"Each accuracy is one draw of {cfg.n_test} random offsets, shared by all stimuli and noise levels: "
+                  "where the offset matters (a pitch near the dots' 2.5 mm spacing) another draw moves it more than "
+                  "a binomial 95 % interval over the readings says, so before choosing on a cell near "
+                  f"{GOOD:g} rerun it with another `--seed` and more `--offsets`.", ""]
     if "letters" in cfg.sets:
         lines += _trust_section(chart, trust)
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
