@@ -107,3 +107,13 @@ def test_the_filter_table_names_its_half_space_column_and_reads_the_nyquist_pitc
     assert "not a limit on telling known stimuli apart" in md
     assert "The paper's rule (half the 1.5 mm span of the Braille pressure at t = 1) gives 0.75 mm" in md
     assert "travel into the skin from first touch" in md
+
+
+def test_the_conditions_say_what_each_classifier_knows():
+    """'rule: template (nearest template over 4x4 offsets; `lda` in the CSV)' did not say that the
+    template rule is given the noise-free responses a trained decoder is not (t = 1 mm letters,
+    2.5 mm pitch, noise 0.01: template 0.93, lda 0.38)."""
+    md = " ".join(markdown(_one_row_chart(1.0)).split())
+    assert ("rules: template: the nearest of every stimulus's noise-free readings at 4x4 offsets, a reader "
+            "that knows each stimulus's response but not its position; lda: a linear discriminant trained on 16 noisy "
+            "readings per stimulus, as a decoder trained on readings would be (the tables: template; the CSV: both);") in md
