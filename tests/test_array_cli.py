@@ -236,6 +236,19 @@ def test_the_fallback_help_says_the_run_rows_join_the_projects_measurements():
     assert "rows first, else the project's" not in " ".join(readme.read_text(encoding="utf-8").split())
 
 
+def test_the_help_says_what_pitch_and_full_scale_are():
+    """--help read 'Array pitches (mm)' and 'Noise std as fractions of full scale' without saying
+    that a pitch is the taxels' centre-to-centre spacing or what the full scale is (the set's
+    largest pressure, per thickness: 0.042 MPa at t = 1, 0.032 at t = 2 for the letters)."""
+    from click.testing import CliRunner
+
+    from tactileskin.cli import cli
+
+    text = " ".join(CliRunner().invoke(cli, ["array", "--help"]).output.split())
+    assert "taxel centre to centre" in text
+    assert "each set's largest pressure at that thickness" in text
+
+
 def test_the_readme_names_every_column_of_accuracies_csv():
     """accuracies.csv's `n_test` (test readings per stimulus) was explained nowhere, nor were
     most of its columns: the README named only `status`."""

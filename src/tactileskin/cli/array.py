@@ -60,8 +60,11 @@ def load_config(path) -> dict:
 @click.option("--config", type=click.Path(dir_okay=False), default=None, help="TOML with an [array] table; flags override it.")
 @click.option("--thickness", "-t", default=None, help="Thicknesses (mm), e.g. '1,3'. Default 1,3.")
 @click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone.")
-@click.option("--pitch", default=None, help="Array pitches (mm). Default 0.5,0.75,1,1.5,2,4.")
-@click.option("--noise", default=None, help="Noise std as fractions of full scale. Default 0.01,0.05,0.1.")
+@click.option("--pitch", default=None, help="Array pitches (mm): taxel centre to centre, a square lattice on the "
+              "bonded surface over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
+@click.option("--noise", default=None, help="Noise std as fractions of full scale: each set's largest pressure at that "
+              "thickness, so one fraction is a different noise in MPa at each thickness (array_chart.md gives it). "
+              "Default 0.01,0.05,0.1.")
 @click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
 @click.option("--bits", type=int, default=None, help="ADC bits over full scale. Default 12.")
 @click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters (a-z, 0-9), shapes (the paper's three and a "
