@@ -16,6 +16,7 @@ Accuracy is over a test draw independent of both; confusion[i, j] counts class i
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +50,9 @@ class Evaluation:
     accuracy: dict          # method -> fraction correct
     confusion: dict         # method -> (n, n) counts, rows true, columns read
     n_test: int             # test readings per class
+    # method -> (n_test,) fraction of the classes read right at each test offset (the offsets
+    # are shared by all classes: the clusters of chart.accuracy_interval)
+    offset_accuracy: dict = dataclasses.field(default_factory=dict)
 
     @property
     def chance(self) -> float:
@@ -121,6 +125,11 @@ def score(pred: dict, labels) -> tuple[dict, dict]:
     return acc, conf
 
 
+def offset_scores(pred: dict) -> dict:
+    """{method: (n_test,) fraction of the classes read right at each test offset}."""
+    return {m: np.mean(p == np.arange(p.shape[0])[:, None], axis=0) for m, p in pred.items()}
+
+
 def evaluate(maps: dict, spec: ArraySpec, readout: Readout, rng: np.random.Generator, *,
              n_train: int = 24, n_test: int = 24, template_grid: int = 4, methods=METHODS,
              clean: dict | None = None) -> Evaluation:
@@ -132,8 +141,9 @@ def evaluate(maps: dict, spec: ArraySpec, readout: Readout, rng: np.random.Gener
     clean = clean or clean_readings(maps, spec, rng, n_train=n_train, n_test=n_test, template_grid=template_grid)
     train = readout(clean["train"], rng)
     test = readout(clean["test"], rng)
-    acc, conf = score(classify(train, test, clean["templates"], methods), list(maps))
-    return Evaluation(list(maps), acc, conf, test.shape[1])
+    pred = classify(train, test, clean["templates"], methods)
+    acc, conf = score(pred, list(maps))
+    return Evaluation(list(maps), acc, conf, test.shape[1], offset_scores(pred))
 
 
 def clean_readings(maps: dict, spec: ArraySpec, rng: np.random.Generator, *, n_train: int = 24,

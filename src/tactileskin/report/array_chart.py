@@ -165,8 +165,10 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                   # accuracy by 4-5x the binomial std over the readings (README: seeds 0-5 at 2.5 mm)
                   f"Each accuracy is one draw of {cfg.n_test} random offsets, shared by all stimuli and noise levels: "
                   "where the offset matters (a pitch near the dots' 2.5 mm spacing) another draw moves it more than "
-                  "a binomial 95 % interval over the readings says, so before choosing on a cell near "
-                  f"{GOOD:g} rerun it with another `--seed` and more `--offsets`.", ""]
+                  "a binomial 95 % interval over the readings says, so accuracies.csv's `ci_low` / `ci_high` (and the "
+                  "verdicts' \"borderline\") take the wider of that and a t-interval over the offsets' own "
+                  f"accuracies; before choosing on a cell near {GOOD:g} rerun it with another `--seed` and more "
+                  "`--offsets`.", ""]
     if "letters" in cfg.sets:
         lines += _trust_section(chart, trust)
     lines += ["### The paper's design claims", "", "| material | claim | verdict | evidence |", "|---|---|---|---|"]
