@@ -446,11 +446,7 @@ class FileCoordinates:
             hit = (u >= -tol) & (u <= 1 + tol)
             u = np.clip(u, 0.0, 1.0)
             return hit, Y[:, 0] + u * (Y[:, 1] - Y[:, 0])
-        a, b, c = L[:, 0], L[:, 1], L[:, 2]
-        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
-        p = q - a
-        l1 = (p[:, 0] * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * p[:, 1]) / det
-        l2 = ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det
+        l1, l2 = _barycentric(L, q)
         hit = (l1 >= -tol) & (l2 >= -tol) & (l1 + l2 <= 1 + tol)
         return hit, Y[:, 0] + l1 * (Y[:, 1] - Y[:, 0]) + l2 * (Y[:, 2] - Y[:, 0])
 
@@ -478,11 +474,7 @@ class FileCoordinates:
                 y = Y[:, 0] * (1 - u) * (1 - 2 * u) + Y[:, 1] * u * (2 * u - 1) + Y[:, 2] * 4 * u * (1 - u)
                 out.append((hit, y))
             return out
-        a, b, c = L[:, 0], L[:, 1], L[:, 2]  # the straight facet's (u, v) start Newton
-        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
-        p = q - a
-        u = (p[:, 0] * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * p[:, 1]) / det
-        v = ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det
+        u, v = _barycentric(L, q)  # the straight facet's (u, v) start Newton
 
         def shape(u, v):
             w = 1.0 - u - v
@@ -567,6 +559,16 @@ class FileCoordinates:
         n = len(s)
         return (np.column_stack([self.x_top + s, y]), np.tile([0.0, 1.0], (n, 1)), np.tile([1.0, 0.0], (n, 1)),
                 np.ones(n))
+
+
+def _barycentric(L, q) -> tuple[np.ndarray, np.ndarray]:
+    """(l1, l2): the points q (m, 2) in the triangles L (m, >= 3, 2) of their first three
+    nodes, q = a + l1 (b - a) + l2 (c - a)."""
+    a, b, c = L[:, 0], L[:, 1], L[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    p = q - a
+    return ((p[:, 0] * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * p[:, 1]) / det,
+            ((b[:, 0] - a[:, 0]) * p[:, 1] - p[:, 0] * (b[:, 1] - a[:, 1])) / det)
 
 
 @register
