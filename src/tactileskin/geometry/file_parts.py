@@ -23,9 +23,10 @@ from pathlib import Path
 import build123d as bd
 
 from tactileskin.errors import ParameterError
-from tactileskin.geometry.molds import MoldParams, vertical_cylinder
+from tactileskin.geometry.molds import MoldParams
+from tactileskin.geometry.pad_parts import face_down_mold
 from tactileskin.geometry.parts import Part
-from tactileskin.geometry.solids import box, check_solid, occ_guard
+from tactileskin.geometry.solids import check_solid, occ_guard
 
 NO_MOLDS = "or build without molds (--no-molds)"
 
@@ -98,31 +99,21 @@ def file_mold(skin: bd.Solid, y_b: float, path, mp: MoldParams | None = None):
     if bb.min.Y < y_b - tol:
         raise ParameterError("skin_file", str(path), "a skin above its bonded plane (the mold's split plane)",
                              f"{name} reaches y = {bb.min.Y:.4g} mm, below its bonded faces at y = {y_b:.4g} mm")
-    hole = mp.pin_diameter + mp.pin_clearance
-    xp = (bb.min.X - mp.wall - 0.5 * hole, bb.max.X + mp.wall + 0.5 * hole)  # `wall` from the pocket
-    x0, x1 = xp[0] - 0.5 * hole - mp.pin_flange, xp[1] + 0.5 * hole + mp.pin_flange
-    z0, z1 = bb.min.Z - mp.wall, bb.max.Z + mp.wall
-    lid = max(mp.wall, mp.pin_height + mp.pin_depth_clearance + 1.0)  # the pin holes stay blind
-    pins = [(x, z) for x in xp for z in (bb.min.Z, bb.max.Z)]
     p = dict(skin_file=name, bonded_y=y_b, wall=mp.wall)
-    with occ_guard("building the skin's mold", **p):
-        pin_solids = [vertical_cylinder(x, z, y_b - mp.pin_height, y_b, mp.pin_diameter) for x, z in pins]
-        lower = box(x0, x1, y_b, bb.max.Y + mp.wall, z0, z1).cut(skin)
+
+    def one_pocket(lower):
         pieces = len(lower.solids())
-    if pieces != 1:
-        # the skin closes a room under it onto the bonded plane (a hollow over a core): the
-        # block there is a loose core, which this two-part mold cannot hold
-        raise ParameterError("skin_file", str(path), "a skin whose mold pocket is one piece (open only at the "
-                             "bonded plane)", f"{name} encloses {pieces - 1} room(s) under it down to its "
-                             f"bonded plane y = {y_b:.4g} mm, which would be loose core(s) of the mold")
-    sprue, vents = hole_positions(_bonded_faces(skin, y_b, tol), y_b, bb.min.Z, bb.max.Z, mp, path)
-    with occ_guard("building the skin's mold", **p):
-        lower = lower.fuse(*pin_solids).clean()
-        holes = [vertical_cylinder(x, z, y_b - (mp.pin_height + mp.pin_depth_clearance), y_b, hole) for x, z in pins]
-        holes += [vertical_cylinder(*sprue, y_b - lid - 1.0, y_b, mp.pour_diameter)]
-        holes += [vertical_cylinder(x, z, y_b - lid - 1.0, y_b, mp.vent_diameter) for x, z in vents]
-        upper = box(x0, x1, y_b - lid, y_b, z0, z1).cut(*holes).clean()
-    return check_solid(lower, "skin mold lower part", **p), check_solid(upper, "skin mold lid", **p)
+        if pieces != 1:
+            # the skin closes a room under it onto the bonded plane (a hollow over a core): the
+            # block there is a loose core, which this two-part mold cannot hold
+            raise ParameterError("skin_file", str(path), "a skin whose mold pocket is one piece (open only at the "
+                                 "bonded plane)", f"{name} encloses {pieces - 1} room(s) under it down to its "
+                                 f"bonded plane y = {y_b:.4g} mm, which would be loose core(s) of the mold")
+
+    return face_down_mold(skin, (bb.min.X, bb.max.X, bb.max.Y, bb.min.Z, bb.max.Z), y_b, mp, "skin mold", p,
+                          check=one_pocket,
+                          holes=lambda: hole_positions(_bonded_faces(skin, y_b, tol), y_b, bb.min.Z, bb.max.Z, mp,
+                                                       path))
 
 
 def build_file_parts(path, bonded=None, *, molds: bool = True) -> list[Part]:

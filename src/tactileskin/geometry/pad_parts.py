@@ -47,22 +47,41 @@ def pad_mold(width: float, length: float, thickness: float, mp: MoldParams | Non
     if z < need:
         raise ParameterError("pad_length", length, f">= {2 * need:g} mm for the mold's sprue and two vents "
                              "(molds.toml [pour])", no_molds)
-    hole = mp.pin_diameter + mp.pin_clearance
-    xp = w + mp.wall + 0.5 * hole
-    A, Z = xp + 0.5 * hole + mp.pin_flange, z + mp.wall
-    lid = max(mp.wall, mp.pin_height + mp.pin_depth_clearance + 1.0)  # the pin holes stay blind
-    pins = [(sx * xp, sz * z) for sx in (-1, 1) for sz in (-1, 1)]
     p = dict(width=width, length=length, thickness=thickness, wall=mp.wall)
     with occ_guard("building the pad mold", **p):
         cavity = pad_solid(width, length, thickness)
-        pin_solids = [vertical_cylinder(x, zz, -mp.pin_height, 0.0, mp.pin_diameter) for x, zz in pins]
-        lower = box(-A, A, 0.0, thickness + mp.wall, -Z, Z).cut(cavity).fuse(*pin_solids).clean()
-        holes = [vertical_cylinder(x, zz, -(mp.pin_height + mp.pin_depth_clearance), 0.0, hole) for x, zz in pins]
-        zv = z - mp.vent_inset
-        holes += [vertical_cylinder(0.0, 0.0, -lid - 1.0, 0.0, mp.pour_diameter)]
-        holes += [vertical_cylinder(0.0, s * zv, -lid - 1.0, 0.0, mp.vent_diameter) for s in (-1, 1)]
-        upper = box(-A, A, -lid, 0.0, -Z, Z).cut(*holes).clean()
-    return check_solid(lower, "pad mold lower part", **p), check_solid(upper, "pad mold lid", **p)
+    zv = z - mp.vent_inset
+    return face_down_mold(cavity, (-w, w, thickness, -z, z), 0.0, mp, "pad mold", p,
+                          holes=lambda: ((0.0, 0.0), [(0.0, -zv), (0.0, zv)]))
+
+
+def face_down_mold(skin, extent, y_b: float, mp: MoldParams, what: str, p: dict, *, holes, check=None):
+    """(lower part with the pocket and pins, lid with sprue and vents) of a skin cast face down:
+    the pocket is a block `wall` around the skin minus the skin, open at its bonded plane y = y_b,
+    which the lid closes; a pin at each corner of the skin's footprint, in a flange beside the
+    pocket. extent: (x0, x1, y_top, z0, z1) of the skin; holes(): ((x, z) of the sprue, [(x, z)
+    of the vents]), asked once the pocket is made and `check`ed (check(lower): raises for a
+    pocket the mold cannot cast)."""
+    x0, x1, y_top, z0, z1 = extent
+    hole = mp.pin_diameter + mp.pin_clearance
+    xp = (x0 - mp.wall - 0.5 * hole, x1 + mp.wall + 0.5 * hole)  # `wall` from the pocket
+    bx0, bx1 = xp[0] - 0.5 * hole - mp.pin_flange, xp[1] + 0.5 * hole + mp.pin_flange
+    bz0, bz1 = z0 - mp.wall, z1 + mp.wall
+    lid = max(mp.wall, mp.pin_height + mp.pin_depth_clearance + 1.0)  # the pin holes stay blind
+    pins = [(x, z) for x in xp for z in (z0, z1)]
+    with occ_guard(f"building the {what}", **p):
+        pin_solids = [vertical_cylinder(x, z, y_b - mp.pin_height, y_b, mp.pin_diameter) for x, z in pins]
+        lower = box(bx0, bx1, y_b, y_top + mp.wall, bz0, bz1).cut(skin)
+    if check is not None:
+        check(lower)
+    sprue, vents = holes()
+    with occ_guard(f"building the {what}", **p):
+        lower = lower.fuse(*pin_solids).clean()
+        drill = [vertical_cylinder(x, z, y_b - (mp.pin_height + mp.pin_depth_clearance), y_b, hole) for x, z in pins]
+        drill += [vertical_cylinder(*sprue, y_b - lid - 1.0, y_b, mp.pour_diameter)]
+        drill += [vertical_cylinder(x, z, y_b - lid - 1.0, y_b, mp.vent_diameter) for x, z in vents]
+        upper = box(bx0, bx1, y_b - lid, y_b, bz0, bz1).cut(*drill).clean()
+    return check_solid(lower, f"{what} lower part", **p), check_solid(upper, f"{what} lid", **p)
 
 
 def build_pad_parts(thickness: float, width: float, length: float, *, molds: bool = True) -> list[Part]:
