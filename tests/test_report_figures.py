@@ -322,3 +322,24 @@ def test_a_figure_saved_twice_has_the_same_bytes(tmp_path):
         got.append({p.name: p.read_bytes() for p in figures._save(fig, out, figures.DESIGN_STEMS[0])})
     assert sorted(got[0]) == ["metrics_vs_thickness.pdf", "metrics_vs_thickness.png", "metrics_vs_thickness.svg"]
     assert got[0] == got[1]
+
+
+def test_every_format_of_a_figure_has_the_constrained_layout_of_the_first(tmp_path, monkeypatch):
+    """The layout is computed once, for the first format, and kept for the others (it was
+    recomputed per savefig, ~30 % of the figures' time): the axes of every format sit where
+    constrained layout put them, with a long label kept inside, not at matplotlib's defaults."""
+    from tactileskin.report import figures
+
+    plt = figures._plt()
+    fig, ax = plt.subplots(figsize=(3.0, 2.5), constrained_layout=True)
+    ax.plot([0, 1], [0, 2])
+    ax.set_ylabel("a long label of the mean pressure P (MPa)")
+    pos = []
+    real = figures.save_reproducibly
+    monkeypatch.setattr(figures, "save_reproducibly",
+                        lambda f, buf, fmt, dpi: (real(f, buf, fmt, dpi), pos.append(f.axes[0].get_position().bounds)))
+    figures._save(fig, tmp_path, figures.DESIGN_STEMS[0])
+    assert len(pos) == 3
+    assert all(p == pos[0] for p in pos), pos
+    default = plt.rcParams["figure.subplot.left"]
+    assert abs(pos[0][0] - default) > 0.02  # constrained layout moved the axes for the label

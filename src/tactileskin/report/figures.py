@@ -80,6 +80,9 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
             save_reproducibly(fig, buf, ext, 150)
             atomic_write_bytes(p, buf.getvalue())
             paths.append(p)
+            # the layout the first format computed serves the others (positions move < 0.3 pt):
+            # constrained layout per savefig was ~30 % of the figures' time
+            fig.set_layout_engine("none")
     finally:  # a failed write (full disk) too: a notebook's pyplot keeps no figure of ours
         _plt().close(fig)
     return paths
