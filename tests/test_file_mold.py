@@ -110,6 +110,7 @@ def _tube_shell(length=L):
     ("stepped", "plane:y=1", ["skin_file", "reaches y = 0", "below its bonded faces at y = 1"]),
     ("recess", "plane:y=0", ["skin_file", "encloses 1 room", "loose core"]),
     ("short", None, ["skin_file", ">= 11.5 mm along z", "10 mm long there", "--no-molds"]),
+    ("overhang", "plane:y=0", ["skin_file", "undercut <= 1 mm", "undercut 4 mm deep at (x, y, z) = (", "--no-molds"]),
     ("msh", None, ["skin_file", "STEP", "a .msh is a mesh, not CAD"]),
 ])
 def test_a_skin_the_mold_cannot_cast_is_refused(tmp_path, case, bonded, words):
@@ -120,6 +121,8 @@ def test_a_skin_the_mold_cannot_cast_is_refused(tmp_path, case, bonded, words):
         bd.export_step(_tube_shell(), str(path))
     elif case == "stepped":  # bottom faces at y = 0 (x < 0) and y = 1 (x > 0)
         _dome_step(path, _base() - bd.Box(W / 2, 1.0, L, align=(bd.Align.MIN, bd.Align.MIN, bd.Align.CENTER)))
+    elif case == "overhang":  # a T: 4 mm wide neck under a 12 mm wide cap, which the pocket holds
+        bd.export_step(_tee(), str(path))
     elif case == "recess":  # a pocket in the bottom: the block would fill it, loose
         _dome_step(path, _base() - bd.Box(6.0, 2.0, 10.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)))
     else:
@@ -131,6 +134,51 @@ def test_a_skin_the_mold_cannot_cast_is_refused(tmp_path, case, bonded, words):
     if case != "msh":  # without the mold, the skin alone is printed
         assert [p.name for p in get("file").build_parts(H, skin_file=str(path), skin_bonded=bonded,
                                                         molds=False)] == ["skin"]
+
+
+def _tee():
+    """A T along z: a neck x in [-2, 2], y in [0, 2] under a cap x in [-6, 6], y in [2, 4]."""
+    a = (bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER)
+    return (bd.Box(4, 2, L, align=a) + bd.Pos(0, 2, 0) * bd.Box(W, 2, L, align=a)).solids()[0]
+
+
+def test_an_undercut_is_measured_warned_of_and_written_down(tmp_path, caplog):
+    """The pocket was never checked for undercuts: a T-shaped skin (its 4 mm wings held by the
+    pocket) got a mold that cannot be opened, silently. The depth is how far the cast must
+    squeeze sideways to come out along -y: none for the block and the domed block, 0.5 mm for
+    a dovetail groove (2 mm wide at the top, 3 mm at its floor), which builds with a warning
+    naming it, 4 mm for the T (refused: test_a_skin_the_mold_cannot_cast_is_refused)."""
+    import logging
+
+    from tactileskin.geometry.file_parts import undercut
+
+    dovetail = _base() - bd.extrude(bd.Polygon((-1, H), (-1.5, 2), (1.5, 2), (1, H), align=None), amount=L / 2,
+                                    both=True)
+    assert undercut(_base().solids()[0], 0.0) == (0.0, None)
+    assert undercut((_base() & bd.Pos(0, H - R, 0) * bd.Sphere(R)).solids()[0], 0.0) == (0.0, None)
+    depth, at = undercut(_tee(), 0.0)
+    assert depth == pytest.approx(4.0, abs=0.01) and abs(at[0]) == pytest.approx(6.0, abs=0.01)
+    assert at[1] == pytest.approx(2.0, abs=0.01)  # just above the wings' undersides
+    depth, at = undercut(dovetail.solids()[0], 0.0)
+    assert depth == pytest.approx(0.5, abs=0.01) and abs(at[0]) == pytest.approx(1.0, abs=0.01)
+    assert at[1] == pytest.approx(H, abs=0.01)  # at the groove's lips
+    # the dovetail's mold is written, its record and the log say so; the block's says nothing
+    for name, shape, mm in (("dovetail", dovetail, 0.5), ("block", _base(), 0.0)):
+        path = tmp_path / f"{name}.step"
+        bd.export_step(shape, str(path))
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="tactileskin"):
+            manifest = export_parts(get("file").build_parts(H, skin_file=str(path)), tmp_path / name)
+        assert all(e["is_volume"] and e["watertight"] for e in manifest["parts"])
+        lower, upper = manifest["parts"][1:]
+        assert lower["parameters"]["undercut_mm"] == upper["parameters"]["undercut_mm"] == pytest.approx(mm, abs=0.01)
+        warned = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+        if mm:
+            assert "UNDERCUT 0.5 mm" in lower["description"]
+            assert len(warned) == 1 and "undercut 0.5 mm deep at (x, y, z) = (" in warned[0], warned
+            assert "air may stay" in warned[0]
+        else:
+            assert warned == [] and "UNDERCUT" not in lower["description"]
 
 
 def _manifest(out):

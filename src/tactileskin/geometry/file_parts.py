@@ -12,23 +12,39 @@ face down:
   vent with 1 mm of mold between them: off the middle, where the indenters press (the pad's
   sprue is at its centre). The sensor board, if it is to be bonded while curing, replaces the
   lid. Every hole must open wholly onto the bonded plane. Sizes from data/geometry/molds.toml.
-Not checked: undercuts (a skin wider below its top than at its bonded face is held by the
-pocket; a soft one may still come out).
+Undercuts: the cast comes out of the pocket along -y, through its opening. Where the skin is
+wider above than at some section between there and the bonded face (an overhang, a dovetail
+groove, a ball on a neck), the pocket holds it; those are also ceilings under which air may
+stay while pouring (the lid's vents reach only the bonded plane). Elsewhere the vents on x = 0
+are at the cavity's top: poured lid up, the bonded plane is its highest level (the skin lies
+wholly at y >= y_b, checked), and a ridge or a high side off x = 0 is the pocket's floor,
+which fills first. `undercut` measures how far (mm) the cast must squeeze sideways
+there; a silicone skin stretches out of a shallow one: up to UNDERCUT_SILENT nothing is said
+(below a printed layer's step), up to UNDERCUT_REFUSE the mold is written with a warning (log,
+the lower part's description and the mold parts' `undercut_mm`), deeper it is refused.
 """
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import build123d as bd
+import numpy as np
 
-from tactileskin.errors import ParameterError
+from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.molds import MoldParams
 from tactileskin.geometry.pad_parts import face_down_mold
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import check_solid, occ_guard
 
+log = logging.getLogger(__name__)
+
 NO_MOLDS = "or build without molds (--no-molds)"
+# undercut depths (mm): below SILENT, a printed layer's own step; above REFUSE, more than the
+# thinnest skin (1 mm) would have to squeeze or fold to pass: it tears or stays held
+UNDERCUT_SILENT = 0.05
+UNDERCUT_REFUSE = 1.0
 
 
 def read_skin(path) -> bd.Solid:
@@ -88,9 +104,81 @@ def hole_positions(faces: list[bd.Face], y_b: float, lo_z: float, hi_z: float, m
     return sprue, vents
 
 
+def _outline(loops: list[np.ndarray], step: float) -> np.ndarray:
+    """Points every `step` (mm) or closer along the closed polygons `loops` ((n, 2) each)."""
+    q = np.concatenate(loops)
+    e = np.concatenate([np.roll(c, -1, axis=0) - c for c in loops])
+    n = np.maximum(1, np.ceil(np.linalg.norm(e, axis=1) / step)).astype(int)
+    i = np.repeat(np.arange(len(q)), n)
+    k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    return q[i] + (k / n[i])[:, None] * e[i]
+
+
+def undercut(skin: bd.Solid, y_b: float, tol: float = 0.01, step: float = 0.02):
+    """(depth (mm), (x, y, z) where deepest) of the skin's undercut along the pull, -y out through
+    its bonded plane y = y_b: the largest distance of a point of a section y = const of the skin
+    from the part of that section that every section between it and y = y_b also covers (the
+    throat it must pass), i.e. how far it must squeeze sideways; (0, None) for none. Measured
+    on a `tol` mm tessellation, to within `step` / 2, on sections just above and below every
+    height of its vertices (between them the facets' sections change linearly)."""
+    import manifold3d
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    v, f = skin.tessellate(tol, 0.2)
+    mesh = trimesh.Trimesh(np.array([tuple(p) for p in v]), np.array(f), process=True)  # merge the faces' seams
+    xzy = np.ascontiguousarray(np.asarray(mesh.vertices)[:, [0, 2, 1]], np.float64)  # slices are z = const
+    solid = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=xzy, tri_verts=np.ascontiguousarray(
+        np.asarray(mesh.faces)[:, ::-1], np.uint64)))  # swapping y and z mirrors: reverse the winding
+    if solid.status() != manifold3d.Error.NoError:
+        raise CadError(f"measuring the skin's undercut: its {tol:g} mm tessellation is no closed volume "
+                       f"({solid.status()})")
+    heights = np.unique(np.round(xzy[:, 2] / tol) * tol)
+    heights = np.concatenate([[y_b], heights[heights > y_b + tol]])
+    depth, where, throat = 0.0, None, None
+    for lo, hi in zip(heights[:-1], heights[1:]):
+        d = min(1e-4, 0.25 * (hi - lo))
+        for y in (lo + d, hi - d):
+            section = solid.slice(y)
+            if throat is None:
+                throat = None if section.is_empty() else section
+                continue
+            out = section - throat
+            if out.area() > tol * tol:
+                # the farthest point lies on its outline; the throat's sampled as finely: the
+                # distance to a sample is at most step / 2 more than to the outline
+                pts = _outline(out.to_polygons(), step)
+                far, i = cKDTree(_outline(throat.to_polygons(), step)).query(pts)
+                if far.max() > depth:
+                    i = int(far.argmax())
+                    depth, where = float(far[i]), (float(pts[i, 0]), float(y), float(pts[i, 1]))
+            common = throat ^ section
+            if not common.is_empty():  # else (a leaning part) what follows is measured from the last one
+                throat = common
+    return depth, where
+
+
+def check_undercut(skin: bd.Solid, y_b: float, path) -> float:
+    """The skin's undercut depth (mm, `undercut`): ParameterError above UNDERCUT_REFUSE, a
+    warning above UNDERCUT_SILENT."""
+    depth, at = undercut(skin, y_b)
+    if depth <= UNDERCUT_SILENT:
+        return depth
+    name = Path(str(path)).name
+    where = f"{depth:.3g} mm deep at (x, y, z) = ({at[0]:.3g}, {at[1]:.3g}, {at[2]:.3g}) mm"
+    if depth > UNDERCUT_REFUSE:
+        raise ParameterError("skin_file", str(path), f"a skin the mold releases along -y (out through its bonded face "
+                             f"y = {y_b:.4g} mm) with an undercut <= {UNDERCUT_REFUSE:g} mm",
+                             f"{name}'s pocket holds it by an undercut {where}; {NO_MOLDS}")
+    log.warning("%s: the mold's pocket holds the cast by an undercut %s (it must squeeze that far sideways to come "
+                "out along -y; a soft silicone stretches out of up to %g mm, a stiff one may tear), and air may stay "
+                "under it while pouring", name, where, UNDERCUT_REFUSE)
+    return depth
+
+
 def file_mold(skin: bd.Solid, y_b: float, path, mp: MoldParams | None = None):
-    """(lower part with the pocket and pins, lid with sprue and vents) of the skin `skin`, bonded
-    on the plane y = y_b."""
+    """(lower part with the pocket and pins, lid with sprue and vents, undercut depth (mm)) of the
+    skin `skin`, bonded on the plane y = y_b."""
     mp = mp or MoldParams.from_params()
     bb = skin.bounding_box()
     size = max(bb.size.X, bb.size.Y, bb.size.Z)
@@ -109,11 +197,14 @@ def file_mold(skin: bd.Solid, y_b: float, path, mp: MoldParams | None = None):
             raise ParameterError("skin_file", str(path), "a skin whose mold pocket is one piece (open only at the "
                                  "bonded plane)", f"{name} encloses {pieces - 1} room(s) under it down to its "
                                  f"bonded plane y = {y_b:.4g} mm, which would be loose core(s) of the mold")
+        depth.append(check_undercut(skin, y_b, path))  # a loose core is also an undercut: named first
 
-    return face_down_mold(skin, (bb.min.X, bb.max.X, bb.max.Y, bb.min.Z, bb.max.Z), y_b, mp, "skin mold", p,
-                          check=one_pocket,
-                          holes=lambda: hole_positions(_bonded_faces(skin, y_b, tol), y_b, bb.min.Z, bb.max.Z, mp,
-                                                       path))
+    depth = []
+    lower, upper = face_down_mold(skin, (bb.min.X, bb.max.X, bb.max.Y, bb.min.Z, bb.max.Z), y_b, mp, "skin mold", p,
+                                  check=one_pocket,
+                                  holes=lambda: hole_positions(_bonded_faces(skin, y_b, tol), y_b, bb.min.Z,
+                                                               bb.max.Z, mp, path))
+    return lower, upper, depth[0]
 
 
 def build_file_parts(path, bonded=None, *, molds: bool = True) -> list[Part]:
@@ -129,9 +220,11 @@ def build_file_parts(path, bonded=None, *, molds: bool = True) -> list[Part]:
     skin = read_skin(path)
     parts = [Part("skin", f"your skin ({Path(str(path)).name}; cast in the mold)", skin, fp)]
     if molds:
-        lower, upper = file_mold(skin, y_b, path)
-        fp = dict(fp, bonded_y=y_b)
-        parts.append(Part("mold_lower", "skin mold, lower part (pocket = the skin, cast face down; pins)", lower, fp))
+        lower, upper, depth = file_mold(skin, y_b, path)
+        fp = dict(fp, bonded_y=y_b, undercut_mm=round(depth, 3))
+        held = f"; UNDERCUT {depth:.2g} mm: stretch the cast out" if depth > UNDERCUT_SILENT else ""
+        parts.append(Part("mold_lower", f"skin mold, lower part (pocket = the skin, cast face down; pins{held})", lower,
+                          fp))
         parts.append(Part("mold_upper", "skin mold, lid over the bonded face (sprue, vents; or the sensor board)",
                           upper, fp))
     return parts
