@@ -70,6 +70,33 @@ def test_an_almost_symmetric_step_stays_whole_on_that_axis(tmp_path):
     assert not sm.halved and sm.z_symmetric and "symmetry" not in sm.boundaries
 
 
+def _pad(path, *features, cut=False):
+    """A 100 x 100 x 5 mm pad (x, z centred, y in [0, 5]) with `features` added (cut=True: cut)."""
+    s = bd.Box(100, 5, 100, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    for f in features:
+        s = s - f if cut else s + f
+    bd.export_step(s, str(path))
+    return str(path)
+
+
+def test_a_small_feature_on_one_side_of_a_large_step_keeps_it_whole(tmp_path):
+    """A 0.25 x 0.3 x 0.25 mm nub or a 1 mm dimple 0.03 mm deep at x = z = 20 on a 100 x 100 x 5
+    pad: 7.5e-7 and 9.5e-7 of its volume, under SYMMETRY_TOL, read symmetric and the quarter
+    dropped the feature; the difference's piece is 0.1 / 0.028 mm thick (SYMMETRY_LENGTH 1e-4).
+    The same features mirrored at (+-20, +-20) keep the pad symmetric."""
+    def nub(x, z):
+        return bd.Pos(x, 5, z) * bd.Box(0.25, 0.3, 0.25, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+
+    def dimple(x, z):
+        return bd.Pos(x, 5, z) * bd.Cylinder(0.5, 0.06, rotation=(90, 0, 0))
+
+    assert step_symmetry(_pad(tmp_path / "nub.step", nub(20, 20))) == (False, False)
+    assert step_symmetry(_pad(tmp_path / "dimple.step", dimple(20, 20), cut=True)) == (False, False)
+    four = [(x, z) for x in (-20, 20) for z in (-20, 20)]
+    assert step_symmetry(_pad(tmp_path / "nubs.step", *(nub(x, z) for x, z in four))) == (True, True)
+    assert step_symmetry(_pad(tmp_path / "dimples.step", *(dimple(x, z) for x, z in four), cut=True)) == (True, True)
+
+
 def test_an_asymmetric_indenter_keeps_the_whole_step(tmp_path):
     """Braille ⠑ (dots at (-1.17, 1.17) and (1.17, -1.17) mm: symmetric about neither plane) on
     the symmetric block: the whole model, as before the cut existed."""

@@ -57,6 +57,12 @@ DEFAULT_RULE = "normal:-y"
 # tolerances, far above OCC's 1e-7 mm modelling precision; a 12 mm domed block moved 0.001 mm
 # along x (2.4e-4) already stays whole
 SYMMETRY_TOL = 1e-6
+# ... and each piece of that difference is thinner than this (mm; its mean thickness 2 V / S):
+# the fraction of the volume alone hid a local asymmetry on a large skin (a 1 mm dimple 0.03 mm
+# deep on one side of a 100 x 100 x 5 mm pad read 9.5e-7, and the quarter dropped it); a
+# face's offset d leaves a slab 2 d thick, a nub or hole about a third of its size. 1e-4 mm: 5x
+# below the finest cells (mesh_size 0.01 / refinement 20), 1000x above OCC's 1e-7 mm precision
+SYMMETRY_LENGTH = 1e-4
 RULE_FORMS = "'normal:-y' (optionally ':TOL_DEG'), 'normal:+x', ... or 'plane:y=0' (x, y or z)"
 _VALID_FILE = "a gmsh .msh with named physical groups or a STEP (.step/.stp) of the skin solid, in mm"
 
@@ -323,7 +329,8 @@ def _import_step(gmsh, path: Path) -> None:
 
 def step_symmetry(path, bonded=None) -> tuple[bool, bool]:
     """(about x = 0, about z = 0): a STEP skin solid is its own mirror image about the plane
-    (symmetric difference below SYMMETRY_TOL of its volume) and so are its bonded faces (the
+    (symmetric difference below SYMMETRY_TOL of its volume, each piece of it thinner than
+    SYMMETRY_LENGTH) and so are its bonded faces (the
     rule `bonded` picks mirror images of bonded faces unless it names that axis: 'normal:+x',
     'plane:x=1' bond one side only). Cached by the file's bytes."""
     kind, a, _ = parse_rule(bonded)
@@ -350,12 +357,22 @@ def _solid_symmetry(path: str, digest: str) -> tuple[bool, bool]:
                                Path(path).name, "xz"[plane[2]], e)
                 out.append(False)
                 continue
-            diff = 2.0 * sum(occ.getMass(*e) for e in rest if e[0] == 3)
+            pieces = [e for e in rest if e[0] == 3]
+            diff = 2.0 * sum(occ.getMass(*e) for e in pieces)
+            thick = max((_thickness(occ, e[1]) for e in pieces), default=0.0)
             occ.remove(rest, recursive=True)
-            out.append(diff <= SYMMETRY_TOL * v)
+            out.append(diff <= SYMMETRY_TOL * v and thick <= SYMMETRY_LENGTH)
             logger.info("STEP skin %s: symmetric difference with its mirror image about %s = 0: %.3g of its "
-                        "volume (symmetric below %g)", Path(path).name, "xz"[plane[2]], diff / v, SYMMETRY_TOL)
+                        "volume, its thickest piece %.3g mm (symmetric below %g and %g mm)", Path(path).name,
+                        "xz"[plane[2]], diff / v, thick, SYMMETRY_TOL, SYMMETRY_LENGTH)
     return out[0], out[1]
+
+
+def _thickness(occ, tag: int) -> float:
+    """Mean thickness 2 V / S (mm) of an OCC volume: d for a slab d thick, a / 3 for a cube of
+    side a."""
+    area = sum(occ.getMass(2, f) for loop in occ.getSurfaceLoops(tag)[1] for f in loop)
+    return 2.0 * occ.getMass(3, tag) / area if area > 0.0 else 0.0
 
 
 def _keep_half(gmsh, halve, lo, hi) -> None:
