@@ -97,6 +97,30 @@ def test_a_small_feature_on_one_side_of_a_large_step_keeps_it_whole(tmp_path):
     assert step_symmetry(_pad(tmp_path / "dimples.step", *(dimple(x, z) for x, z in four), cut=True)) == (True, True)
 
 
+def test_a_cut_that_splits_the_step_falls_back_to_the_whole_model(tmp_path, caplog):
+    """A 20 x 20 x 2 mm pad with 2 mm square holes at (+-3, +-3) and a notch 1e-5 mm wide through
+    it at z = 3 from the hole at x = -3 to the edge x = 10 is its mirror image within the
+    tolerances (difference under 1e-6 of its volume, 1e-5 mm thick), but its quarter x, z >= 0
+    falls in two pieces: that raised MeshError; now the whole pad is meshed, saying why."""
+    import logging
+
+    pad = bd.Box(20, 2, 20, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    for x, z in ((-3, -3), (-3, 3), (3, -3), (3, 3)):
+        pad -= bd.Pos(x, 1, z) * bd.Box(2, 2, 2)
+    notch = bd.Pos(-3, 0, 3) * bd.Box(13, 2, 1e-5, align=(bd.Align.MIN, bd.Align.MIN, bd.Align.MIN))
+    path = tmp_path / "notched.step"
+    bd.export_step(pad - notch, str(path))
+    assert step_symmetry(path) == (True, True)
+    sc = Scene(skin_file=str(path), indenter="sphere", indenter_radius=1.5, depth=0.1, skin="file",
+               viscoelastic=False, mesh_size=2.0, refinement=1.0)
+    with caplog.at_level(logging.WARNING, logger="tactileskin.mesh.skinfile"):
+        sm = build_mesh(sc)
+    assert not sm.halved and not sm.z_symmetric and not {"symmetry", "end_back"} & set(sm.boundaries)
+    # the whole bonded face: 400 mm^2 less the holes (16) and the notch's 10 mm outside them
+    assert sm.boundary_measure("bone_interface") == pytest.approx(384.0 - 10 * 1e-5, rel=1e-9)
+    assert any("left 2 volumes, not one: meshed whole" in r.getMessage() for r in caplog.records)
+
+
 def test_an_asymmetric_indenter_keeps_the_whole_step(tmp_path):
     """Braille ⠑ (dots at (-1.17, 1.17) and (1.17, -1.17) mm: symmetric about neither plane) on
     the symmetric block: the whole model, as before the cut existed."""

@@ -20,7 +20,8 @@ facet satisfies the rule `skin_bonded`: "normal:-y" (outward normal within 10 de
 within 1e-6 of the part size); every other face is `outer_surface`. A STEP solid that is its own
 mirror image about x = 0 (z = 0) (`step_symmetry`) is meshed as its half x >= 0 (z >= 0) where
 the caller asks (`mesh_step(halve=...)`: skins.file, for an indenter symmetric the same way):
-the cut faces are `symmetry` (`symmetry_z`, held as `end_back`), as in a .msh half.
+the cut faces are `symmetry` (`symmetry_z`, held as `end_back`), as in a .msh half; a cut
+that leaves other than one volume (a hairline notch within the tolerances) meshes it whole.
 
 Units: a part whose bounding box is smaller than 0.1 mm or larger than 1 m is refused (a
 file in metres or micrometres).
@@ -375,17 +376,22 @@ def _thickness(occ, tag: int) -> float:
     return 2.0 * occ.getMass(3, tag) / area if area > 0.0 else 0.0
 
 
-def _keep_half(gmsh, halve, lo, hi) -> None:
-    """Cut the model's one volume to x >= 0 (halve[0]) and z >= 0 (halve[1])."""
+def _keep_half(gmsh, halve, lo, hi, path: Path) -> bool:
+    """Cut the model's one volume to x >= 0 (halve[0]) and z >= 0 (halve[1]); False (logged) if
+    that left other than one volume: the model is then spent, the caller re-imports it whole."""
     occ = gmsh.model.occ
     pad = 1.0 + float(np.max(hi - lo))
     a = [0.0 if halve[0] else lo[0] - pad, lo[1] - pad, 0.0 if halve[1] else lo[2] - pad]
     box = occ.addBox(*a, *(hi + pad - np.array(a)))
     out, _ = occ.intersect(gmsh.model.getEntities(3), [(3, box)])
     occ.synchronize()
-    if len([e for e in out if e[0] == 3]) != 1:
-        raise MeshError(f"cutting the STEP skin at {' and '.join(n for n, h in zip(('x = 0', 'z = 0'), halve) if h)}"
-                        f" left {len(out)} volumes, not one")
+    nvol = len([e for e in out if e[0] == 3])
+    if nvol != 1:
+        # a mirror image within SYMMETRY_TOL / SYMMETRY_LENGTH, not an exact one: a hairline
+        # notch on one side splits the part kept (the exact mirror image of one solid cannot)
+        logger.warning("STEP skin %s: cutting it at %s left %d volumes, not one: meshed whole", path.name,
+                       " and ".join(n for n, h in zip(("x = 0", "z = 0"), halve) if h), nvol)
+    return nvol == 1
 
 
 def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float = 1.0, order: int = 2,
@@ -394,7 +400,8 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
     around the top of the bounding box on x = z = 0, a fifth of the part's size); mesh_size
     None: an eighth of the part's size. halve: (x, z) mesh the part x >= 0 (z >= 0) only, its
     cut faces `symmetry` (`end_back`, z_symmetric): for a solid that `step_symmetry` finds
-    symmetric (the caller's check); sizes default from the whole solid."""
+    symmetric (the caller's check); sizes default from the whole solid. A cut that leaves other
+    than one volume falls back to the whole solid (a warning; not halved)."""
     path = Path(path)
     parse_rule(bonded)  # a bad rule fails before any CAD work
     halve = (bool(halve[0]), bool(halve[1]))
@@ -405,8 +412,11 @@ def mesh_step(path, *, bonded=None, mesh_size: float | None, refinement: float =
         _import_step(gmsh, path)
         lo, hi = np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2)
         size = float(np.max(hi - lo))
-        if any(halve):
-            _keep_half(gmsh, halve, lo, hi)
+        if any(halve) and not _keep_half(gmsh, halve, lo, hi, path):
+            gmsh.model.remove()  # the cut consumed the solid: a fresh model of the whole one
+            gmsh.model.add("skinstep")
+            _import_step(gmsh, path)
+            halve = (False, False)
         mesh_size = size / 8.0 if mesh_size is None else mesh_size
         centre = (0.0, hi[1], 0.0) if centre is None else centre
         radius = 0.2 * size if radius is None else radius
