@@ -214,6 +214,120 @@ def test_stale_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
     code_digest.cache_clear()
 
 
+# A long-lived Python (a notebook kernel) on a copy of the package: it imports tactileskin, then
+# `git pull` edits a module it already ran, then it runs a serial sweep (its solve stubbed: quick)
+_SESSION = """
+import json, sys
+import numpy as np
+import tactileskin.sweep as sw
+from pathlib import Path
+from tactileskin.cache import ResultCache, cache_key
+from tactileskin.results import Result
+from tactileskin.scene import Scene
+
+sc = Scene(thickness=1.0, mesh_size=1.0, refinement=2.0)
+src = Path(sw.__file__).parent / "results.py"
+src.write_text(src.read_text() + "\\nEDITED = True\\n")   # the pull
+s = np.linspace(0.0, 5.0, 11)
+sw.solve_case = lambda scene: Result(s=s, pressure=np.exp(-s ** 2), contact_x=s[:3], contact_pressure=s[:3],
+                                     reaction=0.5, stats={"dofs": 10, "increments": 1, "newton_iterations": 2})
+outs = [sw.run_sweep([sc], ResultCache(sys.argv[1]), serial=True)[0] for _ in range(2)]
+print(json.dumps({"key": cache_key(sc), "status": [o.status for o in outs], "error": outs[0].error}))
+"""
+
+_FRESH = """
+import json, sys
+import tactileskin.sweep as sw
+from tactileskin.cache import ResultCache, cache_key
+from tactileskin.scene import Scene
+
+sc = Scene(thickness=1.0, mesh_size=1.0, refinement=2.0)
+sw.solve_case = lambda scene: None   # a Dask worker of the session's sweep: must not get this far
+ran = sw._run_one_safely(sc, sys.argv[2])
+print(json.dumps({"key": cache_key(sc), "found": ResultCache(sys.argv[1]).lookup(sc) is not None,
+                  "worker": ran[0], "worker_error": ran[3]}))
+"""
+
+
+def _run_python(pkg, code, *args):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=str(pkg))
+    r = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.splitlines()[-1]), r.stderr
+
+
+def test_sources_edited_after_import_are_neither_keyed_nor_stored_as_the_new_code(tmp_path):
+    """The key hashed the package's files on disk at its first use: after a `git pull` in a
+    running kernel, the old code's result was stored under the new code's key, and every fresh
+    process (new code) reused it. The key names the code this process imported; while the
+    sources on disk differ from it, no entry is stored or reused (a WARNING names the file)."""
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    cache = tmp_path / "cache"
+    session, log_text = _run_python(pkg, _SESSION, cache)
+    # the session's key names the code it runs: the unedited package's (this process's)
+    assert session["key"] == cache_key(Scene(**COARSE))
+    assert session["status"] == ["failed", "failed"] and "restart" in session["error"]
+    assert log_text.count("results.py") == 1 and "restart" in log_text   # warned once, naming the file
+    assert not [p for p in cache.iterdir() if p.is_dir()]                # nothing stored
+    fresh, _ = _run_python(pkg, _FRESH, cache, session["key"])
+    assert fresh["key"] != session["key"]          # the new code: another key
+    assert not fresh["found"]                       # the old code's result is not reused as the new code's
+    # a worker started after the pull runs the new code: it refuses the sweep's (old code's) key
+    assert fresh["worker"] == "failed" and "differ from the sweep's" in fresh["worker_error"]
+
+
+_CLI_PULL_MID_RUN = """
+import sys
+import numpy as np
+import tactileskin.sweep as sw
+from pathlib import Path
+from tactileskin.cli import main
+from tactileskin.results import Result
+
+def solve_then_pull(scene):   # the first case's solve ends as `git pull` edits a module
+    src = Path(sw.__file__).parent / "results.py"
+    src.write_text(src.read_text() + "\\nEDITED = True\\n")
+    s = np.linspace(0.0, 5.0, 11)
+    return Result(s=s, pressure=np.exp(-s ** 2), contact_x=s[:3], contact_pressure=s[:3], reaction=0.5,
+                  stats={"dofs": 10, "increments": 1, "newton_iterations": 2})
+
+sw.solve_case = solve_then_pull
+sys.exit(main(["sweep", "-t", "1,2", "-i", "flat", "-m", "polyurethane", "--quality", "preview", "--serial",
+               "--no-render", "-o", sys.argv[1], "--cache", sys.argv[2]]))
+"""
+
+
+def test_cli_sweep_warns_once_when_the_sources_change_mid_run(tmp_path):
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    cache = tmp_path / "cache"
+    r = subprocess.run([sys.executable, "-c", _CLI_PULL_MID_RUN, str(tmp_path / "out"), str(cache)],
+                       capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(pkg), COLUMNS="400"))
+    text = r.stdout + r.stderr
+    assert r.returncode == 1, text                                    # both cases failed
+    assert text.count("WARNING") == 1 and "restart Python" in text    # one warning, not one per case
+    assert "not stored" in text and "not solved" in text              # solved before the pull; after it not
+    assert not [p for p in cache.iterdir() if p.is_dir()]
+
+
 def test_edited_material_file_is_recomputed(tmp_path):
     mat = _material_file(tmp_path / "pu.toml")
     sc = Scene(material=str(mat), indenter="curved", **COARSE)

@@ -15,7 +15,13 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   own source and data files (but the shipped molds.toml) and the versions of the libraries that mesh and solve (gmsh,
   scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused; a .pyc Python runs instead of its edited source
-  (same size and time stamp) adds its code (`_stale_bytecode`).
+  (same size and time stamp) adds its code (`_stale_bytecode`). The .py files are hashed as this
+  process imported them (`tactileskin._IMPORTED_SOURCES`), not as they are on disk at key time.
+While the package's .py files on disk differ from those it imported (a `git pull` in a running
+notebook kernel: the old code runs, or old and new mixed as modules load), the process neither
+stores nor reuses entries and its cases fail (`code_changes`: a WARNING names the files and says
+to restart Python); a Dask worker started after the change imports the new code, whose key
+differs from the sweep's, so it refuses the case.
 Every caller that identifies a cached result (the cache itself, run_sweep, results.csv's
 `key` column) uses this key. Files are hashed on every call (a few kB), never memoised by
 time stamp, so an edit within the same second is not missed.
@@ -97,10 +103,15 @@ def code_digest(root: Path | None = None) -> str:
     """SHA-256 of the code that produces a result: the names and bytes of every .py, .json and
     .toml file of the package (`root`, default the installed package's folder; sorted by path)
     and the installed versions of SOLVER_LIBRARIES; plus the code of any .pyc Python runs in place
-    of its source (_stale_bytecode). Computed once per process: it is the code this process
-    imported and runs (~130 files, ~20 ms)."""
+    of its source (_stale_bytecode). Computed once per process (~130 files, ~20 ms). For the
+    installed package the .py files are those this process imported (their hashes at import,
+    tactileskin._IMPORTED_SOURCES), not the files on disk now: after a `git pull` in a running
+    kernel the disk's were the new code's, while the old code ran (see code_changes)."""
     from importlib import metadata
 
+    import tactileskin
+
+    imported = tactileskin._IMPORTED_SOURCES if root is None else None
     root = Path(__file__).resolve().parent if root is None else Path(root)
     h = hashlib.sha256()
     try:
@@ -108,12 +119,21 @@ def code_digest(root: Path | None = None) -> str:
         # too, or editing data/geometry/molds.toml in place re-solved every case all the same
         skip = {f"data/geometry/{n}" for n in params.NOT_SOLVED}
         paths = sorted(p for p in root.rglob("*") if p.suffix in (".py", ".json", ".toml") and p.is_file()
-                       and "__pycache__" not in p.parts and p.relative_to(root).as_posix() not in skip)
+                       and "__pycache__" not in p.parts and p.relative_to(root).as_posix() not in skip
+                       and not (imported is not None and p.suffix == ".py"))
         for p in paths:
             data = p.read_bytes()
             h.update(p.relative_to(root).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
             if p.suffix == ".py" and (old := _stale_bytecode(p, data)) is not None:
                 h.update(b"stale bytecode\0" + old)  # results of the code that runs, not of the file
+        for rel, digest in sorted((imported or {}).items()):
+            h.update(f"{rel}\0{digest}\0".encode())
+            try:
+                data = (root / rel).read_bytes()
+            except OSError:
+                continue  # removed since: code_changes() keeps the cache closed
+            if hashlib.sha256(data).hexdigest() == digest and (old := _stale_bytecode(root / rel, data)) is not None:
+                h.update(b"stale bytecode\0" + old)
     except OSError as e:  # an unreadable install: the version alone names the code
         log.warning("package files not readable (%s); cache keys use the version %s only", e, __version__)
         h.update(b"unreadable")
@@ -124,6 +144,31 @@ def code_digest(root: Path | None = None) -> str:
             v = "-"
         h.update(f"{name}={v}\0".encode())
     return h.hexdigest()
+
+
+_WARNED_CHANGES: set[tuple[str, ...]] = set()
+
+
+def code_changes() -> list[str]:
+    """The package's .py files (paths in it) whose bytes on disk are not those this process
+    imported: edited, added or removed since (a `git pull` in a running kernel). While there are
+    any, the process runs other code than the files say (the old, or old and new mixed as modules
+    load), so the cache neither stores nor reuses entries. Each new list is logged once as a
+    WARNING. Hashes the files on every call (~130 files, 3-8 ms), as the geometry files are."""
+    import tactileskin
+
+    now, then = tactileskin._source_hashes(), tactileskin._IMPORTED_SOURCES
+    changed = sorted(k for k in now.keys() | then.keys() if now.get(k) != then.get(k))
+    if changed and tuple(changed) not in _WARNED_CHANGES:
+        _WARNED_CHANGES.add(tuple(changed))
+        log.warning("%s (a notebook's kernel, a Dask cluster's workers): until then it runs the code it imported, "
+                    "and no result is cached or taken from the cache", changed_code_message(changed))
+    return changed
+
+
+def changed_code_message(changed: list[str]) -> str:
+    names = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" if len(changed) > 5 else "")
+    return f"tactileskin's sources changed since this Python imported them ({names}): restart Python to run them"
 
 
 def _stale_bytecode(p: Path, source: bytes) -> bytes | None:
@@ -262,6 +307,8 @@ class ResultCache:
     def lookup(self, scene: Scene, key: str | None = None, *, repair: bool = True) -> CaseRecord | None:
         """The validated entry of `scene`, or None when there is none or it is damaged.
         With repair, a damaged entry is logged (WARNING, naming its path) and removed."""
+        if code_changes():
+            return None  # not the code the key names runs here (logged): not reused
         key = key or self.key(scene)
         p = self.root / key
         rec, problem = self._check(p, scene, key)
@@ -343,6 +390,8 @@ class ResultCache:
     # --- writing ------------------------------------------------------------------------
     def store(self, scene: Scene, result, key: str | None = None) -> Path:
         """Write `result` (has .write_owned(dir)) under the scene's key, atomically."""
+        if changed := code_changes():
+            raise CacheError(f"not stored: {changed_code_message(changed)}")
         key = key or self.key(scene)
         final = self.root / key
         with fileio.os_errors(final), staging.staged_dir(final) as tmp:

@@ -31,6 +31,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from tactileskin.cache import CaseRecord, ResultCache, cache_key, read_profile  # noqa: F401 (API)
+from tactileskin.cache import changed_code_message, code_changes
 from tactileskin.errors import ParameterError, TactileSkinError
 from tactileskin.geometry.indenters.registry import get as get_kind
 from tactileskin.scene import Scene
@@ -377,6 +378,8 @@ def _run_one_safely(scene: Scene, key: str | None = None):
     files change during the solve, fails the case rather than store it under a wrong key."""
     t0 = time.perf_counter()
     try:
+        if key is not None and (changed := code_changes()):  # its result could not be stored
+            raise TactileSkinError(f"not solved: {changed_code_message(changed)}")
         if key is not None and cache_key(scene) != key:
             raise TactileSkinError("the material or geometry files, the tactileskin code or the solving "
                                    "libraries' versions seen by the worker differ from the sweep's; not solved")
