@@ -3,6 +3,7 @@ entries are recomputed with a warning (never used), and two runs share one case'
 
 import json
 import logging
+import os
 import shutil
 import threading
 import time
@@ -177,7 +178,6 @@ def test_stale_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
     in runs the old code. Its results took the new source's key and were reused as the new code's
     once the .pyc was refreshed (a results.py printing 10 digits stood for one printing 12)."""
     import importlib.util
-    import os
     import py_compile
 
     from tactileskin.cache import code_digest
@@ -211,6 +211,50 @@ def test_stale_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
     compile_pyc()                                      # a .pyc that matches its source changes nothing
     code_digest.cache_clear()
     assert code_digest(pkg) == fresh
+    code_digest.cache_clear()
+
+
+def test_unchecked_hash_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
+    """A PEP 552 unchecked-hash .pyc (`py_compile --invalidation-mode unchecked-hash`: distro
+    packages, reproducible builds) runs whatever its source now says; only time-stamp .pyc files
+    were compared, so an edited source's key was given to the old code's results. A checked-hash
+    .pyc is recompiled from a changed source: it changes nothing."""
+    import importlib.util
+    import py_compile
+
+    from tactileskin.cache import code_digest
+
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    mod = pkg / "rtol.py"
+    pyc = importlib.util.cache_from_source(str(mod))
+
+    def compile_pyc(mode):
+        py_compile.compile(str(mod), cfile=pyc, doraise=True, invalidation_mode=mode)
+
+    def digest():
+        code_digest.cache_clear()
+        return code_digest(pkg)
+
+    mod.write_text("RTOL = 1e-8\n")
+    compile_pyc(py_compile.PycInvalidationMode.UNCHECKED_HASH)
+    mod.write_text("RTOL = 1e-06\n")                   # edited: another size and time stamp
+    spec = importlib.util.spec_from_file_location("rtol_unchecked", mod)
+    ran = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ran)
+    assert ran.RTOL == 1e-8                            # the premise: Python runs the old code
+    with caplog.at_level(logging.WARNING, logger="tactileskin.cache"):
+        stale = digest()
+    os.remove(pyc)
+    fresh = digest()
+    assert stale != fresh                              # the old code's results are not the new code's
+    assert "rtol.py" in caplog.text and "earlier version" in caplog.text
+    compile_pyc(py_compile.PycInvalidationMode.UNCHECKED_HASH)   # compiled from this source: the same code
+    assert digest() == fresh
+    mod.write_text("RTOL = 1e-8\n")
+    compile_pyc(py_compile.PycInvalidationMode.CHECKED_HASH)
+    mod.write_text("RTOL = 1e-06\n")                   # Python sees the hash differ and compiles the source
+    assert digest() == fresh
     code_digest.cache_clear()
 
 
@@ -250,7 +294,6 @@ print(json.dumps({"key": cache_key(sc), "found": ResultCache(sys.argv[1]).lookup
 
 
 def _run_python(pkg, code, *args):
-    import os
     import subprocess
     import sys
 
@@ -308,7 +351,6 @@ sys.exit(main(["sweep", "-t", "1,2", "-i", "flat", "-m", "polyurethane", "--qual
 
 
 def test_cli_sweep_warns_once_when_the_sources_change_mid_run(tmp_path):
-    import os
     import subprocess
     import sys
     from pathlib import Path
@@ -326,6 +368,32 @@ def test_cli_sweep_warns_once_when_the_sources_change_mid_run(tmp_path):
     assert text.count("WARNING") == 1 and "restart Python" in text    # one warning, not one per case
     assert "not stored" in text and "not solved" in text              # solved before the pull; after it not
     assert not [p for p in cache.iterdir() if p.is_dir()]
+
+
+def test_unchecked_hash_bytecode_of_the_package_is_keyed_apart(tmp_path):
+    """As above, in a copy of the package itself (the key of a fresh process importing it)."""
+    import importlib.util
+    import py_compile
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    mod = pkg / "tactileskin" / "results.py"
+    pyc = importlib.util.cache_from_source(str(mod))
+    py_compile.compile(str(mod), cfile=pyc, doraise=True, invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
+    mod.write_text(mod.read_text() + "\nEDITED = True\n")
+    code = ("import json, tactileskin.results as r; from tactileskin.cache import cache_key; "
+            "from tactileskin.scene import Scene; print(json.dumps({'key': cache_key(Scene()), "
+            "'edited': hasattr(r, 'EDITED')}))")
+    stale, log_text = _run_python(pkg, code)
+    assert not stale["edited"]                          # the premise: the .pyc's old code runs
+    assert "results.py" in log_text and "unchecked-hash" in log_text
+    os.remove(pyc)
+    fresh, _ = _run_python(pkg, code)
+    assert fresh["edited"] and fresh["key"] != stale["key"]
 
 
 def test_edited_material_file_is_recomputed(tmp_path):

@@ -15,7 +15,7 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   own source and data files (but the shipped molds.toml) and the versions of the libraries that mesh and solve (gmsh,
   scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused; a .pyc Python runs instead of its edited source
-  (same size and time stamp) adds its code (`_stale_bytecode`). The .py files are hashed as this
+  (same size and time stamp, or an unchecked-hash .pyc, PEP 552) adds its code (`_stale_bytecode`). The .py files are hashed as this
   process imported them (`tactileskin._IMPORTED_SOURCES`), not as they are on disk at key time.
 While the package's .py files on disk differ from those it imported (a `git pull` in a running
 notebook kernel: the old code runs, or old and new mixed as modules load), the process neither
@@ -175,8 +175,11 @@ def _stale_bytecode(p: Path, source: bytes) -> bytes | None:
     """The body of p's .pyc when Python runs it instead of p's code, else None. Python takes a
     time-stamp .pyc while it names the source's mtime in whole seconds and its size, so a same-size
     edit within the second the .pyc was compiled in, or with the time stamp set back (touch -d,
-    cp -p), still runs the old code. Compiled (~3 ms) and compared only when p changed after the
-    .pyc was written (their ctimes, which no tool sets back): other .pyc files cost a 16-byte read."""
+    cp -p), still runs the old code; and it takes an unchecked-hash .pyc (PEP 552) whatever the
+    source says (a checked-hash one is recompiled when the source's hash differs). Compiled (~3 ms)
+    and compared only when p changed after the .pyc was written (their ctimes, which no tool sets
+    back): other .pyc files cost a 16-byte read."""
+    import _imp
     import importlib.util
     import marshal
     import types
@@ -185,10 +188,13 @@ def _stale_bytecode(p: Path, source: bytes) -> bytes | None:
     try:
         with open(importlib.util.cache_from_source(str(p)), "rb") as fh:
             head, written, st = fh.read(16), os.fstat(fh.fileno()).st_ctime_ns, p.stat()
-            if (len(head) < 16 or head[:4] != importlib.util.MAGIC_NUMBER or head[4:8] != bytes(4)
-                    or int.from_bytes(head[8:12], "little") != int(st.st_mtime) & 0xFFFFFFFF
-                    or int.from_bytes(head[12:16], "little") != st.st_size & 0xFFFFFFFF
-                    or st.st_ctime_ns < written):
+            flags, check = int.from_bytes(head[4:8], "little"), _imp.check_hash_based_pycs
+            if flags == 0:  # time stamp
+                taken = (int.from_bytes(head[8:12], "little") == int(st.st_mtime) & 0xFFFFFFFF
+                         and int.from_bytes(head[12:16], "little") == st.st_size & 0xFFFFFFFF)
+            else:  # source hash: unchecked (1), or checked (3) under --check-hash-based-pycs never
+                taken = check != "always" and (flags == 1 or (flags == 3 and check == "never"))
+            if len(head) < 16 or head[:4] != importlib.util.MAGIC_NUMBER or not taken or st.st_ctime_ns < written:
                 return None  # none, not one Python takes, or compiled after p's last change
             body = fh.read()
         code = marshal.loads(body)
@@ -203,9 +209,10 @@ def _stale_bytecode(p: Path, source: bytes) -> bytes | None:
                 return None
     except (SyntaxError, ValueError):
         pass  # the source does not compile: the .pyc's code is all the more not the source's
-    log.warning("Python runs %s, compiled from an earlier version of %s (changed within the second it "
-                "was compiled in, or its time stamp set back): results are cached as that code's; delete "
-                "the .pyc to run the file's code", importlib.util.cache_from_source(str(p)), p)
+    log.warning("Python runs %s, compiled from an earlier version of %s (%s): results are cached as that "
+                "code's; delete the .pyc to run the file's code", importlib.util.cache_from_source(str(p)), p,
+                "changed within the second it was compiled in, or its time stamp set back" if flags == 0
+                else "an unchecked-hash .pyc, which Python runs without looking at the source")
     return body
 
 
