@@ -21,7 +21,9 @@ surface, the paper's sensor film):
 
 Solves go through the sweep's result cache (run_sweep), so a rerun only reads files.
 Each (material, thickness, set, pitch) gets one draw of offsets; every noise level reads
-the same noise-free readings (so the noise axis compares like with like).
+the same noise-free readings (so the noise axis compares like with like). The noise axis is
+fractions of each set's full scale (noise_fs) or a fixed std in MPa (noise_mpa); it enters
+no solve, so either reads the same cached solves.
 """
 
 from __future__ import annotations
@@ -51,6 +53,7 @@ GOOD = 0.95                 # accuracy at which a set counts as discriminated
 LETTERS = "".join(sorted(BRAILLE_LETTERS))
 DIGITS = "".join(BRAILLE_DIGITS)
 CHARACTERS = LETTERS + DIGITS
+NOISE_FS = (0.01, 0.05, 0.1)  # the default noise axis (x full scale)
 SETS = ("paper", "letters", "shapes")  # the index seeds each set's offsets: append only
 SKINS = ("pad", "fingertip")
 LETTERS_MODELS = ("interaction", "sum", "full")
@@ -107,7 +110,11 @@ class ChartConfig:
     thicknesses: tuple = (1.0, 3.0)
     materials: tuple = ("silicone",)
     pitches: tuple = (0.5, 0.75, 1.0, 1.5, 2.0, 4.0)
-    noise_fs: tuple = (0.01, 0.05, 0.1)   # noise std as a fraction of each set's full scale
+    # noise std as a fraction of each set's full scale (None: NOISE_FS unless noise_mpa is given)
+    noise_fs: tuple | None = None
+    # or a fixed noise std in MPa, the same at every thickness and set (a real sensor's noise
+    # floor does not scale with the stimulus); not with noise_fs
+    noise_mpa: tuple | None = None
     taxel_fraction: float = 0.8            # taxel side / pitch (area averaging)
     bits: int | None = 12
     window: float = 8.0                    # array side (mm): n = floor(window / pitch) + 1 taxels a side
@@ -153,10 +160,18 @@ class ChartConfig:
         from tactileskin.scene import MESH_SIZE, REFINEMENT
 
         set_ = lambda name, v: object.__setattr__(self, name, v)  # noqa: E731 (frozen)
+        if self.noise_mpa is not None:  # one noise axis: a fraction and an MPa value would be two
+            if self.noise_fs is not None:
+                raise ParameterError("noise_mpa (--noise-mpa)", self.noise_mpa,
+                                     "not with noise_fs (--noise): the noise is either in MPa or x full scale")
+            set_("noise_mpa", _numbers(self.noise_mpa, "noise_mpa (--noise-mpa)", 0.0, None, "MPa", True))
+        elif self.noise_fs is None:
+            set_("noise_fs", NOISE_FS)
         for name, flag, lo, hi, lo_open, unit in (("thicknesses", "-t", 0.0, None, True, "mm"),  # the skin: its range
                                                   ("pitches", "--pitch", 0.05, 20.0, False, "mm"),
                                                   ("noise_fs", "--noise", 0.0, 10.0, False, "x full scale")):
-            set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
+            if getattr(self, name) is not None:  # noise_fs: None with noise_mpa
+                set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
         for name, flag, choices in (("materials", "-m", None), ("sets", "--set", SETS)):
             set_(name, _names(getattr(self, name), f"{name} ({flag})", choices))
         set_("taxel_fraction", check_range("taxel_fraction (--taxel)", self.taxel_fraction, 0.0, 1.0,
@@ -271,6 +286,26 @@ class ChartConfig:
         if self.max_depth is None or Scene.depth_fraction * thickness <= self.max_depth:
             return None
         return float(self.max_depth)
+
+    @property
+    def noise_levels(self) -> tuple:
+        """The noise axis: noise_mpa (MPa) where given, else noise_fs (x full scale)."""
+        return self.noise_fs if self.noise_mpa is None else self.noise_mpa
+
+    @property
+    def noise_key(self) -> str:
+        """The accuracy rows' column the noise axis is: "noise_mpa" or "noise_fs"."""
+        return "noise_fs" if self.noise_mpa is None else "noise_mpa"
+
+    @property
+    def noise_unit(self) -> str:
+        return "x full scale" if self.noise_mpa is None else "MPa"
+
+    def readout(self, full_scale: float, noise: float) -> Readout:
+        """The electronics at one level of the noise axis over a set's full scale."""
+        if self.noise_mpa is None:
+            return Readout(full_scale=full_scale, noise_fs=noise, bits=self.bits)
+        return Readout(full_scale=full_scale, noise_mpa=noise, bits=self.bits)
 
     @property
     def min_taxel(self) -> float:
@@ -481,7 +516,7 @@ class Chart:
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
         for r in self.rows:
-            if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r["noise_fs"], r["method"]) == \
+            if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r[self.config.noise_key], r["method"]) == \
                     (material, t, set_, pitch, noise, method):
                 return r["accuracy"]
         return float("nan")
@@ -685,14 +720,14 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                 # which thickness and what the numbers are: the pitch lines came once per thickness
                 # and material ("letters pitch 1 mm: 1.00, 0.98"), naming neither, nor the noise
                 say(f"  {material}, t = {t:g} mm, {set_}: accuracy at noise "
-                    + ", ".join(f"{n:g}" for n in cfg.noise_fs) + " x full scale")
+                    + ", ".join(f"{n:g}" for n in cfg.noise_levels) + f" {cfg.noise_unit}")
                 for pitch in cfg.pitches:
                     spec = cfg.spec(pitch)
                     rng = np.random.default_rng([cfg.seed, int(t * 1000), int(pitch * 1000), SETS.index(set_)])
                     clean = classify.clean_readings(maps_, spec, rng, n_train=cfg.n_train, n_test=cfg.n_test,
                                                     template_grid=cfg.template_grid)
-                    for noise in cfg.noise_fs:
-                        ro = Readout(full_scale=fs, noise_fs=noise, bits=cfg.bits)
+                    for noise in cfg.noise_levels:
+                        ro = cfg.readout(fs, noise)
                         ev = classify.evaluate(maps_, spec, ro, rng, clean=clean)
                         chart.confusions[(material, t, set_, pitch, noise)] = ev.confusion
                         for m, acc in ev.accuracy.items():
@@ -700,11 +735,12 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                                                        ev.offset_accuracy.get(m))
                             chart.rows.append(dict(material=material, thickness_mm=float(t), set=set_,
                                                    pitch_mm=float(pitch), taxel_mm=float(spec.taxel),
-                                                   noise_fs=float(noise), noise_mpa=float(ro.sigma),
+                                                   noise_fs=float(noise if cfg.noise_mpa is None else ro.sigma / fs),
+                                                   noise_mpa=float(ro.sigma),
                                                    full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
                                                    chance=ev.chance, n_test=ev.n_test, ci_low=lo, ci_high=hi))
                     say(f"    pitch {pitch:g} mm: " + ", ".join(
-                        f"{chart.accuracy(material, t, set_, pitch, n):.2f}" for n in cfg.noise_fs))
+                        f"{chart.accuracy(material, t, set_, pitch, n):.2f}" for n in cfg.noise_levels))
     chart.seconds = time.perf_counter() - t0
     return chart
 
@@ -745,7 +781,7 @@ def _off_paper_depth(cfg: ChartConfig, t: float) -> str:
 
 def _row(chart: Chart, material, t, set_, pitch, noise, method) -> dict | None:
     for r in chart.rows:
-        if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r["noise_fs"], r["method"]) == \
+        if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r[chart.config.noise_key], r["method"]) == \
                 (material, t, set_, pitch, noise, method):
             return r
     return None
@@ -792,7 +828,7 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
     A claim checked at a thickness the depth cap indents less than the paper's 20 % of t says
     so in its verdict and evidence (the paper's claim is about 20 %)."""
     cfg = chart.config
-    noise = min(cfg.noise_fs)
+    noise = min(cfg.noise_levels)
     out = []
     for material in cfg.materials:
         if "letters" in cfg.sets and 1.0 in cfg.thicknesses and PAPER_PITCH in cfg.pitches:

@@ -11,7 +11,7 @@ from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
 EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve` and `sweep`)
-KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "taxel_fraction", "bits", "window", "sets",
+KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "noise_mpa", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
         "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality"}
 MAX_TEXTS = 100  # Braille texts to validate: each is a full 3D solve per thickness
@@ -21,7 +21,7 @@ MAX_TEXTS = 100  # Braille texts to validate: each is a full 3D solve per thickn
 # commas as the matching CLI option (--set paper,letters) is; a string of numbers is refused
 # by ChartConfig (TOML has numbers: "1,3" there is a mistake)
 NAME_LISTS = {"materials", "sets", "validate"}
-NUMBER_LISTS = {"thicknesses", "pitches", "noise_fs"}
+NUMBER_LISTS = {"thicknesses", "pitches", "noise_fs", "noise_mpa"}
 
 
 def load_config(path) -> dict:
@@ -65,6 +65,8 @@ def load_config(path) -> dict:
 @click.option("--noise", default=None, help="Noise std as fractions of full scale: each set's largest pressure at that "
               "thickness, so one fraction is a different noise in MPa at each thickness (array_chart.md gives it). "
               "Default 0.01,0.05,0.1.")
+@click.option("--noise-mpa", default=None, help="Noise std in MPa instead of --noise, the same at every thickness "
+              "and set (a real sensor's noise floor), e.g. '0.001,0.005'.")
 @click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
 @click.option("--bits", type=int, default=None, help="ADC bits over full scale. Default 12.")
 @click.option("--set", "sets", default=None, help="Stimulus sets: paper (flat/curved/dot), letters (a-z, 0-9), shapes (the paper's three and a "
@@ -101,7 +103,7 @@ def load_config(path) -> dict:
               help="Processes solving uncached cases at once (each single-threaded). Default: one per core.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
-def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, letters, offsets, mesh_size,
+def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bits, sets, letters, offsets, mesh_size,
             refinement, max_depth, sphere_radius, sphere_quality, seed, skin, validate, letters_model, fallback,
             workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
@@ -121,10 +123,17 @@ def command(out, config, thickness, material, pitch, noise, taxel, bits, sets, l
     kw = load_config(config) if config else {}
     texts = kw.pop("validate", None)
     names = lambda v, n: tuple(x.strip() for x in v.split(",") if x.strip())  # noqa: E731
+    if noise is not None and noise_mpa is not None:
+        raise ParameterError("noise_mpa (--noise-mpa)", noise_mpa, "not with --noise: the noise is either in MPa "
+                             "or x full scale")
+    if noise is not None or noise_mpa is not None:  # a flag's noise axis replaces the config's
+        kw.pop("noise_fs", None)
+        kw.pop("noise_mpa", None)
     flags = dict(thicknesses=thickness and tuple(parse_values(thickness, "thickness")),
                  materials=material and names(material, "material"),
                  pitches=pitch and tuple(parse_values(pitch, "pitch")),
                  noise_fs=noise and tuple(parse_values(noise, "noise")),
+                 noise_mpa=noise_mpa and tuple(parse_values(noise_mpa, "noise_mpa (--noise-mpa)")),
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
                  max_depth=max_depth, letters_model=letters_model, fallback=fallback, sphere_radius=sphere_radius,

@@ -39,9 +39,10 @@ def write_figures(chart, out: Path, method: str = "template", indicative: dict |
     ts, ps = list(cfg.thicknesses), list(cfg.pitches)
     for material in cfg.materials:
         for set_ in cfg.sets:
-            fig, axes = plt.subplots(1, len(cfg.noise_fs), figsize=(3.6 * len(cfg.noise_fs) + 1.0, 0.55 * len(ts) + 2.0),
+            levels = cfg.noise_levels
+            fig, axes = plt.subplots(1, len(levels), figsize=(3.6 * len(levels) + 1.0, 0.55 * len(ts) + 2.0),
                                      squeeze=False, constrained_layout=True)
-            for ax, noise in zip(axes[0], cfg.noise_fs):
+            for ax, noise in zip(axes[0], levels):
                 A = np.array([[chart.accuracy(material, t, set_, p, noise, method) for p in ps] for t in ts])
                 im = ax.imshow(A, vmin=0, vmax=1, cmap="viridis", aspect="auto", origin="lower")
                 for i in range(len(ts)):
@@ -53,7 +54,7 @@ def write_figures(chart, out: Path, method: str = "template", indicative: dict |
                                                           else "") for t in ts])
                 ax.set_xlabel("pitch (mm)")
                 ax.set_ylabel("skin thickness t (mm)")
-                ax.set_title(f"noise {noise:g} x full scale", fontsize=9)
+                ax.set_title(f"noise {noise:g} {cfg.noise_unit}", fontsize=9)
                 if PAPER_PITCH in ps:
                     ax.axvline(ps.index(PAPER_PITCH), color="tab:red", ls="--", lw=1.2, label="paper: 0.75 mm")
                 if 5.0 in ts and set_ == "paper":
@@ -121,8 +122,9 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                                          if {"paper", "shapes"} & set(cfg.sets) else "")
              + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
              + f". Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
-             f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise as "
-             f"a fraction of full scale; stimuli at random sub-pitch offsets ({cfg.n_test} test and "
+             f"{cfg.window:g} mm window, {cfg.bits} bits over each set's full scale, Gaussian noise "
+             + ("as a fraction of full scale" if cfg.noise_mpa is None else "of a fixed std in MPa (--noise-mpa)")
+             + f"; stimuli at random sub-pitch offsets ({cfg.n_test} test and "
              f"{cfg.n_train} training reads per stimulus); rules: " + _rules(cfg, method) + ". "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
@@ -151,16 +153,20 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                       "|---|---|---|" + "---|" * len(cfg.pitches)]
             for t in cfg.thicknesses:
                 mark = " †" if set_ == "letters" and trust[(material, t)]["status"] not in TRUSTED else ""
-                for n in cfg.noise_fs:
-                    lines.append(f"| {t:g}{mark} | {n:g} | {_noise_mpa(chart, material, t, set_, n)} | " + " | ".join(
+                for n in cfg.noise_levels:
+                    lines.append(f"| {t:g}{mark} | {_noise_cells(chart, material, t, set_, n)} | " + " | ".join(
                         _cell(chart.accuracy(material, t, set_, p, n, method)) for p in cfg.pitches) + " |")
             lines.append("")
     if chart.rows:
         lines += [f"Accuracy ({method}): the fraction of test readings told right; **bold** at >= {GOOD:g}. Columns: the "
                   f"array pitch (taxel centre to centre, mm) and its taxels (n x n: n = floor({cfg.window:g} / pitch) + 1 "
                   f"over the {cfg.window:g} mm window), each taxel a square of {cfg.taxel_fraction:g} x the pitch "
-                  "averaging the pressure on the sensor plane over it. Noise: Gaussian, its std as a fraction of the set's "
-                  "full scale (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv) and in MPa. "
+                  "averaging the pressure on the sensor plane over it. Noise: Gaussian, its std "
+                  + ("as a fraction of the set's full scale (its largest pressure at that thickness; `full_scale_mpa` in "
+                     "accuracies.csv) and in MPa. " if cfg.noise_mpa is None else
+                     "fixed in MPa (`--noise-mpa`: the same at every thickness and set) and as the fraction of the set's "
+                     "full scale it is (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv). ")
+                  + 
                   # the readings share one draw of offsets: at a coarse pitch the draw moves the
                   # accuracy by 4-5x the binomial std over the readings (README: seeds 0-5 at 2.5 mm)
                   f"Each accuracy is one draw of {cfg.n_test} random offsets, shared by all stimuli and noise levels: "
@@ -308,12 +314,16 @@ def _rules(cfg, method: str) -> str:
         "accuracy hangs on what the reader knows"
 
 
-def _noise_mpa(chart, material, t, set_, noise) -> str:
-    """The noise std in MPa of the rows of (material, t, set_, noise) (their set's full scale)."""
+def _noise_cells(chart, material, t, set_, noise) -> str:
+    """The table's two noise cells of (material, t, set_) at the noise level `noise`: its std
+    as a fraction of the set's full scale and in MPa (the one the axis does not fix differs
+    per thickness)."""
+    key = chart.config.noise_key
     for r in chart.rows:
-        if (r["material"], r["thickness_mm"], r["set"], r["noise_fs"]) == (material, t, set_, noise):
-            return f"{r['noise_mpa']:.3g}"
-    return "-"
+        if (r["material"], r["thickness_mm"], r["set"], r[key]) == (material, t, set_, noise):
+            # the axis's own value as given, the other one derived (3 digits)
+            return " | ".join(f"{noise:g}" if k == key else f"{r[k]:.3g}" for k in ("noise_fs", "noise_mpa"))
+    return f"{noise:g} | -" if key == "noise_fs" else f"- | {noise:g}"
 
 
 def _cell(a: float) -> str:
