@@ -151,6 +151,10 @@ class ChartConfig:
     # finest level of benchmarks/results/convergence3d.md, 3 s CPU)
     sphere_radius: float = 2.5
     sphere_quality: str = "preview"
+    # where the taxels sit: None, the bonded surface (the paper's film on the bone, the solves'
+    # bone maps); else this depth (mm) below the contact surface, in the undeformed skin, the
+    # maps read from each cached solve's result.vtu (map_of: no solve again)
+    sensor_depth: float | None = None
 
     def __post_init__(self):
         # every field's type and range before any solve: a config file's `pitches = "abc"` or
@@ -172,6 +176,12 @@ class ChartConfig:
                                                   ("noise_fs", "--noise", 0.0, 10.0, False, "x full scale")):
             if getattr(self, name) is not None:  # noise_fs: None with noise_mpa
                 set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
+        if self.sensor_depth is not None:  # inside every skin of the chart: below its surface, above its bone
+            thin = min(self.thicknesses)
+            set_("sensor_depth", check_range("sensor_depth (--sensor-depth)", self.sensor_depth, 0.0, thin,
+                                             lo_open=True, hi_open=True,
+                                             unit=f"mm below the contact surface (the thinnest skin is {thin:g} mm; "
+                                                  "leave it out for the bonded surface)"))
         for name, flag, choices in (("materials", "-m", None), ("sets", "--set", SETS)):
             set_(name, _names(getattr(self, name), f"{name} ({flag})", choices))
         set_("taxel_fraction", check_range("taxel_fraction (--taxel)", self.taxel_fraction, 0.0, 1.0,
@@ -374,11 +384,12 @@ def blank_scene(dot):
                  depth=d, rate=dot.rate)
 
 
-def blank_map(scene, record, like: BoneMap) -> BoneMap:
-    """The blank plate's full bone map (3D) or its 2D profile extruded over like.z."""
+def blank_map(scene, record, like: BoneMap, depth: float | None = None) -> BoneMap:
+    """The blank plate's full bone map (3D) or its 2D profile extruded over like.z (at the
+    sensor `depth` below the contact surface where given: map_of, profile_of)."""
     if scene.dim == 3:
-        return bone_map_of(record)
-    return extruded(record.s, record.pressure, like.z)
+        return map_of(record, depth)
+    return extruded(*profile_of(record, depth), like.z)
 
 
 def result_cache(cache):
@@ -430,6 +441,61 @@ def suspect_solves(recs: dict) -> list[str]:
 
 def bone_map_of(record) -> BoneMap:
     return mirrored(read_bone_map(record.path / "bone_map.csv"))
+
+
+def map_of(record, depth: float | None = None) -> BoneMap:
+    """The full map a chart reads from a 3D solve: its bone map, or (depth in mm below the
+    contact surface) the pressure on that depth surface (raw_map_of), mirrored as the bone map."""
+    return bone_map_of(record) if depth is None else mirrored(raw_map_of(record, depth))
+
+
+def raw_map_of(record, depth: float | None = None) -> BoneMap:
+    """The map of a 3D solve's modelled part: bone_map.csv, or at `depth` below the contact
+    surface P = -tr(sigma) / 3 read from its result.vtu (fe.probe.result_sampler: the cached
+    solve, not solved again) at the bone map's (s, z) carried along the skin's normal to that
+    depth (sensors.coordinates_for, as a sensor layout at that depth reads it), s then the arc
+    length on the depth surface (the array lies on it)."""
+    m = read_bone_map(record.path / "bone_map.csv")
+    if depth is None:
+        return m
+    s, P = _at_depth(record, m.s, m.z, depth)
+    return BoneMap(s, m.z, P, m.section_z)
+
+
+def profile_of(record, depth: float | None = None) -> tuple:
+    """(s, P) of a 2D solve: its bone profile, or P on the depth surface (as raw_map_of)."""
+    if depth is None:
+        return record.s, record.pressure
+    return _at_depth(record, np.asarray(record.s, float), None, depth)
+
+
+def _at_depth(record, s, z, depth: float) -> tuple:
+    """(arc length on the depth surface (ns,), P (nz, ns), or (ns,) in 2D where z is None) of a
+    solve at the bone positions s (and z) carried to `depth`; positions past the end of the
+    skin at that depth (the fingertip's nail cut: sensors.SectionCoordinates.s_limit) read 0."""
+    from tactileskin.fe.probe import result_sampler
+    from tactileskin.sensors import coordinates_for
+
+    coords = coordinates_for(record.scene)
+    s = np.asarray(s, float)
+    limit = coords.s_limit(depth) if hasattr(coords, "s_limit") else np.inf
+    inside = np.abs(s) <= limit + 1e-9
+    xy = coords.frame(s[inside], np.full(int(inside.sum()), depth))[0]
+    if z is None:
+        pts = xy
+    else:  # z-major, as the bone map's rows
+        pts = np.column_stack([np.tile(xy, (len(z), 1)), np.repeat(np.asarray(z, float), len(xy))])
+    sig = result_sampler(record.path / "result.vtu")(pts)
+    P = np.zeros((1 if z is None else len(z), s.size))
+    P[:, inside] = (-np.trace(sig, axis1=1, axis2=2) / 3.0).reshape(P.shape[0], -1)
+    if not getattr(coords, "straight", False):  # a curved section: s as arc length at that depth
+        fine = np.linspace(0.0, max(float(np.abs(s).max()), 1e-12), 4001)
+        jac = np.ones_like(fine)
+        ok = fine <= limit
+        jac[ok] = coords.frame(fine[ok], np.full(int(ok.sum()), depth))[3]
+        arc = np.concatenate([[0.0], np.cumsum(0.5 * (jac[1:] + jac[:-1]) * np.diff(fine))])
+        s = np.sign(s) * np.interp(np.abs(s), fine, arc)
+    return s, (P[0] if z is None else P)
 
 
 def surface_deflection(record, top: float):
@@ -574,7 +640,8 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
 
     dot = dot_scene(t, material, cfg)
     return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
-                    model=model, extent=cfg.read_extent, taxel=cfg.min_taxel, standard=cfg.standard)
+                    model=model, extent=cfg.read_extent, taxel=cfg.min_taxel, standard=cfg.standard,
+                    sensor_depth=cfg.sensor_depth)
 
 
 def letters_judgment(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
@@ -674,18 +741,19 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot, pdot, blank, sec2, sphere = cases[(material, t)]
-            kernels = {x: bone_map_of(recs[x]) for x in (dot, pdot) if x is not None}
+            sd = cfg.sensor_depth  # None: the bone maps
+            kernels = {x: map_of(recs[x], sd) for x in (dot, pdot) if x is not None}
             height = get_standard(cfg.standard).height
             base = None
             if blank is not None:
-                base = blank_map(blank, recs[blank], kernels[dot])
+                base = blank_map(blank, recs[blank], kernels[dot], sd)
                 if not full[(material, t)]:
                     note = (f"t = {t:g} mm: the depth {dot.indentation:.3g} mm passes the dot height {height:g} mm, "
                             "so the Braille plate presses the skin too: the letters are the blank plate plus the "
                             "plate-aware kernels (surrogate.plate_kernel)")
                     log.info(note)
                     chart.notes.append(note)
-            profiles = {k: (recs[sc].s, recs[sc].pressure) for k, sc in sec2.items()}
+            profiles = {k: profile_of(recs[sc], sd) for k, sc in sec2.items()}
             letter_kernel = kernels.get(dot) if base is None else surrogate.plate_kernel(kernels[dot], base)
             for sc, kernel in kernels.items():
                 if sc == dot:  # the filter of a dot is what it adds to the plate
@@ -695,8 +763,8 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                                       "depth_mm": float(sc.indentation),
                                       "peak_mpa": float(kernel.pressure.max()), "kc_rad_per_mm": kc,
                                       "nyquist_pitch_mm": float(np.pi / kc) if 0 < kc < np.inf else float("nan"),
-                                      "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t)})
-            letters = {c: surrogate.placed(read_bone_map(recs[sc].path / "bone_map.csv"), c, dot.section(),
+                                      "halfspace_nyquist_pitch_mm": halfspace.nyquist_pitch(t if sd is None else sd)})
+            letters = {c: surrogate.placed(raw_map_of(recs[sc], sd), c, dot.section(),
                                            cfg.standard) for c, sc in full[(material, t)].items()} or None
             model = "full" if letters else letters_model(cfg, dot, base)
             weights = None
@@ -712,7 +780,7 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
             if dot is not None:
                 chart.letters_models[(material, t)] = model
             sets = stimulus_maps(letter_kernel, dot and dot.section(), profiles, cfg, kernels.get(pdot), base=base,
-                                 letters=letters, sphere=None if sphere is None else bone_map_of(recs[sphere]),
+                                 letters=letters, sphere=None if sphere is None else map_of(recs[sphere], sd),
                                  weights=weights)
             for set_, maps_ in sets.items():
                 chart.labels[set_] = list(maps_)
@@ -774,9 +842,10 @@ def _off_paper_depth(cfg: ChartConfig, t: float) -> str:
     from tactileskin.scene import Scene
 
     d = cfg.depth_for(t)
-    if d is None:
-        return ""
-    return f" (at the capped depth {d:g} mm, not the paper's {Scene.depth_fraction * t:g} mm)"
+    out = "" if d is None else f" (at the capped depth {d:g} mm, not the paper's {Scene.depth_fraction * t:g} mm)"
+    if cfg.sensor_depth is not None:  # the paper's claims are about its film on the bone
+        out += f" (sensors {cfg.sensor_depth:g} mm below the surface, not the paper's film on the bone)"
+    return out
 
 
 def _row(chart: Chart, material, t, set_, pitch, noise, method) -> dict | None:
@@ -921,12 +990,12 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         for x, sc in zip(texts, fulls):
             notes = shared + suspect_solves({sc: recs[sc]})
             solve_status[x] = "suspect: " + "; ".join(notes) if notes else "ok"
-        kernel = bone_map_of(recs[dot])
+        kernel = map_of(recs[dot], cfg.sensor_depth)
         sec = dot.section()
-        refs = {x: read_bone_map(recs[sc].path / "bone_map.csv") for x, sc in zip(texts, fulls)}
+        refs = {x: raw_map_of(recs[sc], cfg.sensor_depth) for x, sc in zip(texts, fulls)}
         depth = float(dot.indentation)
         if blank is not None:
-            base = blank_map(blank, recs[blank], kernel)
+            base = blank_map(blank, recs[blank], kernel, cfg.sensor_depth)
             pk = surrogate.plate_kernel(kernel, base)
             scale = surrogate.fit_scale(pk, refs, sec, cfg.standard, base=base)
             models = {"sum": (kernel, {}), "plate + sum": (pk, {"base": base}),
@@ -946,5 +1015,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                 rows.append({"material": material, "thickness_mm": t, "depth_mm": depth, "text": x, "model": name,
                              "taxel_mm": float(cfg.min_taxel),
                              "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
-                             "solve_status": solve_status[x], **err})
+                             "solve_status": solve_status[x],
+                             **({} if cfg.sensor_depth is None else {"sensor_depth_mm": float(cfg.sensor_depth)}),
+                             **err})
     return rows

@@ -2,8 +2,9 @@
 
 A map is a `results.BoneMap` (s, z grids in mm, pressure[j, i] at (s_i, z_j)). A *map source*
 is any function returning one: today the bone-pressure map of a 3D solve (the sensor film on
-the bone, Result.bone_map); a sensor plane at another depth is another source, and nothing
-downstream (sampler, classify, chart) needs to change.
+the bone, Result.bone_map), or at ChartConfig.sensor_depth below the contact surface the
+pressure read from the cached solve's result.vtu (chart.map_of); nothing downstream (sampler,
+classify, chart) changes.
 """
 
 from __future__ import annotations

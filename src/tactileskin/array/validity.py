@@ -69,6 +69,11 @@ def _reference(row: dict, mesh) -> float:
     return float(size) / float(ratio)
 
 
+def _same_sensors(a, b) -> bool:
+    """Two sensor depths (None: the bonded surface) are the same plane."""
+    return (a is None) == (b is None) and (a is None or _match(a, b))
+
+
 def _taxel_ok(row_taxel: float, taxel: float | None) -> bool:
     """A row read with taxels of side row_taxel answers for a chart whose smallest is `taxel`."""
     return taxel is None or float(row_taxel) <= float(taxel) + 1e-9
@@ -76,7 +81,7 @@ def _taxel_ok(row_taxel: float, taxel: float | None) -> bool:
 
 def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, validation=None,
              model: str = "sum", extent: float | None = None, taxel: float | None = None,
-             standard: str = DATA_STANDARD) -> dict:
+             standard: str = DATA_STANDARD, sensor_depth: float | None = None) -> dict:
     """{"error": worst taxel error over the peak or None, "texts": the validated characters,
     "source": where the numbers come from, "status": "within" | "exceeds" | "not validated",
     "reference_mesh": (mesh_size, refinement) of the full solves judged against, finer than
@@ -84,19 +89,23 @@ def measured(material: str, skin: str, mesh: tuple, t: float, depth: float, vali
     (ChartConfig.read_extent), which a row's own extent must cover; `taxel`: the chart's smallest
     taxel side (mm; 0 = point sensors), which must be at least the rows' (DATA_TAXEL where a row
     does not say); `standard`: the chart's Braille standard (the data file's rows answer only
-    for the dots they were measured on: DATA_STANDARD, from the shipped geometry files)."""
+    for the dots they were measured on: DATA_STANDARD, from the shipped geometry files);
+    `sensor_depth`: the chart's sensor depth below the contact surface (None: the bonded
+    surface), which a row's "sensor_depth_mm" must match (the data file's rows are all on the
+    bonded surface: at another depth only this run's validation answers)."""
     rows = []
     for r in validation or ():
         rt = float(r.get("taxel_mm", DATA_TAXEL))
         key = "max_abs_over_peak_taxel" if rt > 0 else "max_abs_over_peak"  # taxel 0: pointwise
         if r.get("model", "sum") == model and r["material"] == material and _match(r["thickness_mm"], t) \
                 and _match(r.get("depth_mm", depth), depth) and key in r \
-                and _covers(r, extent) and _taxel_ok(rt, taxel) and r.get("solve_status", "ok") == "ok":
+                and _covers(r, extent) and _taxel_ok(rt, taxel) and r.get("solve_status", "ok") == "ok" \
+                and _same_sensors(r.get("sensor_depth_mm"), sensor_depth):
             rows.append({"text": r["text"], "taxel_max_error": r[key],
                          "reference_mesh": r.get("reference_mesh"), "source": RUN_SOURCE})
     shipped = _shipped_dots()
     for case in load()["cases"]:
-        if not shipped or case.get("standard", DATA_STANDARD) != standard:
+        if not shipped or case.get("standard", DATA_STANDARD) != standard or sensor_depth is not None:
             continue
         if case["material"] != material or case["skin"] != skin or \
                 not all(_match(x, y) for x, y in zip(case["mesh"], mesh)):

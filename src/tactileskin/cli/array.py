@@ -13,7 +13,8 @@ from tactileskin.errors import ParameterError
 EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve` and `sweep`)
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "noise_mpa", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
-        "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality"}
+        "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality",
+        "sensor_depth"}
 MAX_TEXTS = 100  # Braille texts to validate: each is a full 3D solve per thickness
 
 
@@ -82,6 +83,10 @@ def load_config(path) -> dict:
 @click.option("--sphere-radius", type=float, default=None, help="Radius (mm) of the shapes set's sphere. Default 2.5.")
 @click.option("--sphere-quality", type=click.Choice(["preview", "default", "fine"]), default=None,
               help="3D mesh preset of the sphere solves. Default preview.")
+@click.option("--sensor-depth", type=float, default=None,
+              help="Taxels at this depth (mm) below the contact surface, inside every skin of the chart "
+                   "(0 < depth < the thinnest t), read from the cached solves (no solve again). Default: the "
+                   "bonded surface (the paper's film on the bone).")
 @click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
 @click.option("--skin", type=click.Choice(["pad", "fingertip"]), default=None,
               help="Skin of the 3D dot solves: pad (flat, a dot's response translates exactly; default) or "
@@ -104,7 +109,7 @@ def load_config(path) -> dict:
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, sphere_radius, sphere_quality, seed, skin, validate, letters_model, fallback,
+            refinement, max_depth, sphere_radius, sphere_quality, sensor_depth, seed, skin, validate, letters_model, fallback,
             workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
 
@@ -137,7 +142,7 @@ def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bi
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
                  max_depth=max_depth, letters_model=letters_model, fallback=fallback, sphere_radius=sphere_radius,
-                 sphere_quality=sphere_quality)
+                 sphere_quality=sphere_quality, sensor_depth=sensor_depth)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:  # the config key's rule (at most MAX_TEXTS full solves per thickness)
         texts = validate_mod.string_list(names(validate, "validate"), "validate (--validate)", MAX_TEXTS,

@@ -174,3 +174,43 @@ def stress_sampler(model, point_data: dict):
         return sig
 
     return sample
+
+
+def result_sampler(path):
+    """stress_sampler of a saved result.vtu (as fe.output.vtk_fields writes it: the scalar dofs'
+    positions as points, each cell's dofs in scikit-fem's order): the stresses of a cached solve
+    at any point of its reference mesh, without solving again. Read back at the bonded surface
+    it gives the bone map to 2e-10 of its peak (t = 1 mm pad, single dot)."""
+    import skfem
+    from scipy.spatial import cKDTree
+
+    from tactileskin.errors import TactileSkinError
+    from tactileskin.results import read_vtu
+
+    try:
+        m = read_vtu(path)
+    except (OSError, ValueError) as e:
+        raise TactileSkinError(f"cannot read the result {path}: {e}") from None
+    kinds = {"tetra10": (skfem.MeshTet2, skfem.ElementTetP2), "tetra": (skfem.MeshTet1, skfem.ElementTetP1),
+             "triangle6": (skfem.MeshTri2, skfem.ElementTriP2), "triangle": (skfem.MeshTri1, skfem.ElementTriP1)}
+    block = next((c for c in m.cells if c.type in kinds), None)  # the skin's cells (then the boundaries')
+    if block is None:
+        raise TactileSkinError(f"no skin cells in {path} (has {[c.type for c in m.cells]})")
+    mesh_cls, element = kinds[block.type]
+    dim = 3 if block.type.startswith("tetra") else 2
+    X = np.ascontiguousarray(m.points[:, :dim])
+    mesh = mesh_cls(np.ascontiguousarray(X.T), np.ascontiguousarray(block.data.T), sort_t=False)
+    basis = skfem.Basis(mesh, element(), intorder=2)
+    # the rebuilt basis numbers its edge dofs itself: each dof's point in the file
+    dist, idx = cKDTree(X).query(basis.doflocs.T)
+    if basis.N != len(X) or dist.max() > 1e-9 * max(1.0, float(np.abs(X).max())):
+        raise TactileSkinError(f"the mesh of {path} does not rebuild (its nodes are not a P{element().maxdeg} mesh's)")
+    model = _Model(mesh, basis, element(), basis.element_dofs.T, basis.N, dim)
+    return stress_sampler(model, {k: np.asarray(v)[idx] for k, v in m.point_data.items()})
+
+
+class _Model:
+    """What the probe needs of a model (mesh, basis, element, scalar dofs; its caches)."""
+
+    def __init__(self, mesh, basis, element, sdofs, nsdof, m):
+        self.mesh, self.basis, self.element, self.sdofs, self.nsdof, self.m = mesh, basis, element, sdofs, nsdof, m

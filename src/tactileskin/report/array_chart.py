@@ -94,6 +94,15 @@ def _skins(cfg) -> str:
     return ", ".join(out)
 
 
+def _sensor_plane(cfg) -> str:
+    """Where the taxels sit (ChartConfig.sensor_depth)."""
+    if cfg.sensor_depth is None:
+        return "the bonded surface, t below the contact surface (the paper's film on the bone)"
+    return (f"{cfg.sensor_depth:g} mm below the contact surface (`--sensor-depth`; t - {cfg.sensor_depth:g} mm above "
+            "the bone, in the undeformed skin), P = -tr(sigma) / 3 read there from each cached solve's result.vtu "
+            "along the skin's normal, s the arc length on that surface")
+
+
 def _cap_text(cfg) -> str:
     """The depth cap's sentence: it keeps the Braille plate off only below the dot height (a
     cap of 0.55 mm read 'below the dot height, so the plate never touches' while the notes
@@ -117,8 +126,9 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
     notes = suspect(chart, validation, trust)
     lines = ["## Sensor-array design chart", "", *(["**Suspect:** " + n for n in notes] + [""] if notes else []),
-             f"Skin: {_skins(cfg)}. Sensor plane: the bonded surface, t below the contact surface (the paper's film on the bone), map P(s, z) of 3D single-dot solves "
-             f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D bone profiles extruded along z"
+             f"Skin: {_skins(cfg)}. Sensor plane: " + _sensor_plane(cfg) + ", map P(s, z) of 3D single-dot solves "
+             f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D " + ("bone profiles" if cfg.sensor_depth is None else "profiles at that depth")
+                                            + " extruded along z"
                                          if {"paper", "shapes"} & set(cfg.sets) else "")
              + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
              + f". Array: square taxels of {cfg.taxel_fraction:g} x pitch (area averaged) over a "
@@ -128,7 +138,8 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"{cfg.n_train} training reads per stimulus); rules: " + _rules(cfg, method) + ". "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
-             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth t (mm) |",
+             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth "
+             + ("t" if cfg.sensor_depth is None else f"{cfg.sensor_depth:g} mm") + " (mm) |",
              "|---|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
         kc, ny = c["kc_rad_per_mm"], c["nyquist_pitch_mm"]

@@ -1,0 +1,152 @@
+"""`--sensor-depth`: the chart's taxels at a depth below the contact surface, their maps read
+from each cached solve's result.vtu (fe.probe.result_sampler), as a sensor layout at that
+depth reads them, instead of the bone maps only."""
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import meshio
+import numpy as np
+import pytest
+import skfem
+
+from tactileskin.array import chart, maps, validity
+from tactileskin.cli import main
+from tactileskin.errors import ParameterError
+from tactileskin.scene import Scene
+
+# coarse 2D fingertip (about 1 s per solve), as tests/test_sensors.py
+COARSE = dict(thickness=3.0, indenter="curved", mesh_size=0.5, refinement=2)
+DEPTH = 1.25
+
+
+@pytest.fixture(scope="module")
+def solved(tmp_path_factory):
+    """The chart's kind of solve (no sensors) written as the cache holds it, and the same scene
+    solved with a sensor line at DEPTH: what the solver's own sensors read there."""
+    from tactileskin.fe import solve
+
+    plain = Scene(**COARSE)
+    res = solve(plain)
+    path = tmp_path_factory.mktemp("case")
+    res.write(path)
+    line = {"name": "d", "kind": "line", "s": [0, 6], "pitch": 0.1, "depth": DEPTH}
+    read = solve(Scene(**COARSE, sensors=[line])).sensors.select("d")
+    return SimpleNamespace(scene=plain, path=path, s=res.s, pressure=res.pressure), read
+
+
+def test_a_cached_2d_solve_read_at_depth_is_what_a_sensor_line_there_reads(solved):
+    rec, line = solved
+    s, P = chart._at_depth(rec, line.s, None, DEPTH)
+    # the same nodal stresses, interpolated in the same elements: equal to round-off
+    assert np.allclose(P, line.pressure, rtol=0, atol=1e-9 * line.pressure.max())
+    # s is the arc length on the depth surface: on this convex section it is longer than the
+    # bone's arc length by the depth surface's own polyline
+    from tactileskin.sensors import coordinates_for
+
+    fine = np.linspace(0, 6, 6001)
+    pts = coordinates_for(rec.scene).frame(fine, np.full(fine.size, DEPTH))[0]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    assert np.allclose(s, np.interp(line.s, fine, arc), atol=1e-5)
+    assert s[-1] > 6.0 * 1.05
+    # at the bonded surface the same reading is the solve's bone profile
+    sb, Pb = chart.profile_of(rec, COARSE["thickness"] - 1e-12)
+    assert np.allclose(Pb, rec.pressure, rtol=0, atol=1e-9 * rec.pressure.max())
+    assert np.allclose(sb, rec.s, atol=1e-9)
+    assert chart.profile_of(rec) == (rec.s, rec.pressure)  # no depth: the bone profile itself
+
+
+def test_a_3d_map_at_depth_follows_the_z_rows_of_the_bone_map(tmp_path):
+    """A 3D result.vtu (as fe.output writes it) of a linear stress field on a P2 mesh of the
+    pad: the map at depth is that field on the plane y = t - d, row j at z_j (the bone map's
+    z-major layout), exactly (P2 holds a linear field)."""
+    t = 1.0
+    m = skfem.MeshTet1.init_tensor(np.linspace(0, 3, 4), np.linspace(0, t, 3), np.linspace(0, 2, 3))
+    basis = skfem.Basis(m, skfem.ElementTetP2())
+    x, y, z = basis.doflocs
+    f = {"sxx": -(1 + x + 2 * y + 3 * z), "syy": -(2 - y), "szz": -(0.5 + z), "sxy": 0 * x, "syz": 0 * x, "sxz": 0 * x}
+    meshio.write(tmp_path / "result.vtu", meshio.Mesh(basis.doflocs.T, [("tetra10", basis.element_dofs.T)],
+                                                       point_data={f"{k}_MPa": v for k, v in f.items()}))
+    rec = SimpleNamespace(scene=Scene(dim=3, skin="pad", indenter="braille", thickness=t), path=tmp_path)
+    s, zg = np.linspace(0, 3, 7), np.linspace(0, 2, 5)
+    d = 0.3
+    sa, P = chart._at_depth(rec, s, zg, d)
+    S, Z = np.meshgrid(s, zg)
+    exact = (1 + S + 2 * (t - d) + 3 * Z + 2 - (t - d) + 0.5 + Z) / 3
+    assert np.array_equal(sa, s)  # flat: s stays x
+    assert P.shape == (zg.size, s.size) and np.allclose(P, exact, atol=1e-12)
+
+
+def test_the_chart_reads_every_map_at_the_sensor_depth(monkeypatch):
+    """compute() with sensor_depth: every solve's map (the dots, the 2D sections) is read at
+    that depth, the half-space comparison is at that depth, and the letters, whose surrogate
+    was validated on the bone only, are not shown as validated there."""
+    grid = np.linspace(-8, 8, 161)
+    width = {"flat": 3.0, "curved": 1.5, "braille": 0.4}
+
+    def fake_solve(scenes, cache, on_event=None, workers=None):
+        return {sc: SimpleNamespace(s=grid, pressure=np.exp(-grid ** 2 / width[sc.indenter] ** 2), scene=sc,
+                                    path=Path("unread"), summary={"reaction_n_per_mm": float(sc.indentation) ** 1.5})
+                for sc in scenes}
+
+    read = []
+
+    def at_depth(rec, s, z, depth):  # the map a depth reading gives: wider than the bone's
+        read.append((rec.scene.dim, rec.scene.indenter, depth))
+        w = 1.5 * width[rec.scene.indenter]
+        if z is None:
+            return s, np.exp(-s ** 2 / w ** 2)
+        S, Z = np.meshgrid(s, z)
+        return s, np.exp(-(S ** 2 + Z ** 2) / w ** 2)
+
+    monkeypatch.setattr(chart, "solve_cached", fake_solve)
+    monkeypatch.setattr(chart, "read_bone_map", lambda path: maps.on_grid(lambda s, z: 0 * s, grid[80:], grid[80:]))
+    monkeypatch.setattr(chart, "_at_depth", at_depth)
+    monkeypatch.setattr(chart, "surface_deflection", lambda rec, top: lambda dx, dz: 0.0 * np.asarray(dx))
+    cfg = chart.ChartConfig(thicknesses=(1.0,), sets=("paper", "letters"), letters="abl", pitches=(0.5,),
+                            noise_fs=(0.01,), n_train=4, n_test=4, template_grid=2, sensor_depth=0.4)
+    ch = chart.compute(cfg, cache=None)
+    assert sorted(set(read)) == [(2, "curved", 0.4), (2, "flat", 0.4), (3, "braille", 0.4)]
+    assert len([r for r in read if r[0] == 3]) == 2  # the pad's dot and the fingertip's
+    (c,) = {c["halfspace_nyquist_pitch_mm"] for c in ch.cutoffs}
+    from tactileskin.array import halfspace
+
+    assert c == pytest.approx(halfspace.nyquist_pitch(0.4)) and c != pytest.approx(halfspace.nyquist_pitch(1.0))
+    # the project's measurements are bone maps: at 0.4 mm the letters are not validated ...
+    assert chart.surrogate_trust(cfg, "silicone", 1.0, "interaction")["status"] == "not validated"
+    # ... unless this run validated them at that depth
+    row = {"material": "silicone", "thickness_mm": 1.0, "depth_mm": 0.2, "text": "l", "model": "interaction",
+           "taxel_mm": 0.4, "max_abs_over_peak_taxel": 0.02}
+    assert chart.surrogate_trust(cfg, "silicone", 1.0, "interaction", [row])["status"] == "not validated"
+    assert chart.surrogate_trust(cfg, "silicone", 1.0, "interaction",
+                                 [{**row, "sensor_depth_mm": 0.4}])["status"] == "within"
+    # and a bone chart does not take a row read at a depth
+    assert validity.measured("silicone", "pad", cfg.mesh_for(1.0), 1.0, 0.2, [{**row, "sensor_depth_mm": 0.4}],
+                             model="interaction", taxel=0.4)["source"] != validity.RUN_SOURCE
+    from tactileskin.report.array_chart import markdown
+
+    md = markdown(ch)
+    assert "Sensor plane: 0.4 mm below the contact surface (`--sensor-depth`; t - 0.4 mm above the bone" in md
+    assert "half-space Nyquist pitch at depth 0.4 mm (mm)" in md
+    assert "flat and curved: 2D profiles at that depth extruded along z" in md
+
+
+@pytest.mark.parametrize("value, words", [
+    (0.0, ["sensor_depth (--sensor-depth)=0.0", "(0, 1) mm below the contact surface"]),
+    (1.0, ["sensor_depth (--sensor-depth)=1.0", "(0, 1) mm", "the thinnest skin is 1 mm"]),
+    (2.0, ["sensor_depth (--sensor-depth)=2.0", "(0, 1) mm"]),
+    (float("nan"), ["sensor_depth (--sensor-depth)=nan"]),
+])
+def test_a_sensor_depth_outside_every_skin_is_one_line_before_any_solve(tmp_path, capsys, monkeypatch, value, words):
+    def refuse(*a, **k):
+        raise AssertionError("the chart started solving")
+
+    monkeypatch.setattr(chart, "compute", refuse)
+    out = tmp_path / "o"
+    assert main(["array", "-o", str(out), "--set", "paper", "-t", "1,3", "--sensor-depth", str(value)]) == 2
+    raw = capsys.readouterr().err
+    err = " ".join(raw.split())
+    assert raw.startswith("error:") and all(w in err for w in words) and "Traceback" not in err, err
+    assert not out.exists()
+    with pytest.raises(ParameterError, match="sensor_depth"):
+        chart.ChartConfig(thicknesses=(1.0, 3.0), sets=("paper",), sensor_depth=value)
