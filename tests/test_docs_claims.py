@@ -175,3 +175,40 @@ def test_readme_dome_sensor_numbers_are_the_dome_coordinates():
     assert f"x = 3 mm is s = {s3:.2f} mm at t = 2" in readme and thick[0] == 2.0
     assert f"({thick[1]:.3f} mm at x = 1, {thick[2]:.3f} at x = 3, t = 2)" in readme
     assert f"thicker than t ({tip['top'][0] - tip['floor'][0]:.1f} mm on the axis at z = c - t, t = 2)" in readme
+
+
+def test_readme_choosing_an_array_runs_and_names_what_the_chart_writes():
+    """The README's how-to for choosing an array: its command's options are `tactileskin
+    array`'s, and what it tells the reader to look for is what array_chart.md and
+    accuracies.csv hold."""
+    import re
+    import shlex
+
+    from tactileskin.array.chart import Chart, ChartConfig
+    from tactileskin.cli.array import command
+    from tactileskin.report.array_chart import markdown
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "### Choosing an array" in text
+    howto = text.split("### Choosing an array", 1)[1].split("\n### ", 1)[0]
+    assert 5 <= len([ln for ln in howto.splitlines() if ln.strip()]) <= 12
+    cmd = re.search(r"`(tactileskin array [^`]+)`", howto).group(1)
+    args = shlex.split(cmd)[2:]
+    ctx = command.make_context("array", list(args))  # an unknown option or a bad value raises
+    ChartConfig(thicknesses=(float(ctx.params["thickness"]),), pitches=tuple(
+        float(p) for p in ctx.params["pitch"].split(",")), noise_mpa=(float(ctx.params["noise_mpa"]),),
+        sets=(ctx.params["sets"],))
+    for opt in re.findall(r"`(--[a-z-]+)", howto):
+        assert any(opt in p.opts or opt in p.secondary_opts for p in command.params), opt
+    ch = Chart(ChartConfig(thicknesses=(2.0,), pitches=(1.0,), noise_mpa=(0.002,), sets=("paper",)))
+    ch.labels["paper"] = ["flat", "curved", "braille"]
+    ch.rows.append(dict(material="silicone", thickness_mm=2.0, set="paper", pitch_mm=1.0, taxel_mm=0.8,
+                        noise_fs=0.02, noise_mpa=0.002, full_scale_mpa=0.1, bits=12, method="template",
+                        accuracy=0.97, chance=1 / 3, n_test=16, ci_low=0.9, ci_high=0.99))
+    md = markdown(ch)
+    # the table (its header gives the taxels), the bold rule, the rule's name, the filter table
+    assert "| t (mm) | noise (x full scale) | noise (MPa) | 1 mm (9 x 9) |" in md
+    assert "| 2 | 0.02 | 0.002 | **0.97** |" in md and "**bold** at >= 0.95" in md
+    assert "template: the nearest of every stimulus's noise-free readings" in md
+    assert "### The skin as a spatial filter" in md and "Nyquist pitch (mm)" in md
+    assert {"ci_low", "ci_high", "method"} <= set(ch.to_csv().splitlines()[0].split(","))
