@@ -165,19 +165,51 @@ def test_a_step_block_reads_the_sensors_of_the_3d_pad(tmp_path):
     assert np.ptp(ra.pressure) > 2 * tol  # the readings vary by more than the tolerance
 
 
-def test_a_curved_step_skins_sensors_follow_its_surface(tmp_path):
-    """On a sphere cap (R 6, 2 mm over a flat base) a grid at depth 0 lies on the cap's
-    surface, within the sag of the analysis mesh's chords under it (measured 0.006-0.039 mm:
-    size / 8 = 1 mm facets)."""
+def _cap(tmp_path):
+    """A sphere cap (R 6, 2 mm over a flat base 8 x 8 mm) as STEP, and its top y(x, z)."""
     import build123d as bd
 
     path = tmp_path / "cap.step"
     base = bd.Box(8.0, 2.0, 8.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
     bd.export_step(bd.Pos(0, -4.0, 0) * bd.Sphere(6.0) & base, str(path))
+    return path, lambda x, z: -4.0 + np.sqrt(36.0 - np.square(x) - np.square(z))
+
+
+def test_a_curved_step_skins_sensors_follow_its_surface(tmp_path):
+    """On a sphere cap a grid at depth 0 lies on the cap's CAD surface (within 1e-8 mm); it lay
+    on the coarse analysis mesh's chords, 0.006-0.039 mm under it (size / 8 = 1 mm facets)."""
+    path, top = _cap(tmp_path)
     lay = {"name": "c", "kind": "grid", "s": [-3.0, 3.0], "z": [-3.0, 3.0], "pitch": [1.0], "depth": 0.0}
     x, y, z = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[lay])).xyz.T
-    sag = -4.0 + np.sqrt(36.0 - x ** 2 - z ** 2) - y
-    assert sag.min() >= 0.0 and sag.max() < 0.05
+    assert np.abs(top(x, z) - y).max() < 1e-8
+
+
+def test_a_step_skins_sensors_are_checked_on_its_cad_faces(tmp_path):
+    """The scene checks a STEP skin's sensors on its CAD faces, not on the coarse analysis
+    mesh's chords. Under the sphere cap's top the chords lay 0.0285 mm low at (1.3, 1.7): a
+    sensor 0.002 mm under the surface (height 1.6034 mm) was refused ("valid: [0, 1.57683]
+    mm"). Over the half tube's R 6 bonded face the chords lay low (t 2.2258 for 2.2200 mm at s
+    = 3): a sensor 0.005 mm under the bone was held and refused only after meshing."""
+    import build123d as bd
+
+    path, top = _cap(tmp_path)
+    h = top(1.3, 1.7) - 0.002
+    lay = {"name": "hi", "kind": "points", "s": [1.3], "z": [1.7], "height": h}
+    y = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[lay])).xyz[0, 1]
+    assert abs(y - h) < 1e-9  # h straight up from the flat bonded face y = 0
+
+    tube = bd.Cylinder(8, 8) - bd.Cylinder(6, 8)
+    shell = tmp_path / "shell.step"
+    bd.export_step(tube - bd.Box(20, 10, 20, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER)), str(shell))
+    t = np.sqrt(64.0 - 9.0) - np.sqrt(36.0 - 9.0)  # 2.22005 mm at s = 3
+    kw = dict(skin="file", skin_file=str(shell), skin_bonded="normal:-y:89.99")
+    for d, ok in ((t, True), (t + 0.005, False)):
+        lay = {"name": "deep", "kind": "points", "s": [3.0], "z": [0.5], "depth": d}
+        if ok:
+            assert abs(sensors.sites_for(Scene(sensors=[lay], **kw)).xyz[0, 1] - np.sqrt(36.0 - 9.0)) < 1e-8
+        else:
+            with pytest.raises(ParameterError, match=r"depth=2\.225.*valid: \[0, 2\.22005\] mm at s = 3, z = 0\.5"):
+                Scene(sensors=[lay], **kw)
 
 
 def _distance_to_polyline(points, poly):

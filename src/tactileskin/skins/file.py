@@ -18,7 +18,7 @@ along the bonded surface is x - x_top (signed), the section plane of a 3D
 profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth straight down (-y)
 from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
 first face under the contact surface), normal +y; both surfaces read on the analysed mesh's
-boundary facets (quadratic on a P2 .msh, as the solver's; a STEP's analysis mesh: chords).
+boundary facets (quadratic on a P2 .msh, as the solver's), a STEP's on its CAD faces.
 The model is the half x >= 0 when a .msh names a `symmetry` group, or when a STEP solid and its
 bonded faces are mirror-symmetric about x = 0 (mesh.skinfile.step_symmetry) and so is the
 indenter (geometry.indenters.indenter_symmetry): the solid is cut there; likewise z = 0 (3D).
@@ -59,6 +59,7 @@ class FileGeometry:
     # mesh the mid-edge nodes (2D: 1; 3D: ab, bc, ca), which curve them as the solver's mesh
     facets: np.ndarray | None = None
     facet_kind: np.ndarray | None = None  # (n,): OUTER, BONDED or 0 (another boundary)
+    facet_face: np.ndarray | None = None  # (n,): a STEP analysis mesh's facets' CAD face tags
 
 
 AXIS_GAP = 0.02  # of t: how far the outer surface on the axis may lie below the top point
@@ -247,7 +248,12 @@ def _analyse(kind: str, path: str, digest: str, bonded, outer) -> FileGeometry:
         # the facets are chords of the CAD: read t on the bonded faces themselves
         cad = skinfile.distance_to_faces(path, on_axis, sm.bonded_faces)
         t = t if cad is None else cad
-        return FileGeometry(**{**g.__dict__, "top_point": tuple(float(c) for c in on_axis), "thickness": t})
+        # the sensors' columns are read on those faces too (FileCoordinates(cad=path))
+        tags = np.zeros(sm.mesh.facets.shape[1], int)
+        for tag, f in sm.face_facets.items():
+            tags[f] = tag
+        return FileGeometry(**{**g.__dict__, "top_point": tuple(float(c) for c in on_axis), "thickness": t,
+                               "facet_face": tags[sm.mesh.boundary_facets()]})
     check_placement(g, path, kind, bonded, outer)
     return g
 
@@ -258,7 +264,7 @@ def geometry(scene) -> FileGeometry:
 
 @functools.lru_cache(maxsize=16)
 def _coordinates(*key) -> "FileCoordinates":
-    return FileCoordinates(_analyse(*key))
+    return FileCoordinates(_analyse(*key), cad=key[1] if key[0] == "step" else None)
 
 
 def _key(scene) -> tuple:
@@ -335,16 +341,18 @@ class FileCoordinates:
     surface and the point must lie above the first boundary under it (which, for a height,
     must be bonded); the heights are read on the mesh's boundary facets, quadratic on a P2
     mesh as the solver's (on their chords a bone sensor of the fingertip's own mesh lay inside
-    the bone, and the solve failed reading it), a STEP's on its P1 analysis mesh (chords of its
-    faces) for the scene's check and on the mesh solved for the readings (mesh_coordinates). A
-    half model (`symmetry`, `symmetry_z`) answers for
-    its mirror image by reflection, as the solver's sampler does."""
+    the bone, and the solve failed reading it); a STEP's on its CAD faces (`cad`: the file; its
+    P1 analysis mesh's chords find the faces) for the scene's check, and on the mesh solved for
+    the readings (mesh_coordinates). A half model
+    (`symmetry`, `symmetry_z`) answers for its mirror image by reflection, as the solver's
+    sampler does."""
 
     straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
     local = True     # sensors.resolve: depth, thickness and extent vary with (x, z): self.depths
 
-    def __init__(self, geo: FileGeometry):
+    def __init__(self, geo: FileGeometry, cad=None):
         self.geo, self.dim = geo, geo.dim
+        self.cad = cad
         self.thickness = float(geo.thickness)
         self.x_top = float(geo.top_point[0])
         lat = [0] if geo.dim == 2 else [0, 2]
@@ -366,6 +374,7 @@ class FileCoordinates:
         # are its neighbours' (a sensor on a side's line reads the top and bottom facets)
         keep = area > 1e-9 * size ** (geo.dim - 1)
         self._L, self._y, self._kind = L[keep], F[keep][:, :, 1], np.asarray(geo.facet_kind)[keep]
+        self._face = None if cad is None or geo.facet_face is None else np.asarray(geo.facet_face)[keep]
         self._curved = F.shape[1] > geo.dim
         box = self._L
         if self._curved:  # a quadratic edge lies in the hull of its ends and 2 mid - (a + b) / 2
@@ -425,6 +434,8 @@ class FileCoordinates:
             found = self._cross_curved(q[pt], f) if self._curved else [self._cross(q[pt], f)]
             y = np.concatenate([yy[hit] for hit, yy in found])
             pt, f = (np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f))
+            if self._face is not None:
+                y = self._on_cad(q[pt], f, y)
             np.maximum.at(top, pt, y)
             out = self._kind[f] == OUTER
             np.maximum.at(outer, pt[out], y[out])
@@ -435,6 +446,14 @@ class FileCoordinates:
         nan = lambda v: np.where(np.isfinite(v), v, np.nan)  # noqa: E731
         return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
                 "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
+
+    def _on_cad(self, q, f, y) -> np.ndarray:
+        """The heights y of the chords f under the points q read on the chords' CAD faces (the
+        chord's where the line misses its face: the face's trim ends there)."""
+        from tactileskin.mesh.skinfile import line_heights
+
+        cad = line_heights(self.cad, self._face[f], np.column_stack([q[:, 0], y, q[:, 1]]))
+        return np.where(np.isnan(cad), y, cad)
 
     def _cross(self, q, f):
         """(hit, y) of the vertical lines through the points q (m, k) and the facets f (m,)."""
@@ -618,6 +637,7 @@ class FileSkin(Skin):
         # the halves of the model solved: a symmetric STEP is cut at x = 0 / z = 0 for its solve
         # only, so its sensors on the other side read their mirror images there
         return FileCoordinates(dataclasses.replace(geometry(scene), facets=facets, facet_kind=kind,
+                                                   facet_face=None,
                                                    symmetric=bool(skinmesh.halved),
                                                    z_symmetric=bool(getattr(skinmesh, "z_symmetric", False))))
 
