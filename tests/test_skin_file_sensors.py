@@ -285,3 +285,25 @@ def test_a_step_skins_sensors_are_read_on_its_solved_curved_faces(tmp_path):
     r = np.hypot(read.xyz[:, 0], read.xyz[:, 1])
     assert np.abs(r[on_bone] - 6.0).max() < 2e-4 and np.abs(r[~on_bone] - 8.0).max() < 2e-4
     assert np.abs(read.sigma_nn).max() > 0
+
+
+def test_the_solve_places_in_its_mesh_what_the_scene_held(tmp_path):
+    """The solve places the sensors the scene held on the STEP's CAD in the mesh solved, moved
+    at most as far as that mesh's faces lie off the CAD, and refuses what the scene refuses in
+    the scene's words. A sensor 0.002 mm under the cap passed the scene and was refused on a P1
+    mesh (h = 1: its chords 0.0168 mm low there, "valid: [0, 1.58851] mm") after meshing."""
+    path, top = _cap(tmp_path)
+    sc = Scene(skin="file", skin_file=str(path), order=1, formulation="displacement", mesh_size=1.0,
+               refinement=1.0, indenter="flat", depth_fraction=0.03, viscoelastic=False)
+    coords = sc.skin_kind.mesh_coordinates(sc, build_mesh(sc))
+    chord = coords.column([1.3], [1.7])["top"][0]
+    assert 0.01 < top(1.3, 1.7) - chord < 0.05  # the P1 mesh's chords under the cap there
+    lay = {"name": "hi", "kind": "points", "s": [1.3], "z": [1.7], "height": top(1.3, 1.7) - 0.002}
+    y = sensors.resolve(sensors.layouts([lay]), coords, 3).xyz[0, 1]
+    assert y == pytest.approx(chord, abs=1e-9)  # on the mesh's top face: 0.0148 mm down
+    out = {**lay, "height": top(1.3, 1.7) + 0.001}
+    with pytest.raises(ParameterError) as scene:
+        Scene(skin="file", skin_file=str(path), sensors=[out])
+    with pytest.raises(ParameterError) as solve_time:
+        sensors.resolve(sensors.layouts([out]), coords, 3)
+    assert str(solve_time.value) == str(scene.value) and "valid: [0, 1.60535] mm" in str(scene.value)

@@ -28,6 +28,7 @@ The geometry checks above read the whole solid.
 from __future__ import annotations
 
 import functools
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +38,7 @@ from tactileskin.errors import ParameterError
 from tactileskin.skins.base import Skin
 from tactileskin.skins.registry import register
 
+logger = logging.getLogger(__name__)
 DEFAULT_THICKNESS = 3.0  # Scene's default: taken as "not given"
 _TOL = 1e-9  # mm: a sensor on a range's end is inside (sensors._TOL)
 
@@ -343,16 +345,18 @@ class FileCoordinates:
     mesh as the solver's (on their chords a bone sensor of the fingertip's own mesh lay inside
     the bone, and the solve failed reading it); a STEP's on its CAD faces (`cad`: the file; its
     P1 analysis mesh's chords find the faces) for the scene's check, and on the mesh solved for
-    the readings (mesh_coordinates). A half model
+    the readings (mesh_coordinates), whose `reference` (the scene's coordinates) decides which
+    sensors are in the skin: the solve accepts what the scene accepted. A half model
     (`symmetry`, `symmetry_z`) answers for its mirror image by reflection, as the solver's
     sampler does."""
 
     straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
     local = True     # sensors.resolve: depth, thickness and extent vary with (x, z): self.depths
+    reference = None  # (subclasses that set their own fields: skins.dome.DomeCoordinates)
 
-    def __init__(self, geo: FileGeometry, cad=None):
+    def __init__(self, geo: FileGeometry, cad=None, reference: "FileCoordinates | None" = None):
         self.geo, self.dim = geo, geo.dim
-        self.cad = cad
+        self.cad, self.reference = cad, reference
         self.thickness = float(geo.thickness)
         self.x_top = float(geo.top_point[0])
         lat = [0] if geo.dim == 2 else [0, 2]
@@ -518,9 +522,15 @@ class FileCoordinates:
         """The depth below the contact surface of each point (s, z) of the layout `lay` (its
         depth, or the height over the bonded surface there); a point outside the skin is a
         ParameterError naming the layout, the sensor (`idx`: its index in the layout) and the
-        valid range there."""
+        valid range there. With a `reference` (mesh_coordinates) its check decides, and the
+        depths it accepts are clamped into this mesh's columns."""
         s = np.atleast_1d(np.asarray(s, float))
         z = np.broadcast_to(np.asarray(z, float), s.shape)
+        if self.reference is not None:
+            # the scene's check on the CAD, its answer and message: a STEP's solved faces lie off
+            # the CAD (on a sphere cap R 6 at h = 1 up to 5.4e-4 mm P2, 0.040 mm P1) and a sensor
+            # the scene held within that of a face was refused after meshing
+            self.reference.depths(where, lay, s, z, idx, what)
         col = self.column(s, z if self.dim == 3 else None)
         t = col["top"] - col["floor"]
 
@@ -550,6 +560,8 @@ class FileCoordinates:
                                  "(skin_outer)")
         if lay.depth is not None:
             d = np.full(len(s), float(lay.depth))
+            if self.reference is not None:
+                return self._clamped(lay, d, t)
             bad = (d < -_TOL) | (d > t + _TOL)
             if bad.any():
                 i = first(bad)
@@ -562,12 +574,25 @@ class FileCoordinates:
             raise ParameterError(f"{where} height", h, "a depth instead where no bonded surface is under the "
                                  "sensor", f"{sensor(i)}: at {at(i)} the face under the contact surface is "
                                  "not bonded")
+        if self.reference is not None:
+            return self._clamped(lay, t - h, t)
         bad = (h < -_TOL) | (h > t + _TOL)
         if bad.any():
             i = first(bad)
             raise ParameterError(f"{where} height", h, f"[0, {t[i]:.6g}] mm at {at(i)} (the skin's thickness "
                                  "over its bonded surface there)", sensor(i))
         return t - h
+
+    def _clamped(self, lay, d, t) -> np.ndarray:
+        """The depths d (the reference's check held them) moved into this mesh's columns [0, t]:
+        at most as far as its faces lie off the reference's there."""
+        out = np.clip(d, 0.0, t)
+        moved = float(np.max(np.abs(out - d), initial=0.0))
+        if moved > self.tol:
+            logger.info("sensor layout %r: %d point(s) moved up to %.3g mm onto the solved mesh's faces (they "
+                        "lie that far off the CAD's there)", lay.name, int(np.sum(np.abs(out - d) > self.tol)),
+                        moved)
+        return out
 
     def frame(self, s, depth, z=None):
         """(xy (n, 2), normal +y, tangent +x, area element 1) at depth below the contact
@@ -630,7 +655,10 @@ class FileSkin(Skin):
         """The sensor coordinates on the mesh solved: a STEP's analysis mesh is coarse and
         straight, its solve mesh curved onto the CAD (bone sensors of a half tube's R 6 bonded
         face lay up to 0.077 mm inside the bone on the chords and the solve failed reading
-        them); a .msh's is its own mesh (the same faces)."""
+        them); a .msh's is its own mesh (the same faces). Which sensors are in the skin is the
+        scene's answer (`reference`: a STEP's CAD faces), so the solve refuses none the scene
+        held (a sensor 0.002 mm under a sphere cap's top, on a P1 mesh whose chords lay 0.017
+        mm low there) and holds none it refused."""
         import dataclasses
 
         facets, kind = boundary_facets(skinmesh)
@@ -639,7 +667,8 @@ class FileSkin(Skin):
         return FileCoordinates(dataclasses.replace(geometry(scene), facets=facets, facet_kind=kind,
                                                    facet_face=None,
                                                    symmetric=bool(skinmesh.halved),
-                                                   z_symmetric=bool(getattr(skinmesh, "z_symmetric", False))))
+                                                   z_symmetric=bool(getattr(skinmesh, "z_symmetric", False))),
+                               reference=cls.coordinates(scene))
 
     @classmethod
     def cache_content(cls, scene) -> dict:
