@@ -224,7 +224,8 @@ def test_the_default_dome_molds_step_files_reread_as_their_solids(tmp_path):
 def test_dome_sensor_sites_stand_on_vertical_lines_through_the_exact_surfaces():
     """The dome's sensors use the file skin's convention (skins.dome.DomeCoordinates; every
     layout was refused): s = x, z as given, depth straight down from the outer surface at
-    (x, z), height straight up from the bone there, normal +y, tangents x and z. The scene
+    (x, z), height straight up from the bone there, the sensor plane along the surface over
+    (x, z) (normal: the surface's; t1 in the x-y plane). The scene
     places them on the exact surfaces: the ellipse (a, b) / bone (a - t, b - t) for z <= 0, the
     half ellipsoids of semi-axis c / c - t along z on the tip (z > 0), where the vertical line
     is not the surface's normal (the skin there is thicker than t along it)."""
@@ -253,7 +254,21 @@ def test_dome_sensor_sites_stand_on_vertical_lines_through_the_exact_surfaces():
     assert st.depth[i["mid-2"]] == pytest.approx(7.0 * math.sqrt(1 - 9 / 64 - 0.25) - bone - 0.5)
     # over the flank (x > a - t: no bone under it) a depth is taken, along -y from the surface
     assert y[i["side-0"]] == pytest.approx(B * math.sqrt(1 - (7.5 / A) ** 2) - 1.0)
-    assert np.allclose(st.normal, [0, 1, 0]) and np.allclose(st.t1, [1, 0, 0]) and np.allclose(st.t2, [0, 0, 1])
+    # the sensor plane lies along the surface over the line (it was horizontal, normal +y, and
+    # read sigma_yy: 0.009-0.016 MPa, 4.7-8.3 % of the peak sigma_nn 0.19, under the 20-45 degree
+    # slopes of the flanks and the tip beside a flat plate 0.6 mm deep, where sigma_nn is ~0):
+    # the outer body's gradient at the footprint, to the central difference's step across z = 0
+    # (where the tip's curvature begins: 3e-5); t1 in the x-y plane, t2 = t1 x n
+    zt = np.maximum(z, 0.0)
+    top = B * np.sqrt(1.0 - (x / A) ** 2 - (zt / c) ** 2)
+    n = np.column_stack([x / A ** 2, top / B ** 2, zt / c ** 2])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    assert np.allclose(st.normal, n, rtol=0, atol=1e-4)
+    assert np.abs(st.normal[z >= 1.0] - n[z >= 1.0]).max() < 1e-6 and st.normal[:, 2].max() > 0.5  # on the tip
+    t1 = np.column_stack([n[:, 1], -n[:, 0], np.zeros_like(x)])
+    assert np.allclose(st.t1, t1 / np.linalg.norm(t1, axis=1, keepdims=True), rtol=0, atol=1e-4)
+    assert np.allclose(st.t2, np.cross(st.t1, st.normal), rtol=0, atol=1e-12)
+    assert np.array_equal(st.normal[x == 0.0][:, 0], np.zeros((x == 0.0).sum()))  # the symmetry line
 
 
 @pytest.mark.parametrize("layout,match", [

@@ -1,7 +1,8 @@
 """Sensor layouts inside a user's file skin (skins.file.FileCoordinates): s = x - x_top, depth
 straight down from the contact surface at (x, z), height straight up from the bonded surface
-there, normal +y. The pad's own mesh read back as a file skin reads what the pad reads; the
-coordinates follow a skin that is not a flat layer; a sensor outside the skin is refused."""
+there, the sensor plane along the contact surface over (x, z). The pad's own mesh read back as
+a file skin reads what the pad reads; the coordinates follow a skin that is not a flat layer; a
+sensor outside the skin is refused."""
 
 import numpy as np
 import pytest
@@ -66,7 +67,12 @@ def test_depth_and_height_follow_the_skin_at_each_x(tmp_path):
     assert y["deep-0"] == pytest.approx(0.1)
     depth = dict(zip(st.ids, st.depth))
     assert (depth["h-0"], depth["h-1"]) == (pytest.approx(1.05), pytest.approx(1.55))
-    assert np.allclose(st.normal, [0.0, 1.0, 0.0]) and np.allclose(st.t1, [1.0, 0.0, 0.0])
+    # the sensor plane lies along the contact surface over it (slope 0.4 / 4 down from the axis)
+    sign = np.sign(st.s)[:, None]
+    assert np.allclose(st.normal, np.column_stack([0.1 * sign, np.ones((7, 1)), np.zeros((7, 1))]) / np.sqrt(1.01),
+                       rtol=0, atol=1e-9)
+    assert np.allclose(st.t1, np.column_stack([np.ones((7, 1)), -0.1 * sign, np.zeros((7, 1))]) / np.sqrt(1.01),
+                       rtol=0, atol=1e-9)
     g = np.polynomial.legendre.leggauss(3)[0]
     i = st.ids.index("tx-0")
     assert np.allclose(st.samples[i, :3, 0], 2.0 + g)  # the side along x
@@ -285,6 +291,81 @@ def test_a_step_skins_sensors_are_read_on_its_solved_curved_faces(tmp_path):
     r = np.hypot(read.xyz[:, 0], read.xyz[:, 1])
     assert np.abs(r[on_bone] - 6.0).max() < 2e-4 and np.abs(r[~on_bone] - 8.0).max() < 2e-4
     assert np.abs(read.sigma_nn).max() > 0
+    # each sensor's plane lies along the R 8 surface over it, the tube's along z (2.6e-4 off it
+    # on these h = 2 quadratic faces; it was horizontal, 30 degrees off at s = 4)
+    x = read.xyz[:, 0]
+    n = np.column_stack([x, np.sqrt(64.0 - x ** 2), np.zeros_like(x)]) / 8.0
+    assert np.abs(read.normal - n).max() < 1e-3
+
+
+def _half_tube(path, R=8.0, r=6.0, h=0.5):
+    """A whole 2D half tube (outer R, inner r, y >= 0) bonded on its inner arc, P2 (curved)."""
+    import gmsh
+
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        c = occ.addPoint(0, 0, 0)
+        p = [occ.addPoint(x, 0, 0) for x in (R, r, -r, -R)]
+        top, mid = occ.addPoint(0, R, 0), occ.addPoint(0, r, 0)
+        ends = [occ.addLine(p[1], p[0]), occ.addLine(p[3], p[2])]
+        outer = [occ.addCircleArc(p[0], c, top), occ.addCircleArc(top, c, p[3])]
+        inner = [occ.addCircleArc(p[2], c, mid), occ.addCircleArc(mid, c, p[1])]
+        occ.addPlaneSurface([occ.addCurveLoop([ends[0], *outer, ends[1], *inner])])
+        occ.synchronize()
+        for name, lines in (("bonded", inner), ("outer_surface", outer), ("ends", ends)):
+            gmsh.model.addPhysicalGroup(1, lines, name=name)
+        gmsh.model.addPhysicalGroup(2, [1], name="skin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(2)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def test_sensors_under_a_slope_lie_along_the_surface_and_read_across_it(tmp_path):
+    """A sensor stands on the vertical line under the contact surface but its plane lies along
+    that surface (normal: the surface's over it, t1 along it in the x-y plane), as a chip
+    embedded under a slope does. On a half tube (R 8, t 2) under a flat plate the sensors 0.5 mm
+    under the 30 and 45 degree slopes, on the free surface beside the contact, read the traction
+    across that plane: ~0 (measured 0.5 and 0.06 % of the peak sigma_nn, -0.37 MPa at the top).
+    With the plane horizontal (normal +y) they read sigma_yy, -0.011 and -0.014 MPa, 3.1 and 3.8 %
+    of that peak, a pressure where none acts (at 10 degrees, under the contact, 3.8 % of the
+    reading). The normals are the circle's to 1.6e-6 on these P2 faces (h = 0.5)."""
+    path = _half_tube(tmp_path / "tube.msh")
+    ang = np.radians([0.0, 10.0, 20.0, 30.0, 45.0])
+    lays = [{"name": "s", "kind": "points", "s": (8.0 * np.sin(ang)).tolist(), "depth": 0.5},
+            {"name": "b", "kind": "points", "s": [-3.0, 2.0], "height": 0.0}]
+    sc = Scene(skin="file", skin_file=str(path), indenter="flat", depth=0.5, viscoelastic=False, sensors=lays)
+    st = sensors.sites_for(sc)
+    x = st.xyz[:, 0]
+    n = np.column_stack([x, np.sqrt(64.0 - x ** 2), np.zeros_like(x)]) / 8.0  # the circle's over x
+    assert np.allclose(st.normal, n, rtol=0, atol=1e-5)
+    assert np.allclose(st.t1, np.column_stack([n[:, 1], -n[:, 0], np.zeros_like(x)]), rtol=0, atol=1e-5)
+    assert np.allclose(st.t2, [0.0, 0.0, 1.0])
+    read = solve(sc).sensors.select("s")
+    peak = np.abs(read.sigma_nn).max()
+    assert peak > 0.1 and np.abs(read.sigma_nn[3:]).max() < 0.01 * peak
+
+
+def test_a_taxel_under_a_slope_is_warned_of(tmp_path, caplog):
+    """A taxel keeps its side along x while its plane follows the surface: under the half
+    tube's 38.7 degree slope (x = 5) it averages side / cos = 1.28 sides of the surface, said
+    once (in whole degrees, and 1 / cos of them); under 7 degrees (x = 1, +0.8 %) nothing is said."""
+    import logging
+
+    path = str(_half_tube(tmp_path / "tube.msh"))
+    lay = {"name": "tx", "kind": "points", "s": [1.0, 5.0], "depth": 0.5, "taxel": 1.0}
+    with caplog.at_level(logging.WARNING, logger="tactileskin.sensors"):
+        Scene(skin="file", skin_file=path, indenter="flat", sensors=[lay])
+        Scene(skin="file", skin_file=path, indenter="flat", sensors=[lay])
+        Scene(skin="file", skin_file=path, indenter="flat", sensors=[{**lay, "name": "flat", "s": [1.0]}])
+    said = [r.getMessage() for r in caplog.records if "slope" in r.getMessage()]
+    assert said == ["sensor layout 'tx': sensor tx-1 lies under a 39 degree slope; its taxel's side is along x, "
+                    "so it averages 29 % more of the surface than its side"]
 
 
 def test_the_solve_places_in_its_mesh_what_the_scene_held(tmp_path):

@@ -11,7 +11,8 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
 - z (mm, 3D only): along the finger; the slab spans [-L/2, L/2] (L = fingertip sample_length).
 A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top,
 its depth straight down from the contact surface at (x, z) and its height straight up from the
-bonded surface there (skins.file.FileCoordinates).
+bonded surface there, its plane along the contact surface over (x, z) (skins.file.FileCoordinates,
+the dome's too; its n has a z part where the surface slopes along z).
 
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
@@ -29,8 +30,9 @@ Readings, per sensor, from the Cauchy stress sigma of the final state (sampled b
 inside the elements, fe.probe): P = -tr(sigma)/3 (the paper's mean pressure, compression
 positive), sigma_nn = n.sigma.n (tension positive) and the shears tau_1 = t1.sigma.n,
 tau_2 = t2.sigma.n, with n the sensor plane's normal in the undeformed skin (the local normal of
-the depth surface, pointing out of the skin; exact on the bonded surface, which does not move),
-t1 along increasing s in the section plane and t2 = t1 x n along +z. A taxel averages the tensor
+the depth surface, pointing out of the skin; exact on the bonded surface, which does not move; a
+file skin's: the contact surface's over the sensor), t1 along increasing s in the x-y plane (n x
+e_z normalised) and t2 = t1 x n (+z where n has no z part). A taxel averages the tensor
 over its area, then projects it on its centre's frame (a flat, rigid chip). In 2D plane strain
 sigma_xz = sigma_yz = 0, so tau_2 = 0 exactly.
 
@@ -62,6 +64,10 @@ MAX_TAXEL_POINTS = 16        # Gauss points per direction
 # thickness, not on the taxel); one point per 0.25 mm put both within 1 %.
 TAXEL_SPACING = 0.25
 MIN_TAXEL_POINTS = 3
+# a file skin's taxel keeps its side along x (and z) while its plane follows the surface: on a
+# slope theta it averages side / cos theta of the surface (+1.5 % at 10 degrees, +6.4 % at 20,
+# +41 % at 45); past 5 % (18.2 degrees) a warning says so
+TAXEL_SLOPE_COS = 1.0 / 1.05
 
 
 def default_taxel_points(taxel: float) -> int:
@@ -209,6 +215,15 @@ def _short_end(name: str, lo: float, hi: float, p: float, last: float) -> None:
     """Say once per layout that its pitch does not reach the range's end."""
     log.warning("sensor layout %r: the pitch %g mm does not divide [%g, %g]: its last sensor is at %g mm, "
                 "%g mm short of the end", name, p, lo, hi, last, hi - last)
+
+
+@functools.lru_cache(maxsize=256)
+def _sloped_taxel(name: str, sensor: str, degrees: int, dim: int) -> None:
+    """Say once (the scene's check and the solve, on another mesh, both resolve the layout)
+    that a taxel under a slope averages more of the surface than its side."""
+    log.warning("sensor layout %r: sensor %s lies under a %d degree slope; its taxel's side is along x%s, "
+                "so it averages %.0f %% more of the surface than its side", name, sensor, degrees,
+                " and z" if dim == 3 else "", 100.0 * (1.0 / np.cos(np.radians(degrees)) - 1.0))
 
 
 def _numbers(v, name) -> tuple[float, ...]:
@@ -427,9 +442,15 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         z = np.zeros_like(z)
     xy, n2, t2d, _ = coords.frame(s, depth, z) if local else coords.frame(s, depth)
     xyz = np.column_stack([xy, z])
-    normal = np.column_stack([n2, np.zeros(len(s))])
-    t1 = np.column_stack([t2d, np.zeros(len(s))])
+    # a section's frame lies in the x-y plane; a file skin's 3D one follows its surface out of it
+    normal = n2 if n2.shape[1] == 3 else np.column_stack([n2, np.zeros(len(s))])
+    t1 = t2d if t2d.shape[1] == 3 else np.column_stack([t2d, np.zeros(len(s))])
     t2 = np.cross(t1, normal)
+    for lay, i0, cnt in layout_of:
+        cos = normal[i0:i0 + cnt, 1]
+        if local and lay.taxel and cos.min() < TAXEL_SLOPE_COS:
+            i = int(np.argmin(cos))
+            _sloped_taxel(lay.name, ids[i0 + i], int(round(np.degrees(np.arccos(min(cos[i], 1.0))))), dim)
     # taxel samples: Gauss-Legendre in (s, z) on the depth surface, area-weighted
     kmax = max((lay.taxel_points ** (dim - 1) if lay.taxel else 1) for lay, _, _ in layout_of)
     samples = np.repeat(xyz[:, None, :], kmax, axis=1)
@@ -453,7 +474,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         zz = (z[rows, None] + 0.5 * lay.taxel * gz[None, :]).ravel() if dim == 3 else np.zeros(len(ss))
         if local:  # each point at the layout's depth (or height) at its own (x, z)
             dq = coords.depths(f"sensor layout {lay.name!r}", lay, ss, zz, np.repeat(np.arange(cnt), k))
-            pq = coords.frame(ss, dq, zz)[0]
+            pq = coords.frame(ss, dq, zz, normals=False)[0]
         else:
             pq, _, _, _ = coords.frame(ss, np.repeat(depth[rows], k))
         samples[rows, :k] = np.column_stack([pq, zz]).reshape(cnt, k, 3)

@@ -14,10 +14,11 @@ also parametrises the bone under the dome); the 3D profile's section plane is z 
 
 Sensors (`DomeCoordinates`): a user's file skin's vertical columns (skins.file.FileCoordinates),
 not the fingertip's normals: s = x, z as given (z in [-dome_length, dome_tip]), depth straight
-down (-y) from the outer surface at (x, z), height straight up (+y) from the bone there, normal
-+y, tangents x and z. The bone is the outer body shrunk by t per semi-axis, not its offset (no
-common normal from the surface to the bone), and on the tip the surface normal leaves the plane
-z = const, where sensors.resolve keeps its frames; a vertical line is one answer everywhere. On
+down (-y) from the outer surface at (x, z), height straight up (+y) from the bone there, the
+sensor plane along the outer surface over (x, z) (normal the surface's, out of the plane z =
+const on the tip; t1 in the x-y plane). The bone is the outer body shrunk by t per semi-axis,
+not its offset (no common normal from the surface to the bone): a vertical line is one answer
+everywhere. On
 the tip (z > 0) the line meets the bone's cap (`bone_tip`, bonded) while |x| < (a - t) sqrt(1 -
 (z / (c - t))^2); past it (the flanks, the last t of the tip) no bone is under it: a height is
 refused there and a depth runs through to the skin's underside. The scene checks the layouts on
@@ -245,7 +246,8 @@ class DomeCoordinates(FileCoordinates):
         self.sec, self.dim = sec, 3
         self.thickness = float(sec.thickness)
         self.x_top = 0.0
-        self.tol = 1e-7 * max(sec.a, sec.b, sec.c, sec.length)  # FileCoordinates.tol
+        self._size = max(sec.a, sec.b, sec.c, sec.length)  # FileCoordinates' (surface_normal's step)
+        self.tol = 1e-7 * self._size  # FileCoordinates.tol
         self.s_range = (-sec.a, sec.a)
         self.s_max = float(sec.a)
         self.z_range = (-sec.length, sec.c)

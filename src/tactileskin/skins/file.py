@@ -17,7 +17,8 @@ x = z = 0; `check_placement` refuses a skin upside down, off the axis or highest
 along the bonded surface is x - x_top (signed), the section plane of a 3D
 profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth straight down (-y)
 from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
-first face under the contact surface), normal +y; both surfaces read on the analysed mesh's
+first face under the contact surface), the sensor plane along the contact surface over (x, z)
+(normal: that surface's, t1 along it in the x-y plane); both surfaces read on the analysed mesh's
 boundary facets (quadratic on a P2 .msh, as the solver's), a STEP's on its CAD faces.
 The model is the half x >= 0 when a .msh names a `symmetry` group, or when a STEP solid and its
 bonded faces are mirror-symmetric about x = 0 (mesh.skinfile.step_symmetry) and so is the
@@ -64,6 +65,12 @@ class FileGeometry:
     facet_face: np.ndarray | None = None  # (n,): a STEP analysis mesh's facets' CAD face tags
 
 
+# the contact surface's slope under a sensor (FileCoordinates.surface_normal): central differences
+# over this fraction of the skin's size (2e-3 mm on a 20 mm skin: within one facet, and the
+# quadratic faces' curvature changes the slope by ~(step / R)^2), and slopes below FLAT_SLOPE are
+# rounding (a flat face's heights differ by ~1e-16 of the size: ~1e-12 in slope)
+SLOPE_STEP = 1e-4
+FLAT_SLOPE = 1e-9
 AXIS_GAP = 0.02  # of t: how far the outer surface on the axis may lie below the top point
 OUTER, BONDED = 1, 2  # FileGeometry.facet_kind
 # the bonded surfaces held fixed: the fingertip's nail and the dome's bone under its tip, as
@@ -338,7 +345,9 @@ class FileSection:
 class FileCoordinates:
     """Sensor coordinates of a file skin (the `coordinates` duck type of sensors.resolve): s =
     x - x_top, z as given (3D); depth straight down (-y) from the contact surface at (x, z),
-    height straight up (+y) from the bonded surface there; normal +y, tangents +x (and +z).
+    height straight up (+y) from the bonded surface there; the sensor plane lies along the
+    contact surface over (x, z): normal that surface's (+y where it is flat), t1 = n x e_z
+    normalised (+x on a flat top), t2 = t1 x n (+z).
     The sensor's column is the vertical line through (x, z): its top must be the contact
     surface and the point must lie above the first boundary under it (which, for a height,
     must be bonded); the heights are read on the mesh's boundary facets, quadratic on a P2
@@ -594,15 +603,50 @@ class FileCoordinates:
                         moved)
         return out
 
-    def frame(self, s, depth, z=None):
-        """(xy (n, 2), normal +y, tangent +x, area element 1) at depth below the contact
-        surface over (s, z)."""
+    def frame(self, s, depth, z=None, normals: bool = True):
+        """(xy (n, 2), the contact surface's outward unit normal at (s, z) (n, 2; in 3D (n, 3)),
+        t1 along that surface in the x-y plane (n, 2 / 3), area element 1) at depth below the
+        contact surface over (s, z). A sensor stands on the vertical line but lies parallel to
+        the surface over it (a depth layout's surface is that one moved down, with its normal), as
+        a chip embedded under a slope does: its plane had normal +y everywhere, and 0.5 mm under
+        20-45 degree slopes of a half tube (R 8, t 2) and of the dome, beside a flat plate's
+        contact, read sigma_yy, 0.009-0.016 MPa where sigma_nn is ~0 (5-8 % of the reading at
+        10 degrees under the contact, itself 3-4 % off). normals=False: the points only (NaN
+        normals), for taxel samples."""
         s = np.atleast_1d(np.asarray(s, float))
         depth = np.broadcast_to(np.asarray(depth, float), s.shape)
         y = self.column(s, z)["top"] - depth
         n = len(s)
-        return (np.column_stack([self.x_top + s, y]), np.tile([0.0, 1.0], (n, 1)), np.tile([1.0, 0.0], (n, 1)),
-                np.ones(n))
+        xy = np.column_stack([self.x_top + s, y])
+        if not normals:
+            return xy, np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.ones(n)
+        nrm = self.surface_normal(s, z)
+        t1 = np.column_stack([nrm[:, 1], -nrm[:, 0]] + ([np.zeros(n)] if self.dim == 3 else []))
+        t1 /= np.linalg.norm(t1, axis=1, keepdims=True)  # n x e_z: +x where the surface is flat
+        return xy, nrm if self.dim == 3 else nrm[:, :2], t1 if self.dim == 3 else t1[:, :2], np.ones(n)
+
+    def surface_normal(self, s, z=None) -> np.ndarray:
+        """(n, 3) outward unit normal of the contact surface y = top(x, z) over each (s, z): by
+        central differences of the column's top over SLOPE_STEP of the skin's size (one-sided at
+        the skin's edge; a mirror half's top is even, so its symmetry line reads flat). A slope
+        under FLAT_SLOPE (rounding: heights of a flat P2 face differ by ~1e-16 of the size) is
+        flat: normal exactly +y, so a flat top reads as it always did."""
+        s = np.atleast_1d(np.asarray(s, float))
+        z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape)
+        h = SLOPE_STEP * self._size
+        zz = z if self.dim == 3 else None
+        grads = []
+        for ds, dz in ((h, 0.0),) + (((0.0, h),) if self.dim == 3 else ()):
+            top = self.column(np.concatenate([s + ds, s - ds, s]),
+                              None if zz is None else np.concatenate([zz + dz, zz - dz, zz]))["top"]
+            up, down, mid = top.reshape(3, -1)
+            g = np.where(np.isfinite(up) & np.isfinite(down), (up - down) / (2 * h),
+                         np.where(np.isfinite(up), (up - mid) / h, (mid - down) / h))
+            g = np.where(np.isfinite(g) & (np.abs(g) > FLAT_SLOPE), g, 0.0)
+            grads.append(g)
+        gx, gz = grads[0], (grads[1] if self.dim == 3 else np.zeros_like(s))
+        nrm = np.column_stack([-gx, np.ones_like(gx), -gz])
+        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
 
 def _barycentric(L, q) -> tuple[np.ndarray, np.ndarray]:
