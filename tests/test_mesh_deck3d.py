@@ -310,3 +310,57 @@ def test_sphere_deck_on_a_pad():
     assert pole.sum() > 100 and np.allclose(b[pole, 1], ind.surface_y(b[pole, 0], b[pole, 2]), atol=1e-12, rtol=0)
     assert b[:, 1].min() == pytest.approx(ind.y0, abs=1e-12)  # a node at the pole: it touches the pad's top
     assert "a flat flange beyond" in deck.text
+
+
+def _steps(p):
+    """The blocks of each *STEP ... *END STEP, in order."""
+    out, cur = [], None
+    for b in p["blocks"]:
+        if b[0] == "STEP":
+            cur = []
+        elif b[0] == "END STEP":
+            out.append(cur)
+            cur = None
+        elif cur is not None:
+            cur.append(b)
+    return out
+
+
+def test_force_control_is_a_pressed_pre_step_then_the_force_on_the_tied_indenter():
+    """A free rigid indenter at first touch has no stiffness in y (the penalty acts on
+    penetration only): the deck presses it PRE_TRAVEL x the expected travel, then frees its y
+    and ramps the force on the node every indenter node's y is tied to. Was refused
+    (ParameterError on loading); ccx reaches the force (benchmarks/results/calculix_compare3d.md)."""
+    from tactileskin.mesh.deck3d import PRE_TRAVEL
+
+    sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="sphere", indenter_radius=2.5,
+               force=0.3, dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0)
+    sm = build_mesh(sc)
+    deck = deck_text(sc, sm, "calculix")
+    p = parse_deck(deck.text)
+    assert undefined_names(p) == []
+    ref = deck.n_skin_nodes + 1
+    assert p["nsets"]["indenter_ref"] == [ref] and p["nsets"]["indenter_nodes"][0] == ref
+    eq = next(rows for kw, _, rows in p["blocks"] if kw == "EQUATION")
+    assert all(r == ["2"] for r in eq[::2])
+    terms = eq[1::2]  # each other indenter node's y follows the reference node's, once
+    assert sorted(int(r[0]) for r in terms) == list(range(ref + 1, ref + deck.info["indenter_nodes"]))
+    assert all(r[1:] == ["2", "1.", str(ref), "2", "-1."] for r in terms)
+    supports = {tuple(r) for kw, prm, rows in p["blocks"][:p["blocks"].index(next(b for b in p["blocks"]
+                                                                                  if b[0] == "STEP"))]
+                if kw == "BOUNDARY" for r in rows}
+    assert supports == {("bone_interface", "1", "3"), ("symmetry", "1", "1"), ("end_back", "3", "3"),
+                        ("indenter_nodes", "1", "1"), ("indenter_nodes", "3", "3")}
+    pre, load = _steps(p)
+    assert [(kw, prm.get("AMPLITUDE"), rows) for kw, prm, rows in pre if kw == "BOUNDARY"] == [
+        ("BOUNDARY", "pre", [["indenter_ref", "2", "2", _num(-PRE_TRAVEL * sc.indentation)]])]
+    new = [b for b in load if b[0] == "BOUNDARY"]
+    assert len(new) == 1 and new[0][1].get("OP") == "NEW" and {tuple(r) for r in new[0][2]} == supports
+    cload = [b for b in load if b[0] == "CLOAD"]
+    assert cload == [("CLOAD", {"AMPLITUDE": "travel"}, [["indenter_ref", "2", _num(-0.3 / 4.0)]])]
+    assert deck.info["force_factor"] == 4.0 and deck.info["force_n"] == 0.3 and deck.info["depth_mm"] is None
+    assert "*NODE PRINT, NSET=indenter_ref\nU\n" in deck.text  # the travel, which force control finds
+    # a depth scene keeps its one displacement step and no ties
+    d = deck_text(sc.replace(force=None, depth=0.2), sm, "calculix")
+    assert "*EQUATION" not in d.text and "*CLOAD" not in d.text and d.text.count("*STEP") == 1
+

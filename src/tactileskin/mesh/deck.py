@@ -320,10 +320,11 @@ def _check_scene(scene, dialect: str) -> None:
 
     _check_dim(scene.dim, dialect)
     program = scene.program()
-    if len(program) != 1 or program[0].kind != "depth":
+    force_ok = scene.dim == 3 and len(program) == 1 and program[0].kind == "force"  # deck3d's two steps
+    if not force_ok and (len(program) != 1 or program[0].kind != "depth"):
         raise ParameterError("loading", "force control" if scene.force is not None else "a loading history",
-                             "a depth ramp (the deck has one displacement step)",
-                             "force control and [[loading]] histories are not written to decks yet; export "
+                             "a depth ramp (the deck has one displacement step), or in 3D one force ramp",
+                             "2D force control and [[loading]] histories are not written to decks yet; export "
                              "the scene with its depth")
     mat = get_material(scene.material)
     if mat.law_name != "hyperfoam":  # was "valid: hyperfoam (use Material.law)", after meshing
@@ -553,7 +554,7 @@ def undefined_names(parsed: dict) -> list[str]:
         if kw == "SOLID SECTION":
             need("elset", prm["ELSET"])
             need("material", prm["MATERIAL"])
-        elif kw == "BOUNDARY":
+        elif kw in ("BOUNDARY", "CLOAD"):
             if "AMPLITUDE" in prm:
                 need("amplitude", prm["AMPLITUDE"])
             for r in rows:

@@ -19,7 +19,15 @@
   linear penalty `penalty` MPa/mm (default 40 K0 / h_fine: at 2D's 10 K0 / h ccx let the t = 1 mm
   plate penetrate 3.5 % of the travel and read 5.6 % low in bone pressure; 40 and 160 converged
   on every 3D case run, benchmarks/results/calculix_compare3d.md);
-- one NLGEOM *STATIC step from zero to the full travel over the scene's ramp time.
+- one NLGEOM *STATIC step from zero to the full travel over the scene's ramp time; under
+  force control (a scene's `force`, no [[loading]]) two: the indenter's wedge nodes keep x and
+  z fixed and their y tied to its first node, indenter_ref (*EQUATION: a rigid translation),
+  which the first step presses PRE_TRAVEL x the expected travel (a free indenter at first touch
+  has no stiffness in y: the penalty acts on penetration only, so ccx's first increment would
+  be singular); the second frees it (*BOUNDARY, OP=NEW) and ramps the force on it (*CLOAD,
+  the modelled part's share) from zero over the ramp time. On the R 2.5 sphere on the t = 1
+  pad at 0.3 N ccx travelled 0.1966 mm, tactileskin 0.1957 mm on the same mesh (displacement
+  formulation; +0.44 %: ccx's penetration and facets), benchmarks/results/calculix_compare3d.md.
 
 Forces in the .dat totals are those of the modelled part (a quarter for a flat plate or a
 symmetric Braille cell): `info["force_factor"]` gives the whole indenter's, as
@@ -38,8 +46,9 @@ from tactileskin.errors import ParameterError
 
 log = logging.getLogger(__name__)
 
-WEDGE_HEIGHT = 0.5  # mm: thickness of the indenter's wedge layer (its nodes are all prescribed)
+WEDGE_HEIGHT = 0.5  # mm: thickness of the indenter's wedge layer (its nodes all prescribed or tied)
 PENALTY_FACTOR = 40.0  # default contact slope in K0 / h_fine (module docstring)
+PRE_TRAVEL = 0.01  # force control: the pre-step's travel, a fraction of the expected travel (module docstring)
 
 
 def footprint(skinmesh, margin: float = 1.0) -> tuple[float, float, float, float]:
@@ -91,13 +100,19 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     w(f"*SOLID SECTION, ELSET=skin, MATERIAL={_name(mat.name)}\n")
 
     ref, n_ind = n_nodes + 1, len(ipts)
-    w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, moves by -"
-      + _num(depth) + " mm over " + _num(T) + " s; C3D6 wedges, face S1 on the working face,\n"
-      "** all nodes prescribed (a rigid translation)\n")
+    moves = ("moves by -" + _num(depth) + " mm" if scene.force is None else "pushed by " + _num(scene.force) + " N")
+    w("**\n** Indenter (" + ind.kind + "): lowest point at y0 = " + _num(ind.y0) + " mm, " + moves + " over "
+      + _num(T) + " s; C3D6 wedges, face S1 on the working face,\n"
+      + ("** all nodes prescribed (a rigid translation)\n" if scene.force is None else
+         "** x and z fixed, y tied to indenter_ref's (*EQUATION: a rigid translation)\n"))
     if face.caps:
         w("** the face is the exact surface up to " + _num(cap_rise(ind, scene.reach)) + " mm above its lowest point "
           "(at most twice the travel), a flat flange beyond\n")
     indenter_mesh_lines(fh, ref, n_ind, icells, n_cells, "C3D6")
+    if scene.force is not None:  # one rigid translation: every node's y follows the first's
+        w(f"*NSET, NSET=indenter_ref\n{ref}\n*EQUATION\n")
+        for k in range(ref + 1, ref + n_ind):
+            w(f"2\n{k}, 2, 1., {ref}, 2, -1.\n")
     w("*MATERIAL, NAME=indenter_rigid\n*ELASTIC\n1e6, 0.3\n")
     w("*SOLID SECTION, ELSET=indenter, MATERIAL=indenter_rigid\n")
 
@@ -111,27 +126,54 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     fixed = [b for b in scene.skin_kind.fixed_boundaries if b in skinmesh.boundaries]
     w("**\n** Supports: " + ", ".join(fixed) + " fixed" + ("; symmetry plane x = 0" if halved else "")
       + ("; end_back is the symmetry plane z = 0" if zsym else "") + "\n")
-    w("*BOUNDARY\n" + "".join(f"{b}, 1, 3\n" for b in fixed))
-    if halved:
-        w("symmetry, 1, 1\n")
-    if zsym:
-        w("end_back, 3, 3\n")
-    w("indenter_nodes, 1, 1\nindenter_nodes, 3, 3\n")
+    supports = ("".join(f"{b}, 1, 3\n" for b in fixed) + ("symmetry, 1, 1\n" if halved else "")
+                + ("end_back, 3, 3\n" if zsym else "") + "indenter_nodes, 1, 1\nindenter_nodes, 3, 3\n")
+    w("*BOUNDARY\n" + supports)
 
     dt0 = T / increments
-    w(f"**\n** indentation {_num(depth)} mm at {_num(scene.rate)} mm/s\n")
-    w("*STEP, NLGEOM, INC=10000\n")
-    w(f"*STATIC\n{_num(dt0)}, {_num(T)}, {_num(T * 1e-6)}, {_num(T / 10)}\n")
-    w("*BOUNDARY, AMPLITUDE=travel\n")
-    w(f"indenter_nodes, 2, 2, {_num(-depth)}\n")
-    w("*NODE FILE\nU, RF\n*EL FILE\nS, E\n*CONTACT FILE\nCDIS, CSTR\n")
-    w("*NODE PRINT, NSET=bone_interface, TOTALS=ONLY\nRF\n")
-    w("*NODE PRINT, NSET=indenter_nodes, TOTALS=ONLY\nRF\n")
-    w("*END STEP\n")
+    factor = (2.0 if halved else 1.0) * (2.0 if zsym else 1.0)
+    force, pre = scene.force, None
+    if force is None:
+        w(f"**\n** indentation {_num(depth)} mm at {_num(scene.rate)} mm/s\n")
+        w("*STEP, NLGEOM, INC=10000\n")
+        w(f"*STATIC\n{_num(dt0)}, {_num(T)}, {_num(T * 1e-6)}, {_num(T / 10)}\n")
+        w("*BOUNDARY, AMPLITUDE=travel\n")
+        w(f"indenter_nodes, 2, 2, {_num(-depth)}\n")
+        _outputs(w)
+        w("*END STEP\n")
+    else:
+        # force control: a free indenter at first touch has no stiffness in y (the penalty acts on
+        # penetration only), so a first step presses it PRE_TRAVEL x the expected travel under
+        # displacement control, then the second frees it and ramps the force from zero (the
+        # pre-step's reaction, ~0.1 % of a Hertzian force, is let go at once)
+        pre = PRE_TRAVEL * depth
+        t_pre = pre / scene.rate
+        w(f"**\n** pre-step: {_num(pre)} mm under displacement control, then force control: {_num(force)} N on "
+          f"the whole indenter ({_num(force / factor)} N on the modelled part) over {_num(T)} s\n")
+        w(f"*AMPLITUDE, NAME=pre\n0., 0., {_num(t_pre)}, 1.\n")
+        w("*STEP, NLGEOM, INC=10000\n")
+        w(f"*STATIC\n{_num(t_pre / 2)}, {_num(t_pre)}, {_num(t_pre * 1e-6)}, {_num(t_pre)}\n")
+        w("*BOUNDARY, AMPLITUDE=pre\n")
+        w(f"indenter_ref, 2, 2, {_num(-pre)}\n")
+        w("*END STEP\n")
+        w("*STEP, NLGEOM, INC=10000\n")
+        w(f"*STATIC\n{_num(dt0)}, {_num(T)}, {_num(T * 1e-6)}, {_num(T / 10)}\n")
+        w("*BOUNDARY, OP=NEW\n" + supports)  # all but indenter_ref's y
+        w("*CLOAD, AMPLITUDE=travel\n")
+        w(f"indenter_ref, 2, {_num(-force / factor)}\n")
+        _outputs(w)
+        w("*NODE PRINT, NSET=indenter_ref\nU\n")
+        w("*END STEP\n")
     if visco and mat.prony.n_terms:
         log.warning("CalculiX has no Prony viscoelasticity: the deck uses the instantaneous hyperfoam alone")
     info = {"indenter_nodes": n_ind, "indenter_cells": len(icells), "penalty_mpa_per_mm": float(penalty),
-            "viscoelastic": False, "time_s": T, "depth_mm": depth,
-            "force_factor": (2.0 if halved else 1.0) * (2.0 if zsym else 1.0),
+            "viscoelastic": False, "time_s": T, "depth_mm": None if force is not None else depth,
+            "force_n": force, "pre_travel_mm": pre, "force_factor": factor,
             "face_size_mm": h_face, "face_chord_error_mm": max_chord_error(face, ind)}
     return Deck(fh.getvalue(), "calculix", n_nodes, n_cells, etype, info)
+
+
+def _outputs(w) -> None:
+    w("*NODE FILE\nU, RF\n*EL FILE\nS, E\n*CONTACT FILE\nCDIS, CSTR\n")
+    w("*NODE PRINT, NSET=bone_interface, TOTALS=ONLY\nRF\n")
+    w("*NODE PRINT, NSET=indenter_nodes, TOTALS=ONLY\nRF\n")
