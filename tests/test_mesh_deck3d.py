@@ -364,3 +364,35 @@ def test_force_control_is_a_pressed_pre_step_then_the_force_on_the_tied_indenter
     d = deck_text(sc.replace(force=None, depth=0.2), sm, "calculix")
     assert "*EQUATION" not in d.text and "*CLOAD" not in d.text and d.text.count("*STEP") == 1
 
+
+def test_a_file_indenter_is_written_as_its_own_triangles(tmp_path):
+    """A user's STL indenter: the wedges' faces S1 are its own triangles as the solver places
+    them (the surface its gap measures: no chord error), all of those that reach below
+    y0 + CAP_RISE x the travel over the skin; a face with walls there is refused, the file
+    named. Was refused for every file ("not meshed as rigid 3D surfaces yet")."""
+    trimesh = pytest.importorskip("trimesh")
+    f = tmp_path / "ball.stl"
+    trimesh.creation.icosphere(subdivisions=3, radius=2.5).export(f)
+    sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="file", indenter_file=str(f),
+               depth=0.2, dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0)
+    sm = build_mesh(sc)
+    deck = deck_text(sc, sm, "calculix")
+    p = parse_deck(deck.text)
+    assert undefined_names(p) == [] and deck.info["force_factor"] == 4.0
+    ids, X = _elements(p, "C3D6")
+    assert len(ids) == deck.info["indenter_cells"] > 0 and deck.info["face_chord_error_mm"] == 0.0
+    ind = indenter_for_scene(sc)
+    key = lambda t: tuple(sorted(map(tuple, np.round(t, 9))))  # noqa: E731 - a triangle, any order
+    tris = ind.vertices[ind.faces]
+    assert {key(t) for t in X[:, :3]} <= {key(t) for t in tris}
+    low = tris[:, :, 1].max(axis=1) <= ind.y0 + 0.4  # CAP_RISE x 0.2 mm
+    over = np.all((tris[:, :, [0, 2]] >= 0.0) & (tris[:, :, [0, 2]] <= 10.0), axis=(1, 2))  # the quarter pad
+    assert (low & over).sum() >= 10 and {key(t) for t in tris[low & over]} <= {key(t) for t in X[:, :3]}
+    assert X[:, :3, 1].min() == pytest.approx(ind.y0, abs=1e-12)
+    bot, top = X[:, :3], X[:, 3:]
+    n = np.cross(bot[:, 1] - bot[:, 0], bot[:, 2] - bot[:, 0])
+    assert np.all(np.einsum("ij,ij->i", n, top.mean(1) - bot.mean(1)) > 0.0) and np.all(n[:, 1] > 0.0)
+    box = tmp_path / "punch.stl"  # a flat punch: its side walls rise from its face
+    trimesh.creation.box(extents=(2.0, 2.0, 2.0)).export(box)
+    with pytest.raises(ParameterError, match=r"indenter_file=.*punch.stl.*walls"):
+        deck_text(sc.replace(indenter_file=str(box)), sm, "calculix")

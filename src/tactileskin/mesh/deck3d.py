@@ -11,7 +11,9 @@
   the mesh is z-symmetric (the plane z = 0); end_front (and a non-symmetric end_back) free;
 - the indenter (flat, braille, sphere, cylinder, curved): its working face triangulated on
   the kind's exact surface (mesh.indenter3d; a sphere or cylinder up to twice the travel
-  above its lowest point, a flat flange beyond, where the skin cannot reach), thickened
+  above its lowest point, a flat flange beyond, where the skin cannot reach); a file
+  indenter: its own triangles that reach below twice the travel over the skin (its face must
+  point down there: indenter3d.file_face; the facets are the solver's surface too); thickened
   into C3D6 wedges whose nodes are all moved by the travel (a rigid translation without
   *RIGID BODY, as the 2D CalculiX deck does); the face extends 1 mm past the skin on every
   side, like the solver's unbounded analytic indenter;
@@ -69,7 +71,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     from tactileskin.materials import get_material
     from tactileskin.mesh.deck import (Deck, _name, _num, abaqus_cells, contact_nodes, indenter_mesh_lines,
                                         material_lines, skin_mesh_lines)
-    from tactileskin.mesh.indenter3d import cap_rise, indenter_face, max_chord_error, wedge_cells
+    from tactileskin.mesh.indenter3d import cap_rise, file_face, indenter_face, max_chord_error, wedge_cells
 
     if skinmesh.dim != 3:
         raise ParameterError("mesh", f"{skinmesh.dim}D", "a 3D skin mesh for a 3D deck")
@@ -86,7 +88,11 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
         penalty = PENALTY_FACTOR * max(hf.K0, hf.mu0) / h_fine
     if not (isinstance(penalty, (int, float)) and np.isfinite(penalty) and penalty > 0):
         raise ParameterError("penalty", penalty, "a positive contact stiffness (MPa/mm)")
-    face = indenter_face(ind, footprint(skinmesh), h_face, cap_size, reach=scene.reach)
+    if ind.kind == "file":  # its own triangles: the surface the solver's gap measures, exact
+        face, chord = file_face(ind, footprint(skinmesh), scene.reach), 0.0
+    else:
+        face = indenter_face(ind, footprint(skinmesh), h_face, cap_size, reach=scene.reach)
+        chord = max_chord_error(face, ind)
     ipts, icells = wedge_cells(face, WEDGE_HEIGHT)
     halved, zsym = bool(skinmesh.halved), bool(getattr(skinmesh, "z_symmetric", False))
 
@@ -169,7 +175,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
     info = {"indenter_nodes": n_ind, "indenter_cells": len(icells), "penalty_mpa_per_mm": float(penalty),
             "viscoelastic": False, "time_s": T, "depth_mm": None if force is not None else depth,
             "force_n": force, "pre_travel_mm": pre, "force_factor": factor,
-            "face_size_mm": h_face, "face_chord_error_mm": max_chord_error(face, ind)}
+            "face_size_mm": h_face, "face_chord_error_mm": chord}
     return Deck(fh.getvalue(), "calculix", n_nodes, n_cells, etype, info)
 
 

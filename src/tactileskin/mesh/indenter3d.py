@@ -20,6 +20,8 @@ y = indenter.surface_y(x, z): every node lies on the true face. Kinds:
   the Braille caps use measured against their travel (1.0 um at 0.2 mm: ccx's force 0.2 %
   below tactileskin's; 3 um, 1.5 %, read 0.9 % below). A Hertzian force goes as travel^1.5
   and the facets' mean offset is about half their largest, so this costs ~0.4 % of force.
+A file indenter (file_face) is not remeshed: its own triangles that can touch are the face,
+exactly the surface the solver's gap measures.
 The footprint may extend past the printed face (the solver's contact is against the kind's
 unbounded analytic surface, `Indenter.gap`): outside the face box the face is continued as
 its base plane (surface_y at the clipped point, which is the base plane there because every
@@ -136,7 +138,7 @@ def indenter_face(indenter, box: tuple[float, float, float, float], h: float,
 
     if indenter.kind not in KINDS:
         raise ParameterError("indenter", indenter.kind, ", ".join(KINDS) + " for a 3D deck",
-                             "other kinds (a file indenter) are not meshed as rigid 3D surfaces yet")
+                             "a file indenter's face is its own triangles (file_face)")
     x0, x1, z0, z1 = (float(v) for v in box)
     if not (x1 > x0 and z1 > z0):
         raise ParameterError("box", box, "xmin < xmax and zmin < zmax (mm)")
@@ -245,6 +247,34 @@ def indenter_face(indenter, box: tuple[float, float, float, float], h: float,
     n_y = np.cross(pts[tris[:, 1]] - pts[tris[:, 0]], pts[tris[:, 2]] - pts[tris[:, 0]])[:, 1]
     tris[n_y > 0] = tris[n_y > 0][:, [0, 2, 1]]
     return IndenterFace(points=pts, tris=tris, kind=indenter.kind, caps=flange)
+
+
+def file_face(indenter, box: tuple[float, float, float, float], reach: float) -> IndenterFace:
+    """A file indenter's own triangles (the surface the solver's gap measures, so no chord
+    error) that reach below y0 + CAP_RISE x reach (what the skin can touch, as a sphere's cap)
+    and overlap the footprint box. They are thickened upwards into wedges (wedge_cells), so each
+    must face the skin (outward normal's y < 0): walls or overhangs there are refused."""
+    if not (reach is not None and math.isfinite(reach) and reach > 0.0):
+        raise ParameterError("reach", reach, "a positive travel (mm) for the file indenter's face")
+    x0, x1, z0, z1 = (float(v) for v in box)
+    tri = indenter.vertices[indenter.faces]
+    keep = ((tri[:, :, 1].min(axis=1) <= indenter.y0 + CAP_RISE * reach)
+            & (tri[:, :, 0].max(axis=1) >= x0) & (tri[:, :, 0].min(axis=1) <= x1)
+            & (tri[:, :, 2].max(axis=1) >= z0) & (tri[:, :, 2].min(axis=1) <= z1))
+    faces = indenter.faces[keep]
+    n = np.cross(tri[keep, 1] - tri[keep, 0], tri[keep, 2] - tri[keep, 0])  # outward (file._read)
+    up = n[:, 1] >= -1e-3 * np.linalg.norm(n, axis=1)  # vertical within 0.06 degrees, or facing up
+    if up.any() or not len(faces):
+        at = tri[keep][up].mean(axis=1)[0] if up.any() else None
+        raise ParameterError("indenter_file", indenter.file,
+                             "a surface facing the skin (down) everywhere within "
+                             f"{CAP_RISE * reach:g} mm above its lowest point, for a deck",
+                             f"{int(up.sum())} of its triangles there face sideways or up (walls, overhangs), "
+                             f"the first near ({at[0]:.3g}, {at[1]:.3g}, {at[2]:.3g}) mm; such faces are not "
+                             "written to decks yet" if up.any() else "no triangle of it lies over the skin")
+    used, tris = np.unique(faces, return_inverse=True)
+    tris = tris.reshape(-1, 3)  # the outward normal points down: already right-hand along -y
+    return IndenterFace(points=indenter.vertices[used].copy(), tris=tris, kind=indenter.kind)
 
 
 def max_chord_error(face: IndenterFace, indenter, samples: int = 3) -> float:
