@@ -18,8 +18,8 @@ the band:
    and rows closer than half that width inward of the 90 % row are dropped (for a Gaussian
    blur of sd b this keeps rows >= 2.6 b inside the edge, which read within 0.5 % of the
    band). A sharp edge loses nothing. Rows left that hold under a quarter of the half-maximum
-   run of a region about as long as wide (<= 1.4 x) mean no flat top across, a round press:
-   the run is kept (its fall-off is flagged);
+   run (or under 3 rows) of a region about as long as wide (<= 1.4 x) mean no flat top across,
+   a round press: the run is kept (its fall-off is flagged);
 4. along the strip: the region's extent plus 1 mm on each side (clipped to the image), so
    the profile shows its return to zero; what lies beyond read as unactivated film.
 """
@@ -40,8 +40,8 @@ ROUND_ASPECT = 1.4  # or if the activated region is longer than this x its width
 RULE = ("auto: heaviest connected activated region (pressure above the lower clip, 3x3 "
         "opening); across the strip the rows at >= 50 % of the largest row-mean pressure, "
         "less the blurred edge rows (half the 10-90 % edge width inward of the outermost 90 % row, "
-        "90 % at most the run's median; none if that leaves < 1/4 of the run and the region is <= 1.4 x as "
-        "long as wide: a round press); "
+        "90 % at most the run's median; none if that leaves < 1/4 of the run or < 3 rows and the region "
+        "is <= 1.4 x as long as wide: a round press); "
         "along it the region's extent + 1 mm each side")
 
 
@@ -102,7 +102,8 @@ def find_strip(pmap: np.ndarray, p_lo: float, px_per_mm: float) -> tuple[int, in
     # beside the other axis's 1-2 rows. A blurred strip keeps >= 0.43 of them noise-free, but a 2 mm one
     # (16 rows at 8 px/mm, 1.5-2 px blur) under 3 GS kept 1-3 of 12-14 (9 of 600 2-3 mm strips): it is
     # longer than wide (activated 1.7-2.5 x), a round spot is not (0.8-1.16 x: a = 0.5-4 mm, 0-7.65 GS)
-    flat = core[0] <= core[1] and core[1] - core[0] + 1 >= FLAT * (b - a + 1)
+    # and 1-2 rows are no flat top either: a dot of radius 0.5 mm (4 px at 8 px/mm) kept 2 of its 6
+    flat = core[0] <= core[1] and core[1] - core[0] + 1 >= max(FLAT * (b - a + 1), 3)
     if core[0] <= core[1] and (flat or c1 - c0 > ROUND_ASPECT * (rows.stop - rows.start)):
         a, b = max(a, core[0]), min(b, core[1])
     pad = int(round(PAD_MM * px_per_mm))

@@ -426,9 +426,10 @@ def _diluted(pmap: np.ndarray, box, axis: str) -> str:
 # (its 3D section's centre line reads the 0.5), status ok. Flagged when the outer half of the strip's
 # rows (STRIP_ROWS; by distance from their middle) reads below this share of the inner half: a contrast
 # of two means of many rows, so row noise does not trigger it. Under 3 GS noise and 0-2 px blur (5 seeds,
-# 0.05-0.9 MPa/mm) strips 5-10 mm wide read >= 0.904 (in a box exactly on them; found automatically
-# >= 0.919), round spots with >= 4 rows (Gaussian sd 0.5-3 mm, Hertzian a 0.75-3 mm, 0.1-0.9 MPa/mm)
-# <= 0.838: the threshold is midway. A narrow strip's blurred edge rows fall off too (2 mm in a box on it
+# 0.05-0.9 MPa/mm) strips 5-10 mm wide read >= 0.898 (in a box exactly on them; found automatically
+# >= 0.941), round spots with >= 4 rows (Gaussian sd 0.5-3 mm, Hertzian a 0.75-3 mm, 0.1-0.9 MPa/mm)
+# <= 0.808; Hertzian dots of a = 0.5 mm (4-6 rows at 8 px/mm) <= 0.884, 76 of 80 flagged (the 4 others:
+# 4 rows, 1-2 px blur, 0.1-0.2 MPa/mm). A narrow strip's blurred edge rows fall off too (2 mm in a box on it
 # under >= 1 px blur: its mean 7-13 % below its middle rows; found automatically, its edges are dropped)
 ROUND = 0.87
 
@@ -440,9 +441,12 @@ def _not_uniform(pmap: np.ndarray, box, axis: str) -> str:
     idx = np.flatnonzero(rows >= STRIP_ROWS * rows.max())
     if idx.size < 4:  # a row or three: read as the centre line already
         return ""
-    order = idx[np.argsort(np.abs(idx - 0.5 * (idx[0] + idx[-1])), kind="stable")]
-    half = idx.size // 2
-    ratio = float(rows[order[half:]].mean() / rows[order[:half]].mean())
+    dist = np.abs(idx - 0.5 * (idx[0] + idx[-1]))
+    order = idx[np.argsort(dist, kind="stable")]
+    # the nearer half by distance, the two rows at a distance on one side: split by count, a pair was
+    # parted and a dot of 5 rows (radius 0.5 mm at 8 px/mm) read 0.873 for its tie-free 0.80
+    inner = dist <= np.sort(dist)[idx.size // 2 - 1]
+    ratio = float(rows[idx[~inner]].mean() / rows[idx[inner]].mean())
     if ratio >= ROUND:
         return ""
     mid = np.sort(order[:max(idx.size // 4, 1)])
