@@ -123,3 +123,25 @@ def test_a_film_in_another_unit_than_mpa_is_a_suspect_comparison(tmp_path, capsy
                  str(tmp_path / "cmp8")]) == 0
     doc = json.loads((tmp_path / "cmp8" / "comparison.json").read_text())
     assert doc["status"] == "ok" and abs(doc["percent_diff"]["peak"]) < 1
+
+
+def test_rows_centre_reads_the_row_through_the_peak(tmp_path, capsys):
+    # a round press: the default reading (the rows' mean) is suspect and names --rows centre; with it, the
+    # row through the peak is read, exit 0, and the region printed and saved is that row
+    cal = paper_eq8()  # a Hertzian spot, a = 1.5 mm, off the pixel grid, at 8 px/mm
+    x = (np.arange(160) + 0.5) / 8 - 10.03
+    y = (np.arange(96) + 0.5) / 8 - 6.04
+    p = 0.5 * np.sqrt(np.clip(1 - (x[None, :] ** 2 + y[:, None] ** 2) / 1.5 ** 2, 0, None))
+    gs = cal.grayscale(p)
+    img = np.clip(np.rint(np.where(np.abs(gs - cal.threshold_gs) < 0.5, 245.0, gs)), 0, 255).astype(np.uint8)
+    scan = save_scan(img, tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "all")]) == 3
+    assert "--rows centre" in json.loads((tmp_path / "all" / "summary.json").read_text())["warnings"][0]
+    capsys.readouterr()
+    assert main(["film", "analyze", str(scan), "--rows", "centre", "--out", str(tmp_path / "c")]) == 0
+    out = capsys.readouterr().out
+    assert "y 48-49 px" in out and "centre: the row through the peak, y 48 px" in out
+    summ = json.loads((tmp_path / "c" / "summary.json").read_text())
+    assert summ["width_px"] == 1 and summ["warnings"] == [] and abs(summ["metrics_two_sided"]["peak"] - 0.5) < 0.003
+    assert main(["film", "analyze", str(scan), "--rows", "middle", "--out", str(tmp_path / "bad")]) == 2
+    assert not (tmp_path / "bad").exists()

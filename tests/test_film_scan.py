@@ -311,6 +311,39 @@ def test_a_dot_of_radius_half_a_millimetre_is_read_as_round():
         assert not any("--axis" in w for w in fp.warnings)
 
 
+@pytest.mark.parametrize("a, ppm", [(1.0, PPM), (2.0, PPM), (1.0, 300 / 25.4)])
+def test_rows_centre_reads_a_round_press_on_its_centre_line(a, ppm):
+    """rows="centre" (film analyze --rows centre) reads the one row through the peak: a Hertzian spot, read
+    across its rows, averages its fall-off (9 % low, the round-press warning). Off the pixel grid and
+    noise-free, the row and the column nearest its centre are each within half a pixel of it, so the peak
+    reads P0 sqrt(1 - r^2 / a^2) with r^2 <= 2 (0.5 px)^2, to the 8-bit rounding (0.5 GS: 0.0021 MPa/mm)."""
+    img = _spot(0.5, a, "hertz", blur=0.0, seed=0, ppm=ppm, noise=0.0, dx=0.29 / ppm, dy=0.37 / ppm)
+    mean = analyze_scan(img, px_per_mm=ppm)
+    assert mean.metrics["peak"] < 0.93 * 0.5 and any("--rows centre" in w for w in mean.warnings)
+    fp = analyze_scan(img, px_per_mm=ppm, rows="centre")
+    half = 0.5 / (a * ppm)  # half a pixel over the radius
+    assert 0.5 * np.sqrt(1 - 2 * half ** 2) - 0.0022 <= fp.metrics["peak"] <= 0.5 + 0.0022, fp.metrics["peak"]
+    assert fp.warnings == [] and fp.pressure_map.shape[0] == 1
+    row = fp.box_px[1]  # the image row holding the spot's centre, 6 mm + dy from the top
+    assert row == int((6.0 + 0.37 / ppm) * ppm) and fp.box_px[3] == row + 1
+    assert fp.summary()["region"]["rows"].startswith("centre") and fp.summary()["width_px"] == 1
+    # the same along y, on the transposed scan
+    ty = analyze_scan(np.ascontiguousarray(img.T), px_per_mm=ppm, axis="y", rows="centre")
+    assert ty.metrics["peak"] == pytest.approx(fp.metrics["peak"], abs=1e-12) and ty.box_px[0] == row
+    with pytest.raises(ParameterError, match="rows"):
+        analyze_scan(img, px_per_mm=ppm, rows="middle")
+    # one row keeps its pixels' noise and its largest sample reads high: flagged with a box on 5 rows
+    weak = _spot(0.2, a, "hertz", blur=1.0, seed=1, ppm=ppm, noise=3.0)
+    noisy = analyze_scan(weak, px_per_mm=ppm, rows="centre")
+    said = [w for w in noisy.warnings if "pixel noise" in w]  # (its noise may read as asymmetry too)
+    assert len(said) == 1, noisy.warnings
+    box = tuple(int(v) for v in said[0].split("--box-px ")[1].split())
+    assert box[3] - box[1] == 5 and box[1] < noisy.box_px[1] < box[3]
+    # a strong press under the same noise is not (its noise 1.4 % of the peak)
+    assert analyze_scan(_spot(0.9, a, "hertz", blur=1.0, seed=1, ppm=ppm, noise=3.0), px_per_mm=ppm,
+                        rows="centre").warnings == []
+
+
 @pytest.mark.parametrize("angle, flagged", [(0, False), (3, False), (10, True)])
 def test_a_strip_tilted_on_the_scan_is_flagged(angle, flagged):
     # averaging across a tilted strip smears the profile: a 6 mm wide strip at 10 degrees read a

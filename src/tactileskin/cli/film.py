@@ -78,11 +78,14 @@ def calibrate(cal_csv, out, model, activation_range, plot):
               help="Direction of the strip in the image.")
 @click.option("--centre", default="peak", show_default=True,
               help="Origin of s: peak, midspan, or a position in mm from the image edge.")
+@click.option("--rows", type=click.Choice(["all", "centre"]), default="all", show_default=True,
+              help="Across the strip: all (the profile is the mean of the region's rows) or centre (the "
+                   "row through the peak: a round press's centre line, one row's noise).")
 @click.option("--cmap", default="viridis", show_default=True,
               help="Colour map (viridis: perceptually uniform; jet: as in the paper).")
 @click.option("--out", "-o", type=click.Path(file_okay=False), required=True,
               help="Output directory: profile.csv, summary.json, pressure_map.png.")
-def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, out):
+def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, rows, cmap, out):
     """Convert a scanned film to pressure and its profile along the strip.
 
     Exit status 3 when the profile was written but is suspect (saturated film, pixels
@@ -99,12 +102,14 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, cmap, ou
             raise click.BadParameter("peak, midspan or a number (mm)", param_hint="--centre")
     cal = load_calibration(calibration)
     fp = analyze_scan(scan, cal, px_per_mm=px_per_mm, box_px=box_px or None,
-                      box_mm=box_mm or None, axis=axis, centre=centre)
+                      box_mm=box_mm or None, axis=axis, centre=centre, rows=rows)
     with claimed_output(out, "film-analyze"):  # a failed write leaves no folder of a marker alone
         fp.write_owned(out, cmap=cmap)  # the lock is held: fp.write would take it again
     x0, y0, x1, y1 = fp.box_px
     how = ("found automatically (the activated strip; --box-px/--box-mm to override)"
            if fp.region.get("method") == "auto" else f"given ({fp.region.get('method')})")
+    if "rows" in fp.region:
+        how += f"; {fp.region['rows']}"
     click.echo(f"region x {x0}-{x1}, y {y0}-{y1} px {how}")
     m, f = fp.metrics, fp.folded["metrics"]
     click.echo(f"origin {fp.origin_mm:.3f} mm; two-sided: peak {m['peak']:.4g} {fp.unit}, "
