@@ -232,8 +232,11 @@ def test_the_fallback_help_says_the_run_rows_join_the_projects_measurements():
 
     text = " ".join(CliRunner().invoke(cli, ["array", "--help"]).output.split())
     assert "else the project's" not in text and "together with the project's measurements" in text
-    readme = Path(__file__).resolve().parents[1] / "README.md"
-    assert "rows first, else the project's" not in " ".join(readme.read_text(encoding="utf-8").split())
+    root = Path(__file__).resolve().parents[1]
+    for doc in ("README.md", "docs/commands.md"):  # the array cell moved to docs/commands.md
+        assert "rows first, else the project's" not in " ".join((root / doc).read_text(encoding="utf-8").split())
+    assert "this run's `--validate` rows together with the project's measurements" in " ".join(
+        (root / "docs" / "commands.md").read_text(encoding="utf-8").split())
 
 
 def test_the_help_says_what_pitch_and_full_scale_are():
@@ -251,14 +254,15 @@ def test_the_help_says_what_pitch_and_full_scale_are():
 
 def test_the_readme_names_every_column_of_accuracies_csv():
     """accuracies.csv's `n_test` (test readings per stimulus) was explained nowhere, nor were
-    most of its columns: the README named only `status`."""
+    most of its columns: the README named only `status`. (The column list moved from the
+    README's Commands table to docs/commands.md.)"""
     import re
     from pathlib import Path
 
     from tactileskin.array.chart import Chart, ChartConfig
 
     header = Chart(ChartConfig()).to_csv().splitlines()[0].split(",")
-    readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8").split())
-    cell = re.search(r"`accuracies\.csv` \((.*?)\), `array_chart\.md`", readme).group(1)
+    doc = " ".join((Path(__file__).resolve().parents[1] / "docs" / "commands.md").read_text(encoding="utf-8").split())
+    cell = re.search(r"- `accuracies\.csv`: (.*?) - `array_chart\.md`", doc).group(1)
     assert "n_test" in header and [c for c in header if f"`{c}`" not in cell] == []
     assert "test readings per stimulus" in cell

@@ -157,10 +157,11 @@ def test_hard_cases_p1_note_says_the_scene_is_refused():
     assert "*Resolved:* `Scene` refuses `order=1` with the mixed formulation" in doc
 
 
-def test_readme_dome_sensor_numbers_are_the_dome_coordinates():
+def test_commands_doc_dome_sensor_numbers_are_the_dome_coordinates():
     """The README's dome sentence said layouts were not taken; it now gives the sensors' s = x
     against the profile's bone arc length, and the skin's thickness along a vertical line,
-    which the dome's own coordinates must reproduce."""
+    which the dome's own coordinates must reproduce. (The sentence moved with the Commands
+    table's long cells to docs/commands.md.)"""
     import numpy as np
 
     from tactileskin.scene import Scene
@@ -171,7 +172,7 @@ def test_readme_dome_sensor_numbers_are_the_dome_coordinates():
     s3 = sec.s_of_point([[3.0, (sec.b - 2.0) * np.sqrt(1 - (3.0 / (sec.a - 2.0)) ** 2)]])[0]
     thick = col["top"] - col["floor"]
     tip = coordinates_for(sc).column(np.zeros(1), np.array([sec.c - 2.0]))
-    readme = _text("README.md")
+    readme = _text("docs/commands.md")
     assert f"x = 3 mm is s = {s3:.2f} mm at t = 2" in readme and thick[0] == 2.0
     assert f"({thick[1]:.3f} mm at x = 1, {thick[2]:.3f} at x = 3, t = 2)" in readme
     assert f"thicker than t ({tip['top'][0] - tip['floor'][0]:.1f} mm on the axis at z = c - t, t = 2)" in readme
@@ -212,3 +213,65 @@ def test_readme_choosing_an_array_runs_and_names_what_the_chart_writes():
     assert "template: the nearest of every stimulus's noise-free readings" in md
     assert "### The skin as a spatial filter" in md and "Nyquist pitch (mm)" in md
     assert {"ci_low", "ci_high", "method"} <= set(ch.to_csv().splitlines()[0].split(","))
+
+
+def _anchors(path: Path):
+    """GitHub's heading ids: lower case, punctuation but '-' and '_' dropped, spaces to '-',
+    repeats numbered; headings inside code fences are not headings."""
+    import re
+
+    seen: dict[str, int] = {}
+    fence = False
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fence = not fence
+        m = None if fence else re.match(r"#{1,6} (.*)", line)
+        if m:
+            slug = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-")
+            n = seen.get(slug, 0)
+            seen[slug] = n + 1
+            yield slug if n == 0 else f"{slug}-{n}"
+
+
+def _links(path: Path):
+    """Relative markdown links [text](target) outside code fences and inline code."""
+    import re
+
+    fence = False
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fence = not fence
+            continue
+        if not fence:
+            for target in re.findall(r"\]\(([^)\s]+)\)", re.sub(r"`[^`]*`", "", line)):
+                if not re.match(r"[a-z]+:", target):
+                    yield target
+
+
+def test_every_relative_link_in_readme_and_docs_resolves():
+    """The README's Commands table links to sections of docs/commands.md: a renamed heading or
+    file would leave a dead link."""
+    docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    dead, n = [], 0
+    for doc in docs:
+        for target in _links(doc):
+            n += 1
+            file, _, anchor = target.partition("#")
+            dest = (doc.parent / file).resolve() if file else doc
+            if not dest.is_file() or (anchor and anchor not in set(_anchors(dest))):
+                dead.append(f"{doc.relative_to(ROOT)}: {target}")
+    assert n >= 20 and dead == []
+
+
+def test_readme_commands_table_is_short_and_links_each_row_to_its_section():
+    """The README's Commands table had cells of 1,500-5,600 characters (array, export, the
+    file skin...); each row is now one sentence and a link to its section of docs/commands.md,
+    where the full text lives."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    table = text[text.index("| command | what it does |"):].split("\n\n")[0]
+    rows = [ln for ln in table.splitlines() if ln.startswith("| `tactileskin")]
+    assert len(rows) >= 15
+    for row in rows:
+        what = row.rsplit(" | ", 1)[1]
+        assert len(what) <= 300 and "](docs/commands.md#" in what, row
+    assert "docs/commands.md" in text[text.index("## Documentation"):text.index("## Development")]

@@ -588,7 +588,7 @@ class Chart:
         return float("nan")
 
     def to_csv(self, indicative: dict | None = None) -> str:
-        """The accuracy rows (columns in README.md, `tactileskin array`; `n_test`: test readings per
+        """The accuracy rows (columns in docs/commands.md, `tactileskin array`; `n_test`: test readings per
         stimulus, so an accuracy counts n_test / chance readings); `indicative` {(material,
         thickness): reason} marks the letters rows whose surrogate is not shown within the
         tolerance (status "indicative: reason"), as the report's daggers do."""

@@ -179,7 +179,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                      "full scale it is (its largest pressure at that thickness; `full_scale_mpa` in accuracies.csv). ")
                   + 
                   # the readings share one draw of offsets: at a coarse pitch the draw moves the
-                  # accuracy by 4-5x the binomial std over the readings (README: seeds 0-5 at 2.5 mm)
+                  # accuracy by 4-5x the binomial std over the readings (docs/commands.md: seeds 0-5 at 2.5 mm)
                   f"Each accuracy is one draw of {cfg.n_test} random offsets, shared by all stimuli and noise levels: "
                   "where the offset matters (a pitch near the dots' 2.5 mm spacing) another draw moves it more than "
                   "a binomial 95 % interval over the readings says, so accuracies.csv's `ci_low` / `ci_high` (and the "
