@@ -201,3 +201,19 @@ def test_compare_flags_a_result_changed_since_it_was_written(tmp_path, capsys, s
     (film / "profile.csv").write_text("".join(flines[:-5]))
     assert main(["film", "compare", str(film), str(sim)]) == 3
     assert "the film profile is suspect: profile.csv changed since `film analyze` wrote it" in capsys.readouterr().err
+
+
+def test_the_pressure_map_names_the_profile_it_plots(tmp_path, monkeypatch):
+    """--rows centre plots the one row through the peak; its legend said "mean across width", as for
+    the rows' mean (the default), so a figure of the centre line read as an average of the rows."""
+    from tactileskin.film import plots
+    from tactileskin.film.scan import analyze_scan
+
+    img = render_scan(gaussian_profile(0.4, 1.0), background_gs=245)
+    labels = []
+    monkeypatch.setattr(plots, "_save", lambda fig, path: labels.append(
+        [t.get_text() for t in fig.axes[1].get_legend().get_texts()]) or path)
+    plots.pressure_map(analyze_scan(img), tmp_path / "all.png")
+    plots.pressure_map(analyze_scan(img, rows="centre"), tmp_path / "centre.png")
+    assert "mean across width" in labels[0]
+    assert "mean across width" not in labels[1] and any("row through the peak" in t for t in labels[1]), labels

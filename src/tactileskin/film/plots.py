@@ -61,7 +61,9 @@ def pressure_map(fp, path, *, cmap: str = DEFAULT_CMAP) -> Path:
     ax.set_ylabel("across strip (mm)")
     ax.set_title(f"film pressure ({fp.calibration.name})" + _suspect_note(fp.warnings, "summary.json"))
     fig.colorbar(im, ax=[ax, ax2], label=f"pressure ({fp.unit})", shrink=0.9)
-    ax2.plot(fp.s_mm, fp.pressure, "k-", lw=1.2, label="mean across width")
+    # rows="centre" (--rows centre) reads the one row through the peak, not the rows' mean
+    ax2.plot(fp.s_mm, fp.pressure, "k-", lw=1.2,
+             label="row through the peak" if "rows" in (fp.region or {}) else "mean across width")
     if fp.band_lo is not None:
         ax2.fill_between(fp.s_mm, fp.band_lo, fp.band_hi, color="0.7", alpha=0.6,
                          label="calibration 90 % band")

@@ -162,7 +162,7 @@ class FilmProfile:
     """Result of ``analyze_scan``. Pressures in ``unit`` (the calibration's)."""
 
     s_mm: np.ndarray            # distance from the origin along the strip
-    pressure: np.ndarray        # mean across the strip width
+    pressure: np.ndarray        # mean across the strip width (rows='centre': the row through the peak)
     pressure_sd: np.ndarray     # standard deviation across the width
     band_lo: np.ndarray | None  # calibration 90 % band, mean across the width like pressure
     band_hi: np.ndarray | None
