@@ -286,3 +286,18 @@ def test_the_bonded_face_rule_is_an_option_of_the_commands(tmp_path, capsys):
     # build takes it too: the inner face is curved, so the mold is refused naming the rule given
     assert main(["build", "--skin-file", step, "--skin-bonded", "normal:-y:89.9", "--out", str(tmp_path / "b")]) == 2
     assert "skin_bonded='normal:-y:89.9'" in capsys.readouterr().err and not (tmp_path / "b").exists()
+
+
+def test_the_declared_manifold3d_has_the_64_bit_mesh_undercut_uses():
+    """file_parts.undercut builds its solid with manifold3d.Mesh64, which manifold3d 3.0.0 first
+    ships (2.5.1's module has no Mesh64): pyproject's 'manifold3d>=2.4' let pip keep a 2.x, where
+    every `build --skin-file` with molds stopped in an AttributeError traceback."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from packaging.version import Version
+
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())["project"]
+    floor = [re.search(r">=\s*([0-9.]+)", r).group(1) for r in project["dependencies"] if r.startswith("manifold3d")]
+    assert floor and Version(floor[0]) >= Version("3.0"), floor
