@@ -677,3 +677,27 @@ def test_a_damaged_vtu_reads_as_an_error_not_an_exit(tmp_path):
     path.write_text('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="0.1">\n<Unstr')
     with pytest.raises(ValueError, match="r.vtu"):
         read_vtu(path)
+
+
+def test_an_editor_lock_file_in_the_package_is_not_code(tmp_path):
+    """Emacs marks a buffer with unsaved edits by a dangling symlink `.#name.py` beside the file.
+    The import-time snapshot of the package's .py files took it in (digest None; code_digest's
+    rglob had skipped it, not a file): a fresh process's key then changed while an editor held
+    such a buffer, and every case was solved again under that key."""
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    lock = pkg / "tactileskin" / ".#results.py"
+    code = ("import json, sys, os; from tactileskin.cache import cache_key, code_changes; "
+            "from tactileskin.scene import Scene; key = cache_key(Scene()); "
+            "len(sys.argv) > 1 and os.symlink('user@host.1234:1700000000', sys.argv[1]); "
+            "print(json.dumps({'key': key, 'changes': code_changes()}))")
+    plain, _ = _run_python(pkg, code, lock)   # the lock appears after the import
+    assert plain["changes"] == []
+    held, _ = _run_python(pkg, code)          # imported while the lock is there
+    lock.unlink()
+    assert held["key"] == plain["key"] and held["changes"] == []

@@ -23,8 +23,9 @@ def _source_hashes() -> dict:
     for folder, dirs, files in os.walk(root):
         dirs[:] = [d for d in dirs if d != "__pycache__"]
         for name in files:
-            if name.endswith(".py"):
-                path = os.path.join(folder, name)
+            path = os.path.join(folder, name)
+            # a regular file, as code_digest's were: not an editor's dangling lock link (Emacs' .#name.py)
+            if name.endswith(".py") and os.path.isfile(path):
                 try:
                     with open(path, "rb") as fh:
                         digest = hashlib.sha256(fh.read()).hexdigest()
