@@ -1,10 +1,13 @@
 """The 3D CalculiX deck (mesh.deck3d) and the meshed indenter face (mesh.indenter3d): element
 counts, node order (positive isoparametric volumes that add up to the mesh's), sets, surfaces,
 supports as the 3D solver applies them, and the indenter face on the kind's exact surface.
-No CalculiX needed (benchmarks/calculix_compare3d.py runs ccx)."""
+No CalculiX needed (benchmarks/calculix_compare3d.py runs ccx), but for one force-control run where ccx is
+installed (skipped otherwise)."""
 
 from __future__ import annotations
 
+import os
+import shutil
 from types import SimpleNamespace
 
 import numpy as np
@@ -396,3 +399,24 @@ def test_a_file_indenter_is_written_as_its_own_triangles(tmp_path):
     trimesh.creation.box(extents=(2.0, 2.0, 2.0)).export(box)
     with pytest.raises(ParameterError, match=r"indenter_file=.*punch.stl.*walls"):
         deck_text(sc.replace(indenter_file=str(box)), sm, "calculix")
+
+
+@pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) not installed")
+def test_ccx_runs_a_force_controlled_deck_on_a_coarse_mesh(tmp_path):
+    """The pre-step must leave a contact that carries the first force increment: at 1 % of
+    the expected travel (0.002 mm) the sphere at 0.3 N on the 1.6 / 4 pad left ccx 2.20 a
+    singular matrix in step 2's first increment (spooles, exit 255; likewise the commit's
+    1.6 / 8 deck under OMP_NUM_THREADS=2), so the deck written as good did not run. At 5 % it
+    reaches the force (0.0750 N on the quarter) at a travel of 0.1947 mm (~12 s)."""
+    import subprocess
+
+    sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="sphere", indenter_radius=2.5,
+               force=0.3, dim=3, viscoelastic=False, mesh_size=1.6, refinement=4.0)
+    deck = deck_text(sc, build_mesh(sc), "calculix")
+    (tmp_path / "f.inp").write_text(deck.text)
+    run = subprocess.run(["ccx", "-i", "f"], cwd=tmp_path, capture_output=True, text=True, timeout=600,
+                         env={**os.environ, "OMP_NUM_THREADS": "1"})
+    assert run.returncode == 0 and "Job finished" in run.stdout, run.stdout[-2000:]
+    dat = (tmp_path / "f.dat").read_text()
+    fy = float(dat.split("for set BONE_INTERFACE")[-1].split()[4])
+    assert fy == pytest.approx(0.3 / deck.info["force_factor"], rel=1e-3)

@@ -50,7 +50,12 @@ log = logging.getLogger(__name__)
 
 WEDGE_HEIGHT = 0.5  # mm: thickness of the indenter's wedge layer (its nodes all prescribed or tied)
 PENALTY_FACTOR = 40.0  # default contact slope in K0 / h_fine (module docstring)
-PRE_TRAVEL = 0.01  # force control: the pre-step's travel, a fraction of the expected travel (module docstring)
+# force control: the pre-step's travel, a fraction of the expected travel (module docstring). At 1 %
+# (0.002 mm on the t = 1 pad) the contact it left could not carry the first force increment: ccx 2.20
+# stopped on a singular matrix in step 2 for the R 2.5 sphere at 0.3 N on the 1.6 / 4 mesh (also an
+# icosphere STL there, and the 1.6 / 8 deck under OMP_NUM_THREADS=2); at 5 % all three reach the force,
+# the 1.6 / 8 travel 0.19662 mm (0.19657 at 1 %, one thread). Elastic and frictionless: the path does not matter
+PRE_TRAVEL = 0.05
 
 
 def footprint(skinmesh, margin: float = 1.0) -> tuple[float, float, float, float]:
@@ -151,7 +156,7 @@ def deck_text_3d(scene, skinmesh, *, penalty: float | None = None, increments: i
         # force control: a free indenter at first touch has no stiffness in y (the penalty acts on
         # penetration only), so a first step presses it PRE_TRAVEL x the expected travel under
         # displacement control, then the second frees it and ramps the force from zero (the
-        # pre-step's reaction, ~0.1 % of a Hertzian force, is let go at once)
+        # pre-step's reaction, ~1 % of a Hertzian force, is let go at once)
         pre = PRE_TRAVEL * depth
         t_pre = pre / scene.rate
         w(f"**\n** pre-step: {_num(pre)} mm under displacement control, then force control: {_num(force)} N on "
