@@ -150,3 +150,14 @@ def test_a_sensor_depth_outside_every_skin_is_one_line_before_any_solve(tmp_path
     assert not out.exists()
     with pytest.raises(ParameterError, match="sensor_depth"):
         chart.ChartConfig(thicknesses=(1.0, 3.0), sets=("paper",), sensor_depth=value)
+
+
+def test_the_pitch_help_does_not_put_every_lattice_on_the_bonded_surface():
+    """--pitch's help said the lattice lies on the bonded surface, which --sensor-depth moves."""
+    from click.testing import CliRunner
+
+    from tactileskin.cli.array import command
+
+    text = " ".join(CliRunner().invoke(command, ["--help"], terminal_width=200).output.split())
+    pitch = text.split("--pitch TEXT")[1].split("--noise TEXT")[0]
+    assert "--sensor-depth" in pitch, pitch

@@ -62,7 +62,7 @@ def load_config(path) -> dict:
 @click.option("--thickness", "-t", default=None, help="Thicknesses (mm), e.g. '1,3'. Default 1,3.")
 @click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone.")
 @click.option("--pitch", default=None, help="Array pitches (mm): taxel centre to centre, a square lattice on the "
-              "bonded surface over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
+              "bonded surface (or at --sensor-depth) over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
 @click.option("--noise", default=None, help="Noise std as fractions of full scale: each set's largest pressure at that "
               "thickness, so one fraction is a different noise in MPa at each thickness (array_chart.md gives it). "
               "Default 0.01,0.05,0.1.")
