@@ -107,6 +107,12 @@ def test_the_chart_reads_every_map_at_the_sensor_depth(monkeypatch):
                             noise_fs=(0.01,), n_train=4, n_test=4, template_grid=2, sensor_depth=0.4)
     ch = chart.compute(cfg, cache=None)
     assert sorted(set(read)) == [(2, "curved", 0.4), (2, "flat", 0.4), (3, "braille", 0.4)]
+    # accuracies.csv read on its own names the plane: 0.4 mm, not the bonded surface's depth t
+    import csv
+    import io
+
+    got = list(csv.DictReader(io.StringIO(ch.to_csv())))
+    assert got and {r["sensor_depth_mm"] for r in got} == {"0.4"}
     assert len([r for r in read if r[0] == 3]) == 2  # the pad's dot and the fingertip's
     (c,) = {c["halfspace_nyquist_pitch_mm"] for c in ch.cutoffs}
     from tactileskin.array import halfspace

@@ -592,14 +592,16 @@ class Chart:
         stimulus, so an accuracy counts n_test / chance readings); `indicative` {(material,
         thickness): reason} marks the letters rows whose surrogate is not shown within the
         tolerance (status "indicative: reason"), as the report's daggers do."""
-        cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "noise_fs", "noise_mpa",
+        cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "sensor_depth_mm", "noise_fs", "noise_mpa",
                 "full_scale_mpa", "bits", "method", "accuracy", "chance", "n_test", "ci_low", "ci_high"]
         lines = [",".join(cols + ["status"])]
         for r in self.rows:
             why = (indicative or {}).get((r["material"], r["thickness_mm"])) if r["set"] == "letters" else None
             bad = self.suspect.get((r["material"], r["thickness_mm"]))
             status = ('"suspect: ' + bad.replace('"', "'") + '"' if bad else f'"indicative: {why}"' if why else "ok")
-            vals = [r.get(c, "") if c in ("ci_low", "ci_high") else r[c] for c in cols]  # older rows: no interval
+            # older rows: no interval, taxels on the bonded surface (t below the contact surface)
+            vals = [r.get(c, "") if c in ("ci_low", "ci_high") else r.get(c, r["thickness_mm"])
+                    if c == "sensor_depth_mm" else r[c] for c in cols]
             lines.append(",".join([*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in vals), status]))
         return "\n".join(lines) + "\n"
 
@@ -803,6 +805,8 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                                                        ev.offset_accuracy.get(m))
                             chart.rows.append(dict(material=material, thickness_mm=float(t), set=set_,
                                                    pitch_mm=float(pitch), taxel_mm=float(spec.taxel),
+                                                   sensor_depth_mm=float(t if cfg.sensor_depth is None
+                                                                         else cfg.sensor_depth),
                                                    noise_fs=float(noise if cfg.noise_mpa is None else ro.sigma / fs),
                                                    noise_mpa=float(ro.sigma),
                                                    full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
