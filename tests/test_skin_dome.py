@@ -328,6 +328,33 @@ def test_a_dome_bone_sensor_reads_the_bone_map_there():
     assert dist.max() < 1e-3 and (z > 0).sum() == 5
 
 
+def test_the_solve_places_in_its_dome_mesh_what_the_scene_held():
+    """The scene checks the sensors on the exact surfaces, the solve places them on its P2 mesh,
+    whose column at (4.88, -6.9) is 9e-4 mm thinner (h = 2): a depth or a height 1e-4 mm short
+    of the exact thickness passed the scene and was refused after meshing ("valid: [0, 2.6369]
+    mm"). Now the scene's check decides (skins.file FileCoordinates' `reference`) and the sensor
+    is clamped onto the mesh's face; one outside the exact skin is refused in the scene's words."""
+    from tactileskin import sensors
+
+    sc = Scene(skin="dome", thickness=2.0, mesh_size=2.0, refinement=2.0, indenter="flat", viscoelastic=False)
+    coords = sc.skin_kind.mesh_coordinates(sc, build_mesh(sc))
+    at = {"s": [4.88], "z": [-6.9]}
+    exact = sc.skin_kind.coordinates(sc).column(at["s"], at["z"])
+    mesh = coords.column(at["s"], at["z"])
+    t = exact["top"][0] - exact["floor"][0]
+    assert 5e-4 < t - (mesh["top"][0] - mesh["floor"][0]) < 2e-3  # the mesh's column is thinner
+    for key, y in (("depth", mesh["floor"][0]), ("height", mesh["top"][0])):
+        lay = {"name": key, "kind": "points", **at, key: t - 1e-4}
+        Scene(skin="dome", thickness=2.0, sensors=[lay])  # held on the exact surfaces
+        assert sensors.resolve(sensors.layouts([lay]), coords, 3).xyz[0, 1] == pytest.approx(y, abs=1e-9)
+        out = {**lay, key: t + 1e-3}
+        with pytest.raises(ParameterError) as scene:
+            Scene(skin="dome", thickness=2.0, sensors=[out])
+        with pytest.raises(ParameterError) as solve_time:
+            sensors.resolve(sensors.layouts([out]), coords, 3)
+        assert str(solve_time.value) == str(scene.value) and "valid: [0, 2.63782] mm" in str(scene.value)
+
+
 def test_the_dome_sensor_layouts_enter_the_cache_key():
     from tactileskin.cache import cache_key
 
