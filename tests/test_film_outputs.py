@@ -217,3 +217,30 @@ def test_the_pressure_map_names_the_profile_it_plots(tmp_path, monkeypatch):
     plots.pressure_map(analyze_scan(img, rows="centre"), tmp_path / "centre.png")
     assert "mean across width" in labels[0]
     assert "mean across width" not in labels[1] and any("row through the peak" in t for t in labels[1]), labels
+
+
+def test_a_centre_row_profile_leaves_its_spread_empty(tmp_path, scan, sim):
+    """--rows centre reads one row: its pressure_sd (the spread across the width) was written as
+    a column of 0 (a spread of one value), as if the film were uniform across the strip. It is
+    left empty, as the band columns are without a band; the rows' mean keeps its spread, and
+    `film compare` reads both folders (it reads s_mm and pressure)."""
+    import csv
+
+    def columns(folder):
+        with open(folder / "profile.csv", newline="") as f:
+            return list(csv.DictReader(f))
+
+    for rows in ("all", "centre"):
+        film = tmp_path / rows
+        # a box inside the uniform strip: found automatically, its centre row is the strip's edge
+        # row, whose noise against the white row beside it makes the profile suspect
+        assert main(["film", "analyze", str(scan), "--rows", rows, "--box-px", "40", "20", "120", "50",
+                     "--out", str(film)]) == 0
+        table = columns(film)
+        assert len(table) > 10 and all(float(r["pressure"]) >= 0 for r in table)
+        sd = [r["pressure_sd"] for r in table]
+        if rows == "centre":
+            assert sd == [""] * len(table)
+        else:
+            assert max(float(v) for v in sd) > 0
+        assert main(["film", "compare", str(film), str(sim)]) == 0

@@ -163,7 +163,7 @@ class FilmProfile:
 
     s_mm: np.ndarray            # distance from the origin along the strip
     pressure: np.ndarray        # mean across the strip width (rows='centre': the row through the peak)
-    pressure_sd: np.ndarray     # standard deviation across the width
+    pressure_sd: np.ndarray | None  # standard deviation across the width (None for one row: rows='centre')
     band_lo: np.ndarray | None  # calibration 90 % band, mean across the width like pressure
     band_hi: np.ndarray | None
     pressure_map: np.ndarray    # (width, length) region, strip along axis 1
@@ -241,8 +241,8 @@ class FilmProfile:
         for k in range(self.s_mm.size):
             lo = f"{self.band_lo[k]:.6g}" if self.band_lo is not None else ""
             hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
-            lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},"
-                         f"{self.pressure_sd[k]:.6g},{lo},{hi}")
+            sd = f"{self.pressure_sd[k]:.6g}" if self.pressure_sd is not None else ""
+            lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},{sd},{lo},{hi}")
         with staging.staged_files(out, ANALYZE_NAMES + COMPARE_NAMES, last=names["summary"]) as tmp:
             fileio.atomic_write_text(tmp / names["profile"], "\n".join(lines) + "\n")
             fileio.atomic_write_json(tmp / names["summary"], self.summary())
@@ -641,7 +641,8 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
                         f"its {n_top} samples within 3 sd of it, reads high by up to about {_row_reach(n_top):.1f} x "
                         f"that; average a few rows through it: --box-px {' '.join(str(int(v)) for v in fix)}")
         log.warning("%s", warnings[-1])
-    sd = pmap.std(axis=0)
+    # one row has no spread across the width: its column is left empty, not a row of zeros
+    sd = pmap.std(axis=0) if pmap.shape[0] > 1 else None
     x_mm = (start + np.arange(region.shape[1]) + 0.5) / px_per_mm   # pixel centres
     if centre == "peak":
         origin = _peak_position(x_mm, prof)
