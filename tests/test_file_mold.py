@@ -259,6 +259,31 @@ def test_build_refuses_a_skin_file_it_cannot_mold_in_one_line(tmp_path, capsys, 
     assert not out.exists()  # nothing written
 
 
+def test_a_skin_whose_undercut_cannot_be_measured_is_refused_naming_no_molds(tmp_path, capsys, monkeypatch):
+    """file_parts.undercut refuses a skin whose tessellation is no closed volume (a CadError):
+    its message alone of the mold's refusals did not say the skin builds without molds. Now it
+    does, and the CLI prints it as one line, exit 2, nothing written; --no-molds builds."""
+    from tactileskin.cli import main
+
+    class Open:  # manifold3d's answer for a tessellation with a hole
+        def __init__(self, mesh):
+            pass
+
+        def status(self):
+            return manifold3d.Error.NotManifold
+
+    monkeypatch.setattr(manifold3d, "Manifold", Open)
+    path, out = _dome_step(tmp_path / "dome.step"), tmp_path / "out"
+    assert main(["build", "--skin-file", str(path), "--indenter", "none", "--out", str(out)]) == 2
+    cap = capsys.readouterr()
+    assert len(cap.err.strip().splitlines()) == 1 and "Traceback" not in cap.err + cap.out, cap.err
+    err = " ".join(cap.err.split())
+    assert "tessellation is no closed volume" in err and "--no-molds" in err, err
+    assert not out.exists()  # nothing written
+    assert main(["build", "--skin-file", str(path), "--indenter", "none", "--no-molds", "--out", str(out)]) == 0
+    assert [e["name"] for e in _manifest(out)["parts"]] == ["skin"]
+
+
 def test_the_bonded_face_rule_is_an_option_of_the_commands(tmp_path, capsys):
     """The STEP's bonded-face rule could only be set in a scene file: a new user's half tube,
     bonded on its curved inner face, was meshed bonded on its two end strips (64 mm^2, t = 10).

@@ -131,8 +131,9 @@ def undercut(skin: bd.Solid, y_b: float, tol: float = 0.01, step: float = 0.02):
     solid = manifold3d.Manifold(manifold3d.Mesh64(vert_properties=xzy, tri_verts=np.ascontiguousarray(
         np.asarray(mesh.faces)[:, ::-1], np.uint64)))  # swapping y and z mirrors: reverse the winding
     if solid.status() != manifold3d.Error.NoError:
+        # the mold is what needs the measure: the skin alone is built without it
         raise CadError(f"measuring the skin's undercut: its {tol:g} mm tessellation is no closed volume "
-                       f"({solid.status()})")
+                       f"({solid.status()}); {NO_MOLDS}")
     heights = np.unique(np.round(xzy[:, 2] / tol) * tol)
     heights = np.concatenate([[y_b], heights[heights > y_b + tol]])
     depth, where, throat = 0.0, None, None
