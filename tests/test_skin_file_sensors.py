@@ -388,3 +388,37 @@ def test_the_solve_places_in_its_mesh_what_the_scene_held(tmp_path):
     with pytest.raises(ParameterError) as solve_time:
         sensors.resolve(sensors.layouts([out]), coords, 3)
     assert str(solve_time.value) == str(scene.value) and "valid: [0, 1.60535] mm" in str(scene.value)
+
+
+def test_a_line_inside_a_curved_rim_reads_the_top_and_the_bonded_face_not_the_wall(tmp_path, capsys):
+    """A disc (R 5, 2 mm thick, y in [-2, 0], bonded on its bottom): inside its rim the coarse
+    analysis mesh's wall chords lean (|n_y| 0.02-0.03) and a vertical line crossed them where it
+    missed the top and bottom chords. At r = 4.99 the scene read 27 of the 28 lines it held
+    0.05-0.59 mm thick, not bonded (one 0.308: top -0.731, floor -1.040), and placed a depth-0.2
+    sensor there at y = -0.93, inside the CAD's skin but not 0.2 under its top. Now such a line is read on the CAD faces beside the wall: 2 mm, as the CAD says,
+    or no skin (refused) where no face is crossed; a sensor outside the disc is one line."""
+    import build123d as bd
+
+    from tactileskin.cli import main
+
+    path = tmp_path / "disc.step"
+    bd.export_step(bd.Cylinder(5.0, 2.0, rotation=(90, 0, 0), align=(bd.Align.CENTER, bd.Align.CENTER,
+                                                                      bd.Align.MIN)), str(path))
+    coords = sensors.coordinates_for(Scene(skin="file", skin_file=str(path), indenter="flat"))
+    ang = np.linspace(0.0, 0.5 * np.pi, 31)
+    col = coords.column(4.99 * np.cos(ang), 4.99 * np.sin(ang))
+    held = np.isfinite(col["top"])
+    assert held.sum() >= 20  # 28: the lines crossing a chord (the coarse mesh's; a line in no chord is refused)
+    assert np.allclose(col["top"][held], 0.0, atol=1e-9) and np.allclose(col["floor"][held], -2.0, atol=1e-9)
+    assert col["bonded"][held].all()
+    at = {"s": [4.92856], "z": [0.780608]}  # r = 4.99: crossed two wall chords only
+    for key, y in (("depth", -0.2), ("height", -1.8)):
+        lay = {"name": "rim", "kind": "points", **at, key: 0.2}
+        xyz = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=[lay])).xyz
+        assert xyz[0, 1] == pytest.approx(y, abs=1e-9)
+    (tmp_path / "s.toml").write_text('[[sensors]]\nname = "out"\ns = [4.97]\nz = [0.79]\ndepth = 0.2\n')  # r 5.03
+    rc = main(["solve", "--skin-file", str(path), "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
+               "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "sensor layout 'out'" in err and "no skin under it" in err and not (tmp_path / "o").exists()

@@ -73,6 +73,9 @@ SLOPE_STEP = 1e-4
 FLAT_SLOPE = 1e-9
 AXIS_GAP = 0.02  # of t: how far the outer surface on the axis may lie below the top point
 OUTER, BONDED = 1, 2  # FileGeometry.facet_kind
+# a STEP analysis mesh's facet within ~6 degrees of vertical is a wall (the disc's wall chords
+# inside its R 5 rim: |n_y| 0.024-0.032); crossed where the line misses its CAD face it is the mesh's
+WALL_NY = 0.1
 # the bonded surfaces held fixed: the fingertip's nail and the dome's bone under its tip, as
 # `tactileskin mesh` writes them, where the file has them
 FIXED = ("bone_interface", "nail_edge", "bone_tip")
@@ -444,11 +447,12 @@ class FileCoordinates:
             pt = np.repeat(rows, cnt)
             off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
             f = self._owner[np.repeat(self._start[c], cnt) + off]
+            near = pt, f  # every candidate facet of each point
             found = self._cross_curved(q[pt], f) if self._curved else [self._cross(q[pt], f)]
             y = np.concatenate([yy[hit] for hit, yy in found])
             pt, f = (np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f))
             if self._face is not None:
-                y = self._on_cad(q[pt], f, y)
+                pt, f, y = self._on_cad(q, pt, f, y, near)
             np.maximum.at(top, pt, y)
             out = self._kind[f] == OUTER
             np.maximum.at(outer, pt[out], y[out])
@@ -460,13 +464,38 @@ class FileCoordinates:
         return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
                 "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
 
-    def _on_cad(self, q, f, y) -> np.ndarray:
-        """The heights y of the chords f under the points q read on the chords' CAD faces (the
-        chord's where the line misses its face: the face's trim ends there)."""
+    def _on_cad(self, q, pt, f, y, near) -> tuple:
+        """(pt, f, y): the crossings y of the lines through the points q[pt] and the chords f read
+        on the chords' CAD faces (the chord's where the line misses its face: the face's trim ends
+        there). A steep chord (a wall's: |n_y| < WALL_NY) whose face the line misses is the coarse
+        mesh's, not the skin's: inside a curved rim the lines crossed a disc's wall chords (0.308 mm
+        apart at r = 4.99 of R 5) and missed its top and bottom chords. Those points' lines are
+        read on the CAD faces of the facets `near` (pt, f) them instead (the trimmed face's, or none)."""
         from tactileskin.mesh.skinfile import line_heights
 
-        cad = line_heights(self.cad, self._face[f], np.column_stack([q[:, 0], y, q[:, 1]]))
-        return np.where(np.isnan(cad), y, cad)
+        cad = line_heights(self.cad, self._face[f], np.column_stack([q[pt, 0], y, q[pt, 1]]))
+        wall = np.isnan(cad) & self._steep(f)
+        y = np.where(np.isnan(cad), y, cad)
+        if not wall.any():
+            return pt, f, y
+        # one probe per point and face near it, at the height of one of that face's chords there
+        npt, nf = near
+        on = np.isin(npt, pt[wall])
+        pairs = np.unique(np.column_stack([npt[on], self._face[nf[on]]]), axis=0, return_index=True)[1]
+        npt, nf = npt[on][pairs], nf[on][pairs]
+        ny = line_heights(self.cad, self._face[nf], np.column_stack([q[npt, 0], self._y[nf].mean(axis=1),
+                                                                     q[npt, 1]]))
+        hit, keep = np.isfinite(ny), ~wall
+        return (np.concatenate([pt[keep], npt[hit]]), np.concatenate([f[keep], nf[hit]]),
+                np.concatenate([y[keep], ny[hit]]))
+
+    def _steep(self, f) -> np.ndarray:
+        """Whether the straight facets f are steep walls (|n_y| < WALL_NY of their normal)."""
+        if self.dim != 3:
+            return np.zeros(len(f), bool)
+        P = np.stack([self._L[f][:, :3, 0], self._y[f][:, :3], self._L[f][:, :3, 1]], axis=2)
+        n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+        return np.abs(n[:, 1]) < WALL_NY * np.linalg.norm(n, axis=1)
 
     def _cross(self, q, f):
         """(hit, y) of the vertical lines through the points q (m, k) and the facets f (m,)."""
