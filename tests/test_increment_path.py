@@ -58,3 +58,24 @@ def test_sticking_the_committed_contact_keeps_the_answer():
     assert a.peak == pytest.approx(b.peak, rel=7e-4)
     assert a.span == pytest.approx(b.span, rel=1e-3)
     assert a.reaction == pytest.approx(b.reaction, rel=7e-4)
+
+
+
+def test_committed_contact_keeps_no_pull_while_the_indenter_backs_off(monkeypatch):
+    """Unloading (a depth or force ramp down): the points pressed at the committed state are
+    leaving the indenter, and stuck from the second iterate each kept a pull of up to penalty x
+    tol_penetration: an R 0.5 sphere held at 0.45 mm on 2 mm silicone, then raised to 0.1 mm,
+    read 0.0049969 N (-9.0 %) for the 0.0054926 N of a 10x tighter contact tolerance (1e-5 h:
+    0.0054917-0.0054927), and a full release after a second press left -0.0026 N on the
+    indenter. Measured with the fix: 0.0054945 N."""
+    from tactileskin.fe import model as fe_model
+
+    scene = Scene(dim=3, indenter="sphere", indenter_radius=0.5, thickness=2.0, depth=0.45, mesh_size=2.5,
+                  refinement=8.0, loading=({"hold": 0.5}, {"depth": 0.1, "rate": 1.0}))
+    mesh = build_mesh(scene)
+    now = fe.solve(scene, mesh).history[-1]
+    monkeypatch.setitem(fe_model.TOL_RELATIVE, 3, 1e-4)
+    ref = fe.solve(scene, mesh, options=SolverOptions(stick_committed=False)).history[-1]
+    assert now["d"] == ref["d"] == pytest.approx(0.1)
+    assert now["reaction"] == pytest.approx(ref["reaction"], rel=2e-3)
+    assert now["peak_mpa"] == pytest.approx(ref["peak_mpa"], rel=2e-3)
