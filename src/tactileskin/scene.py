@@ -44,9 +44,9 @@ from tactileskin.skins import registry as _skins
 # 13: 3D spheres and file indenters meshed by the local plan at their contact spots, as
 # Braille dots: their peaks move by up to 12 %; the 3D reaction is the whole indenter's force
 # (it was the modelled half or quarter's); a file indenter's profile runs through the map's peak;
-# 14: every increment's travel capped at 0.1 x the tip radius and (3D) the committed contact
-# points sticky from the second Newton iterate: other increment sequences for dots, spheres,
-# cylinders and the 2D Braille ridge, peaks within 0.4 % (the capped viscoelastic update is the closer))
+# 14: in 3D every increment's travel capped at 0.1 x the tip radius and the committed contact
+# points sticky from the second Newton iterate: other increment sequences for dots, spheres and
+# cylinders, peaks within 0.4 % (the capped viscoelastic update is the closer))
 SCHEMA_VERSION = 14
 
 
