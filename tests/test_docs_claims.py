@@ -275,3 +275,18 @@ def test_readme_commands_table_is_short_and_links_each_row_to_its_section():
         what = row.rsplit(" | ", 1)[1]
         assert len(what) <= 300 and "](docs/commands.md#" in what, row
     assert "docs/commands.md" in text[text.index("## Documentation"):text.index("## Development")]
+
+
+def test_docs_say_a_step_skins_sensors_are_checked_on_its_cad_faces():
+    """commands.md and architecture.md said the scene checks a STEP skin's sensors on the
+    straight chords of its analysis mesh; since 7834a83 it reads them on the CAD faces (the
+    chords only find the faces), and since 1c84faf the solve holds what the scene held."""
+    from tactileskin.skins.file import FileCoordinates, _coordinates
+
+    assert "cad" in FileCoordinates.__init__.__code__.co_varnames
+    assert "cad=" in __import__("inspect").getsource(_coordinates)
+    for name in ("docs/commands.md", "docs/architecture.md"):
+        doc = _text(name)
+        assert "(a STEP's: the straight chords of a size/8 mesh, within their sag" not in doc, name
+        assert "(a STEP's: chords of its size / 8 mesh, 0.006-0.039 mm under an R 6 cap)" not in doc, name
+        assert "on its CAD faces" in doc, name
