@@ -639,9 +639,9 @@ def _predicted_increment(model: Model, t: float, dt: float, opts: SolverOptions,
     return _solve_increment(model, model.u, t, dt, opts, stats)
 
 
-def _first_dt(model: Model, t: float, dt: float, opts: SolverOptions) -> float:
+def _travel_capped_dt(model: Model, t: float, dt: float, opts: SolverOptions) -> float:
     """dt, shortened so that the indenter travels at most opts.first_travel_radius x its
-    tip radius in it."""
+    tip radius in it (the first increment; in 3D every one, travel_cap_every)."""
     R = getattr(getattr(model.contact, "indenter", None), "tip_radius", np.inf)
     if opts.first_travel_radius <= 0 or not np.isfinite(R) or dt <= 0:
         return dt
@@ -680,7 +680,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
     t0 = time.perf_counter() - stats.wall_s
     t = model.t
     span = T - t
-    dt = _first_dt(model, t, opts.dt0_fraction * span, opts) if increment is None else opts.dt0_fraction * span
+    dt = _travel_capped_dt(model, t, opts.dt0_fraction * span, opts) if increment is None else opts.dt0_fraction * span
     dt_min = opts.dt_min_fraction * span
     dt_cap = np.inf  # opts.failed_dt_fraction x the shortest increment that failed
     easy = EASY_ITERATIONS.get(getattr(model, "m", 2), 7) if opts.easy_iterations is None else opts.easy_iterations
@@ -691,7 +691,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
         dt = min(dt, T - t, opts.dt_max_fraction * span, dt_cap)
         cap_every = getattr(model, "m", 2) == 3 if opts.travel_cap_every is None else opts.travel_cap_every
         if cap_every and increment is None:
-            dt = _first_dt(model, t, dt, opts)
+            dt = _travel_capped_dt(model, t, dt, opts)
         if T - (t + dt) < 1e-3 * dt:
             dt = T - t
         try:
