@@ -286,15 +286,22 @@ def face_cap_size(face, cap):
     return float(np.median(e))
 
 
-def test_sphere_deck_on_a_pad():
-    """A sphere (R 2.5, 0.2 mm) on a quarter pad: counts, sets, supports, the face's wedges on
-    the sphere at the pole (the ccx run: benchmarks/results/calculix_compare3d.md)."""
+def _pad_sphere_deck(**load):
+    """(scene, mesh, deck, parsed deck) of an R 2.5 sphere on the t = 1 quarter pad at 1.6 / 8
+    under `load` (depth= or force=); the deck's names all defined."""
     sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="sphere", indenter_radius=2.5,
-               depth=0.2, dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0)
+               dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0, **load)
     sm = build_mesh(sc)
     deck = deck_text(sc, sm, "calculix")
     p = parse_deck(deck.text)
     assert undefined_names(p) == []
+    return sc, sm, deck, p
+
+
+def test_sphere_deck_on_a_pad():
+    """A sphere (R 2.5, 0.2 mm) on a quarter pad: counts, sets, supports, the face's wedges on
+    the sphere at the pole (the ccx run: benchmarks/results/calculix_compare3d.md)."""
+    sc, sm, deck, p = _pad_sphere_deck(depth=0.2)
     ids, X = _elements(p, "C3D10")
     assert len(ids) == deck.n_skin_cells == sm.mesh.nelements
     ids, X = _elements(p, "C3D6")
@@ -336,12 +343,7 @@ def test_force_control_is_a_pressed_pre_step_then_the_force_on_the_tied_indenter
     (ParameterError on loading); ccx reaches the force (benchmarks/results/calculix_compare3d.md)."""
     from tactileskin.mesh.deck3d import PRE_TRAVEL
 
-    sc = Scene(thickness=1.0, material="polyurethane", skin="pad", indenter="sphere", indenter_radius=2.5,
-               force=0.3, dim=3, viscoelastic=False, mesh_size=1.6, refinement=8.0)
-    sm = build_mesh(sc)
-    deck = deck_text(sc, sm, "calculix")
-    p = parse_deck(deck.text)
-    assert undefined_names(p) == []
+    sc, sm, deck, p = _pad_sphere_deck(force=0.3)
     ref = deck.n_skin_nodes + 1
     assert p["nsets"]["indenter_ref"] == [ref] and p["nsets"]["indenter_nodes"][0] == ref
     eq = next(rows for kw, _, rows in p["blocks"] if kw == "EQUATION")
