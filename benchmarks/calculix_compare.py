@@ -164,26 +164,34 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(L) + "\n"
 
 
-def plot(rows: list[dict], path: Path) -> None:
+def plot_panels(panels: list[dict], path: Path) -> None:
+    """One panel per dict: the CalculiX profile(s) as markers and tactileskin's per formulation
+    as lines; keys title, xlim, ccx [(s, p, label, marker, colour)], ts {form: (s, p)}.
+    Shared by the 2D and 3D comparisons."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(rows), figsize=(4.2 * len(rows), 3.4), squeeze=False)
-    for ax, r in zip(axes[0], rows):
-        s, p = r["profile_ccx"]
-        ax.plot(s, p, "o", ms=3, color="#0072B2", label="CalculiX (nodal)")
-        for (form, t), c in zip(r["ts"].items(), ("#D55E00", "#009E73")):
-            ax.plot(*t["profile"], "-", color=c, lw=1.2, label=f"tactileskin {form}")
-        ax.set(title=f"{r['scene']} {r['mesh']}, {r['penalty_factor']:g} K0/h", xlabel="s along the bone (mm)",
-               ylabel="bone pressure P (MPa)", xlim=(0, 8))
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.4), squeeze=False)
+    for ax, pn in zip(axes[0], panels):
+        for s, p, label, marker, colour in pn["ccx"]:
+            ax.plot(s, p, marker, ms=3 if marker == "o" else 4, color=colour, label=label)
+        for (form, prof), c in zip(pn["ts"].items(), ("#D55E00", "#009E73")):
+            ax.plot(*prof, "-", color=c, lw=1.2, label=f"tactileskin {form}")
+        ax.set(title=pn["title"], xlabel="s along the bone (mm)", ylabel="bone pressure P (MPa)", xlim=pn["xlim"])
         ax.title.set_fontsize(8)
         ax.legend(fontsize=7)
     fig.tight_layout()
     with fileio.atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
     plt.close(fig)
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    plot_panels([{"title": f"{r['scene']} {r['mesh']}, {r['penalty_factor']:g} K0/h", "xlim": (0, 8),
+                  "ccx": [(*r["profile_ccx"], "CalculiX (nodal)", "o", "#0072B2")],
+                  "ts": {form: t["profile"] for form, t in r["ts"].items()}} for r in rows], path)
 
 
 def main(argv=None) -> int:

@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from calculix_compare import read_dat_totals, read_frd_last  # noqa: E402
+from calculix_compare import plot_panels, read_dat_totals, read_frd_last  # noqa: E402
 
 from tactileskin import fileio  # noqa: E402
 from tactileskin.fe.recovery import PointFit  # noqa: E402
@@ -334,33 +334,20 @@ def markdown(rows: list[dict], cmd: str, refs: list[dict] = ()) -> str:
 
 
 def plot(rows: list[dict], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     stiffest = {}
     for r in rows:  # one panel per case and mesh: its stiffest penalty
         k = (r["scene"], r["mesh"])
         if k not in stiffest or r["penalty_factor"] > stiffest[k]["penalty_factor"]:
             stiffest[k] = r
-    rows = list(stiffest.values())
-    fig, axes = plt.subplots(1, len(rows), figsize=(4.2 * len(rows), 3.4), squeeze=False)
-    for ax, r in zip(axes[0], rows):
-        s, p = r["ccx"]["profile"]
-        ax.plot(s, p, "o", ms=3, color="#0072B2", label="CalculiX (nodal, extrapolated)")
+    panels = []
+    for r in stiffest.values():
+        ccx = [(*r["ccx"]["profile"], "CalculiX (nodal, extrapolated)", "o", "#0072B2")]
         if "pointfit_profile" in r["ccx"]:
-            ax.plot(*r["ccx"]["pointfit_profile"], "x", ms=4, color="#56B4E9", label="CalculiX via PointFit")
-        for (form, t), col in zip(r["ts"].items(), ("#D55E00", "#009E73")):
-            ax.plot(*t["profile"], "-", color=col, lw=1.2, label=f"tactileskin {form}")
-        ax.set(title=f"{r['scene']} {r['mesh']}, {r['penalty_factor']:g} K0/h", xlabel="s along the bone (mm)",
-               ylabel="bone pressure P (MPa)", xlim=(0, 4 if "flat" in r["scene"] else 2))
-        ax.title.set_fontsize(8)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    with fileio.atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+            ccx.append((*r["ccx"]["pointfit_profile"], "CalculiX via PointFit", "x", "#56B4E9"))
+        panels.append({"title": f"{r['scene']} {r['mesh']}, {r['penalty_factor']:g} K0/h",
+                       "xlim": (0, 4 if "flat" in r["scene"] else 2), "ccx": ccx,
+                       "ts": {form: t["profile"] for form, t in r["ts"].items()}})
+    plot_panels(panels, path)
 
 
 def main(argv=None) -> int:
