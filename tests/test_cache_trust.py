@@ -329,6 +329,28 @@ def test_sources_edited_after_import_are_neither_keyed_nor_stored_as_the_new_cod
     assert fresh["worker"] == "failed" and "differ from the sweep's" in fresh["worker_error"]
 
 
+def test_reloading_the_package_keeps_the_sources_it_imported(tmp_path):
+    """importlib.reload(tactileskin) (to pick up a `git pull`) re-ran the package's snapshot of
+    its sources: the edited results.py read as imported while the module already loaded still
+    ran the old code, so the old code's result was stored under the new code's key, which every
+    fresh process (the new code) reuses. The snapshot stays the first import's."""
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    cache = tmp_path / "cache"
+    code = _SESSION.replace("# the pull\n", "# the pull\nimport importlib, tactileskin; importlib.reload(tactileskin)\n")
+    assert code != _SESSION
+    session, log_text = _run_python(pkg, code, cache)
+    assert session["key"] == cache_key(Scene(**COARSE))                  # the code it runs: the old
+    assert session["status"] == ["failed", "failed"] and "restart" in session["error"]
+    assert "results.py" in log_text
+    assert not [p for p in cache.iterdir() if p.is_dir()]                # nothing stored
+
+
 _CLI_PULL_MID_RUN = """
 import sys
 import numpy as np

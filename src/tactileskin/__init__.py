@@ -36,8 +36,11 @@ def _source_hashes() -> dict:
 
 
 # the sources as this process imports them (3-8 ms), before any other module of the package: a
-# `git pull` in a running kernel leaves the old code running, and cache.code_changes() sees it
-_IMPORTED_SOURCES = _source_hashes()
+# `git pull` in a running kernel leaves the old code running, and cache.code_changes() sees it.
+# Kept by importlib.reload(tactileskin): it re-runs this file alone, the loaded modules keep
+# running, so a new snapshot would take the pulled files for the code that runs
+if "_IMPORTED_SOURCES" not in globals():
+    _IMPORTED_SOURCES = _source_hashes()
 
 from tactileskin.errors import (  # noqa: F401  (re-exported API)
     CadError,

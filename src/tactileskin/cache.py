@@ -16,7 +16,7 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused; a .pyc Python runs instead of its edited source
   (same size and time stamp, or an unchecked-hash .pyc, PEP 552) adds its code (`_stale_bytecode`). The .py files are hashed as this
-  process imported them (`tactileskin._IMPORTED_SOURCES`), not as they are on disk at key time.
+  process first imported them (`tactileskin._IMPORTED_SOURCES`, kept by importlib.reload), not as they are on disk at key time.
 While the package's .py files on disk differ from those it imported (a `git pull` in a running
 notebook kernel: the old code runs, or old and new mixed as modules load), the process neither
 stores nor reuses entries and its cases fail (`code_changes`: a WARNING names the files and says
