@@ -292,3 +292,49 @@ def test_threaded_solid_loop_has_the_serial_bits():
     for a, b in zip(one, two):
         assert np.array_equal(a, b)
     assert np.array_equal(s_only[0], one[0]) and np.array_equal(s_only[2], one[2])
+
+
+_CAPS_PROBE = """
+import json
+import numpy as np
+from tactileskin.materials import get_material, hyperfoam as hf
+mat = get_material("silicone").law
+c = float(np.exp(25.0))   # |ln c| = 25: admissible under LOG_C_CAP = 30, not under 20
+ok2 = hf.pk2_tangent_plane(mat, np.diag([c, 1.0 / c])[None], tangent=False)[2][0]
+ok3 = hf.pk2_tangent(mat, np.diag([c, 1.0 / c, 1.0])[None])[2][0]
+print(json.dumps({"compiled": bool(ok2), "numpy": bool(ok3)}))
+"""
+
+
+def test_a_cap_edited_in_hyperfoam_py_is_not_run_by_a_stale_compiled_kernel(tmp_path):
+    """numba keys the kernels it caches in __pycache__ by the bytes of the file defining them:
+    the caps _hyperfoam_nb imported from hyperfoam.py were frozen into its cache, so after
+    LOG_C_CAP 30 -> 20 in hyperfoam.py the plane kernel still took |ln c| = 25 as admissible
+    (the 3x3 path did not), while the result cache's key named the edited code. The caps are
+    written in _hyperfoam_nb.py itself, and an edit of hyperfoam.py's alone is refused."""
+    import json
+    import os
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import tactileskin
+
+    pkg = tmp_path / "src"
+    shutil.copytree(Path(tactileskin.__file__).parent, pkg / "tactileskin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+
+    def probe():
+        return subprocess.run([sys.executable, "-c", _CAPS_PROBE], capture_output=True, text=True,
+                              env=dict(os.environ, PYTHONPATH=str(pkg)))
+
+    r = probe()   # compiles the kernels into the copy's __pycache__
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout) == {"compiled": True, "numpy": True}
+    src = pkg / "tactileskin" / "materials" / "hyperfoam.py"
+    text = src.read_text()
+    assert "\nLOG_C_CAP = 30.0 " in text
+    src.write_text(text.replace("\nLOG_C_CAP = 30.0 ", "\nLOG_C_CAP = 20.0 "))
+    r = probe()
+    assert r.returncode != 0 and "LOG_C_CAP" in r.stderr, r.stdout   # not the cached kernel's 30

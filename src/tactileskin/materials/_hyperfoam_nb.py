@@ -25,7 +25,18 @@ import math
 import numba
 import numpy as np
 
-from tactileskin.materials.hyperfoam import _CLIP, EXP_CAP, LOG_C_CAP
+from tactileskin.errors import TactileSkinError
+from tactileskin.materials import hyperfoam as _hf
+
+# hyperfoam's caps, written here: numba freezes a global into the kernels it caches in
+# __pycache__ and keys them by this file's bytes alone, so caps imported from hyperfoam.py kept
+# their old values there after an edit (the result cache's key named the edited code)
+EXP_CAP = 300.0
+LOG_C_CAP = 30.0
+_CLIP = EXP_CAP + 4.0 * LOG_C_CAP
+if (EXP_CAP, LOG_C_CAP, _CLIP) != (_hf.EXP_CAP, _hf.LOG_C_CAP, _hf._CLIP):
+    raise TactileSkinError(f"materials/_hyperfoam_nb.py has EXP_CAP = {EXP_CAP:g}, LOG_C_CAP = {LOG_C_CAP:g}, "
+                           f"hyperfoam.py {_hf.EXP_CAP:g}, {_hf.LOG_C_CAP:g}: write the same caps in both")
 
 __all__ = ["plane_kernel", "MODE_S", "MODE_D2", "MODE_D3"]
 
