@@ -172,6 +172,36 @@ def test_key_follows_the_code_that_computes(tmp_path, monkeypatch):
     assert cache_key(sc) == k
 
 
+def test_key_follows_the_gmsh_that_python_imports(tmp_path):
+    """A gmsh SDK's lib folder on PYTHONPATH (as its docs say to set up) shadows the pip gmsh:
+    its own gmsh.py and libgmsh mesh, while the key named the pip distribution's version, so
+    upgrading the SDK reused the old mesher's results. The key has the API version of the
+    gmsh.py that `import gmsh` loads (read from it: libgmsh is not loaded for a key)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import tactileskin
+
+    src = Path(tactileskin.__file__).parent.parent
+    code = ("from tactileskin.cache import cache_key; from tactileskin.scene import Scene; "
+            "import sys; print(cache_key(Scene())); assert 'gmsh' not in sys.modules")
+
+    def key(*path):
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(map(str, (*path, src))))
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+        assert r.returncode == 0, r.stderr
+        return r.stdout.split()[-1]
+
+    sdk = tmp_path / "gmsh-sdk" / "lib"
+    sdk.mkdir(parents=True)
+    (sdk / "gmsh.py").write_text('GMSH_API_VERSION = "4.11.1"\n')
+    old = key(sdk)
+    (sdk / "gmsh.py").write_text('GMSH_API_VERSION = "4.13.0"\n')      # the SDK upgraded
+    assert key(sdk) != old
+    assert key() not in (old, key(sdk))                                 # the pip gmsh, unshadowed
+
+
 def test_stale_bytecode_is_keyed_as_the_code_it_runs(tmp_path, caplog):
     """Python takes a .pyc while it names its source's mtime (whole seconds) and size: a same-size
     edit with the time stamp set back (touch -d, cp -p) or within the second the .pyc was compiled

@@ -13,7 +13,8 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's
   own source and data files (but the shipped molds.toml) and the versions of the libraries that mesh and solve (gmsh,
-  scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP), so a result computed by other code (an update of
+  scikit-fem, numpy, scipy, numba, mkl, meshio, trimesh, build123d, OCP; and the API version of the gmsh.py Python
+  imports, which a gmsh SDK on PYTHONPATH provides), so a result computed by other code (an update of
   tactileskin, a changed mesher) is never reused; a .pyc Python runs instead of its edited source
   (same size and time stamp, or an unchecked-hash .pyc, PEP 552) adds its code (`_stale_bytecode`). The .py files are hashed as this
   process first imported them (`tactileskin._IMPORTED_SOURCES`, kept by importlib.reload), not as they are on disk at key time.
@@ -143,7 +144,24 @@ def code_digest(root: Path | None = None) -> str:
         except metadata.PackageNotFoundError:
             v = "-"
         h.update(f"{name}={v}\0".encode())
+    h.update(f"gmsh module={_gmsh_api_version()}\0".encode())
     return h.hexdigest()
+
+
+def _gmsh_api_version() -> str:
+    """GMSH_API_VERSION of the gmsh.py `import gmsh` loads, read from its source (a key does not
+    load libgmsh): a gmsh SDK's lib folder on PYTHONPATH shadows the pip gmsh with its own
+    gmsh.py and libgmsh, which the pip distribution's version does not name. "-" if none."""
+    import importlib.util
+    import re
+
+    try:
+        origin = importlib.util.find_spec("gmsh").origin
+        text = Path(origin).read_text(encoding="utf-8", errors="replace")
+    except (ImportError, AttributeError, TypeError, ValueError, OSError):
+        return "-"
+    found = re.search(r'^GMSH_API_VERSION\s*=\s*"([^"]*)"', text, re.M)
+    return found.group(1) if found else "-"
 
 
 _WARNED_CHANGES: set[tuple[str, ...]] = set()
