@@ -403,3 +403,25 @@ def test_rows_centre_on_a_flat_top_flags_the_noise_of_its_many_samples():
             said = [w for w in fp.warnings if "pixel noise" in w]
             assert len(said) == int(flagged) and len(fp.warnings) == int(flagged), fp.warnings
             assert not flagged or "--box-px" in said[0]
+
+
+@pytest.mark.parametrize("ppm", [PPM, 300 / 25.4])
+def test_rows_centre_on_a_uniform_strip_reads_its_middle_row(ppm):
+    """A uniform strip's rows read alike: their largest mean picked the first of them, the strip's edge row,
+    whose neighbour on the scan is white film, and its 'pixel noise' against that neighbour (the step to
+    white) was flagged: exit 3 on a noise-free scan. The row through the peak of the row means is a flat
+    top's middle row; a noisy strip's too (within a quarter of the strip of its middle)."""
+    for peak in (0.1, 0.5, 0.9):
+        img = render_scan(gaussian_profile(peak, 1.0), paper_eq8(), width_mm=5.0, px_per_mm=ppm,
+                          background_gs=245.0)
+        auto = analyze_scan(img, px_per_mm=ppm)
+        fp = analyze_scan(img, px_per_mm=ppm, rows="centre")
+        y0, y1 = auto.box_px[1], auto.box_px[3]
+        assert abs(fp.box_px[1] - 0.5 * (y0 + y1 - 1)) <= 0.5, (peak, auto.box_px, fp.box_px)
+        assert fp.warnings == [] and fp.metrics["peak"] == pytest.approx(auto.metrics["peak"], abs=1e-12)
+    for seed in range(3):
+        img = render_scan(gaussian_profile(0.5, 1.0), paper_eq8(), width_mm=5.0, px_per_mm=ppm, noise_gs=1.0,
+                          blur_px=1.0, background_gs=245.0, seed=seed)
+        y0, y1 = analyze_scan(img, px_per_mm=ppm).box_px[1::2]
+        row = analyze_scan(img, px_per_mm=ppm, rows="centre").box_px[1]
+        assert abs(row - 0.5 * (y0 + y1 - 1)) <= 0.25 * (y1 - y0), (seed, y0, y1, row)

@@ -503,8 +503,8 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     neither: the activated strip is found automatically (``film.region``; refused if
     ambiguous). centre: "peak", "midspan" or a number (origin in mm from the image's left
     edge for axis "x", top edge for "y", inside the image). rows: "all" (the profile is the
-    mean across the region's rows) or "centre" (the one row through the peak, the largest
-    mean pressure: a round press's centre line; one row's noise is not averaged down).
+    mean across the region's rows) or "centre" (the one row through the peak of the rows' mean
+    pressures, a flat top's middle row: a round press's centre line; one row's noise is not averaged down).
     """
     cal = calibration or paper_eq8()
     lo_s, hi_s = PX_PER_MM_RANGE
@@ -565,8 +565,10 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     full = pmap  # the strip's orientation and an inverted scan are judged on all its rows
     if rows == "centre":
         # a round press read across its rows averages its fall-off (a Hertzian spot's mean 9 % below its
-        # centre line): the row with the largest mean pressure is the section through the peak
-        k = int(np.argmax(pmap.mean(axis=1)))
+        # centre line): the row through the peak of the row means, found as the peak along the strip is
+        # (a parabola over the rows >= 80 % of the largest; a flat top's middle). Their largest alone picked
+        # the first of a uniform strip's equal rows, its edge, whose neighbour is white film (exit 3)
+        k = int(np.rint(_peak_position(np.arange(pmap.shape[0], dtype=float), pmap.mean(axis=1))))
         oriented, r = (gray, y0 + k) if axis == "x" else (gray.T, x0 + k)  # its row in the image
         c_lo, c_hi = (x0, x1) if axis == "x" else (y0, y1)
         # the rows beside it on the image (the region found may be a row or two)
