@@ -470,3 +470,25 @@ def test_the_sweep_report_names_sensors_csv_when_cases_have_sensors(tmp_path):
                    status="ok", **summary)
         texts.append(build_report([row], [rec], [], [], [], 1.0))
     assert "`sensors.csv` (one row per case and sensor" in texts[0] and "sensors.csv" not in texts[1]
+
+
+def test_sensors_csv_gives_each_sensors_plane_normal(tmp_path):
+    """sensors.csv had no normal: the frame the stresses are resolved in (the sensor plane's
+    unit normal, 55 degrees off +y at s = 5 on the t = 3 fingertip) could not be seen. nx, ny,
+    nz are appended after the twelve columns it had, and a file of those twelve still reads."""
+    sc = Scene(**COARSE, sensors=[{"name": "a", "kind": "points", "s": [0.0, -5.0, 5.0], "depth": 1.0}])
+    st = sensors.sites_for(sc)
+    assert st.normal[2, 0] > 0.8  # a normal well off +y (0.817)
+    rd = sensors.readings_from_stress(st, np.tile(-0.1 * np.eye(3), (3, 1, 1)))
+    text = rd.to_csv()
+    head = text.splitlines()[0].split(",")
+    assert head == list(sensors.OLD_COLUMNS) + ["nx", "ny", "nz"]
+    assert text.splitlines()[1].endswith(",0,1,0")  # s = 0: +y, no "-0"
+    (tmp_path / "sensors.csv").write_text(text)
+    back = sensors.read_sensors_csv(tmp_path / "sensors.csv")
+    assert np.allclose(back.normal, st.normal, rtol=0, atol=1e-9)
+    assert np.allclose(np.linalg.norm(back.normal, axis=1), 1.0, rtol=0, atol=1e-9)
+    old = "\n".join(",".join(r.split(",")[:12]) for r in text.splitlines()) + "\n"
+    (tmp_path / "old.csv").write_text(old)
+    back = sensors.read_sensors_csv(tmp_path / "old.csv")
+    assert np.allclose(back.pressure, 0.1) and np.isnan(back.normal).all()

@@ -584,8 +584,11 @@ def readings_from_stress(sites: Sites, sig: np.ndarray) -> "SensorReadings":
         taxel_points=(sites.weights > 0).sum(axis=1))
 
 
-COLUMNS = ("sensor_id", "layout", "x_mm", "y_mm", "z_mm", "s_mm", "depth_mm", "pressure_mpa",
-           "sigma_nn_mpa", "tau_1_mpa", "tau_2_mpa", "taxel_points")
+# nx, ny, nz (the sensor plane's unit normal, the frame the stresses are resolved in) are
+# appended: a reader of the first twelve columns reads them as before
+OLD_COLUMNS = ("sensor_id", "layout", "x_mm", "y_mm", "z_mm", "s_mm", "depth_mm", "pressure_mpa",
+               "sigma_nn_mpa", "tau_1_mpa", "tau_2_mpa", "taxel_points")
+COLUMNS = OLD_COLUMNS + ("nx", "ny", "nz")
 
 
 @dataclass
@@ -641,13 +644,14 @@ class SensorReadings:
             vals = (x, y, z, self.s[i], self.depth[i], self.pressure[i], self.sigma_nn[i], self.tau_1[i],
                     self.tau_2[i])
             buf.write(",".join([self.ids[i], self.layout[i], *(f"{v:.10g}" for v in vals),
-                                str(int(self.taxel_points[i]))]) + "\n")
+                                str(int(self.taxel_points[i])),
+                                *(f"{v + 0.0:.10g}" for v in self.normal[i])]) + "\n")  # + 0.0: no "-0"
         return buf.getvalue()
 
 
 def read_sensors_csv(path) -> SensorReadings:
-    """The SensorReadings of a sensors.csv (as Result.write writes it); a file that is not one
-    raises ParameterError naming it."""
+    """The SensorReadings of a sensors.csv (as Result.write writes it; one written before the
+    normal columns reads NaN normals); a file that is not one raises ParameterError naming it."""
     import csv
     from pathlib import Path
 
@@ -656,12 +660,14 @@ def read_sensors_csv(path) -> SensorReadings:
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             rows = list(csv.DictReader(fh))
-        if not rows or tuple(rows[0].keys()) != COLUMNS:
+        if not rows or tuple(rows[0].keys()) not in (COLUMNS, OLD_COLUMNS):
             raise ValueError("unexpected header")
-        f = {c: np.array([float(r[c]) for r in rows]) for c in COLUMNS[2:]}
+        cols = tuple(rows[0].keys())
+        f = {c: np.array([float(r[c]) for r in rows]) for c in cols[2:]}
     except (OSError, ValueError, KeyError, TypeError) as e:
         raise ParameterError("sensors file", str(path), valid, hint=str(e)) from None
     xyz = np.column_stack([f["x_mm"], f["y_mm"], f["z_mm"]])
     return SensorReadings([r["sensor_id"] for r in rows], [r["layout"] for r in rows], xyz, f["s_mm"],
-                          f["depth_mm"], np.full((len(rows), 3), np.nan), f["pressure_mpa"],
+                          f["depth_mm"], (np.column_stack([f["nx"], f["ny"], f["nz"]]) if "nx" in f
+                                          else np.full((len(rows), 3), np.nan)), f["pressure_mpa"],
                           f["sigma_nn_mpa"], f["tau_1_mpa"], f["tau_2_mpa"], f["taxel_points"].astype(int))
