@@ -422,3 +422,53 @@ def test_a_line_inside_a_curved_rim_reads_the_top_and_the_bonded_face_not_the_wa
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
     assert "sensor layout 'out'" in err and "no skin under it" in err and not (tmp_path / "o").exists()
+
+
+def _disc(tmp_path):
+    """A disc (R 5, 2 mm thick, y in [-2, 0], bonded on its bottom) as STEP."""
+    import build123d as bd
+
+    path = tmp_path / "disc.step"
+    bd.export_step(bd.Cylinder(5.0, 2.0, rotation=(90, 0, 0), align=(bd.Align.CENTER, bd.Align.CENTER,
+                                                                      bd.Align.MIN)), str(path))
+    return path
+
+
+def test_a_coarse_p1_solve_places_the_rim_sensors_the_scene_held(tmp_path):
+    """On a P1 solve mesh (h = 2) of the disc the rim's straight wall chords lean: at r = 4.95 a
+    vertical line crossed them under the top face, and a depth-0.2 sensor the scene placed at y =
+    -0.2 (the CAD's) was put up to 0.48 mm deeper (128 of 181 such lines; 4 of these 7, 0.37 mm);
+    at r = 4.98 a line crossed no face at all and the sensor the scene held was refused ("no skin
+    under it"). The walls' chords are no top now, and a sensor past the mesh's rim moves onto it
+    (0.036-0.065 mm here, at most a quarter of the rim's edge): each reads 0.2 under the top, near
+    where it was put."""
+    path = _disc(tmp_path)
+    ang = np.linspace(0.0, 0.5 * np.pi, 7)
+    lays = [{"name": f"r{k}", "kind": "points", "s": (r * np.cos(ang)).tolist(), "z": (r * np.sin(ang)).tolist(),
+             "depth": 0.2} for k, r in enumerate((4.95, 4.98))]
+    sc = Scene(skin="file", skin_file=str(path), indenter="flat", order=1, formulation="displacement",
+               mesh_size=2.0, refinement=1.0, sensors=lays)
+    held = sensors.sites_for(sc)  # the scene's check on the CAD
+    assert np.allclose(held.xyz[:, 1], -0.2, rtol=0, atol=1e-9)
+    st = sensors.sites_for(sc, coords=sc.skin_kind.mesh_coordinates(sc, build_mesh(sc)))
+    assert np.allclose(st.xyz[:, 1], -0.2, rtol=0, atol=1e-9)
+    assert np.allclose(st.normal, [0.0, 1.0, 0.0], rtol=0, atol=1e-9)
+    moved = np.hypot(*(st.xyz - held.xyz)[:, [0, 2]].T)
+    assert 0.0 < moved.max() < 0.1  # the rim's sagitta on these 2 mm chords is 0.1 mm
+
+
+def test_a_sensor_just_past_the_meshed_rim_is_refused_with_the_remedy(tmp_path, capsys):
+    """The scene reads a STEP's heights on the CAD faces its analysis mesh's chords find: a line
+    at r = 4.999 of the disc's R 5 crosses none of them (it ends 0.01 mm inside the rim there) and
+    was refused as "no skin under it", nothing said of how far the skin is. The one line now
+    says where the nearest skin is and how far."""
+    from tactileskin.cli import main
+
+    (tmp_path / "s.toml").write_text(f'[[sensors]]\nname = "rim"\ns = [{4.999 * np.cos(0.3)}]\n'
+                                     f'z = [{4.999 * np.sin(0.3)}]\ndepth = 0.2\n')
+    rc = main(["solve", "--skin-file", str(_disc(tmp_path)), "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
+               "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "no skin under it; the nearest skin is 0.00" in err and "mm away (at s = 4.76" in err, err
+    assert "move the sensor in by that" in err and not (tmp_path / "o").exists()

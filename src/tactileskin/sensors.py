@@ -441,7 +441,8 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
     if dim == 2:
         z = np.zeros_like(z)
     xy, n2, t2d, _ = coords.frame(s, depth, z) if local else coords.frame(s, depth)
-    xyz = np.column_stack([xy, z])
+    # a file skin's 3D frame gives z too: the solve may move a rim sensor onto its mesh
+    xyz = xy if xy.shape[1] == 3 else np.column_stack([xy, z])
     # a section's frame lies in the x-y plane; a file skin's 3D one follows its surface out of it
     normal = n2 if n2.shape[1] == 3 else np.column_stack([n2, np.zeros(len(s))])
     t1 = t2d if t2d.shape[1] == 3 else np.column_stack([t2d, np.zeros(len(s))])
@@ -477,7 +478,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
             pq = coords.frame(ss, dq, zz, normals=False)[0]
         else:
             pq, _, _, _ = coords.frame(ss, np.repeat(depth[rows], k))
-        samples[rows, :k] = np.column_stack([pq, zz]).reshape(cnt, k, 3)
+        samples[rows, :k] = (pq if pq.shape[1] == 3 else np.column_stack([pq, zz])).reshape(cnt, k, 3)
         weights[rows, :k] = np.broadcast_to(wq / wq.sum(), (cnt, k))
         weights[rows, k:] = 0.0
     return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim)

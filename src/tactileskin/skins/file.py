@@ -76,6 +76,11 @@ OUTER, BONDED = 1, 2  # FileGeometry.facet_kind
 # a STEP analysis mesh's facet within ~6 degrees of vertical is a wall (the disc's wall chords
 # inside its R 5 rim: |n_y| 0.024-0.032); crossed where the line misses its CAD face it is the mesh's
 WALL_NY = 0.1
+# a sensor the scene held at a curved rim can lie past the solved mesh's rim, whose straight
+# chords cut inside the edge (a disc R 5, P1 h = 2: 69 of the 178 lines at r = 4.98 the scene
+# held crossed no face): the solve moves it onto the nearest point over the mesh's contact
+# surface, at most RIM_SHIFT of that edge's length (a chord's sagitta is L / (8 R) of its length L)
+RIM_SHIFT = 0.25
 # the bonded surfaces held fixed: the fingertip's nail and the dome's bone under its tip, as
 # `tactileskin mesh` writes them, where the file has them
 FIXED = ("bone_interface", "nail_edge", "bone_tip")
@@ -358,7 +363,8 @@ class FileCoordinates:
     the bone, and the solve failed reading it); a STEP's on its CAD faces (`cad`: the file; its
     P1 analysis mesh's chords find the faces) for the scene's check, and on the mesh solved for
     the readings (mesh_coordinates), whose `reference` (the scene's coordinates) decides which
-    sensors are in the skin: the solve accepts what the scene accepted. A half model
+    sensors are in the skin: the solve accepts what the scene accepted (one past its mesh's rim
+    moves onto it: `placed`). A half model
     (`symmetry`, `symmetry_z`) answers for its mirror image by reflection, as the solver's
     sampler does."""
 
@@ -389,6 +395,14 @@ class FileCoordinates:
         # a vertical facet (a side, a symmetry plane) holds no height of its own: its edges
         # are its neighbours' (a sensor on a side's line reads the top and bottom facets)
         keep = area > 1e-9 * size ** (geo.dim - 1)
+        if reference is not None and geo.dim == 3:
+            # the solved mesh's walls too (|n_y| < WALL_NY): a vertical line crosses their chords
+            # where they lean, not where the skin's surface is (the disc R 5 on a P1 h = 2 mesh:
+            # at r = 4.95, 128 of 181 lines took a wall chord for the top, and their depth-0.2
+            # sensors went up to 0.48 mm deeper than the CAD's); the reference decides
+            P = F[:, :3, :]
+            nrm = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+            keep &= np.abs(nrm[:, 1]) >= WALL_NY * np.linalg.norm(nrm, axis=1)
         self._L, self._y, self._kind = L[keep], F[keep][:, :, 1], np.asarray(geo.facet_kind)[keep]
         self._face = None if cad is None or geo.facet_face is None else np.asarray(geo.facet_face)[keep]
         self._curved = F.shape[1] > geo.dim
@@ -463,6 +477,72 @@ class FileCoordinates:
         nan = lambda v: np.where(np.isfinite(v), v, np.nan)  # noqa: E731
         return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
                 "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
+
+    def _query(self, s, z):
+        """The points (m, k) the columns are read at: x (and z), mirrored on a half model."""
+        x = self.x_top + np.atleast_1d(np.asarray(s, float))
+        if self.geo.symmetric:
+            x = np.abs(x)
+        if self.dim == 2:
+            return x[:, None]
+        z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), x.shape)
+        return np.column_stack([x, np.abs(z) if self.geo.z_symmetric else z])
+
+    def nearest_skin(self, s, z=None) -> tuple:
+        """(s, z, distance, edge length): the nearest point over the contact surface's facets
+        seen from above to each (s, z) (nudged just inside its facet; the same sides of the
+        mirror planes), its distance and the length of the facet edge it lies on (0 where the
+        point is over a facet already)."""
+        q = self._query(s, z)
+        m, k = q.shape
+        out = self._L[self._kind == OUTER][:, :self.dim]  # the vertices: the chords of the rim
+        if not len(out):
+            return np.array(s, float), z, np.full(m, np.inf), np.zeros(m)
+        a = out if k == 1 else out[:, [0, 1, 2]]
+        b = out[:, ::-1] if k == 1 else out[:, [1, 2, 0]]
+        cen = np.repeat(out.mean(axis=1), a.shape[1], axis=0)
+        a, b = a.reshape(-1, k), b.reshape(-1, k)
+        best, size, dist = np.empty((m, k)), np.empty(m), np.empty(m)
+        for c in range(0, m, 64):  # bounded memory: 64 points x every edge
+            p = q[c:c + 64, None, :]
+            ab = b - a
+            u = np.clip(np.sum((p - a) * ab, axis=2) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0.0, 1.0)
+            foot = a + u[..., None] * ab
+            d = np.linalg.norm(foot - p, axis=2)
+            j = np.argmin(d, axis=1)
+            r = np.arange(len(j))
+            # a hair towards the facet's centre, so the vertical line crosses it (tolerance 1e-9)
+            best[c:c + 64] = foot[r, j] + 1e-6 * (cen[j] - foot[r, j])
+            dist[c:c + 64], size[c:c + 64] = d[r, j], np.linalg.norm(ab[j], axis=1)
+        inside = np.isfinite(self.column(s, z)["top"])
+        best[inside], dist[inside], size[inside] = q[inside], 0.0, 0.0
+        x = np.atleast_1d(np.asarray(s, float)) + self.x_top
+        zz = np.broadcast_to(np.asarray(0.0 if z is None else z, float), x.shape)
+        nx = np.where(x < 0, -1.0, 1.0) * best[:, 0] if self.geo.symmetric else best[:, 0]
+        nz = None if k == 1 else (np.where(zz < 0, -1.0, 1.0) * best[:, 1] if self.geo.z_symmetric else best[:, 1])
+        return nx - self.x_top, nz, dist, size
+
+    def placed(self, s, z=None) -> tuple:
+        """(s, z) where this mesh reads each sensor: as given, but with a `reference` (the solved
+        mesh's coordinates) a point the reference held past this mesh's rim moves onto the
+        nearest point over its contact surface, at most RIM_SHIFT of that rim's edge (beyond that
+        depths() refuses it, naming the remedy), and the distance moved (0 where none)."""
+        s = np.atleast_1d(np.asarray(s, float))
+        z = None if self.dim == 2 else np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape)
+        moved = np.zeros(len(s))
+        if self.reference is None:
+            return s, z, moved
+        miss = ~np.isfinite(self.column(s, z)["top"])
+        if not miss.any():
+            return s, z, moved
+        ns, nz, d, size = self.nearest_skin(s[miss], None if z is None else z[miss])
+        ok = d <= RIM_SHIFT * size
+        s, i = s.copy(), np.flatnonzero(miss)[ok]
+        s[i], moved[i] = ns[ok], d[ok]
+        if z is not None:
+            z = z.copy()
+            z[i] = nz[ok]
+        return s, z, moved
 
     def _on_cad(self, q, pt, f, y, near) -> tuple:
         """(pt, f, y): the crossings y of the lines through the points q[pt] and the chords f read
@@ -569,6 +649,11 @@ class FileCoordinates:
             # the CAD (on a sphere cap R 6 at h = 1 up to 5.4e-4 mm P2, 0.040 mm P1) and a sensor
             # the scene held within that of a face was refused after meshing
             self.reference.depths(where, lay, s, z, idx, what)
+            s, zq, moved = self.placed(s, z)
+            z = z if zq is None else zq
+            if moved.max(initial=0.0) > 0.0:
+                logger.info("sensor layout %r: %d point(s) past the solved mesh's rim moved up to %.3g mm onto "
+                            "it", lay.name, int(np.sum(moved > 0)), float(moved.max()))
         col = self.column(s, z if self.dim == 3 else None)
         t = col["top"] - col["floor"]
 
@@ -589,7 +674,7 @@ class FileCoordinates:
             z_text = f", z in [{self.z_range[0]:.6g}, {self.z_range[1]:.6g}]" if self.dim == 3 else ""
             raise ParameterError(f"{where} {where_s}{what}", value,
                                  f"over the skin (it spans s in [{self.s_range[0]:.6g}, {self.s_range[1]:.6g}]"
-                                 f"{z_text} mm)", f"{sensor(i)}: no skin under it")
+                                 f"{z_text} mm)", f"{sensor(i)}: no skin under it" + self._remedy(s[i], z[i]))
         up = col["outer"] >= col["top"] - self.tol
         if not up.all():
             i = first(~up)
@@ -621,6 +706,20 @@ class FileCoordinates:
                                  "over its bonded surface there)", sensor(i))
         return t - h
 
+    def _remedy(self, s, z) -> str:
+        """What to do about a point over no skin: move it to the nearest skin, which a mesh's
+        straight chords put inside a curved rim (a STEP's analysis mesh, a solved P1 mesh)."""
+        if not hasattr(self, "_L"):  # analytic surfaces (skins.dome.DomeCoordinates)
+            return ""
+        ns, nz, d, _ = self.nearest_skin([s], None if self.dim == 2 else [z])
+        if not np.isfinite(d[0]) or d[0] <= 0.0:
+            return ""
+        at = f"s = {ns[0]:.6g}" + (f", z = {nz[0]:.6g}" if self.dim == 3 else "")
+        if self.reference is None:  # the scene's mesh (a STEP's analysis mesh: size / 8, fixed)
+            return f"; the nearest skin is {d[0]:.3g} mm away (at {at} mm): move the sensor in by that"
+        return (f"; the solved mesh's nearest skin is {d[0]:.3g} mm away (at {at} mm), its rim's chords inside "
+                "the skin's: a finer mesh_size or order 2, or the sensor that much further in")
+
     def _clamped(self, lay, d, t) -> np.ndarray:
         """The depths d (the reference's check held them) moved into this mesh's columns [0, t]:
         at most as far as its faces lie off the reference's there."""
@@ -633,9 +732,9 @@ class FileCoordinates:
         return out
 
     def frame(self, s, depth, z=None, normals: bool = True):
-        """(xy (n, 2), the contact surface's outward unit normal at (s, z) (n, 2; in 3D (n, 3)),
-        t1 along that surface in the x-y plane (n, 2 / 3), area element 1) at depth below the
-        contact surface over (s, z). A sensor stands on the vertical line but lies parallel to
+        """(xy (n, 2; in 3D xyz (n, 3): z as placed), the contact surface's outward unit normal
+        at (s, z) (n, 2; in 3D (n, 3)), t1 along that surface in the x-y plane (n, 2 / 3), area
+        element 1) at depth below the contact surface over (s, z). A sensor stands on the vertical line but lies parallel to
         the surface over it (a depth layout's surface is that one moved down, with its normal), as
         a chip embedded under a slope does: its plane had normal +y everywhere, and 0.5 mm under
         20-45 degree slopes of a half tube (R 8, t 2) and of the dome, beside a flat plate's
@@ -644,9 +743,10 @@ class FileCoordinates:
         normals), for taxel samples."""
         s = np.atleast_1d(np.asarray(s, float))
         depth = np.broadcast_to(np.asarray(depth, float), s.shape)
+        s, z, _ = self.placed(s, z)  # the solved mesh's rim: as depths() placed them
         y = self.column(s, z)["top"] - depth
         n = len(s)
-        xy = np.column_stack([self.x_top + s, y])
+        xy = np.column_stack([self.x_top + s, y] + ([z] if self.dim == 3 else []))
         if not normals:
             return xy, np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.ones(n)
         nrm = self.surface_normal(s, z)
