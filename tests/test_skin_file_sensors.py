@@ -472,3 +472,23 @@ def test_a_sensor_just_past_the_meshed_rim_is_refused_with_the_remedy(tmp_path, 
     assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
     assert "no skin under it; the nearest skin is 0.00" in err and "mm away (at s = 4.76" in err, err
     assert "move the sensor in by that" in err and not (tmp_path / "o").exists()
+
+
+def test_sensors_csv_says_how_far_under_the_surface_a_vertical_depth_lies(tmp_path):
+    """A file skin's depth is vertical, the fingertip's along the surface normal: a depth-0.5
+    sensor under the half tube's 45 degree slope lies 0.354 mm from the surface along its normal,
+    and sensors.csv said only "depth_mm 0.5". Its last column, normal_depth_mm, is that distance
+    (depth * ny; under the tangent plane over the sensor, which the R 8 surface follows to 0.008
+    mm here), and on the fingertip it equals depth_mm."""
+    path = _half_tube(tmp_path / "tube.msh")
+    lay = {"name": "s", "kind": "points", "s": [0.0, 8.0 * np.sin(np.pi / 4)], "depth": 0.5}
+    st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=[lay]))
+    rd = sensors.readings_from_stress(st, np.zeros((2, 3, 3)))
+    rows = [r.split(",") for r in rd.to_csv().splitlines()]
+    assert rows[0][-1] == "normal_depth_mm" and rows[0][6] == "depth_mm"
+    assert [float(r[6]) for r in rows[1:]] == [0.5, 0.5]
+    assert np.allclose([float(r[-1]) for r in rows[1:]], [0.5, 0.5 * np.sqrt(0.5)], rtol=0, atol=1e-5)
+    # the sensor's distance from the R 8 surface along its normal: 0.354 - 0.008 (the curvature)
+    assert 8.0 - np.hypot(*st.xyz[1, :2]) == pytest.approx(0.346, abs=1e-3)
+    ft = Scene(skin="fingertip", thickness=3.0, sensors=[{"name": "f", "s": [0.0, 5.0], "depth": 1.0}])
+    assert np.array_equal(sensors.sites_for(ft).normal_depth, [1.0, 1.0])

@@ -12,7 +12,9 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
 A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top,
 its depth straight down from the contact surface at (x, z) and its height straight up from the
 bonded surface there, its plane along the contact surface over (x, z) (skins.file.FileCoordinates,
-the dome's too; its n has a z part where the surface slopes along z).
+the dome's too; its n has a z part where the surface slopes along z): vertical, not along n, so
+under a slope theta it lies depth cos theta under the surface along n (Sites.normal_depth,
+sensors.csv's normal_depth_mm).
 
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
@@ -360,6 +362,10 @@ class Sites:
     samples: np.ndarray
     weights: np.ndarray
     dim: int = 2
+    # the distance along the normal from the contact surface's tangent plane over the sensor:
+    # depth on the built-in skins, depth * n_y on a file skin or the dome (depth is vertical
+    # there); None: unknown (NaN in the readings)
+    normal_depth: np.ndarray | None = None
 
     @classmethod
     def at(cls, points, normals, ids=None, dim: int | None = None) -> "Sites":
@@ -481,7 +487,10 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         samples[rows, :k] = (pq if pq.shape[1] == 3 else np.column_stack([pq, zz])).reshape(cnt, k, 3)
         weights[rows, :k] = np.broadcast_to(wq / wq.sum(), (cnt, k))
         weights[rows, k:] = 0.0
-    return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim)
+    # a file skin's depth is vertical: the sensor lies depth * n_y under the tangent plane over it
+    # (0.71 mm for depth 1 under a 45 degree slope); a section's lies along the normal
+    normal_depth = depth * normal[:, 1] if local else depth.copy()
+    return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim, normal_depth)
 
 
 def taxel_s(coords, s_centre, depth: float, g, side: float, n: int = 17) -> np.ndarray:
@@ -579,17 +588,20 @@ def readings_from_stress(sites: Sites, sig: np.ndarray) -> "SensorReadings":
     return SensorReadings(
         ids=list(sites.ids), layout=list(sites.layout), xyz=sites.xyz.copy(), s=sites.s.copy(),
         depth=sites.depth.copy(), normal=n.copy(),
+        normal_depth=(np.full(len(n), np.nan) if sites.normal_depth is None else sites.normal_depth.copy()),
         pressure=-np.trace(sig, axis1=1, axis2=2) / 3.0,
         sigma_nn=np.einsum("ki,ki->k", n, tn), tau_1=np.einsum("ki,ki->k", sites.t1, tn),
         tau_2=np.einsum("ki,ki->k", sites.t2, tn),
         taxel_points=(sites.weights > 0).sum(axis=1))
 
 
-# nx, ny, nz (the sensor plane's unit normal, the frame the stresses are resolved in) are
-# appended: a reader of the first twelve columns reads them as before
+# appended (a reader of the first twelve columns reads them as before): nx, ny, nz, the sensor
+# plane's unit normal (the frame the stresses are resolved in), and normal_depth_mm, the sensor's
+# distance below the surface's tangent plane over it along that normal (= depth_mm where depth is
+# along the normal, depth * ny where it is vertical: a file skin, the dome)
 OLD_COLUMNS = ("sensor_id", "layout", "x_mm", "y_mm", "z_mm", "s_mm", "depth_mm", "pressure_mpa",
                "sigma_nn_mpa", "tau_1_mpa", "tau_2_mpa", "taxel_points")
-COLUMNS = OLD_COLUMNS + ("nx", "ny", "nz")
+COLUMNS = OLD_COLUMNS + ("nx", "ny", "nz", "normal_depth_mm")
 
 
 @dataclass
@@ -608,8 +620,11 @@ class SensorReadings:
     tau_1: np.ndarray
     tau_2: np.ndarray
     taxel_points: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
+    normal_depth: np.ndarray | None = None  # Sites.normal_depth (None: NaN)
 
     def __post_init__(self):
+        if self.normal_depth is None:
+            self.normal_depth = np.full(len(self.ids), np.nan)
         from tactileskin.errors import ConvergenceError
 
         for name in ("pressure", "sigma_nn", "tau_1", "tau_2"):
@@ -627,7 +642,7 @@ class SensorReadings:
         return SensorReadings(
             [i for i, k in zip(self.ids, keep) if k], [layout] * int(keep.sum()), self.xyz[keep],
             self.s[keep], self.depth[keep], self.normal[keep], self.pressure[keep], self.sigma_nn[keep],
-            self.tau_1[keep], self.tau_2[keep], np.asarray(self.taxel_points)[keep])
+            self.tau_1[keep], self.tau_2[keep], np.asarray(self.taxel_points)[keep], self.normal_depth[keep])
 
     def summary(self) -> dict:
         """Summary fields: sensor count, the largest sensor pressure, its sensor and position."""
@@ -646,13 +661,14 @@ class SensorReadings:
                     self.tau_2[i])
             buf.write(",".join([self.ids[i], self.layout[i], *(f"{v:.10g}" for v in vals),
                                 str(int(self.taxel_points[i])),
-                                *(f"{v + 0.0:.10g}" for v in self.normal[i])]) + "\n")  # + 0.0: no "-0"
+                                *(f"{v + 0.0:.10g}" for v in self.normal[i]),  # + 0.0: no "-0"
+                                f"{self.normal_depth[i]:.10g}"]) + "\n")
         return buf.getvalue()
 
 
 def read_sensors_csv(path) -> SensorReadings:
     """The SensorReadings of a sensors.csv (as Result.write writes it; one written before the
-    normal columns reads NaN normals); a file that is not one raises ParameterError naming it."""
+    normal columns reads NaN normals and normal depths); a file that is not one raises ParameterError naming it."""
     import csv
     from pathlib import Path
 
@@ -671,4 +687,5 @@ def read_sensors_csv(path) -> SensorReadings:
     return SensorReadings([r["sensor_id"] for r in rows], [r["layout"] for r in rows], xyz, f["s_mm"],
                           f["depth_mm"], (np.column_stack([f["nx"], f["ny"], f["nz"]]) if "nx" in f
                                           else np.full((len(rows), 3), np.nan)), f["pressure_mpa"],
-                          f["sigma_nn_mpa"], f["tau_1_mpa"], f["tau_2_mpa"], f["taxel_points"].astype(int))
+                          f["sigma_nn_mpa"], f["tau_1_mpa"], f["tau_2_mpa"], f["taxel_points"].astype(int),
+                          f.get("normal_depth_mm"))
