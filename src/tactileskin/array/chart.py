@@ -151,10 +151,14 @@ class ChartConfig:
     # finest level of benchmarks/results/convergence3d.md, 3 s CPU)
     sphere_radius: float = 2.5
     sphere_quality: str = "preview"
-    # where the taxels sit: None, the bonded surface (the paper's film on the bone, the solves'
+    # where the taxels sit: None (and sensor_height None), the bonded surface (the paper's film on the bone, the solves'
     # bone maps); else this depth (mm) below the contact surface, in the undeformed skin, the
     # maps read from each cached solve's result.vtu (map_of: no solve again)
     sensor_depth: float | None = None
+    # or this height (mm) above the bonded surface in every skin (a sensor sheet on a board with a
+    # fixed stand-off, the skin cast over it): read at the depth t - sensor_height (sensor_depth_at);
+    # not with sensor_depth
+    sensor_height: float | None = None
 
     def __post_init__(self):
         # every field's type and range before any solve: a config file's `pitches = "abc"` or
@@ -182,6 +186,16 @@ class ChartConfig:
                                              lo_open=True, hi_open=True,
                                              unit=f"mm below the contact surface (the thinnest skin is {thin:g} mm; "
                                                   "leave it out for the bonded surface)"))
+        if self.sensor_height is not None:  # the same skins from the bone's side
+            if self.sensor_depth is not None:
+                raise ParameterError("sensor_height (--sensor-height)", self.sensor_height,
+                                     "not with sensor_depth (--sensor-depth): the taxels sit either a depth below "
+                                     "the contact surface or a height above the bonded surface")
+            thin = min(self.thicknesses)
+            set_("sensor_height", check_range("sensor_height (--sensor-height)", self.sensor_height, 0.0, thin,
+                                              lo_open=True, hi_open=True,
+                                              unit=f"mm above the bonded surface (the thinnest skin is {thin:g} mm; "
+                                                   "leave it out for the bonded surface)"))
         for name, flag, choices in (("materials", "-m", None), ("sets", "--set", SETS)):
             set_(name, _names(getattr(self, name), f"{name} ({flag})", choices))
         set_("taxel_fraction", check_range("taxel_fraction (--taxel)", self.taxel_fraction, 0.0, 1.0,
@@ -296,6 +310,19 @@ class ChartConfig:
         if self.max_depth is None or Scene.depth_fraction * thickness <= self.max_depth:
             return None
         return float(self.max_depth)
+
+    def sensor_depth_at(self, thickness: float) -> float | None:
+        """The taxels' depth (mm) below the contact surface of the skin of this thickness: None
+        on the bonded surface (the bone maps), sensor_depth, or t - sensor_height."""
+        if self.sensor_height is not None:
+            return float(thickness) - self.sensor_height
+        return self.sensor_depth
+
+    def sensor_height_at(self, thickness: float) -> float:
+        """The taxels' height (mm) above the bonded surface of the skin of this thickness."""
+        if self.sensor_height is not None:
+            return self.sensor_height
+        return 0.0 if self.sensor_depth is None else float(thickness) - self.sensor_depth
 
     @property
     def noise_levels(self) -> tuple:
@@ -592,7 +619,8 @@ class Chart:
         stimulus, so an accuracy counts n_test / chance readings); `indicative` {(material,
         thickness): reason} marks the letters rows whose surrogate is not shown within the
         tolerance (status "indicative: reason"), as the report's daggers do."""
-        cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "sensor_depth_mm", "noise_fs", "noise_mpa",
+        cols = ["material", "thickness_mm", "set", "pitch_mm", "taxel_mm", "sensor_depth_mm", "sensor_height_mm",
+                "noise_fs", "noise_mpa",
                 "full_scale_mpa", "bits", "method", "accuracy", "chance", "n_test", "ci_low", "ci_high"]
         lines = [",".join(cols + ["status"])]
         for r in self.rows:
@@ -600,8 +628,9 @@ class Chart:
             bad = self.suspect.get((r["material"], r["thickness_mm"]))
             status = ('"suspect: ' + bad.replace('"', "'") + '"' if bad else f'"indicative: {why}"' if why else "ok")
             # older rows: no interval, taxels on the bonded surface (t below the contact surface)
-            vals = [r.get(c, "") if c in ("ci_low", "ci_high") else r.get(c, r["thickness_mm"])
-                    if c == "sensor_depth_mm" else r[c] for c in cols]
+            depth = r.get("sensor_depth_mm", r["thickness_mm"])
+            vals = [r.get(c, "") if c in ("ci_low", "ci_high") else depth if c == "sensor_depth_mm"
+                    else r.get(c, r["thickness_mm"] - depth) if c == "sensor_height_mm" else r[c] for c in cols]
             lines.append(",".join([*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in vals), status]))
         return "\n".join(lines) + "\n"
 
@@ -643,7 +672,7 @@ def surrogate_trust(cfg: ChartConfig, material: str, t: float, model: str, valid
     dot = dot_scene(t, material, cfg)
     return measured(material, cfg.skin, cfg.mesh_for(t), t, float(dot.indentation), validation,
                     model=model, extent=cfg.read_extent, taxel=cfg.min_taxel, standard=cfg.standard,
-                    sensor_depth=cfg.sensor_depth)
+                    sensor_depth=cfg.sensor_depth_at(t))
 
 
 def letters_judgment(cfg: ChartConfig, material: str, t: float, dot, blank, validation=None) -> dict | None:
@@ -743,7 +772,7 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
     for material in cfg.materials:
         for t in cfg.thicknesses:
             dot, pdot, blank, sec2, sphere = cases[(material, t)]
-            sd = cfg.sensor_depth  # None: the bone maps
+            sd = cfg.sensor_depth_at(t)  # None: the bone maps
             kernels = {x: map_of(recs[x], sd) for x in (dot, pdot) if x is not None}
             height = get_standard(cfg.standard).height
             base = None
@@ -805,8 +834,8 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                                                        ev.offset_accuracy.get(m))
                             chart.rows.append(dict(material=material, thickness_mm=float(t), set=set_,
                                                    pitch_mm=float(pitch), taxel_mm=float(spec.taxel),
-                                                   sensor_depth_mm=float(t if cfg.sensor_depth is None
-                                                                         else cfg.sensor_depth),
+                                                   sensor_depth_mm=float(t if sd is None else sd),
+                                                   sensor_height_mm=float(cfg.sensor_height_at(t)),
                                                    noise_fs=float(noise if cfg.noise_mpa is None else ro.sigma / fs),
                                                    noise_mpa=float(ro.sigma),
                                                    full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
@@ -849,6 +878,8 @@ def _off_paper_depth(cfg: ChartConfig, t: float) -> str:
     out = "" if d is None else f" (at the capped depth {d:g} mm, not the paper's {Scene.depth_fraction * t:g} mm)"
     if cfg.sensor_depth is not None:  # the paper's claims are about its film on the bone
         out += f" (sensors {cfg.sensor_depth:g} mm below the surface, not the paper's film on the bone)"
+    elif cfg.sensor_height is not None:
+        out += f" (sensors {cfg.sensor_height:g} mm above the bone, not the paper's film on it)"
     return out
 
 
@@ -994,12 +1025,13 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
         for x, sc in zip(texts, fulls):
             notes = shared + suspect_solves({sc: recs[sc]})
             solve_status[x] = "suspect: " + "; ".join(notes) if notes else "ok"
-        kernel = map_of(recs[dot], cfg.sensor_depth)
+        sd = cfg.sensor_depth_at(t)
+        kernel = map_of(recs[dot], sd)
         sec = dot.section()
-        refs = {x: raw_map_of(recs[sc], cfg.sensor_depth) for x, sc in zip(texts, fulls)}
+        refs = {x: raw_map_of(recs[sc], sd) for x, sc in zip(texts, fulls)}
         depth = float(dot.indentation)
         if blank is not None:
-            base = blank_map(blank, recs[blank], kernel, cfg.sensor_depth)
+            base = blank_map(blank, recs[blank], kernel, sd)
             pk = surrogate.plate_kernel(kernel, base)
             scale = surrogate.fit_scale(pk, refs, sec, cfg.standard, base=base)
             models = {"sum": (kernel, {}), "plate + sum": (pk, {"base": base}),
@@ -1020,6 +1052,7 @@ def validate_surrogate(thicknesses, material, texts, cfg: ChartConfig, cache, pr
                              "taxel_mm": float(cfg.min_taxel),
                              "reference_mesh": [float(v) for v in (reference_mesh or cfg.mesh_for(t))],
                              "solve_status": solve_status[x],
-                             **({} if cfg.sensor_depth is None else {"sensor_depth_mm": float(cfg.sensor_depth)}),
+                             **({} if sd is None else {"sensor_depth_mm": float(sd),
+                                                       "sensor_height_mm": float(cfg.sensor_height_at(t))}),
                              **err})
     return rows

@@ -14,7 +14,7 @@ EXIT_SUSPECT = 3  # the chart was written but a part of it is suspect (as `solve
 KEYS = {"thicknesses", "materials", "pitches", "noise_fs", "noise_mpa", "taxel_fraction", "bits", "window", "sets",
         "letters", "n_train", "n_test", "template_grid", "seed", "mesh_size", "refinement", "standard",
         "validate", "skin", "max_depth", "letters_model", "fallback", "sphere_radius", "sphere_quality",
-        "sensor_depth"}
+        "sensor_depth", "sensor_height"}
 MAX_TEXTS = 100  # Braille texts to validate: each is a full 3D solve per thickness
 
 
@@ -62,7 +62,7 @@ def load_config(path) -> dict:
 @click.option("--thickness", "-t", default=None, help="Thicknesses (mm), e.g. '1,3'. Default 1,3.")
 @click.option("--material", "-m", default=None, help="Materials, comma-separated. Default silicone.")
 @click.option("--pitch", default=None, help="Array pitches (mm): taxel centre to centre, a square lattice on the "
-              "bonded surface (or at --sensor-depth) over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
+              "bonded surface (or at --sensor-depth / --sensor-height) over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
 @click.option("--noise", default=None, help="Noise std as fractions of full scale: each set's largest pressure at that "
               "thickness, so one fraction is a different noise in MPa at each thickness (array_chart.md gives it). "
               "Default 0.01,0.05,0.1.")
@@ -87,6 +87,10 @@ def load_config(path) -> dict:
               help="Taxels at this depth (mm) below the contact surface, inside every skin of the chart "
                    "(0 < depth < the thinnest t), read from the cached solves (no solve again). Default: the "
                    "bonded surface (the paper's film on the bone).")
+@click.option("--sensor-height", type=float, default=None,
+              help="Taxels at this height (mm) above the bonded surface, the same in every skin of the chart "
+                   "(a sensor sheet on a stand-off, the skin cast over it; 0 < height < the thinnest t; read at "
+                   "the depth t - height), not with --sensor-depth. Default: the bonded surface.")
 @click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
 @click.option("--skin", type=click.Choice(["pad", "fingertip"]), default=None,
               help="Skin of the 3D dot solves: pad (flat, a dot's response translates exactly; default) or "
@@ -109,7 +113,7 @@ def load_config(path) -> dict:
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache; share the sweep's to reuse its solves).")
 def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bits, sets, letters, offsets, mesh_size,
-            refinement, max_depth, sphere_radius, sphere_quality, sensor_depth, seed, skin, validate, letters_model, fallback,
+            refinement, max_depth, sphere_radius, sphere_quality, sensor_depth, sensor_height, seed, skin, validate, letters_model, fallback,
             workers, cache_dir):
     """Accuracy of an array under the skin at telling stimuli apart; cached, rerun is fast.
 
@@ -134,6 +138,9 @@ def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bi
     if noise is not None or noise_mpa is not None:  # a flag's noise axis replaces the config's
         kw.pop("noise_fs", None)
         kw.pop("noise_mpa", None)
+    if sensor_depth is not None or sensor_height is not None:  # likewise a flag's sensor plane
+        kw.pop("sensor_depth", None)
+        kw.pop("sensor_height", None)
     flags = dict(thicknesses=thickness and tuple(parse_values(thickness, "thickness")),
                  materials=material and names(material, "material"),
                  pitches=pitch and tuple(parse_values(pitch, "pitch")),
@@ -142,7 +149,7 @@ def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bi
                  taxel_fraction=taxel, bits=bits, sets=sets and names(sets, "set"), letters=letters,
                  n_train=offsets, n_test=offsets, mesh_size=mesh_size, refinement=refinement, seed=seed, skin=skin,
                  max_depth=max_depth, letters_model=letters_model, fallback=fallback, sphere_radius=sphere_radius,
-                 sphere_quality=sphere_quality, sensor_depth=sensor_depth)
+                 sphere_quality=sphere_quality, sensor_depth=sensor_depth, sensor_height=sensor_height)
     kw.update({k: v for k, v in flags.items() if v is not None})
     if validate is not None:  # the config key's rule (at most MAX_TEXTS full solves per thickness)
         texts = validate_mod.string_list(names(validate, "validate"), "validate (--validate)", MAX_TEXTS,

@@ -95,12 +95,19 @@ def _skins(cfg) -> str:
 
 
 def _sensor_plane(cfg) -> str:
-    """Where the taxels sit (ChartConfig.sensor_depth)."""
-    if cfg.sensor_depth is None:
+    """Where the taxels sit (ChartConfig.sensor_depth or sensor_height)."""
+    if _on_bone(cfg):
         return "the bonded surface, t below the contact surface (the paper's film on the bone)"
-    return (f"{cfg.sensor_depth:g} mm below the contact surface (`--sensor-depth`; t - {cfg.sensor_depth:g} mm above "
-            "the bone, in the undeformed skin), P = -tr(sigma) / 3 read there from each cached solve's result.vtu "
+    where = (f"{cfg.sensor_depth:g} mm below the contact surface (`--sensor-depth`; t - {cfg.sensor_depth:g} mm above "
+             "the bone" if cfg.sensor_height is None else f"{cfg.sensor_height:g} mm above the bonded surface "
+             f"(`--sensor-height`; t - {cfg.sensor_height:g} mm below the contact surface")
+    return (where + ", in the undeformed skin), P = -tr(sigma) / 3 read there from each cached solve's result.vtu "
             "along the skin's normal, s the arc length on that surface")
+
+
+def _on_bone(cfg) -> bool:
+    """The taxels on the bonded surface (neither a sensor depth nor a height)."""
+    return cfg.sensor_depth is None and cfg.sensor_height is None
 
 
 def _cap_text(cfg) -> str:
@@ -127,7 +134,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     notes = suspect(chart, validation, trust)
     lines = ["## Sensor-array design chart", "", *(["**Suspect:** " + n for n in notes] + [""] if notes else []),
              f"Skin: {_skins(cfg)}. Sensor plane: " + _sensor_plane(cfg) + ", map P(s, z) of 3D single-dot solves "
-             f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D " + ("bone profiles" if cfg.sensor_depth is None else "profiles at that depth")
+             f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D " + ("bone profiles" if _on_bone(cfg) else "profiles at that depth")
                                             + " extruded along z"
                                          if {"paper", "shapes"} & set(cfg.sets) else "")
              + (f"; sphere (R {cfg.sphere_radius:g} mm): 3D at the `{cfg.sphere_quality}` preset" if "shapes" in cfg.sets else "")
@@ -139,7 +146,8 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
              "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth "
-             + ("t" if cfg.sensor_depth is None else f"{cfg.sensor_depth:g} mm") + " (mm) |",
+             + ("t" if _on_bone(cfg) else f"{cfg.sensor_depth:g} mm" if cfg.sensor_height is None
+                else f"t - {cfg.sensor_height:g} mm") + " (mm) |",
              "|---|---|---|---|---|---|---|---|"]
     for c in chart.cutoffs:
         kc, ny = c["kc_rad_per_mm"], c["nyquist_pitch_mm"]
