@@ -485,7 +485,7 @@ def raw_map_of(record, depth: float | None = None) -> BoneMap:
     m = read_bone_map(record.path / "bone_map.csv")
     if depth is None:
         return m
-    s, P = _at_depth(record, m.s, m.z, depth)
+    s, P = _at_depth_kept(record, m.s, m.z, depth)
     return BoneMap(s, m.z, P, m.section_z)
 
 
@@ -493,7 +493,92 @@ def profile_of(record, depth: float | None = None) -> tuple:
     """(s, P) of a 2D solve: its bone profile, or P on the depth surface (as raw_map_of)."""
     if depth is None:
         return record.s, record.pressure
-    return _at_depth(record, np.asarray(record.s, float), None, depth)
+    return _at_depth_kept(record, np.asarray(record.s, float), None, depth)
+
+
+MEMO_DIR = "derived_maps"  # in a cache entry: its maps read at a sensor depth (_at_depth_kept)
+MEMO_VERSION = 1           # the memo's own layout
+
+
+def _at_depth_kept(record, s, z, depth: float) -> tuple:
+    """_at_depth of a validated cache entry (a cache.CaseRecord), kept in the entry's MEMO_DIR:
+    a 3D map at depth locates every grid point in the P2 mesh of result.vtu (2.3 s for the
+    t = 1 mm fingertip dot on 1.2 / 4; about 3 s on the default meshes), on every rerun. The memo
+    is named and checked by everything that made it: the entry's key and the digests cache.json
+    holds of its files (result.vtu, the grids' files), s and z, the depth, and the code
+    (cache.code_digest, which the key holds too); one that does not match or does not read back
+    whole is recomputed and rewritten (logged), never an error; one that cannot be written is
+    skipped (logged). Any other record (not in the cache) is read as it is."""
+    key = _memo_key(record, s, z, depth)
+    path = None if key is None else record.path / MEMO_DIR / f"{key}.npz"
+    if path is not None and path.exists():
+        got = _read_memo(path, key, np.asarray(s).size, None if z is None else np.asarray(z).size)
+        if got is not None:
+            return got
+    out = _at_depth(record, s, z, depth)
+    if path is not None:
+        _write_memo(path, key, *out)
+    return out
+
+
+def _memo_key(record, s, z, depth: float) -> str | None:
+    """The memo's name: SHA-256 of what made the map (_at_depth_kept); None for a record that is
+    not a cache entry."""
+    import hashlib
+    import json
+
+    from tactileskin.cache import CaseRecord, code_digest
+
+    if not isinstance(record, CaseRecord):
+        return None
+    try:
+        meta = json.loads((record.path / "cache.json").read_text(encoding="utf-8"))
+        payload = {"entry": meta["key"], "files": meta["files"], "depth": float(depth).hex(), "code": code_digest(),
+                   "version": MEMO_VERSION,
+                   "grid": [hashlib.sha256(np.ascontiguousarray(v, float).tobytes()).hexdigest() if v is not None
+                            else None for v in (s, z)]}
+        text = json.dumps(payload, sort_keys=True)
+    except (OSError, ValueError, KeyError, TypeError) as e:  # read as if there were no memo
+        log.info("no map memo for %s: %s", record.path, e)
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def _memo_digest(s, P) -> str:
+    import hashlib
+
+    return hashlib.sha256(np.ascontiguousarray(s, float).tobytes() + np.ascontiguousarray(P, float).tobytes()).hexdigest()
+
+
+def _read_memo(path, key: str, ns: int, nz: int | None) -> tuple | None:
+    """(s, P) of a memo written by _write_memo under `key` with the shapes of an (ns, nz) grid;
+    None (logged) where it is anything else."""
+    import zipfile
+
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            s, P, memo = f["s"], f["P"], f["memo"]
+        shape = (ns,) if nz is None else (nz, ns)
+        if str(memo) != f"{key} {_memo_digest(s, P)}" or s.shape != (ns,) or P.shape != shape \
+                or not (np.all(np.isfinite(s)) and np.all(np.isfinite(P))):
+            raise ValueError("another map's or altered")
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
+        log.warning("map memo %s is damaged (%s); the map is read from result.vtu again", path, e)
+        return None
+    return s, P
+
+
+def _write_memo(path, key: str, s, P) -> None:
+    import io
+
+    from tactileskin import fileio
+
+    buf = io.BytesIO()
+    np.savez(buf, s=np.asarray(s, float), P=np.asarray(P, float), memo=np.array(f"{key} {_memo_digest(s, P)}"))
+    try:
+        fileio.atomic_write_bytes(path, buf.getvalue())
+    except (OSError, TactileSkinError) as e:  # a read-only cache: the map is used, not kept
+        log.info("map memo %s not written: %s", path, e)
 
 
 def _at_depth(record, s, z, depth: float) -> tuple:
