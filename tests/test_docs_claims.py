@@ -159,23 +159,31 @@ def test_hard_cases_p1_note_says_the_scene_is_refused():
 
 def test_commands_doc_dome_sensor_numbers_are_the_dome_coordinates():
     """The README's dome sentence said layouts were not taken; it now gives the sensors' s = x
-    against the profile's bone arc length, and the skin's thickness along a vertical line,
-    which the dome's own coordinates must reproduce. (The sentence moved with the Commands
-    table's long cells to docs/commands.md.)"""
+    against the profile's bone arc length, and the skin's thickness along the surface's normal
+    line (a height 0 sensor's depth; it was along a vertical line, 2.015 and 2.159 mm at x = 1
+    and 3), which the dome's own coordinates must reproduce: on the axis t, everywhere between
+    the least bone-to-surface distance (skins.dome.min_thickness) and t. (The sentence moved
+    with the Commands table's long cells to docs/commands.md.)"""
     import numpy as np
 
     from tactileskin.scene import Scene
-    from tactileskin.sensors import coordinates_for
+    from tactileskin.sensors import sites_for
+    from tactileskin.skins.dome import min_thickness
 
-    sc = Scene(skin="dome", thickness=2.0)
-    sec, col = sc.section(), coordinates_for(sc).column(np.array([0.0, 1.0, 3.0]), np.zeros(3))
+    sec = Scene(skin="dome", thickness=2.0).section()
     s3 = sec.s_of_point([[3.0, (sec.b - 2.0) * np.sqrt(1 - (3.0 / (sec.a - 2.0)) ** 2)]])[0]
-    thick = col["top"] - col["floor"]
-    tip = coordinates_for(sc).column(np.zeros(1), np.array([sec.c - 2.0]))
+    S, Z = np.meshgrid(np.linspace(0.0, 7.9, 30), np.linspace(-10.0, 7.9, 30))
+    on = (S / sec.a) ** 2 + (np.maximum(Z, 0.0) / sec.c) ** 2 < 0.999  # over the skin
+    lays = [{"name": "x", "s": [0.0, 1.0, 3.0], "z": [0.0], "height": 0.0},
+            {"name": "all", "s": S[on].tolist(), "z": Z[on].tolist(), "height": 0.0}]
+    st = sites_for(Scene(skin="dome", thickness=2.0, sensors=lays))  # refused where no bone is met
+    thick = st.depth[:3]
+    least = min_thickness(sec.a, sec.b, sec.c, 2.0)
     readme = _text("docs/commands.md")
     assert f"x = 3 mm is s = {s3:.2f} mm at t = 2" in readme and thick[0] == 2.0
-    assert f"({thick[1]:.3f} mm at x = 1, {thick[2]:.3f} at x = 3, t = 2)" in readme
-    assert f"thicker than t ({tip['top'][0] - tip['floor'][0]:.1f} mm on the axis at z = c - t, t = 2)" in readme
+    assert f"({thick[1]:.5f} mm at x = 1, {thick[2]:.5f} at x = 3, t = 2)" in readme
+    assert least - 1e-9 <= st.depth.min() and st.depth.max() <= 2.0 + 1e-9
+    assert f"the skin is {least:.3f}-2.0 mm thick everywhere at t = 2" in readme
 
 
 def test_readme_choosing_an_array_runs_and_names_what_the_chart_writes():

@@ -221,14 +221,42 @@ def test_the_default_dome_molds_step_files_reread_as_their_solids(tmp_path):
         assert cad_volume(back) == pytest.approx(cad_volume(solid), rel=1e-6), name
 
 
-def test_dome_sensor_sites_stand_on_vertical_lines_through_the_exact_surfaces():
+def _surface(x, z, c):
+    """The dome's outer point over (x, z) (z > 0: the tip's half ellipsoid of semi-axis c) and
+    its outward unit normal, the outer body's gradient there."""
+    x, z = np.asarray(x, float), np.asarray(z, float)
+    zt = np.maximum(z, 0.0)
+    p = np.column_stack([x, B * np.sqrt(1.0 - (x / A) ** 2 - (zt / c) ** 2), z])
+    n = np.column_stack([x / A ** 2, p[:, 1] / B ** 2, zt / c ** 2])
+    return p, n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def _to_bone(p, n, t, c):
+    """How far the line p - lam n runs to the bone (semi-axes A - t, B - t, c - t; its
+    cylinder for z <= 0, its cap for z > 0): the quadrics' smallest positive root there."""
+    out = []
+    for q, d in zip(p, -n):
+        best = np.inf
+        for ax, cap in (((A - t, B - t, np.inf), False), ((A - t, B - t, c - t), True)):
+            w = 1.0 / np.square(ax)
+            roots = np.roots([np.sum(w * d * d), 2.0 * np.sum(w * q * d), np.sum(w * q * q) - 1.0])
+            for lam in roots[np.isreal(roots)].real:
+                if lam > 0 and ((q[2] + lam * d[2] > 0) == cap):
+                    best = min(best, lam)
+        out.append(best)
+    return np.array(out)
+
+
+def test_dome_sensor_sites_lie_along_the_exact_surfaces_normal():
     """The dome's sensors use the file skin's convention (skins.dome.DomeCoordinates; every
-    layout was refused): s = x, z as given, depth straight down from the outer surface at
-    (x, z), height straight up from the bone there, the sensor plane along the surface over
-    (x, z) (normal: the surface's; t1 in the x-y plane). The scene
-    places them on the exact surfaces: the ellipse (a, b) / bone (a - t, b - t) for z <= 0, the
-    half ellipsoids of semi-axis c / c - t along z on the tip (z > 0), where the vertical line
-    is not the surface's normal (the skin there is thicker than t along it)."""
+    layout was refused): s = x and z of the outer surface's point, depth along its inward
+    normal there, height from where that line meets the bone, the sensor plane along the
+    surface there (normal: the surface's; t1 in the x-y plane). The scene places them on the
+    exact surfaces: the ellipse (a, b) / bone (a - t, b - t) for z <= 0, the half ellipsoids of
+    semi-axis c / c - t along z on the tip (z > 0). The depth was vertical: on the tip at (3, 4)
+    0.5 lay 0.41 mm from the surface along its normal, and the skin was 2.7 mm thick there for
+    a height; along the normal it is 1.994 mm (the bone is the dome shrunk by t per semi-axis,
+    not its offset)."""
     from tactileskin import sensors
     from tactileskin.mesh.dome import outer_level
 
@@ -236,45 +264,44 @@ def test_dome_sensor_sites_stand_on_vertical_lines_through_the_exact_surfaces():
     lays = [{"name": "bone", "kind": "grid", "s": [-3.0, 4.0], "z": [-9.0, 3.0], "pitch": [1.0], "height": 0.0},
             {"name": "top", "kind": "grid", "s": [0.0, 4.0], "z": [-4.0, 6.0], "pitch": [1.0], "depth": 0.0},
             {"name": "mid", "kind": "points", "s": [0.0, 3.0, 3.0], "z": [-2.0, -2.0, 4.0], "height": 0.5},
-            {"name": "side", "kind": "points", "s": [7.5], "z": [-2.0], "depth": 1.0}]
+            {"name": "side", "kind": "points", "s": [7.5], "z": [-2.0], "depth": 1.0},
+            {"name": "tip", "kind": "points", "s": [3.0, 0.0], "z": [4.0, 7.0], "depth": 0.5}]
     sc = Scene(skin="dome", thickness=t, dome_tip=c, sensors=lays)
     st = sensors.sites_for(sc)
-    x, y, z = st.xyz.T
     of = np.array(st.layout)
-    assert np.allclose(x, st.s) and np.allclose(z, st.z)  # s = x; the half x < 0 by reflection
-    p = np.vstack([np.abs(x), y, z])
-    assert np.abs(outer_level(p[:, of == "bone"], A - t, B - t, c - t)).max() < 1e-12
-    assert np.abs(outer_level(p[:, of == "top"], A, B, c)).max() < 1e-12
-    # 0.5 mm straight up from the bone: at (0, -2) t - 0.5 under the pulp; at (3, 4), on the
-    # tip, the bone's cap is at y = 5 sqrt(1 - (3/6)^2 - (4/6)^2) = 2.764, the surface at
-    # 7 sqrt(1 - (3/8)^2 - (4/8)^2) = 5.464: the sensor 2.200 mm below it
-    i = {k: n for n, k in enumerate(st.ids)}
-    bone = 5.0 * math.sqrt(1 - 0.25 - 4 / 9)
-    assert y[i["mid-0"]] == pytest.approx(B - t + 0.5) and y[i["mid-2"]] == pytest.approx(bone + 0.5)
-    assert st.depth[i["mid-2"]] == pytest.approx(7.0 * math.sqrt(1 - 9 / 64 - 0.25) - bone - 0.5)
-    # over the flank (x > a - t: no bone under it) a depth is taken, along -y from the surface
-    assert y[i["side-0"]] == pytest.approx(B * math.sqrt(1 - (7.5 / A) ** 2) - 1.0)
-    # the sensor plane lies along the surface over the line (it was horizontal, normal +y, and
+    p, n = _surface(st.s, st.z, c)
+    # each sensor at its depth along the surface's inward normal from the point over (s, z)
+    assert np.abs(st.xyz - (p - st.depth[:, None] * n)).max() < 1e-6
+    assert np.array_equal(st.normal_depth, st.depth)
+    x, y, z = st.xyz.T
+    q = np.vstack([np.abs(x), y, z])
+    assert np.abs(outer_level(q[:, of == "bone"], A - t, B - t, c - t)).max() < 1e-9
+    assert np.abs(outer_level(q[:, of == "top"], A, B, c)).max() < 1e-12
+    # a height from where the normal line meets the bone (to 1e-8 of the exact quadrics' roots)
+    up = np.isin(of, ["bone", "mid"])
+    h = np.where(of == "mid", 0.5, 0.0)
+    assert np.abs(st.depth[up] - (_to_bone(p[up], n[up], t, c) - h[up])).max() < 1e-8
+    i = {k: m for m, k in enumerate(st.ids)}
+    assert y[i["mid-0"]] == pytest.approx(B - t + 0.5)  # at x = 0 the normal is +y: t - 0.5 under the pulp
+    assert st.depth[i["mid-2"]] == pytest.approx(1.994374 - 0.5, abs=1e-6)  # on the tip
+    # the sensor plane lies along the surface over (s, z) (it was horizontal, normal +y, and
     # read sigma_yy: 0.009-0.016 MPa, 4.7-8.3 % of the peak sigma_nn 0.19, under the 20-45 degree
     # slopes of the flanks and the tip beside a flat plate 0.6 mm deep, where sigma_nn is ~0):
     # the outer body's gradient at the footprint, to the central difference's step across z = 0
     # (where the tip's curvature begins: 3e-5); t1 in the x-y plane, t2 = t1 x n
-    zt = np.maximum(z, 0.0)
-    top = B * np.sqrt(1.0 - (x / A) ** 2 - (zt / c) ** 2)
-    n = np.column_stack([x / A ** 2, top / B ** 2, zt / c ** 2])
-    n /= np.linalg.norm(n, axis=1, keepdims=True)
     assert np.allclose(st.normal, n, rtol=0, atol=1e-4)
-    assert np.abs(st.normal[z >= 1.0] - n[z >= 1.0]).max() < 1e-6 and st.normal[:, 2].max() > 0.5  # on the tip
+    assert np.abs(st.normal[st.z >= 1.0] - n[st.z >= 1.0]).max() < 1e-6 and st.normal[:, 2].max() > 0.5  # on the tip
     t1 = np.column_stack([n[:, 1], -n[:, 0], np.zeros_like(x)])
     assert np.allclose(st.t1, t1 / np.linalg.norm(t1, axis=1, keepdims=True), rtol=0, atol=1e-4)
     assert np.allclose(st.t2, np.cross(st.t1, st.normal), rtol=0, atol=1e-12)
-    assert np.array_equal(st.normal[x == 0.0][:, 0], np.zeros((x == 0.0).sum()))  # the symmetry line
+    assert np.array_equal(st.normal[st.s == 0.0][:, 0], np.zeros((st.s == 0.0).sum()))  # the symmetry line
 
 
 @pytest.mark.parametrize("layout,match", [
-    # no bone under the line: the flank (x > a - t) and the last t of the tip (z > c - t)
-    ({"s": [6.5], "z": [-2.0], "height": 0.0}, r"'x' height=0.0 .*a depth instead.*x-0: at s = 6.5, z = -2 mm"),
-    ({"s": [0.0], "z": [7.0], "height": 0.2}, r"'x' height=0.2 .*a depth instead.*at s = 0, z = 7 mm"),
+    # over the flank (x > a - t) and the last t of the tip (z > c - t) no bone was under the
+    # vertical line (a height was refused); the normal line meets it 1.994 and 1.995 mm in
+    ({"s": [6.5], "z": [-2.0], "height": 2.1}, r"'x' height=2.1 .*\[0, 1.99438\] mm at s = 6.5, z = -2 mm.*x-0"),
+    ({"s": [0.0], "z": [7.0], "height": 2.1}, r"'x' height=2.1 .*\[0, 1.9954\] mm at s = 0, z = 7 mm"),
     ({"s": [0.0, 3.0], "z": [-1.0], "depth": 2.1}, r"'x' depth=2.1 .*\[0, 2\] mm at s = 0, z = -1 mm.*x-0"),
     ({"s": [1.0], "z": [8.5], "depth": 0.1}, r"'x' s, z=\(1.0, 8.5\) .*z in \[-10, 8\] mm.*x-0: no skin"),
     ({"s": [1.0], "z": [-10.5], "depth": 0.1}, r"'x' s, z=\(1.0, -10.5\)"),
@@ -293,7 +320,8 @@ def test_a_dome_bone_sensor_reads_the_bone_map_there():
     nodal field
     (fe.output._fit_on_path fits the stresses and the pressure at the bone's nodes alike)
     interpolated in the element there. The sensors stand at the map's own grid points (s on
-    the exact bone ellipse -> x), so the only difference is that position: 5e-4 mm times the
+    the exact bone ellipse -> the point, whose nearest outer point's normal runs through it ->
+    that point's x, the layout's s), so the only difference is that position: 5e-4 mm times the
     map's largest slope dP/ds (measured 1.4e-7 MPa of 0.025, the tolerance 8e-6)."""
     from tactileskin.fe import solve
 
@@ -305,7 +333,12 @@ def test_a_dome_bone_sensor_reads_the_bone_map_there():
     sec = plain.section()
     i = np.flatnonzero(bm.s <= 4.0)
     rows = [len(bm.z) - 1, len(bm.z) - 5, len(bm.z) // 2]  # z = 0 (the profile), near it, mid-finger
-    x = sec.point_at_s(bm.s[i])[:, 0]
+    bone = sec.point_at_s(bm.s[i])
+    u = np.arctan2(bone[:, 0] / A, bone[:, 1] / B)  # the outer ellipse (A sin u, B cos u) nearest each
+    for _ in range(30):  # Newton on (E(u) - bone) . E'(u) = 0
+        e, de = np.column_stack([A * np.sin(u), B * np.cos(u)]), np.column_stack([A * np.cos(u), -B * np.sin(u)])
+        u -= np.sum((e - bone) * de, axis=1) / (np.sum(de * de, axis=1) - np.sum((e - bone) * e, axis=1))
+    x = A * np.sin(u)
     lays = [{"name": f"r{j}", "kind": "points", "s": x.tolist(), "z": [float(bm.z[j])], "height": 0.0}
             for j in rows] + [{"name": "tip", "kind": "line", "s": [0.0, 4.0], "z": [3.0], "pitch": [1.0],
                                "height": 0.0}]
@@ -330,29 +363,31 @@ def test_a_dome_bone_sensor_reads_the_bone_map_there():
 
 def test_the_solve_places_in_its_dome_mesh_what_the_scene_held():
     """The scene checks the sensors on the exact surfaces, the solve places them on its P2 mesh,
-    whose column at (4.88, -6.9) is 9e-4 mm thinner (h = 2): a depth or a height 1e-4 mm short
-    of the exact thickness passed the scene and was refused after meshing ("valid: [0, 2.6369]
-    mm"). Now the scene's check decides (skins.file FileCoordinates' `reference`) and the sensor
-    is clamped onto the mesh's face; one outside the exact skin is refused in the scene's words."""
+    whose line along the surface normal at (4.88, -6.9) is 4.3e-4 mm shorter (h = 2; its vertical
+    column 9e-4): a depth or a height 1e-4 mm short of the exact thickness passed the scene and
+    was refused after meshing. Now the scene's check decides (skins.file FileCoordinates'
+    `reference`) and the sensor is clamped onto the mesh's face along that line; one outside the
+    exact skin is refused in the scene's words (the skin 1.9945 mm thick along the normal there,
+    2.6378 vertically)."""
     from tactileskin import sensors
 
     sc = Scene(skin="dome", thickness=2.0, mesh_size=2.0, refinement=2.0, indenter="flat", viscoelastic=False)
     coords = sc.skin_kind.mesh_coordinates(sc, build_mesh(sc))
     at = {"s": [4.88], "z": [-6.9]}
-    exact = sc.skin_kind.coordinates(sc).column(at["s"], at["z"])
-    mesh = coords.column(at["s"], at["z"])
-    t = exact["top"][0] - exact["floor"][0]
-    assert 5e-4 < t - (mesh["top"][0] - mesh["floor"][0]) < 2e-3  # the mesh's column is thinner
-    for key, y in (("depth", mesh["floor"][0]), ("height", mesh["top"][0])):
+    t = _to_bone(*_surface(at["s"], at["z"], A), 2.0, A)[0]  # along the exact surface's normal
+    P, n = coords._surface(np.array(at["s"]), np.array(at["z"]))
+    tm = coords._exit(P, n)[0]  # along the mesh's
+    assert 2e-4 < t - tm < 2e-3  # the mesh's line is shorter
+    for key, y in (("depth", P[0] - tm * n[0]), ("height", P[0])):
         lay = {"name": key, "kind": "points", **at, key: t - 1e-4}
         Scene(skin="dome", thickness=2.0, sensors=[lay])  # held on the exact surfaces
-        assert sensors.resolve(sensors.layouts([lay]), coords, 3).xyz[0, 1] == pytest.approx(y, abs=1e-9)
+        assert np.abs(sensors.resolve(sensors.layouts([lay]), coords, 3).xyz[0] - y).max() < 1e-9
         out = {**lay, key: t + 1e-3}
         with pytest.raises(ParameterError) as scene:
             Scene(skin="dome", thickness=2.0, sensors=[out])
         with pytest.raises(ParameterError) as solve_time:
             sensors.resolve(sensors.layouts([out]), coords, 3)
-        assert str(solve_time.value) == str(scene.value) and "valid: [0, 2.63782] mm" in str(scene.value)
+        assert str(solve_time.value) == str(scene.value) and "valid: [0, 1.9945] mm" in str(scene.value)
 
 
 def test_the_dome_sensor_layouts_enter_the_cache_key():
@@ -368,10 +403,11 @@ def test_the_dome_sensor_layouts_enter_the_cache_key():
 def test_the_cli_refuses_a_sensor_outside_the_dome_in_one_line(tmp_path, capsys):
     from tactileskin.cli import main
 
-    (tmp_path / "s.toml").write_text('[[sensors]]\nname = "tipbone"\ns = [0.0]\nz = [7.0]\nheight = 0.0\n')
+    # the tip's skin is 1.995 mm thick along the normal at (0, 7)
+    (tmp_path / "s.toml").write_text('[[sensors]]\nname = "tipbone"\ns = [0.0]\nz = [7.0]\nheight = 2.1\n')
     rc = main(["solve", "--skin", "dome", "-t", "2", "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
                "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
-    assert "sensor layout 'tipbone' height=0" in err and "tipbone-0" in err and "z = 7 mm" in err
+    assert "sensor layout 'tipbone' height=2.1" in err and "tipbone-0" in err and "z = 7 mm" in err
     assert not (tmp_path / "o").exists()

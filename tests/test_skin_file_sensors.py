@@ -1,6 +1,6 @@
-"""Sensor layouts inside a user's file skin (skins.file.FileCoordinates): s = x - x_top, depth
-straight down from the contact surface at (x, z), height straight up from the bonded surface
-there, the sensor plane along the contact surface over (x, z). The pad's own mesh read back as
+"""Sensor layouts inside a user's file skin (skins.file.FileCoordinates): s = x - x_top and z of
+the contact surface's point, depth along its inward normal there, height along that line from
+the bonded surface, the sensor plane along the contact surface there. The pad's own mesh read back as
 a file skin reads what the pad reads; the coordinates follow a skin that is not a flat layer; a
 sensor outside the skin is refused."""
 
@@ -51,8 +51,10 @@ def _tent(tmp_path):
 
 def test_depth_and_height_follow_the_skin_at_each_x(tmp_path):
     """Depth is measured from the contact surface over the sensor, height from the bonded
-    surface under it, not from the top point's thickness (1.5 here): at s = 2 the top is at
-    y = 1.8 and the base at 0.5, at s = -2 at 1.8 and 0; a taxel's points follow the surface."""
+    surface, not from the top point's thickness (1.5 here): at s = 2 the top is at y = 1.8 and
+    the base at 0.5, at s = -2 at 1.8 and 0; both along the surface's inward normal there (the
+    slope is 0.1: it was straight down, 0.5 / sqrt(1.01) = 0.4975 mm from the surface along it);
+    a taxel's points follow the surface."""
     path = str(_tent(tmp_path))
     lays = [{"name": "d", "kind": "points", "s": [2.0, -2.0, 3.5], "depth": 0.5},
             {"name": "h", "kind": "points", "s": [2.0, -2.0], "height": 0.25},
@@ -61,12 +63,16 @@ def test_depth_and_height_follow_the_skin_at_each_x(tmp_path):
     sc = Scene(skin="file", skin_file=path, indenter="flat", sensors=lays)
     assert sc.thickness == pytest.approx(1.5)
     st = sensors.sites_for(sc)
-    y = dict(zip(st.ids, st.xyz[:, 1]))
-    assert (y["d-0"], y["d-1"], y["d-2"]) == (pytest.approx(1.3), pytest.approx(1.3), pytest.approx(1.15))
-    assert (y["h-0"], y["h-1"]) == (pytest.approx(0.75), pytest.approx(0.25))
-    assert y["deep-0"] == pytest.approx(0.1)
+    c = 1.0 / np.sqrt(1.01)  # the normal's y part; its x part is 0.1 c (the slope 0.4 / 4)
+    xy = dict(zip(st.ids, st.xyz[:, :2]))
+    assert np.allclose([xy["d-0"], xy["d-1"], xy["d-2"]],
+                       [[2.0 - 0.05 * c, 1.8 - 0.5 * c], [-2.0 + 0.05 * c, 1.8 - 0.5 * c], [3.5 - 0.05 * c, 1.65 - 0.5 * c]],
+                       rtol=0, atol=1e-6)
+    # the normal line meets the base y = 0.5 (y = 0) 1.3 / c (1.8 / c) under the surface
+    assert np.allclose([xy["h-0"][1], xy["h-1"][1]], [0.5 + 0.25 * c, 0.25 * c], rtol=0, atol=1e-6)
+    assert xy["deep-0"][1] == pytest.approx(1.8 - 1.7 * c)
     depth = dict(zip(st.ids, st.depth))
-    assert (depth["h-0"], depth["h-1"]) == (pytest.approx(1.05), pytest.approx(1.55))
+    assert (depth["h-0"], depth["h-1"]) == (pytest.approx(1.3 / c - 0.25), pytest.approx(1.8 / c - 0.25))
     # the sensor plane lies along the contact surface over it (slope 0.4 / 4 down from the axis)
     sign = np.sign(st.s)[:, None]
     assert np.allclose(st.normal, np.column_stack([0.1 * sign, np.ones((7, 1)), np.zeros((7, 1))]) / np.sqrt(1.01),
@@ -75,15 +81,16 @@ def test_depth_and_height_follow_the_skin_at_each_x(tmp_path):
                        rtol=0, atol=1e-9)
     g = np.polynomial.legendre.leggauss(3)[0]
     i = st.ids.index("tx-0")
-    assert np.allclose(st.samples[i, :3, 0], 2.0 + g)  # the side along x
-    assert np.allclose(st.samples[i, :3, 1], 2.0 - 0.1 * (2.0 + g) - 0.5)  # 0.5 under the slope
+    assert np.allclose(st.samples[i, :3, 0], 2.0 + g - 0.05 * c)  # the side along x, then 0.5 along -n
+    assert np.allclose(st.samples[i, :3, 1], 2.0 - 0.1 * (2.0 + g) - 0.5 * c)  # 0.5 under the slope
 
 
 @pytest.mark.parametrize("layout,match", [
-    ({"s": [2.0], "depth": 1.4}, r"'x' depth=1.4 .*\[0, 1.3\] mm at s = 2 mm.*sensor x-0"),
-    ({"s": [-2.0], "depth": -0.1}, r"'x' depth=-0.1 .*\[0, 1.8\] mm at s = -2 mm"),      # above the surface
-    ({"s": [0.0, 2.0], "height": 1.4}, r"'x' height=1.4 .*\[0, 1.3\] mm at s = 2 mm.*sensor x-1"),
-    ({"s": [-2.0], "height": -0.2}, r"'x' height=-0.2 .*\[0, 1.8\] mm"),                 # below the bonded face
+    # along the normal (slope 0.1) the skin is 1.3 sqrt(1.01) = 1.30648 mm thick at s = 2 (1.3 vertically)
+    ({"s": [2.0], "depth": 1.4}, r"'x' depth=1.4 .*\[0, 1.30648\] mm at s = 2 mm.*sensor x-0"),
+    ({"s": [-2.0], "depth": -0.1}, r"'x' depth=-0.1 .*\[0, 1.80898\] mm at s = -2 mm"),      # above the surface
+    ({"s": [0.0, 2.0], "height": 1.4}, r"'x' height=1.4 .*\[0, 1.30648\] mm at s = 2 mm.*sensor x-1"),
+    ({"s": [-2.0], "height": -0.2}, r"'x' height=-0.2 .*\[0, 1.80898\] mm"),                 # below the bonded face
     ({"s": [3.5], "height": 0.2}, r"'x' height=0.2 .*a depth instead.*sensor x-0: at s = 3.5 mm.*not bonded"),
     ({"s": [1.0, 4.5], "depth": 0.5}, r"'x' s=4.5 .*s in \[-4, 4\] mm.*sensor x-1: no skin under it"),
     ({"s": [3.8], "depth": 0.5, "taxel": 1.0}, r"'x' s \+- taxel/2=4.3 .*sensor x-0 \(taxel edge at s = 4.3 mm\)"),
@@ -193,28 +200,35 @@ def test_a_curved_step_skins_sensors_follow_its_surface(tmp_path):
 def test_a_step_skins_sensors_are_checked_on_its_cad_faces(tmp_path):
     """The scene checks a STEP skin's sensors on its CAD faces, not on the coarse analysis
     mesh's chords. Under the sphere cap's top the chords lay 0.0285 mm low at (1.3, 1.7): a
-    sensor 0.002 mm under the surface (height 1.6034 mm) was refused ("valid: [0, 1.57683]
-    mm"). Over the half tube's R 6 bonded face the chords lay low (t 2.2258 for 2.2200 mm at s
-    = 3): a sensor 0.005 mm under the bone was held and refused only after meshing."""
+    sensor 0.002 mm under the surface (then height 1.6034 mm, vertical) was refused ("valid:
+    [0, 1.57683] mm"). Over the half tube's R 6 bonded face the chords lay low (t 2.2258 for
+    2.2200 mm vertically at s = 3): a sensor 0.005 mm under the bone was held and refused only
+    after meshing. Both along the surface's normal now (the tube's radial: t = 2)."""
     import build123d as bd
 
     path, top = _cap(tmp_path)
-    h = top(1.3, 1.7) - 0.002
+    ny = (top(1.3, 1.7) + 4.0) / 6.0  # the cap's normal there (its centre is (0, -4, 0)): y part
+    h = top(1.3, 1.7) / ny - 0.002  # the normal line meets the flat bonded face y = 0 top / ny in
     lay = {"name": "hi", "kind": "points", "s": [1.3], "z": [1.7], "height": h}
     y = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=[lay])).xyz[0, 1]
-    assert abs(y - h) < 1e-9  # h straight up from the flat bonded face y = 0
+    # 0.002 along the normal under the surface (the line's direction is the central difference's,
+    # to ~1e-9 on the CAD: y to 1e-8, not the 1e-9 of a vertical line that had no direction to err)
+    assert abs(y - (top(1.3, 1.7) - 0.002 * ny)) < 1e-8
 
     tube = bd.Cylinder(8, 8) - bd.Cylinder(6, 8)
     shell = tmp_path / "shell.step"
     bd.export_step(tube - bd.Box(20, 10, 20, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER)), str(shell))
-    t = np.sqrt(64.0 - 9.0) - np.sqrt(36.0 - 9.0)  # 2.22005 mm at s = 3
+    t = 2.0  # along the normal (radial); 2.22005 mm vertically at s = 3
     kw = dict(skin="file", skin_file=str(shell), skin_bonded="normal:-y:89.99")
     for d, ok in ((t, True), (t + 0.005, False)):
         lay = {"name": "deep", "kind": "points", "s": [3.0], "z": [0.5], "depth": d}
         if ok:
-            assert abs(sensors.sites_for(Scene(sensors=[lay], **kw)).xyz[0, 1] - np.sqrt(36.0 - 9.0)) < 1e-8
+            xy = sensors.sites_for(Scene(sensors=[lay], **kw)).xyz[0, :2]
+            # on R 6, 2 mm along the normal, whose central difference over 1.6e-3 mm errs by
+            # ~(1.6e-3 / 8)^2 / 6 = 7e-9 (the vertical line's 1e-8 had no direction to err)
+            assert np.abs(xy - np.array([3.0, np.sqrt(55.0)]) * 6.0 / 8.0).max() < 5e-8
         else:
-            with pytest.raises(ParameterError, match=r"depth=2\.225.*valid: \[0, 2\.22005\] mm at s = 3, z = 0\.5"):
+            with pytest.raises(ParameterError, match=r"depth=2\.005.*valid: \[0, 2\] mm at s = 3, z = 0\.5"):
                 Scene(sensors=[lay], **kw)
 
 
@@ -291,10 +305,10 @@ def test_a_step_skins_sensors_are_read_on_its_solved_curved_faces(tmp_path):
     r = np.hypot(read.xyz[:, 0], read.xyz[:, 1])
     assert np.abs(r[on_bone] - 6.0).max() < 2e-4 and np.abs(r[~on_bone] - 8.0).max() < 2e-4
     assert np.abs(read.sigma_nn).max() > 0
-    # each sensor's plane lies along the R 8 surface over it, the tube's along z (2.6e-4 off it
-    # on these h = 2 quadratic faces; it was horizontal, 30 degrees off at s = 4)
-    x = read.xyz[:, 0]
-    n = np.column_stack([x, np.sqrt(64.0 - x ** 2), np.zeros_like(x)]) / 8.0
+    # each sensor's plane lies along the R 8 surface over s, the tube's along z (2.6e-4 off it
+    # on these h = 2 quadratic faces; it was horizontal, 30 degrees off at s = 4): its normal is
+    # radial, through the sensor, which lies on that normal line
+    n = np.column_stack([read.xyz[:, :2] / r[:, None], np.zeros_like(r)])
     assert np.abs(read.normal - n).max() < 1e-3
 
 
@@ -327,8 +341,8 @@ def _half_tube(path, R=8.0, r=6.0, h=0.5):
 
 
 def test_sensors_under_a_slope_lie_along_the_surface_and_read_across_it(tmp_path):
-    """A sensor stands on the vertical line under the contact surface but its plane lies along
-    that surface (normal: the surface's over it, t1 along it in the x-y plane), as a chip
+    """A sensor lies on the contact surface's normal line and its plane lies along that surface
+    (normal: the surface's over s, t1 along it in the x-y plane), as a chip
     embedded under a slope does. On a half tube (R 8, t 2) under a flat plate the sensors 0.5 mm
     under the 30 and 45 degree slopes, on the free surface beside the contact, read the traction
     across that plane: ~0 (measured 0.5 and 0.06 % of the peak sigma_nn, -0.37 MPa at the top).
@@ -341,7 +355,7 @@ def test_sensors_under_a_slope_lie_along_the_surface_and_read_across_it(tmp_path
             {"name": "b", "kind": "points", "s": [-3.0, 2.0], "height": 0.0}]
     sc = Scene(skin="file", skin_file=str(path), indenter="flat", depth=0.5, viscoelastic=False, sensors=lays)
     st = sensors.sites_for(sc)
-    x = st.xyz[:, 0]
+    x = st.s  # the surface point's x: the sensor lies on its normal line
     n = np.column_stack([x, np.sqrt(64.0 - x ** 2), np.zeros_like(x)]) / 8.0  # the circle's over x
     assert np.allclose(st.normal, n, rtol=0, atol=1e-5)
     assert np.allclose(st.t1, np.column_stack([n[:, 1], -n[:, 0], np.zeros_like(x)]), rtol=0, atol=1e-5)
@@ -372,22 +386,24 @@ def test_the_solve_places_in_its_mesh_what_the_scene_held(tmp_path):
     """The solve places the sensors the scene held on the STEP's CAD in the mesh solved, moved
     at most as far as that mesh's faces lie off the CAD, and refuses what the scene refuses in
     the scene's words. A sensor 0.002 mm under the cap passed the scene and was refused on a P1
-    mesh (h = 1: its chords 0.0168 mm low there, "valid: [0, 1.58851] mm") after meshing."""
+    mesh (h = 1: its chords 0.0168 mm low there, "valid: [0, 1.58851] mm", vertically) after
+    meshing. Heights are along the cap's normal (1.71838 mm to the base there)."""
     path, top = _cap(tmp_path)
     sc = Scene(skin="file", skin_file=str(path), order=1, formulation="displacement", mesh_size=1.0,
                refinement=1.0, indenter="flat", depth_fraction=0.03, viscoelastic=False)
     coords = sc.skin_kind.mesh_coordinates(sc, build_mesh(sc))
     chord = coords.column([1.3], [1.7])["top"][0]
     assert 0.01 < top(1.3, 1.7) - chord < 0.05  # the P1 mesh's chords under the cap there
-    lay = {"name": "hi", "kind": "points", "s": [1.3], "z": [1.7], "height": top(1.3, 1.7) - 0.002}
+    reach = top(1.3, 1.7) * 6.0 / (top(1.3, 1.7) + 4.0)  # along the cap's normal to the face y = 0
+    lay = {"name": "hi", "kind": "points", "s": [1.3], "z": [1.7], "height": reach - 0.002}
     y = sensors.resolve(sensors.layouts([lay]), coords, 3).xyz[0, 1]
     assert y == pytest.approx(chord, abs=1e-9)  # on the mesh's top face: 0.0148 mm down
-    out = {**lay, "height": top(1.3, 1.7) + 0.001}
+    out = {**lay, "height": reach + 0.001}
     with pytest.raises(ParameterError) as scene:
         Scene(skin="file", skin_file=str(path), sensors=[out])
     with pytest.raises(ParameterError) as solve_time:
         sensors.resolve(sensors.layouts([out]), coords, 3)
-    assert str(solve_time.value) == str(scene.value) and "valid: [0, 1.60535] mm" in str(scene.value)
+    assert str(solve_time.value) == str(scene.value) and "valid: [0, 1.71838] mm" in str(scene.value)
 
 
 def test_a_line_inside_a_curved_rim_reads_the_top_and_the_bonded_face_not_the_wall(tmp_path, capsys):
@@ -474,21 +490,73 @@ def test_a_sensor_just_past_the_meshed_rim_is_refused_with_the_remedy(tmp_path, 
     assert "move the sensor in by that" in err and not (tmp_path / "o").exists()
 
 
-def test_sensors_csv_says_how_far_under_the_surface_a_vertical_depth_lies(tmp_path):
-    """A file skin's depth is vertical, the fingertip's along the surface normal: a depth-0.5
-    sensor under the half tube's 45 degree slope lies 0.354 mm from the surface along its normal,
-    and sensors.csv said only "depth_mm 0.5". Its last column, normal_depth_mm, is that distance
-    (depth * ny; under the tangent plane over the sensor, which the R 8 surface follows to 0.008
-    mm here), and on the fingertip it equals depth_mm."""
+def test_a_depth_under_a_slope_is_along_the_surface_normal(tmp_path):
+    """A file skin's depth was vertical, the fingertip's along the surface normal: a depth-0.5
+    sensor under the half tube's 45 degree slope lay 0.354 mm from the surface along its normal
+    (0.346 from the R 8 circle), and sensors.csv's normal_depth_mm said so. The sensor now lies
+    0.5 mm along the inward normal from the surface point over s, on the P2 .msh (its faces are
+    R 8 to ~1e-6 mm at h = 0.5) and on a STEP's CAD faces (to 1e-6), in the scene's sites and on
+    the solved (P2, h = 2) mesh's; normal_depth_mm = depth_mm."""
+    import build123d as bd
+
+    s45 = 8.0 * np.sin(np.pi / 4)
     path = _half_tube(tmp_path / "tube.msh")
-    lay = {"name": "s", "kind": "points", "s": [0.0, 8.0 * np.sin(np.pi / 4)], "depth": 0.5}
+    lay = {"name": "s", "kind": "points", "s": [0.0, s45], "depth": 0.5}
     st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=[lay]))
-    rd = sensors.readings_from_stress(st, np.zeros((2, 3, 3)))
-    rows = [r.split(",") for r in rd.to_csv().splitlines()]
-    assert rows[0][-1] == "normal_depth_mm" and rows[0][6] == "depth_mm"
-    assert [float(r[6]) for r in rows[1:]] == [0.5, 0.5]
-    assert np.allclose([float(r[-1]) for r in rows[1:]], [0.5, 0.5 * np.sqrt(0.5)], rtol=0, atol=1e-5)
-    # the sensor's distance from the R 8 surface along its normal: 0.354 - 0.008 (the curvature)
-    assert 8.0 - np.hypot(*st.xyz[1, :2]) == pytest.approx(0.346, abs=1e-3)
-    ft = Scene(skin="fingertip", thickness=3.0, sensors=[{"name": "f", "s": [0.0, 5.0], "depth": 1.0}])
-    assert np.array_equal(sensors.sites_for(ft).normal_depth, [1.0, 1.0])
+    assert np.abs(8.0 - np.hypot(*st.xyz[:, :2].T) - 0.5).max() < 2e-6
+    assert abs(st.xyz[1, 0] - st.xyz[1, 1]) < 1e-6  # on the 45 degree ray: along the normal
+    rows = [r.split(",") for r in sensors.readings_from_stress(st, np.zeros((2, 3, 3))).to_csv().splitlines()]
+    assert rows[0][-1] == "normal_depth_mm" and [float(r[-1]) for r in rows[1:]] == [0.5, 0.5]
+
+    tube = bd.Cylinder(8, 8) - bd.Cylinder(6, 8)
+    shell = tmp_path / "shell.step"
+    bd.export_step(tube - bd.Box(20, 10, 20, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER)), str(shell))
+    lays = [{"name": "d", "kind": "points", "s": [0.0, s45, 7.0], "z": [0.5], "depth": 0.5},
+            {"name": "h", "kind": "points", "s": [s45], "z": [0.5], "height": 0.5}]
+    sc = Scene(skin="file", skin_file=str(shell), skin_bonded="normal:-y:89.99", indenter="sphere",
+               indenter_radius=3.0, mesh_size=2.0, refinement=1.0, sensors=lays)
+    for st in (sensors.sites_for(sc), sensors.sites_for(sc, coords=sc.skin_kind.mesh_coordinates(sc, build_mesh(sc)))):
+        r = np.hypot(*st.xyz[:, :2].T)
+        # 0.5 under R 8 (the height 0.5 over the R 6 bone on the same normal line: 1.5 deep)
+        assert np.abs(r - [7.5, 7.5, 7.5, 6.5]).max() < 1e-4
+        assert np.abs(st.xyz[:, 0] / r - st.normal[:, 0]).max() < 1e-4 and np.abs(st.xyz[:, 2] - 0.5).max() < 1e-4
+    assert np.abs(np.hypot(*sensors.sites_for(sc).xyz[:, :2].T) - [7.5, 7.5, 7.5, 6.5]).max() < 1e-6
+
+
+def test_a_too_deep_sensor_under_a_slope_is_refused_in_one_line(tmp_path, capsys):
+    """Under the half tube's 45 degree slope the skin is 2 mm thick along the normal but 3.66
+    mm vertically: a depth 2.1 was held (vertical, 1.49 mm from the surface). Along the normal it is refused
+    in one line naming the layout, the sensor and the largest depth there (2 mm)."""
+    from tactileskin.cli import main
+
+    path = _half_tube(tmp_path / "tube.msh")
+    s45 = 8.0 * np.sin(np.pi / 4)
+    st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat",
+                                 sensors=[{"name": "ok", "s": [s45], "depth": 1.9}]))
+    assert 8.0 - np.hypot(*st.xyz[0, :2]) == pytest.approx(1.9, abs=2e-6)
+    (tmp_path / "s.toml").write_text(f'[[sensors]]\nname = "deep"\ns = [{s45}]\ndepth = 2.1\n')
+    rc = main(["solve", "--skin-file", str(path), "-i", "flat", "--sensors", str(tmp_path / "s.toml"),
+               "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert "sensor layout 'deep' depth=2.1" in err and "[0, 2] mm at s = 5.65685 mm" in err, err
+    assert "(sensor deep-0)" in err and not (tmp_path / "o").exists()
+
+
+def test_a_flat_file_skins_sensors_are_unchanged_to_the_bit(tmp_path):
+    """On a flat top (normal +y) a depth along the normal is the vertical one: the pad's 3D
+    block as STEP places a grid at depth 0.7 and a height-0.3 line exactly where the vertical
+    columns did (x_top + s, top - depth, z), bit for bit."""
+    import build123d as bd
+
+    path = tmp_path / "block.step"
+    bd.export_step(bd.Box(4.0, 2.0, 4.0, align=(bd.Align.CENTER, bd.Align.MAX, bd.Align.CENTER)), str(path))
+    lays = [{"name": "g", "kind": "grid", "s": [-1.5, 1.5], "z": [-1.3, 1.3], "pitch": [0.5, 0.65], "depth": 0.7},
+            {"name": "h", "kind": "line", "s": [-1.0, 1.0], "pitch": [0.25], "z": [0.4], "height": 0.3}]
+    st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=lays))
+    g = np.array([n == "g" for n in st.layout])
+    S, Z = np.meshgrid(-1.5 + 0.5 * np.arange(7), -1.3 + 0.65 * np.arange(5))
+    assert np.array_equal(st.xyz[g], np.column_stack([S.ravel(), np.full(35, 0.0 - 0.7), Z.ravel()]))
+    assert np.array_equal(st.xyz[~g], np.column_stack([-1.0 + 0.25 * np.arange(9), np.full(9, 0.0 - (2.0 - 0.3)),
+                                                       np.full(9, 0.4)]))
+    assert np.array_equal(st.normal, np.tile([0.0, 1.0, 0.0], (44, 1))) and np.array_equal(st.normal_depth, st.depth)

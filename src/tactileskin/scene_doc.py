@@ -34,9 +34,9 @@ FIELDS: dict[str, tuple[str, str, str]] = {
                   "fingertip geometry"),
     "sensors": ("mm", "[[sensors]] layouts: kind points / line / grid (3D), s along the bone, depth "
                 "below the surface or height above the bone, pitch, taxel (inside the skin); pad: s = x, "
-                "depth along -y; file: s = x - x_top, depth straight down (-y) from the contact surface "
-                "at (x, z), height straight up (+y) from the bonded surface there; dome: as file, s = x, "
-                "z in [-dome_length, dome_tip], height over the bone only where the line meets it",
+                "depth along -y; file: s = x - x_top and z of the contact surface's point, depth along its "
+                "inward normal there, height along that line from the bonded surface; dome: as file, s = x, "
+                "z in [-dome_length, dome_tip]",
                 "where stresses are read (sensors.csv); () = none"),
     "indenter_radius": ("mm", "(0.1, 1000]; sphere and cylinder only", "indenter radius"),
     "indenter_axis": ("-", "'z' (along the finger, 2D-exact) or 'x' (3D); cylinder only", "cylinder axis"),

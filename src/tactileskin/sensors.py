@@ -9,12 +9,14 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
   at s is one line from the surface to the bone); or height above the bone, = t - depth.
   depth 0 is the outer surface, depth t (height 0) the bonded (bone) surface;
 - z (mm, 3D only): along the finger; the slab spans [-L/2, L/2] (L = fingertip sample_length).
-A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top,
-its depth straight down from the contact surface at (x, z) and its height straight up from the
-bonded surface there, its plane along the contact surface over (x, z) (skins.file.FileCoordinates,
-the dome's too; its n has a z part where the surface slopes along z): vertical, not along n, so
-under a slope theta it lies depth cos theta under the surface along n (Sites.normal_depth,
-sensors.csv's normal_depth_mm).
+A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top
+and z that of its contact surface's point over (x, z), its depth along that surface's inward
+normal n there and its height along the same line from where it leaves the skin through the
+bonded face, its plane along the surface there (skins.file.FileCoordinates, the dome's too; its
+n has a z part where the surface slopes along z). So on every skin a sensor at depth d lies d
+from the surface along its plane's normal (Sites.normal_depth = depth, sensors.csv's
+normal_depth_mm; a file skin's and the dome's depth was vertical, d cos theta along n under a
+slope theta).
 
 Kinds: `points` (s, and in 3D z, one per sensor), `line` (s = [s0, s1] at `pitch`; in 3D at
 one z), `grid` (3D: s = [s0, s1], z = [z0, z1], pitch one value or [ps, pz]). A taxel of side
@@ -33,7 +35,7 @@ inside the elements, fe.probe): P = -tr(sigma)/3 (the paper's mean pressure, com
 positive), sigma_nn = n.sigma.n (tension positive) and the shears tau_1 = t1.sigma.n,
 tau_2 = t2.sigma.n, with n the sensor plane's normal in the undeformed skin (the local normal of
 the depth surface, pointing out of the skin; exact on the bonded surface, which does not move; a
-file skin's: the contact surface's over the sensor), t1 along increasing s in the x-y plane (n x
+file skin's: the contact surface's at the point the sensor hangs from), t1 along increasing s in the x-y plane (n x
 e_z normalised) and t2 = t1 x n (+z where n has no z part). A taxel averages the tensor
 over its area, then projects it on its centre's frame (a flat, rigid chip). In 2D plane strain
 sigma_xz = sigma_yz = 0, so tau_2 = 0 exactly.
@@ -362,9 +364,9 @@ class Sites:
     samples: np.ndarray
     weights: np.ndarray
     dim: int = 2
-    # the distance along the normal from the contact surface's tangent plane over the sensor:
-    # depth on the built-in skins, depth * n_y on a file skin or the dome (depth is vertical
-    # there); None: unknown (NaN in the readings)
+    # the distance along the normal from the contact surface: depth on every skin (a file
+    # skin's and the dome's was vertical, depth * n_y along it); None: unknown (NaN in the
+    # readings)
     normal_depth: np.ndarray | None = None
 
     @classmethod
@@ -487,9 +489,9 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         samples[rows, :k] = (pq if pq.shape[1] == 3 else np.column_stack([pq, zz])).reshape(cnt, k, 3)
         weights[rows, :k] = np.broadcast_to(wq / wq.sum(), (cnt, k))
         weights[rows, k:] = 0.0
-    # a file skin's depth is vertical: the sensor lies depth * n_y under the tangent plane over it
-    # (0.71 mm for depth 1 under a 45 degree slope); a section's lies along the normal
-    normal_depth = depth * normal[:, 1] if local else depth.copy()
+    # every skin's depth is along the surface's normal now (a file skin's and the dome's was
+    # vertical, depth * n_y along it: 0.71 mm for depth 1 under a 45 degree slope)
+    normal_depth = depth.copy()
     return Sites(ids, names, s, z, depth, xyz, normal, t1, t2, samples, weights, dim, normal_depth)
 
 
@@ -597,8 +599,8 @@ def readings_from_stress(sites: Sites, sig: np.ndarray) -> "SensorReadings":
 
 # appended (a reader of the first twelve columns reads them as before): nx, ny, nz, the sensor
 # plane's unit normal (the frame the stresses are resolved in), and normal_depth_mm, the sensor's
-# distance below the surface's tangent plane over it along that normal (= depth_mm where depth is
-# along the normal, depth * ny where it is vertical: a file skin, the dome)
+# distance from the surface along that normal (= depth_mm on every skin; it was depth * ny while a
+# file skin's and the dome's depth was vertical)
 OLD_COLUMNS = ("sensor_id", "layout", "x_mm", "y_mm", "z_mm", "s_mm", "depth_mm", "pressure_mpa",
                "sigma_nn_mpa", "tau_1_mpa", "tau_2_mpa", "taxel_points")
 COLUMNS = OLD_COLUMNS + ("nx", "ny", "nz", "normal_depth_mm")

@@ -12,17 +12,15 @@ sphere or a Braille dot there presses half on the finger and half on the dome. s
 length along the bone's ellipse (a - t, b - t) from its top, by the angle of (x, y) (so it
 also parametrises the bone under the dome); the 3D profile's section plane is z = 0.
 
-Sensors (`DomeCoordinates`): a user's file skin's vertical columns (skins.file.FileCoordinates),
-not the fingertip's normals: s = x, z as given (z in [-dome_length, dome_tip]), depth straight
-down (-y) from the outer surface at (x, z), height straight up (+y) from the bone there, the
-sensor plane along the outer surface over (x, z) (normal the surface's, out of the plane z =
+Sensors (`DomeCoordinates`): a user's file skin's normal lines (skins.file.FileCoordinates):
+s = x and z (in [-dome_length, dome_tip]) of the outer surface's point, depth along its inward
+normal there (the outer body's exact gradient), height along that line from where it meets the
+bone, the sensor plane along the outer surface there (normal the surface's, out of the plane z =
 const on the tip; t1 in the x-y plane). The bone is the outer body shrunk by t per semi-axis,
-not its offset (no common normal from the surface to the bone): a vertical line is one answer
-everywhere. On
-the tip (z > 0) the line meets the bone's cap (`bone_tip`, bonded) while |x| < (a - t) sqrt(1 -
-(z / (c - t))^2); past it (the flanks, the last t of the tip) no bone is under it: a height is
-refused there and a depth runs through to the skin's underside. The scene checks the layouts on
-the exact surfaces, the solve places them on the mesh it solves (mesh_coordinates).
+not its offset (no common normal from the surface to the bone): along the surface's normal the
+skin is 1.994-2.0 mm thick at t = 2 (c = a), and the line meets the bone everywhere (the
+vertical line missed it over the flanks and the last t of the tip). The scene checks the
+layouts on the exact surfaces, the solve places them on the mesh it solves (mesh_coordinates).
 """
 
 from __future__ import annotations
@@ -238,8 +236,9 @@ def _dim3(scene) -> int:
 
 
 class DomeCoordinates(FileCoordinates):
-    """The dome's sensor coordinates for the scene's check (FileCoordinates' vertical columns,
-    read on the exact surfaces instead of a mesh's faces): the line through (x, z) meets the
+    """The dome's sensor coordinates for the scene's check (FileCoordinates' normal lines,
+    checked on the vertical columns of the exact surfaces instead of a mesh's faces, the normal
+    the exact gradient): the vertical line through (x, z) meets the
     outer body's upper surface (the contact surface) at y = b sqrt(k - (x/a)^2), k = 1 -
     (max(z, 0)/c)^2, then the bone's (bonded) where it passes over the bone, else the skin's
     underside (the outer surface's lower half)."""
@@ -267,3 +266,17 @@ class DomeCoordinates(FileCoordinates):
         floor = np.where(bonded, (sec.b - t) * np.sqrt(np.maximum(bone, 0.0)), -top)
         top, floor = np.where(on, top, np.nan), np.where(on, floor, np.nan)
         return {"top": top, "outer": top, "floor": floor, "bonded": bonded}
+
+    def surface_normal(self, s, z=None) -> np.ndarray:
+        """(n, 3) the outer surface's outward unit normal over each (s, z): the outer body's
+        gradient (x / a^2, y / b^2, max(z, 0) / c^2), exact (FileCoordinates' central difference
+        straddled z = 0, where the tip's curvature begins: a 3e-5 z part, 6e-5 mm of a sensor's
+        position 2 mm along it); +y off the skin, as there."""
+        sec = self.sec
+        x = np.atleast_1d(np.asarray(s, float))
+        z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), x.shape)
+        y = self.column(x, z)["top"]
+        n = np.column_stack([x / sec.a ** 2, y / sec.b ** 2, np.maximum(z, 0.0) / sec.c ** 2])
+        ok = np.isfinite(y)
+        n[~ok] = (0.0, 1.0, 0.0)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)

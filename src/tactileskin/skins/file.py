@@ -15,11 +15,12 @@ value given is refused), the top point (highest point of the outer surface, near
 x = z = 0 among equals; of a STEP, the CAD surface's point on that axis), where indenters start (y0 = its y; indenters stay centred on
 x = z = 0; `check_placement` refuses a skin upside down, off the axis or highest off it). s
 along the bonded surface is x - x_top (signed), the section plane of a 3D
-profile z = 0. Sensors (`FileCoordinates`): s = x - x_top, z as given, depth straight down (-y)
-from the contact surface at (x, z), height straight up (+y) from the bonded surface there (the
-first face under the contact surface), the sensor plane along the contact surface over (x, z)
-(normal: that surface's, t1 along it in the x-y plane); both surfaces read on the analysed mesh's
-boundary facets (quadratic on a P2 .msh, as the solver's), a STEP's on its CAD faces.
+profile z = 0. Sensors (`FileCoordinates`): s = x - x_top and z of the contact surface's point
+over (x, z), depth along its inward normal there (as on the fingertip), height along the same
+line from where it leaves the skin through the bonded surface, the sensor plane along the
+contact surface there (normal: that surface's, t1 along it in the x-y plane); the surfaces read
+on the analysed mesh's boundary facets (quadratic on a P2 .msh, as the solver's), a STEP's on its
+CAD faces.
 The model is the half x >= 0 when a .msh names a `symmetry` group, or when a STEP solid and its
 bonded faces are mirror-symmetric about x = 0 (mesh.skinfile.step_symmetry) and so is the
 indenter (geometry.indenters.indenter_symmetry): the solid is cut there; likewise z = 0 (3D).
@@ -81,6 +82,9 @@ WALL_NY = 0.1
 # held crossed no face): the solve moves it onto the nearest point over the mesh's contact
 # surface, at most RIM_SHIFT of that edge's length (a chord's sagitta is L / (8 R) of its length L)
 RIM_SHIFT = 0.25
+# samples along a sensor's line (FileCoordinates._exit) per stretch, before its exit is bisected:
+# a gap in the skin thinner than the stretch / EXIT_SAMPLES between two samples may be missed
+EXIT_SAMPLES = 16
 # the bonded surfaces held fixed: the fingertip's nail and the dome's bone under its tip, as
 # `tactileskin mesh` writes them, where the file has them
 FIXED = ("bone_interface", "nail_edge", "bone_tip")
@@ -352,13 +356,14 @@ class FileSection:
 
 class FileCoordinates:
     """Sensor coordinates of a file skin (the `coordinates` duck type of sensors.resolve): s =
-    x - x_top, z as given (3D); depth straight down (-y) from the contact surface at (x, z),
-    height straight up (+y) from the bonded surface there; the sensor plane lies along the
-    contact surface over (x, z): normal that surface's (+y where it is flat), t1 = n x e_z
+    x - x_top, z (3D) of the contact surface's point P over (x, z); the sensor at P - depth n,
+    n that surface's outward unit normal at P (+y where it is flat: straight down, as it was
+    everywhere), height along the same line from where it leaves the skin (through a bonded
+    face); the sensor plane lies along the contact surface at P: normal n, t1 = n x e_z
     normalised (+x on a flat top), t2 = t1 x n (+z).
-    The sensor's column is the vertical line through (x, z): its top must be the contact
-    surface and the point must lie above the first boundary under it (which, for a height,
-    must be bonded); the heights are read on the mesh's boundary facets, quadratic on a P2
+    The vertical line through (x, z) must have the contact surface on top, and the normal line
+    must stay in the skin to the depth: each of its points between its own vertical line's top
+    and the first boundary under that (_exit); the heights are read on the mesh's boundary facets, quadratic on a P2
     mesh as the solver's (on their chords a bone sensor of the fingertip's own mesh lay inside
     the bone, and the solve failed reading it); a STEP's on its CAD faces (`cad`: the file; its
     P1 analysis mesh's chords find the faces) for the scene's check, and on the mesh solved for
@@ -637,8 +642,8 @@ class FileCoordinates:
         return [(hit, np.einsum("ni,ni->n", N, Y))]
 
     def depths(self, where: str, lay, s, z, idx, what: str = "") -> np.ndarray:
-        """The depth below the contact surface of each point (s, z) of the layout `lay` (its
-        depth, or the height over the bonded surface there); a point outside the skin is a
+        """The depth along the contact surface's inward normal at each point (s, z) of the
+        layout `lay` (its depth, or the line's length in the skin less its height); a point outside the skin is a
         ParameterError naming the layout, the sensor (`idx`: its index in the layout) and the
         valid range there. With a `reference` (mesh_coordinates) its check decides, and the
         depths it accepts are clamped into this mesh's columns."""
@@ -655,7 +660,6 @@ class FileCoordinates:
                 logger.info("sensor layout %r: %d point(s) past the solved mesh's rim moved up to %.3g mm onto "
                             "it", lay.name, int(np.sum(moved > 0)), float(moved.max()))
         col = self.column(s, z if self.dim == 3 else None)
-        t = col["top"] - col["floor"]
 
         def at(i):
             return f"s = {s[i]:.6g}" + (f", z = {z[i]:.6g}" if self.dim == 3 else "") + " mm"
@@ -681,30 +685,137 @@ class FileCoordinates:
             raise ParameterError(f"{where} s{what}", float(s[i]), "under the contact surface",
                                  f"{sensor(i)}: at {at(i)} the skin's top is not its contact surface "
                                  "(skin_outer)")
+        # the line along the contact surface's inward normal at (s, z): a depth is measured on
+        # it, as on the fingertip (the common normal of its surface and bone), so a skin of
+        # uniform thickness holds depth d at d from its surface everywhere (vertically, 0.5 under
+        # a 45 degree slope lay 0.354 mm from the surface); a height from where it meets the
+        # bonded face (the fingertip's height = t - depth)
+        P, nrm = self._surface(s, z)
         if lay.depth is not None:
             d = np.full(len(s), float(lay.depth))
+            ex = self._exit(P, nrm, np.maximum(d, 0.0))  # inf where the line stays in the skin to d
             if self.reference is not None:
-                return self._clamped(lay, d, t)
-            bad = (d < -_TOL) | (d > t + _TOL)
+                return self._clamped(lay, d, ex)
+            bad = (d < -_TOL) | (d > ex + _TOL)
             if bad.any():
                 i = first(bad)
-                raise ParameterError(f"{where} depth", float(d[i]), f"[0, {t[i]:.6g}] mm at {at(i)} (the skin's "
-                                     "thickness under its contact surface there)", sensor(i))
+                reach = self._exit(P[i:i + 1], nrm[i:i + 1])[0]
+                raise ParameterError(f"{where} depth", float(d[i]), f"[0, {reach:.6g}] mm at {at(i)} (along the "
+                                     "contact surface's inward normal there, to where that line leaves the skin)",
+                                     sensor(i))
             return d
         h = float(lay.height)
-        if not col["bonded"].all():
-            i = first(~col["bonded"])
-            raise ParameterError(f"{where} height", h, "a depth instead where no bonded surface is under the "
-                                 "sensor", f"{sensor(i)}: at {at(i)} the face under the contact surface is "
-                                 "not bonded")
+        ex, bonded = self._exit(P, nrm, bonded=True)
         if self.reference is not None:
-            return self._clamped(lay, t - h, t)
-        bad = (h < -_TOL) | (h > t + _TOL)
+            return self._clamped(lay, ex - h, ex)
+        if not bonded.all():
+            i = first(~bonded)
+            raise ParameterError(f"{where} height", h, "a depth instead where no bonded surface is under the "
+                                 "sensor", f"{sensor(i)}: at {at(i)} the line along the contact surface's "
+                                 "inward normal leaves the skin through a face that is not bonded")
+        bad = (h < -_TOL) | (h > ex + _TOL)
         if bad.any():
             i = first(bad)
-            raise ParameterError(f"{where} height", h, f"[0, {t[i]:.6g}] mm at {at(i)} (the skin's thickness "
-                                 "over its bonded surface there)", sensor(i))
-        return t - h
+            raise ParameterError(f"{where} height", h, f"[0, {ex[i]:.6g}] mm at {at(i)} (the skin's thickness "
+                                 "along the contact surface's inward normal there)", sensor(i))
+        return np.maximum(ex - h, 0.0)
+
+    def _surface(self, s, z) -> tuple:
+        """(P, n): the contact surface's point over each (s, z) ((m, dim): x, y(, z)) and its
+        outward unit normal there ((m, dim))."""
+        s = np.atleast_1d(np.asarray(s, float))
+        top = self.column(s, z if self.dim == 3 else None)["top"]
+        cols = [self.x_top + s, top] + ([np.broadcast_to(np.asarray(z, float), s.shape)] if self.dim == 3 else [])
+        nrm = self.surface_normal(s, z if self.dim == 3 else None)
+        return np.column_stack(cols), (nrm if self.dim == 3 else nrm[:, :2])
+
+    def _inside(self, pts, gap: bool = False) -> np.ndarray:
+        """Whether each point (m, dim) lies in the skin's first layer: on its column, at most the
+        top (+ tol: a point on the surface) and at least the first boundary under it (strictly:
+        a line's exit is the last point in the skin, so a height 0 lies on the bonded face).
+        gap=True: how far inside (mm, vertical; < 0 outside, NaN off the skin) instead."""
+        col = self.column(pts[:, 0] - self.x_top, pts[:, 2] if self.dim == 3 else None)
+        g = np.minimum(col["top"] + self.tol - pts[:, 1], pts[:, 1] - col["floor"])
+        if gap:
+            return g
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(g) & (g >= 0.0)
+
+    def _exit(self, P, n, limit=None, bonded: bool = False):
+        """The distance along -n from each surface point P to where that line leaves the skin
+        (the first boundary under the contact surface, or a side): within `limit` (inf where it
+        stays in the skin that far), or (None) however far (inf: not within twice the skin's
+        size). The line is sampled at EXIT_SAMPLES points per stretch (a stretch: the limit, or
+        the vertical thickness there, doubled until the line leaves), then the exit found to
+        1e-13 of the size (the point returned is in the skin). bonded=True: also whether it
+        leaves through a bonded face."""
+        m = len(P)
+        out, lo, hi = np.full(m, np.inf), np.zeros(m), np.full(m, np.nan)
+        glo, ghi = np.full(m, np.inf), np.full(m, np.nan)  # the gaps there (inf: the surface point)
+        full = limit is None
+        if full:
+            col = self.column(P[:, 0] - self.x_top, P[:, 2] if self.dim == 3 else None)
+            lim = np.where(np.isfinite(col["floor"]), col["top"] - col["floor"], self.thickness)
+            lim = np.maximum(lim, self.tol)
+        else:
+            lim = np.broadcast_to(np.asarray(limit, float), (m,)).copy()
+        live = lim > 0.0
+        k = np.arange(1, EXIT_SAMPLES + 1) / EXIT_SAMPLES
+        for _ in range(12 if full else 1):
+            idx = np.flatnonzero(live)
+            if not idx.size:
+                break
+            lam = lo[idx, None] + (lim[idx] - lo[idx])[:, None] * k[None, :]
+            g = self._inside((P[idx, None, :] - lam[..., None] * n[idx, None, :]).reshape(-1, P.shape[1]), gap=True)
+            g = g.reshape(lam.shape)
+            with np.errstate(invalid="ignore"):
+                ins = g >= 0.0
+            left = ~ins.all(axis=1)
+            j = np.argmax(~ins, axis=1)
+            r = np.arange(len(idx))
+            hi[idx[left]], ghi[idx[left]] = lam[r, j][left], g[r, j][left]
+            before = np.maximum(j - 1, 0)
+            lo[idx[left]] = np.where(j > 0, lam[r, before], lo[idx])[left]
+            glo[idx[left]] = np.where(j > 0, g[r, before], glo[idx])[left]
+            live[idx[left]] = False
+            stay = idx[~left]
+            lo[stay], glo[stay] = lim[stay], g[~left, -1]
+            lim[stay] *= 2.0
+            live[stay] &= full & (lim[stay] <= 4.0 * self._size)
+        go = np.isfinite(hi)
+        # the exit between lo (in) and hi (out): regula falsi (Illinois) on the vertical gap, a
+        # smooth function of the distance across a face (a few column reads, each a CAD query
+        # on a STEP), halving where it is unknown (off the skin's side) or stalls
+        last = np.zeros(m, int)
+        for _ in range(100):
+            act = go & (hi - lo > 1e-13 * self._size) & (glo > 1e-13 * self._size)
+            if not act.any():
+                break
+            ok = np.isfinite(glo) & np.isfinite(ghi) & (ghi < 0.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                mid = np.where(ok, (lo * ghi - hi * glo) / (ghi - glo), 0.5 * (lo + hi))
+            span = hi - lo
+            mid = np.clip(np.where(np.isfinite(mid), mid, 0.5 * (lo + hi)), lo + 1e-3 * span, hi - 1e-3 * span)
+            g = np.full(m, np.nan)
+            g[act] = self._inside(P[act] - mid[act, None] * n[act], gap=True)
+            with np.errstate(invalid="ignore"):
+                ins = act & (g >= 0.0)
+                out_ = act & ~(g >= 0.0)
+            lo, glo = np.where(ins, mid, lo), np.where(ins, g, glo)
+            hi, ghi = np.where(out_, mid, hi), np.where(out_, g, ghi)
+            # Illinois: the end kept twice has its gap halved, so the next step moves it
+            ghi = np.where(ins & (last == 1), 0.5 * ghi, ghi)
+            glo = np.where(out_ & (last == -1), 0.5 * glo, glo)
+            last = np.where(ins, 1, np.where(out_, -1, last))
+        out[go] = lo[go]
+        if not bonded:
+            return out
+        # at the exit the floor of its column is what it meets (not its top, not a side), bonded
+        q = P - np.where(go, lo, 0.0)[:, None] * n
+        col = self.column(q[:, 0] - self.x_top, q[:, 2] if self.dim == 3 else None)
+        with np.errstate(invalid="ignore"):
+            through = go & (q[:, 1] - col["floor"] <= self.tol) & col["bonded"]
+        return out, through
 
     def _remedy(self, s, z) -> str:
         """What to do about a point over no skin: move it to the nearest skin, which a mesh's
@@ -721,8 +832,8 @@ class FileCoordinates:
                 "the skin's: a finer mesh_size or order 2, or the sensor that much further in")
 
     def _clamped(self, lay, d, t) -> np.ndarray:
-        """The depths d (the reference's check held them) moved into this mesh's columns [0, t]:
-        at most as far as its faces lie off the reference's there."""
+        """The depths d (the reference's check held them) moved into this mesh's skin along
+        each sensor's line, [0, t]: at most as far as its faces lie off the reference's there."""
         out = np.clip(d, 0.0, t)
         moved = float(np.max(np.abs(out - d), initial=0.0))
         if moved > self.tol:
@@ -732,24 +843,25 @@ class FileCoordinates:
         return out
 
     def frame(self, s, depth, z=None, normals: bool = True):
-        """(xy (n, 2; in 3D xyz (n, 3): z as placed), the contact surface's outward unit normal
-        at (s, z) (n, 2; in 3D (n, 3)), t1 along that surface in the x-y plane (n, 2 / 3), area
-        element 1) at depth below the contact surface over (s, z). A sensor stands on the vertical line but lies parallel to
-        the surface over it (a depth layout's surface is that one moved down, with its normal), as
-        a chip embedded under a slope does: its plane had normal +y everywhere, and 0.5 mm under
-        20-45 degree slopes of a half tube (R 8, t 2) and of the dome, beside a flat plate's
-        contact, read sigma_yy, 0.009-0.016 MPa where sigma_nn is ~0 (5-8 % of the reading at
-        10 degrees under the contact, itself 3-4 % off). normals=False: the points only (NaN
-        normals), for taxel samples."""
+        """(xy (n, 2; in 3D xyz (n, 3)), the contact surface's outward unit normal n at (s, z)
+        (n, 2; in 3D (n, 3)), t1 along that surface in the x-y plane (n, 2 / 3), area element 1):
+        the point at `depth` along -n from the contact surface's point over (s, z), as on the
+        fingertip (it stood on the vertical line: 0.5 under a 45 degree slope lay 0.354 mm from the
+        surface; on a flat top, n = +y, the point is the same to the bit). The sensor plane lies
+        along the surface there (a depth layout's surface is that one moved in along n), as a chip
+        embedded under a slope does: with it horizontal, 0.5 mm under 20-45 degree slopes of a half
+        tube (R 8, t 2) and of the dome, beside a flat plate's contact, sensors read sigma_yy,
+        0.009-0.016 MPa where sigma_nn is ~0 (5-8 % of the reading at 10 degrees under the
+        contact, itself 3-4 % off). normals=False: NaN normals (the points of taxel samples)."""
         s = np.atleast_1d(np.asarray(s, float))
         depth = np.broadcast_to(np.asarray(depth, float), s.shape)
         s, z, _ = self.placed(s, z)  # the solved mesh's rim: as depths() placed them
-        y = self.column(s, z)["top"] - depth
+        P, nrm = self._surface(s, z)
         n = len(s)
-        xy = np.column_stack([self.x_top + s, y] + ([z] if self.dim == 3 else []))
+        xy = P - depth[:, None] * nrm
         if not normals:
             return xy, np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.ones(n)
-        nrm = self.surface_normal(s, z)
+        nrm = nrm if self.dim == 3 else np.column_stack([nrm, np.zeros(n)])
         t1 = np.column_stack([nrm[:, 1], -nrm[:, 0]] + ([np.zeros(n)] if self.dim == 3 else []))
         t1 /= np.linalg.norm(t1, axis=1, keepdims=True)  # n x e_z: +x where the surface is flat
         return xy, nrm if self.dim == 3 else nrm[:, :2], t1 if self.dim == 3 else t1[:, :2], np.ones(n)
@@ -759,7 +871,12 @@ class FileCoordinates:
         central differences of the column's top over SLOPE_STEP of the skin's size (one-sided at
         the skin's edge; a mirror half's top is even, so its symmetry line reads flat). A slope
         under FLAT_SLOPE (rounding: heights of a flat P2 face differ by ~1e-16 of the size) is
-        flat: normal exactly +y, so a flat top reads as it always did."""
+        flat: normal exactly +y, so a flat top reads as it always did. With a `reference` (the
+        solved mesh's coordinates) the reference's: a sensor's line runs along it, and the P2
+        dome's faces tilt the central difference by ~1.2e-4 (2.4e-4 mm along a 2 mm line, where
+        a bone sensor read the bone map 5e-4 mm off its point)."""
+        if self.reference is not None:
+            return self.reference.surface_normal(s, z)
         s = np.atleast_1d(np.asarray(s, float))
         z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape)
         h = SLOPE_STEP * self._size
