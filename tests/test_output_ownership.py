@@ -88,6 +88,18 @@ def test_an_edited_result_file_is_refused_before_the_solve(tmp_path, capsys, mon
     assert (d / "bone_map.csv").read_text().endswith("0,0,1\n")
 
 
+def test_an_edited_history_does_not_block_a_force_solve_which_writes_none(tmp_path, capsys, fake_solve):
+    # history.csv comes of [[loading]] segments only; a --force ramp writes none, yet its
+    # solve was refused (exit 2, "changed since") over an edited history.csv of an earlier run
+    d = tmp_path / "s1"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    (d / "history.csv").write_text("t_s,travel_mm\n0,0\n")
+    ownership.record_file(d / "history.csv")  # as an earlier indent-hold-release run left it
+    (d / "history.csv").write_text("t_s,travel_mm\n0,0\n1,0.2\n")  # then edited
+    assert main(["solve", *CHEAP, "--force", "0.1", "--out", str(d)]) == 0, _err(capsys)
+    assert (d / "history.csv").read_text().endswith("1,0.2\n")
+
+
 def test_the_solve_table_lists_the_2d_comparison_it_wrote(tmp_path, capsys, fake_solve):
     # the "files" row left out compare_2d.json and section_2d/ of --compare-2d
     d = tmp_path / "s3"

@@ -153,7 +153,7 @@ def _will_write(scene, history: bool, compare_2d: bool) -> list[str]:
         names += ["bone_map.csv", "profile_max_z.csv", "bone_map.png"]
     if scene.sensors:
         names += ["sensors.csv", "sensors.png"]
-    if scene.loading or scene.force is not None:
+    if scene.loading:  # [[loading]] segments; a --force ramp alone writes no history.csv
         names.append("history.csv")
     if history:
         names.append("result.pvd")
