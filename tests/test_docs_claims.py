@@ -298,3 +298,22 @@ def test_docs_say_a_step_skins_sensors_are_checked_on_its_cad_faces():
         assert "(a STEP's: the straight chords of a size/8 mesh, within their sag" not in doc, name
         assert "(a STEP's: chords of its size / 8 mesh, 0.006-0.039 mm under an R 6 cap)" not in doc, name
         assert "on its CAD faces" in doc, name
+
+
+def _commands_section(start: str, end: str) -> str:
+    text = _text("docs/commands.md")
+    return text[text.index(start):text.index(end)]
+
+
+def test_commands_doc_names_every_file_a_solve_writes():
+    """The solve section listed profile.csv, summary.json and result.vtu, not the contact.csv
+    every solve writes, nor the section_2d/ folder of --compare-2d."""
+    from tactileskin.cli.solve import _will_write
+    from tactileskin.scene import Scene
+
+    doc = _commands_section("## solve", "### Sensors inside the skin")
+    names = {*_will_write(Scene(thickness=3, indenter="curved"), True, False),
+             *_will_write(Scene(thickness=1, indenter="braille", braille_text="a", dim=3), False, True)}
+    assert {"contact.csv", "section_2d/profile.csv", "bone_map.png", "result.pvd"} <= names
+    for name in names:
+        assert f"`{name.split('/')[0]}" in doc or f"/{name.split('/')[0]}/`" in doc, name
