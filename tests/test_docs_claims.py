@@ -317,3 +317,33 @@ def test_commands_doc_names_every_file_a_solve_writes():
     assert {"contact.csv", "section_2d/profile.csv", "bone_map.png", "result.pvd"} <= names
     for name in names:
         assert f"`{name.split('/')[0]}" in doc or f"/{name.split('/')[0]}/`" in doc, name
+
+
+def _toml_blocks(section: str) -> list[str]:
+    """The ```toml blocks of a docs/commands.md section (fences may be indented in a list)."""
+    import re
+    import textwrap
+
+    text = (ROOT / "docs/commands.md").read_text(encoding="utf-8")
+    part = text[text.index(section):]
+    part = part[:part.index("\n### ", 1)]
+    return [textwrap.dedent(b) for b in re.findall(r"```toml\n(.*?)\n *```", part, flags=re.S)]
+
+
+def test_commands_doc_sensor_and_loading_examples_are_valid_files(tmp_path):
+    """The sensors and the loading-history sections named the TOML keys but showed no file, and
+    the natural guess at a history, a first [[loading]] segment pressing to the depth, is
+    refused (the first ramp is the scene's depth): each section now shows a file that loads."""
+    import tomllib
+
+    from tactileskin import scenefile
+    from tactileskin.scene import Scene
+
+    (sensors,) = _toml_blocks("### Sensors inside the skin")
+    scene = Scene(thickness=3, indenter="curved", sensors=tomllib.loads(sensors)["sensors"])
+    assert [lay.name for lay in scene.sensors] == ["bone", "mid"]
+    (history,) = _toml_blocks("### Force control and loading histories")
+    (tmp_path / "hold.toml").write_text(history)
+    sc = Scene.from_dict(scenefile.single_scene_fields(scenefile.read(tmp_path / "hold.toml")))
+    assert [g.to_dict() for g in sc.program()] == [{"depth": 0.4, "rate": 1.0}, {"hold": 10.0},
+                                                   {"depth": 0.0, "rate": 1.0}]  # indent, hold, release
