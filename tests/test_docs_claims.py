@@ -347,3 +347,36 @@ def test_commands_doc_sensor_and_loading_examples_are_valid_files(tmp_path):
     sc = Scene.from_dict(scenefile.single_scene_fields(scenefile.read(tmp_path / "hold.toml")))
     assert [g.to_dict() for g in sc.program()] == [{"depth": 0.4, "rate": 1.0}, {"hold": 10.0},
                                                    {"depth": 0.0, "rate": 1.0}]  # indent, hold, release
+
+
+def test_commands_doc_film_and_fit_inputs_are_what_the_commands_read(tmp_path):
+    """The film section's command line was 'tactileskin film calibrate / analyze / compare'
+    (no input, option or output named) and the uniaxial fit did not name its CSV columns: the
+    doc's lines parse as the commands', and the columns and files it names are theirs."""
+    import re
+    import shlex
+
+    from tactileskin.cli import film
+    from tactileskin.materials.fit import read_uniaxial_csv
+
+    text = (ROOT / "docs/commands.md").read_text(encoding="utf-8")
+    sec = text[text.index("\n## film"):text.index("\n## material")]
+    lines = re.search(r"```bash\n(.*?)\n```", sec, flags=re.S).group(1).splitlines()
+    assert [shlex.split(ln)[:3] for ln in lines] == [["tactileskin", "film", c] for c in ("calibrate", "analyze", "compare")]
+    for ln in lines:
+        args = shlex.split(ln)
+        film.command.commands[args[2]].make_context(args[2], args[3:])  # an unknown option raises
+    doc = " ".join(sec.split())
+    helps = " ".join(" ".join(p.help.split()) for c in film.command.commands.values() for p in c.params
+                     if getattr(p, "help", None))
+    for name in ("profile.csv", "summary.json", "pressure_map.png", "comparison.json", "overlay.png"):
+        assert f"`{name}`" in doc and name in helps, name
+    calib = " ".join(film.calibrate.help.split())
+    for col in ("force_n", "area_mm2", "gray", "image"):
+        assert f"`{col}`" in doc and col in calib, col
+    fit = _commands_section("### Fitting a law to a uniaxial test", "### Fitting the shear modulus")
+    for stretch in ("stretch", "strain"):
+        assert f"`{stretch}`" in fit and "`nominal_stress_mpa`" in fit
+        (tmp_path / "t.csv").write_text(f"{stretch},nominal_stress_mpa\n1.2,0.05\n0.9,-0.03\n")
+        lam, p = read_uniaxial_csv(tmp_path / "t.csv")
+        assert list(p) == [0.05, -0.03] and lam[1] == (0.9 if stretch == "stretch" else 1.9)
