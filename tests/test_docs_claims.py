@@ -420,3 +420,19 @@ def test_readme_contact_force_sum_under_the_ridge_is_what_result_vtu_integrates(
     pct = 100 * (summed / reaction - 1)
     assert pct > 1  # tilted normals: the facets' sum exceeds the vertical reaction
     assert f"7 % on the 3D dot, {pct:.0f} % on the 2D ridge, t = 1 mm silicone at `preview`" in _text("README.md")
+
+
+def test_readme_defines_the_metrics_before_using_them():
+    """The README used peak, span and AUC from its Quick start on (the report, r.span, the
+    figures) and defined them only in docs/metrics.md; it now says what they are, with the
+    span's threshold that results.span uses."""
+    import inspect
+
+    from tactileskin.results import span
+
+    frac = inspect.signature(span).parameters["fraction"].default
+    readme = _text("README.md")
+    define = readme.index("**span** (the extent of s where P >= ")
+    assert f"**span** (the extent of s where P >= {100 * frac:.0f} % of the peak)" in readme
+    assert define < readme.index("r.peak, r.span, r.auc") and define < readme.index("## Commands")
+    assert "**peak** (its maximum)" in readme and "**AUC** (the area under P(s), MPa·mm)" in readme
