@@ -436,3 +436,14 @@ def test_readme_defines_the_metrics_before_using_them():
     assert f"**span** (the extent of s where P >= {100 * frac:.0f} % of the peak)" in readme
     assert define < readme.index("r.peak, r.span, r.auc") and define < readme.index("## Commands")
     assert "**peak** (its maximum)" in readme and "**AUC** (the area under P(s), MPa·mm)" in readme
+
+
+def test_readme_says_where_the_tactileskin_command_is_before_using_it():
+    """The Quick start sets up .venv through ./dev, and the Commands table then types a bare
+    `tactileskin`, which a fresh shell does not find ('command not found'): the section says
+    to activate the environment ./dev builds, where ./dev's own run finds the command."""
+    dev = (ROOT / "dev").read_text(encoding="utf-8")
+    assert "VENV=.venv" in dev and 'exec "$VENV/bin/tactileskin"' in dev
+    readme = _text("README.md")
+    commands = readme[readme.index("## Commands"):readme.index("| command | what it does |")]
+    assert "`source .venv/bin/activate`" in commands and "`./dev run solve ...`" in commands
