@@ -447,3 +447,17 @@ def test_readme_says_where_the_tactileskin_command_is_before_using_it():
     readme = _text("README.md")
     commands = readme[readme.index("## Commands"):readme.index("| command | what it does |")]
     assert "`source .venv/bin/activate`" in commands and "`./dev run solve ...`" in commands
+
+
+def test_output_folders_doc_names_every_hidden_file_a_run_leaves(tmp_path):
+    """A solve folder holds four hidden files; the Output folders section named three, not
+    the .tactileskin-run.lock every run leaves, which a user listing the folder finds."""
+    from tactileskin.cli import main
+
+    out = tmp_path / "o"
+    assert main(["solve", "-t", "1", "--quality", "preview", "--elastic", "--out", str(out)]) == 0
+    hidden = sorted(p.name for p in out.iterdir() if p.name.startswith("."))
+    assert len(hidden) == 4, hidden
+    section = _commands_section("## Output folders", "## Exit status")
+    for name in hidden:
+        assert f"`{name}`" in section, name
