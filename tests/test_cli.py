@@ -27,6 +27,16 @@ def test_user_error_is_one_line_without_traceback(capsys, tmp_path):
     assert not (tmp_path / "o").exists()  # nothing written for a rejected request
 
 
+def test_an_error_during_a_solve_is_one_line_on_a_redirected_stderr(capsys, tmp_path):
+    # a missing material file is found when the solve starts: the progress line, not shown
+    # off a terminal, still left an empty line before the error in a log ("\nerror: ...")
+    rc = main(["solve", "-t", "1", "-m", str(tmp_path / "gel.toml"), "--out", str(tmp_path / "o")])
+    cap = capsys.readouterr()
+    assert rc == 2 and cap.out == ""
+    assert cap.err.startswith("error: material file=") and len(cap.err.splitlines()) == 1, repr(cap.err)
+    assert not (tmp_path / "o").exists()
+
+
 def test_ctrl_c_exits_130_not_the_failed_case_code(monkeypatch, capsys, tmp_path):
     """Ctrl-C is 130 (128 + SIGINT), so a script cannot take it for `sweep`'s 1 (some case
     failed, the others reported)."""

@@ -182,9 +182,15 @@ def solve_progress(label: str):
     from tactileskin.cli import raise_if_signalled
     from tactileskin.cli._console import new_console
 
+    console = new_console(stderr=True)
+    if not console.is_terminal:
+        # off a terminal (a log, a pipe) the transient line shows nothing but leaves an empty
+        # line on stderr, before an error's one line too
+        yield lambda i: raise_if_signalled()
+        return
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(bar_width=16),
                   TextColumn("{task.fields[info]}"), TimeElapsedColumn(),
-                  console=new_console(stderr=True), transient=True) as bar:
+                  console=console, transient=True) as bar:
         task = bar.add_task(escape(label), total=1.0, info="meshing, setting up")
 
         def show(i):  # short: it must fit an 80-column terminal beside the label
