@@ -24,6 +24,15 @@ def test_braille_texts_only_multiply_braille_cases():
     assert len(scenes) == 4  # flat, curved, braille, braille 'ab'
 
 
+def test_a_refused_non_braille_case_is_its_own_error_not_a_braille_fallback(caplog):
+    # `sweep -i flat,sphere` without a radius: the sphere's refusal (3D, as every sphere case)
+    # was taken for the Braille dots' ("the Braille cases stay 2D ... the 3D dots of the dot at
+    # t = 1 mm are refused") before the same error came again: a warning about cases not there
+    with pytest.raises(ParameterError, match="indenter_radius"):
+        expand_grid(thicknesses=[1.0], materials=["silicone"], indenters=["flat", "sphere"])
+    assert not [r for r in caplog.records if "Braille" in r.getMessage()]
+
+
 def test_a_braille_standard_is_the_braille_cases_alone():
     # [scene] braille_standard = "ada_2010" went onto the flat and curved cases too: their
     # results were bit-identical, yet re-solved under other keys and left out of the paper checks

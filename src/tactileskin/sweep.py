@@ -187,7 +187,9 @@ def expand_grid(
                     s = base.replace(thickness=t, material=m, indenter=ind, depth=d, braille_text=text, dim=dim,
                                      **fc, **std)
                 except ParameterError as e:
-                    if not (chosen and dim == 3 and len(dims) > 1):
+                    # only a Braille case's 3D dots fall back to the ridge; another kind's
+                    # refusal (a sphere without a radius) is that case's error
+                    if not (chosen and dim == 3 and len(dims) > 1 and kind.section_2d == "ridge"):
                         raise
                     log.warning("the Braille cases stay 2D (the ridge): the 3D dots of %s at t = %g mm are "
                                 "refused (%s); --braille-dim 3 asks for them", text or "the dot", t, e)
