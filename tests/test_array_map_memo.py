@@ -75,7 +75,11 @@ def test_a_damaged_or_foreign_memo_is_recomputed_never_an_error(stored, counted,
         s, P = chart.profile_of(rec, 2.0)
         assert np.array_equal(s, ref[0]) and np.array_equal(P, ref[1])
 
-    for bad in (b"", b"not a zip", memo.read_bytes()[:-40]):  # empty, garbage, cut short
+    import io
+
+    npy = io.BytesIO()
+    np.save(npy, ref[1])  # a bare .npy under the memo's name: np.load gives an array, not an archive
+    for bad in (b"", b"not a zip", memo.read_bytes()[:-40], npy.getvalue()):  # empty, garbage, cut short, .npy
         memo.write_bytes(bad)
         reread()
         assert len(counted) == n + 1, bad  # recomputed ...

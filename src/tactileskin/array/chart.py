@@ -562,7 +562,7 @@ def _read_memo(path, key: str, ns: int, nz: int | None) -> tuple | None:
         if str(memo) != f"{key} {_memo_digest(s, P)}" or s.shape != (ns,) or P.shape != shape \
                 or not (np.all(np.isfinite(s)) and np.all(np.isfinite(P))):
             raise ValueError("another map's or altered")
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as e:
+    except (OSError, ValueError, KeyError, EOFError, TypeError, zipfile.BadZipFile) as e:  # TypeError: a bare .npy
         log.warning("map memo %s is damaged (%s); the map is read from result.vtu again", path, e)
         return None
     return s, P
