@@ -129,3 +129,26 @@ def test_a_3d_map_at_depth_is_kept_per_entry_key(tmp_path, counted):
     (tmp_path / "cache.json").write_text(json.dumps({"key": "b" * 24, "files": {"result.vtu": "x"}}), encoding="utf-8")
     chart.raw_map_of(rec, 0.3)
     assert counted == [0.3, 0.3]
+
+
+def test_an_entry_removed_while_its_map_is_read_is_not_brought_back_by_the_memo(stored, tmp_path, monkeypatch):
+    """Another process may discard the entry (found damaged) while this one reads a map from
+    it: the memo's write made its folders again (mkdir -p), a key folder with no cache.json
+    that the next lookup warns of as a damaged entry. The memo is skipped instead."""
+    import shutil
+
+    c, sc = stored
+    mine = ResultCache(tmp_path / "cache")
+    shutil.copytree(c.lookup(sc).path, mine.path(sc), ignore=shutil.ignore_patterns(chart.MEMO_DIR))
+    rec = mine.lookup(sc)
+    real = chart._at_depth
+
+    def read_then_discarded(r, s, z, depth):
+        out = real(r, s, z, depth)
+        shutil.rmtree(r.path)  # as ResultCache._discard in another process
+        return out
+
+    monkeypatch.setattr(chart, "_at_depth", read_then_discarded)
+    s, P = chart.profile_of(rec, 1.25)
+    assert P.shape == s.shape and np.all(np.isfinite(P))
+    assert not rec.path.exists(), sorted(p.relative_to(tmp_path) for p in rec.path.rglob("*"))

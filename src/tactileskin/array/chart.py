@@ -576,6 +576,9 @@ def _write_memo(path, key: str, s, P) -> None:
     buf = io.BytesIO()
     np.savez(buf, s=np.asarray(s, float), P=np.asarray(P, float), memo=np.array(f"{key} {_memo_digest(s, P)}"))
     try:
+        # the memo folder alone, not its parents (atomic_write_bytes makes them): an entry
+        # discarded meanwhile by another process would come back as a key folder, no cache.json
+        path.parent.mkdir(exist_ok=True)
         fileio.atomic_write_bytes(path, buf.getvalue())
     except (OSError, TactileSkinError) as e:  # a read-only cache: the map is used, not kept
         log.info("map memo %s not written: %s", path, e)
