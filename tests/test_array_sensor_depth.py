@@ -61,13 +61,7 @@ def test_a_3d_map_at_depth_follows_the_z_rows_of_the_bone_map(tmp_path):
     pad: the map at depth is that field on the plane y = t - d, row j at z_j (the bone map's
     z-major layout), exactly (P2 holds a linear field)."""
     t = 1.0
-    m = skfem.MeshTet1.init_tensor(np.linspace(0, 3, 4), np.linspace(0, t, 3), np.linspace(0, 2, 3))
-    basis = skfem.Basis(m, skfem.ElementTetP2())
-    x, y, z = basis.doflocs
-    f = {"sxx": -(1 + x + 2 * y + 3 * z), "syy": -(2 - y), "szz": -(0.5 + z), "sxy": 0 * x, "syz": 0 * x, "sxz": 0 * x}
-    meshio.write(tmp_path / "result.vtu", meshio.Mesh(basis.doflocs.T, [("tetra10", basis.element_dofs.T)],
-                                                       point_data={f"{k}_MPa": v for k, v in f.items()}))
-    rec = SimpleNamespace(scene=Scene(dim=3, skin="pad", indenter="braille", thickness=t), path=tmp_path)
+    rec, _ = _linear_pad(tmp_path, t)
     s, zg = np.linspace(0, 3, 7), np.linspace(0, 2, 5)
     d = 0.3
     sa, P = chart._at_depth(rec, s, zg, d)
