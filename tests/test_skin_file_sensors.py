@@ -560,3 +560,23 @@ def test_a_flat_file_skins_sensors_are_unchanged_to_the_bit(tmp_path):
     assert np.array_equal(st.xyz[~g], np.column_stack([-1.0 + 0.25 * np.arange(9), np.full(9, 0.0 - (2.0 - 0.3)),
                                                        np.full(9, 0.4)]))
     assert np.array_equal(st.normal, np.tile([0.0, 1.0, 0.0], (44, 1))) and np.array_equal(st.normal_depth, st.depth)
+
+
+def test_a_sensor_at_a_step_between_two_top_faces_hangs_from_the_face_not_the_wall(tmp_path):
+    """A top of two faces (y = 2 for x < 1, y = 1.5 past a vertical step at x = 1): the surface
+    normal's central difference over 1e-4 of the size straddled the step within 8e-4 mm of it
+    and read the wall's jump as a slope of 312 (normal (1, 0.0032)), so a depth-0.5 sensor at s
+    = 1 (a round grid point) went 0.5 mm sideways under the upper face, 0.0016 mm below the
+    surface, and a height 1e-4 mm past it was refused ('leaves the skin through a face that is
+    not bonded'; at s = 1 itself the vertical column meets the lower face's edge, as before).
+    A one-sided difference steeper than a wall is the step, not the surface: the
+    other side's is taken, and the sensor hangs straight down from the face it is on."""
+    pts = [(-4, 0), (4, 0), (4, 1.5), (1, 1.5), (1, 2.0), (-4, 2.0)]
+    path = _gmsh_polygon(tmp_path / "step.msh", pts, {"bonded": [0], "sides": [1, 5], "outer_surface": [2, 3, 4]})
+    lays = [{"name": "d", "kind": "points", "s": [1.0, 1.0001, 0.9999], "depth": 0.5},
+            {"name": "h", "kind": "points", "s": [0.9999, 1.0001], "height": 0.5}]
+    st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=lays))
+    assert np.allclose(st.normal, [0.0, 1.0, 0.0], rtol=0, atol=1e-12)
+    assert np.allclose(st.xyz[:, :2], [[1.0, 1.5], [1.0001, 1.0], [0.9999, 1.5], [0.9999, 0.5], [1.0001, 0.5]],
+                       rtol=0, atol=1e-9)
+    assert np.allclose(st.depth, [0.5, 0.5, 0.5, 1.5, 1.0], rtol=0, atol=1e-9)

@@ -869,7 +869,8 @@ class FileCoordinates:
     def surface_normal(self, s, z=None) -> np.ndarray:
         """(n, 3) outward unit normal of the contact surface y = top(x, z) over each (s, z): by
         central differences of the column's top over SLOPE_STEP of the skin's size (one-sided at
-        the skin's edge; a mirror half's top is even, so its symmetry line reads flat). A slope
+        the skin's edge, and where the other side's crosses a step between two top faces: steeper
+        than a wall; a mirror half's top is even, so its symmetry line reads flat). A slope
         under FLAT_SLOPE (rounding: heights of a flat P2 face differ by ~1e-16 of the size) is
         flat: normal exactly +y, so a flat top reads as it always did. With a `reference` (the
         solved mesh's coordinates) the reference's: a sensor's line runs along it, and the P2
@@ -886,8 +887,16 @@ class FileCoordinates:
             top = self.column(np.concatenate([s + ds, s - ds, s]),
                               None if zz is None else np.concatenate([zz + dz, zz - dz, zz]))["top"]
             up, down, mid = top.reshape(3, -1)
-            g = np.where(np.isfinite(up) & np.isfinite(down), (up - down) / (2 * h),
-                         np.where(np.isfinite(up), (up - mid) / h, (mid - down) / h))
+            fwd, back = (up - mid) / h, (mid - down) / h
+            # a one-sided slope steeper than a wall's (|n_y| < WALL_NY) where the other is not
+            # crosses a jump of the top (a step between two top faces), not the surface: the
+            # other side's (the central difference at a step's edge read a slope of ~312 and a
+            # depth-0.5 sensor lay 0.5 mm sideways, 0.0016 mm under the surface)
+            with np.errstate(invalid="ignore"):
+                jf, jb = np.abs(fwd) > 1.0 / WALL_NY, np.abs(back) > 1.0 / WALL_NY
+            g = np.where(np.isfinite(up) & np.isfinite(down),
+                         np.where(jf & ~jb, back, np.where(jb & ~jf, fwd, (up - down) / (2 * h))),
+                         np.where(np.isfinite(up), fwd, back))
             g = np.where(np.isfinite(g) & (np.abs(g) > FLAT_SLOPE), g, 0.0)
             grads.append(g)
         gx, gz = grads[0], (grads[1] if self.dim == 3 else np.zeros_like(s))
