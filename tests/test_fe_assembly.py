@@ -44,3 +44,55 @@ def test_pattern_scatter_and_added_blocks_equal_dense_assembly():
     p.add(d, blocks2, Kb)
     assert np.allclose(p.matrix(d).toarray(), A + _dense(n, blocks2, Kb))
     assert isinstance(p.free_matrix(d), sp.csr_matrix)
+
+
+def _reference(n, edofs, Ke):
+    """The former Pattern: np.unique of the dof-level (row, col) keys, one np.bincount per
+    assembly: (keys, data)."""
+    nd = edofs.shape[1]
+    keys = (np.repeat(edofs, nd, axis=1).astype(np.int64) * n + np.tile(edofs, (1, nd))).ravel()
+    keys, inv = np.unique(keys, return_inverse=True)
+    return keys, np.bincount(inv.ravel(), weights=Ke.ravel(), minlength=len(keys))
+
+
+def test_pattern_from_node_graph_equals_dof_level_bincount_2d_and_3d():
+    """The node-graph pattern and the row-parallel scatter against the former dof-level
+    np.unique + np.bincount, bit for bit (same additions in the same order), on P2 triangle
+    and tet meshes (vector dofs m = 2, 3, and the scalar m = 1), on 1 and 2 numba threads,
+    for a strided Ke too; and the free block and add() on top."""
+    import numba
+    from skfem import Basis, MeshTet, MeshTri
+    from skfem.element import ElementTetP2, ElementTriP2
+
+    from tactileskin.fe.assembly import vector_dofs
+    from tactileskin.threads import numba_threads
+
+    rng = np.random.default_rng(5)
+    for mesh, el in ((MeshTri().refined(3), ElementTriP2()), (MeshTet().refined(2), ElementTetP2())):
+        b = Basis(mesh, el)
+        sd = b.element_dofs.T
+        for m in (mesh.dim(), 1):
+            n, edofs = b.N * m, vector_dofs(sd, m).reshape(len(sd), -1)
+            free = np.flatnonzero(rng.random(n) > 0.2)
+            p = Pattern(n, edofs, free, m)
+            nd = edofs.shape[1]
+            # entries over 16 decades: any change of the order of additions shows in the bits
+            Ke = rng.standard_normal((len(edofs), nd, nd)) * 10.0 ** rng.integers(-8, 8, (len(edofs), nd, nd))
+            keys, ref = _reference(n, edofs, Ke)
+            assert np.array_equal(p.keys, keys)
+            assert np.array_equal(p.indices, keys % n)
+            assert np.array_equal(p.indptr, np.concatenate([[0], np.cumsum(np.bincount(keys // n, minlength=n))]))
+            KeT = np.swapaxes(Ke, 1, 2)                      # a strided view
+            for threads in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+                with numba_threads(threads):
+                    assert np.array_equal(p.data(Ke), ref)
+                    assert np.array_equal(p.data(KeT), _reference(n, edofs, np.ascontiguousarray(KeT))[1])
+            A = p.matrix(p.data(Ke)).toarray()
+            assert np.allclose(A, _dense(n, edofs, Ke), rtol=1e-12, atol=1e-12 * np.abs(Ke).max())
+            assert np.array_equal(p.free_matrix(p.data(Ke)).toarray(), A[np.ix_(free, free)])
+        try:
+            Pattern(b.N * 3, vector_dofs(sd, 2).reshape(len(sd), -1), free, 3)
+        except ValueError:
+            pass
+        else:
+            raise AssertionError("non-interleaved element dofs accepted")

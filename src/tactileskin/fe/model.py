@@ -166,7 +166,7 @@ class Model:
             fixed.append(dofs)
         self.fixed = np.unique(np.concatenate(fixed)) if fixed else np.zeros(0, int)
         self.free = np.setdiff1d(np.arange(self.ndof), self.fixed)
-        self.pattern = Pattern(self.ndof, self.edofs, self.free)
+        self.pattern = Pattern(self.ndof, self.edofs, self.free, m)
 
         # contact
         self.contact = contact
@@ -316,7 +316,7 @@ class Model:
                 ev._D = self._law(ev.kin.C, True)[1]
             Dm = ev._gamma * ev._D[..., :m, :m, :m, :m]
             Ke = kernels.tangent(ev.kin, ev.S[..., :m, :m], Dm)
-        Kd = self.pattern.data(Ke)
+            Kd = self.pattern.data(Ke)   # threaded: the solve's share of the cores
         if self.surface is not None:
             c = self.contact
             tc = time.perf_counter()
