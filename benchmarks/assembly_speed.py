@@ -9,6 +9,8 @@ wall ms, calls of the old and new versions alternating so that both see the same
                    (old) against the node graph (new);
   Pattern.data     the CSR scatter of the element matrices: np.bincount (old) against the
                    row-parallel scatter of fe._sparse_nb (new), 1 and 2 numba threads;
+  kernels.tangent  the element matrices into a new array per call (old) against into the
+                   model's reused buffer (new; the new array's page faults), 2 threads;
 with the largest difference between the two (0: the same bits). Prints the load average.
 
     .venv/bin/python benchmarks/assembly_speed.py [--thickness 5] [--repeat 9]
@@ -87,6 +89,13 @@ def main(argv=None) -> int:
             t = timed({"old": old_data, "new": lambda: p.data(Ke)}, a.repeat)
             diff = np.abs(p.data(Ke) - ref).max()
         row(f"Pattern.data ({th} thread{'s' if th > 1 else ''})", t["old"], t["new"], f"max |diff| {diff:.1e}")
+    with numba_threads(2):
+        Sm, Dm = ev.S[..., :m, :m], np.ascontiguousarray(D[..., :m, :m, :m, :m])
+        buf = np.empty_like(Ke)
+        t = timed({"old": lambda: kernels.tangent(ev.kin, Sm, Dm),
+                   "new": lambda: kernels.tangent(ev.kin, Sm, Dm, out=buf)}, a.repeat)
+        diff = np.abs(kernels.tangent(ev.kin, Sm, Dm, out=buf) - Ke).max()
+    row("kernels.tangent (2 threads)", t["old"], t["new"], f"max |diff| {diff:.1e}")
     print(f"load average at the end {os.getloadavg()[0]:.2f}")
     return 0
 

@@ -149,3 +149,28 @@ def test_compiled_tangent_is_the_derivative_of_the_compiled_residual(kind, mixed
         err.append(_rel(K, Kfd))
     assert err[0] < 1e-3
     assert 50.0 < err[0] / err[1] < 150.0
+
+
+@pytest.mark.parametrize("kind", ["tri", "tet"])
+def test_tangent_into_a_given_buffer_and_the_models_reused_buffer(kind):
+    """kernels.tangent(out=buf) writes every entry of buf (NaN-filled here) with the bits of
+    a fresh call, and refuses a buffer it could overrun; Model.tangent reuses one buffer: two
+    tangents at different states, the second's data the same as a fresh model's."""
+    model, law, ue = _law_state(kind, True, seed=7)
+    kin, S, D = _forces(model, law, ue)
+    K = kernels.tangent(kin, S, D)
+    buf = np.full_like(K, np.nan)
+    assert kernels.tangent(kin, S, D, out=buf) is buf
+    assert np.array_equal(buf, K)
+    for bad in (np.empty(K.shape[:2] + (K.shape[2] - 1,)), np.empty(K.shape, np.float32),
+                np.empty(K.shape[::-1]).T):
+        with pytest.raises(ValueError):
+            kernels.tangent(kin, S, D, out=bad)
+    rng = np.random.default_rng(8)
+    u1, u2 = (0.02 * rng.standard_normal(model.ndof) for _ in range(2))
+    K1 = model.tangent(model.evaluate(u1, 0.0, 1.0, tangent=False)).copy()
+    K2 = model.tangent(model.evaluate(u2, 0.0, 1.0, tangent=False))
+    fresh, _, _ = _law_state(kind, True, seed=7)
+    assert np.array_equal(K2, fresh.tangent(fresh.evaluate(u2, 0.0, 1.0, tangent=False)))
+    assert not np.array_equal(K1, K2)
+    assert model._Ke is not None and not np.shares_memory(model._Ke, K2)

@@ -92,17 +92,21 @@ def residual(kin: Kinematics, S: np.ndarray) -> np.ndarray:
                 _c(S), kin.mixed, np.empty((E, A * m)))
 
 
-def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray) -> np.ndarray:
+def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """Consistent element stiffness (E, A*m, A*m); S (E,Q,m,m), D = dS/dE (E,Q,m,m,m,m).
+    out: a C-contiguous float64 (E, A*m, A*m) array to write it into (None: a new one).
 
     D must have minor symmetry (the material part is evaluated in Voigt pairs) and, in the
     mixed formulation, major symmetry (the rank-one terms use AA F for both sides); any
     D = 2 dS/dC of a hyperelastic S has both. The algebra: fe._kernels_nb. P2 tets run on
     numba's threads (numba.get_num_threads()) from PARALLEL_MIN_ELEMENTS elements."""
     E, Q, A, m = kin.G.shape
+    if out is not None and (out.shape != (E, A * m, A * m) or out.dtype != np.float64
+                            or not out.flags.c_contiguous):   # the loops write without bounds checks
+        raise ValueError(f"tangent out: a C-contiguous float64 {(E, A * m, A * m)} array, not {out.shape} {out.dtype}")
     theta = kin.theta if kin.mixed else np.empty(0)
     args = (kin.G, kin.w, kin.F, kin.Fbar, kin.Finv, kin.alpha, kin.J,
-            _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)))
+            _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)) if out is None else out)
     threads = _kernels_nb.nb.get_num_threads()
     if (m, A) == (3, 10) and threads > 1 and E >= PARALLEL_MIN_ELEMENTS:
         return _kernels_nb.tangent_3_10_parallel(*args, 4 * threads)
