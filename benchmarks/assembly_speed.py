@@ -11,6 +11,10 @@ wall ms, calls of the old and new versions alternating so that both see the same
                    row-parallel scatter of fe._sparse_nb (new), 1 and 2 numba threads;
   kernels.tangent  the element matrices into a new array per call (old) against into the
                    model's reused buffer (new; the new array's page faults), 2 threads;
+  GMRES's product  the free tangent times a vector: scipy's csr_matvec (old, what GMRES
+                   uses) against a numba loop over row ranges (candidate, not adopted; uint32
+                   indices: with int32 numba checks for negative indices, 1.7x slower),
+                   1 and 2 threads.
 with the largest difference between the two (0: the same bits). Prints the load average.
 
     .venv/bin/python benchmarks/assembly_speed.py [--thickness 5] [--repeat 9]
@@ -42,6 +46,25 @@ def timed(fns: dict, repeat: int) -> dict:
 
 def row(name, old, new, diff=""):
     print(f"{name:34s} {old[0]:9.2f} {old[1]:9.2f} {new[0]:9.2f} {new[1]:9.2f} {old[1] / new[1]:7.2f}x  {diff}")
+
+
+def _csr_matvec(indptr, indices, data, x, y, bounds):
+    """y = A x row range by row range on numba's threads (compiled on first use)."""
+    global _csr_matvec
+    import numba as nb
+
+    @nb.njit(cache=True, parallel=True, error_model="numpy")
+    def kernel(indptr, indices, data, x, y, bounds):
+        for c in nb.prange(bounds.shape[0] - 1):
+            for r in range(bounds[c], bounds[c + 1]):
+                s = 0.0
+                for j in range(indptr[r], indptr[r + 1]):
+                    s += data[j] * x[indices[j]]
+                y[r] = s
+        return y
+
+    _csr_matvec = kernel
+    return kernel(indptr, indices, data, x, y, bounds)
 
 
 def main(argv=None) -> int:
@@ -96,6 +119,17 @@ def main(argv=None) -> int:
                    "new": lambda: kernels.tangent(ev.kin, Sm, Dm, out=buf)}, a.repeat)
         diff = np.abs(kernels.tangent(ev.kin, Sm, Dm, out=buf) - Ke).max()
     row("kernels.tangent (2 threads)", t["old"], t["new"], f"max |diff| {diff:.1e}")
+    Af = p.free_matrix(p.data(Ke))
+    x = np.random.default_rng(1).standard_normal(Af.shape[0])
+    ip, ix = Af.indptr.view(np.uint32), Af.indices.view(np.uint32)
+    for th in (1, 2):
+        bounds = np.searchsorted(Af.indptr, np.arange(th + 1) * Af.nnz / th).astype(np.int64)
+        bounds[0], bounds[-1] = 0, Af.shape[0]
+        with numba_threads(th):
+            t = timed({"old": lambda: Af.dot(x), "new": lambda: _csr_matvec(ip, ix, Af.data, x, np.empty_like(x),
+                                                                            bounds)}, 5 * a.repeat)
+            diff = np.abs(_csr_matvec(ip, ix, Af.data, x, np.empty_like(x), bounds) - Af.dot(x)).max()
+        row(f"free K @ x, numba ({th} thread{'s' if th > 1 else ''})", t["old"], t["new"], f"max |diff| {diff:.1e}")
     print(f"load average at the end {os.getloadavg()[0]:.2f}")
     return 0
 
