@@ -382,6 +382,37 @@ def test_a_taxel_under_a_slope_is_warned_of(tmp_path, caplog):
                     "so it averages 29 % more of the surface than its side"]
 
 
+def test_a_taxel_layout_reads_each_point_of_its_lines_once(tmp_path, monkeypatch):
+    """Placing a layout on its normal lines read each surface point twice (depths, then frame)
+    and its top once more per slope direction, and a flat top's vertical line its one column 16
+    times: each read a few CAD queries on a STEP (the half tube's 273-sensor grid with taxels
+    0.4: 0.43 s before the normal lines, 3.1 s after). Two taxels (3 points each, 2D) under the
+    half tube's slope and a sensor on its flat top took 284 + 25 reads; now each line reads its
+    top, its 2 slope points and its EXIT_SAMPLES samples (the flat top's: one column), and every
+    point lies where it did: 0.5 along the radial of R 8 from the surface point over its s."""
+    from tactileskin.skins.file import EXIT_SAMPLES, FileCoordinates
+
+    path = _half_tube(tmp_path / "tube.msh")
+    lays = [{"name": "tx", "kind": "points", "s": [1.0, 5.0], "depth": 0.5, "taxel": 1.0, "taxel_points": 3},
+            {"name": "top", "kind": "points", "s": [0.0], "depth": 0.5}]
+    scenes = [Scene(skin="file", skin_file=str(path), indenter="flat", sensors=[lay]) for lay in lays]
+    sensors.coordinates_for(scenes[0]).__dict__.pop("_surface_memo", None)  # the scenes' checks' answer
+    reads, column = [], FileCoordinates.column
+    monkeypatch.setattr(FileCoordinates, "column", lambda self, s, z=None: reads.append(np.size(s)) or column(self, s, z))
+    st = sensors.sites_for(scenes[0])
+    lines = 2 * (2 + 1 + 3)  # each taxel's edges, centre and Gauss points
+    assert sum(reads) == lines * (3 + EXIT_SAMPLES)
+    reads.clear()
+    top = sensors.sites_for(scenes[1]).xyz[0]
+    assert sum(reads) == 3 + 1
+    g = np.polynomial.legendre.leggauss(3)[0]
+    s = np.concatenate([[1.0, 5.0], (np.array([1.0, 5.0])[:, None] + 0.5 * g).ravel()])
+    xy = np.concatenate([st.xyz[:2, :2], st.samples[:2, :3, :2].reshape(-1, 2)])
+    # on the P2 faces (R 8 to ~1e-6 at h = 0.5): r = 7.5 on the ray through (s, top(s))
+    assert np.abs(np.hypot(*xy.T) - 7.5).max() < 2e-6 and np.abs(xy[:, 0] * 8.0 / 7.5 - s).max() < 1e-5
+    assert top[0] == 0.0 and abs(top[1] - 7.5) < 2e-6
+
+
 def test_the_solve_places_in_its_mesh_what_the_scene_held(tmp_path):
     """The solve places the sensors the scene held on the STEP's CAD in the mesh solved, moved
     at most as far as that mesh's faces lie off the CAD, and refuses what the scene refuses in

@@ -690,7 +690,7 @@ class FileCoordinates:
         # uniform thickness holds depth d at d from its surface everywhere (vertically, 0.5 under
         # a 45 degree slope lay 0.354 mm from the surface); a height from where it meets the
         # bonded face (the fingertip's height = t - depth)
-        P, nrm = self._surface(s, z)
+        P, nrm = self._surface(s, z, col["top"])
         if lay.depth is not None:
             d = np.full(len(s), float(lay.depth))
             ex = self._exit(P, nrm, np.maximum(d, 0.0))  # inf where the line stays in the skin to d
@@ -720,22 +720,36 @@ class FileCoordinates:
                                  "along the contact surface's inward normal there)", sensor(i))
         return np.maximum(ex - h, 0.0)
 
-    def _surface(self, s, z) -> tuple:
+    def _surface(self, s, z, top=None) -> tuple:
         """(P, n): the contact surface's point over each (s, z) ((m, dim): x, y(, z)) and its
-        outward unit normal there ((m, dim))."""
+        outward unit normal there ((m, dim)); `top`: the columns' tops there, where read already."""
         s = np.atleast_1d(np.asarray(s, float))
-        top = self.column(s, z if self.dim == 3 else None)["top"]
-        cols = [self.x_top + s, top] + ([np.broadcast_to(np.asarray(z, float), s.shape)] if self.dim == 3 else [])
-        nrm = self.surface_normal(s, z if self.dim == 3 else None)
-        return np.column_stack(cols), (nrm if self.dim == 3 else nrm[:, :2])
+        zz = np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape) if self.dim == 3 else None
+        # frame() reads the points depths() just read (a sensor's, its taxel's): each a few CAD
+        # queries on a STEP (gmsh isInside, ~10 us a point and face), so the last answer is kept
+        key = (s.tobytes(), None if zz is None else zz.tobytes())
+        memo = getattr(self, "_surface_memo", None)
+        if memo is None or memo[0] != key:
+            if self.reference is None and type(self).surface_normal is FileCoordinates.surface_normal:
+                top, nrm = self._top_normal(s, zz, top)
+            else:  # the reference's normal, the dome's exact one
+                top, nrm = self.column(s, zz)["top"] if top is None else top, self.surface_normal(s, zz)
+            cols = [self.x_top + s, top] + ([zz] if self.dim == 3 else [])
+            memo = self._surface_memo = (key, np.column_stack(cols), nrm if self.dim == 3 else nrm[:, :2])
+        return memo[1].copy(), memo[2].copy()
 
     def _inside(self, pts, gap: bool = False) -> np.ndarray:
         """Whether each point (m, dim) lies in the skin's first layer: on its column, at most the
         top (+ tol: a point on the surface) and at least the first boundary under it (strictly:
         a line's exit is the last point in the skin, so a height 0 lies on the bonded face).
         gap=True: how far inside (mm, vertical; < 0 outside, NaN off the skin) instead."""
-        col = self.column(pts[:, 0] - self.x_top, pts[:, 2] if self.dim == 3 else None)
-        g = np.minimum(col["top"] + self.tol - pts[:, 1], pts[:, 1] - col["floor"])
+        q = np.column_stack([pts[:, 0] - self.x_top] + ([pts[:, 2]] if self.dim == 3 else []))
+        # each column read once (a CAD query on a STEP): a vertical line's (a flat top's, n = +y
+        # exactly) samples all stand on its own column, 16 reads of one
+        key = np.ascontiguousarray(q).view(np.dtype((np.void, q.dtype.itemsize * q.shape[1])))[:, 0]
+        _, first, back = np.unique(key, return_index=True, return_inverse=True)
+        col = self.column(q[first, 0], q[first, 1] if self.dim == 3 else None)
+        g = np.minimum(col["top"][back] + self.tol - pts[:, 1], pts[:, 1] - col["floor"][back])
         if gap:
             return g
         with np.errstate(invalid="ignore"):
@@ -878,15 +892,27 @@ class FileCoordinates:
         a bone sensor read the bone map 5e-4 mm off its point)."""
         if self.reference is not None:
             return self.reference.surface_normal(s, z)
+        return self._top_normal(s, z)[1]
+
+    def _top_normal(self, s, z=None, top=None) -> tuple:
+        """(top, n): the column's top over each (s, z) (`top`, where read already) and
+        surface_normal there, the top read once, with the central differences' points (it was
+        read once more in each direction)."""
         s = np.atleast_1d(np.asarray(s, float))
         z = np.broadcast_to(np.asarray(0.0 if z is None else z, float), s.shape)
-        h = SLOPE_STEP * self._size
         zz = z if self.dim == 3 else None
+        h = SLOPE_STEP * self._size
+        steps = ((h, 0.0),) + (((0.0, h),) if self.dim == 3 else ())
+        # one read of every point (each a CAD query on a STEP): up and down in each direction, mid
+        mid = top
+        ss = np.concatenate([v for ds, _ in steps for v in (s + ds, s - ds)] + ([s] if mid is None else []))
+        top = self.column(ss, None if zz is None else np.concatenate(
+            [v for _, dz in steps for v in (zz + dz, zz - dz)] + ([zz] if mid is None else [])))["top"]
+        top = top.reshape(2 * len(steps) + (mid is None), len(s))
+        mid = top[-1] if mid is None else mid
         grads = []
-        for ds, dz in ((h, 0.0),) + (((0.0, h),) if self.dim == 3 else ()):
-            top = self.column(np.concatenate([s + ds, s - ds, s]),
-                              None if zz is None else np.concatenate([zz + dz, zz - dz, zz]))["top"]
-            up, down, mid = top.reshape(3, -1)
+        for k in range(len(steps)):
+            up, down = top[2 * k], top[2 * k + 1]
             fwd, back = (up - mid) / h, (mid - down) / h
             # a one-sided slope steeper than a wall's (|n_y| < WALL_NY) where the other is not
             # crosses a jump of the top (a step between two top faces), not the surface: the
@@ -901,7 +927,7 @@ class FileCoordinates:
             grads.append(g)
         gx, gz = grads[0], (grads[1] if self.dim == 3 else np.zeros_like(s))
         nrm = np.column_stack([-gx, np.ones_like(gx), -gz])
-        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+        return mid, nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
 
 def _barycentric(L, q) -> tuple[np.ndarray, np.ndarray]:
