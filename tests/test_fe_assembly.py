@@ -1,6 +1,7 @@
 """fe.assembly.Pattern: the CSR scatter of element blocks and the added (contact) blocks."""
 
 import numpy as np
+import pytest
 import scipy.sparse as sp
 
 from tactileskin.fe.assembly import Pattern
@@ -64,6 +65,7 @@ def test_pattern_from_node_graph_equals_dof_level_bincount_2d_and_3d():
     from skfem import Basis, MeshTet, MeshTri
     from skfem.element import ElementTetP2, ElementTriP2
 
+    from tactileskin.fe import _sparse_nb
     from tactileskin.fe.assembly import vector_dofs
     from tactileskin.threads import numba_threads
 
@@ -87,6 +89,9 @@ def test_pattern_from_node_graph_equals_dof_level_bincount_2d_and_3d():
                 with numba_threads(threads):
                     assert np.array_equal(p.data(Ke), ref)
                     assert np.array_equal(p.data(KeT), _reference(n, edofs, np.ascontiguousarray(KeT))[1])
+                    # the threaded loop (Pattern takes it for large P2-tet models) adds alike
+                    par = _sparse_nb.scatter(m, nd // m, True)
+                    assert np.array_equal(par(Ke, p._nptr, p._ne, p._na, p._off, p.indptr, np.empty(len(p.keys))), ref)
             A = p.matrix(p.data(Ke)).toarray()
             assert np.allclose(A, _dense(n, edofs, Ke), rtol=1e-12, atol=1e-12 * np.abs(Ke).max())
             assert np.array_equal(p.free_matrix(p.data(Ke)).toarray(), A[np.ix_(free, free)])
@@ -96,3 +101,40 @@ def test_pattern_from_node_graph_equals_dof_level_bincount_2d_and_3d():
             pass
         else:
             raise AssertionError("non-interleaved element dofs accepted")
+
+
+_FORK_AFTER_SOLVE = """
+import multiprocessing as mp, sys
+from tactileskin.fe import solve
+from tactileskin.scene import Scene
+sc = Scene(thickness=1, indenter='flat', material='silicone', mesh_size=1.0, refinement=2)
+def child(q):
+    q.put(float(solve(sc).peak))
+if __name__ == '__main__':
+    peak = float(solve(sc).peak)
+    ctx = mp.get_context('fork')
+    q = ctx.Queue()
+    p = ctx.Process(target=child, args=(q,), daemon=True)  # a hung child goes with the parent
+    p.start()
+    got = q.get(timeout=60)
+    p.join()
+    sys.exit(0 if got == peak else 1)
+"""
+
+
+def test_a_forked_child_of_a_2d_solve_solves_too(tmp_path):
+    """A 2D solve runs no numba parallel region: one had started numba's OpenMP pool, and a
+    child fork()ed after it (multiprocessing's default on Linux: a user's Pool.map of solves)
+    hung in its first solve."""
+    import multiprocessing
+    import os
+    import subprocess
+    import sys
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork on this platform")
+    script = tmp_path / "fork_after_solve.py"
+    script.write_text(_FORK_AFTER_SOLVE)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    r = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=180)
+    assert r.returncode == 0, r.stderr[-2000:]

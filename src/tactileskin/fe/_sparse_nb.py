@@ -78,5 +78,26 @@ def scatter_any(Ke, nptr, ne, na, off, indptr, out):
     return _scatter(Ke, nptr, ne, na, off, indptr, out, Ke.shape[1] // A, A)
 
 
-def scatter(m: int, A: int):
-    return {(2, 6): scatter_2_6, (3, 10): scatter_3_10}.get((m, A), scatter_any)
+# the same loops on this thread: a parallel region starts numba's OpenMP pool, after which a
+# fork()ed child (multiprocessing's default on Linux) hangs in its first parallel region
+@_jit
+def scatter_serial_2_6(Ke, nptr, ne, na, off, indptr, out):
+    return _scatter(Ke, nptr, ne, na, off, indptr, out, 2, 6)
+
+
+@_jit
+def scatter_serial_3_10(Ke, nptr, ne, na, off, indptr, out):
+    return _scatter(Ke, nptr, ne, na, off, indptr, out, 3, 10)
+
+
+@_jit
+def scatter_serial_any(Ke, nptr, ne, na, off, indptr, out):
+    A = off.shape[2]
+    return _scatter(Ke, nptr, ne, na, off, indptr, out, Ke.shape[1] // A, A)
+
+
+def scatter(m: int, A: int, parallel: bool):
+    """The scatter loop for m components and A nodes per element, on numba's threads or not."""
+    if parallel:
+        return {(2, 6): scatter_2_6, (3, 10): scatter_3_10}.get((m, A), scatter_any)
+    return {(2, 6): scatter_serial_2_6, (3, 10): scatter_serial_3_10}.get((m, A), scatter_serial_any)

@@ -13,6 +13,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tactileskin.fe import _sparse_nb
+from tactileskin.fe.kernels import PARALLEL_MIN_ELEMENTS
 
 
 def vector_dofs(scalar_dofs: np.ndarray, m: int) -> np.ndarray:
@@ -50,7 +51,11 @@ class Pattern:
         order = np.argsort(sd.ravel(), kind="stable")
         self._nptr = np.concatenate([[0], np.cumsum(np.bincount(sd.ravel(), minlength=ns))])
         self._ne, self._na = (order // A).astype(np.int32), (order % A).astype(np.int32)
-        self._scatter = _sparse_nb.scatter(m, A)
+        # on numba's threads as the tangent kernel is (P2 tets from PARALLEL_MIN_ELEMENTS), else
+        # on this thread: a 2D solve starts no OpenMP pool (a fork()ed child of it hung)
+        self._scatter = _sparse_nb.scatter(m, A, False)
+        self._scatter_threads = (_sparse_nb.scatter(m, A, True)
+                                 if (m, A) == (3, 10) and E >= PARALLEL_MIN_ELEMENTS else None)
         # free-free block
         is_free = np.zeros(n, bool)
         is_free[free] = True
@@ -67,12 +72,15 @@ class Pattern:
         self._add_dofs, self._add_pos = None, None   # Pattern.add's positions of its last dofs
 
     def data(self, Ke: np.ndarray) -> np.ndarray:
-        """CSR data from element matrices (E, nd, nd), on numba's threads (the bits of
-        np.bincount over the entries' positions: the same additions in the same order)."""
+        """CSR data from element matrices (E, nd, nd), on numba's threads for large P2-tet
+        models (the bits of np.bincount over the entries' positions: the same additions in the
+        same order, whatever the threads)."""
         Ke = np.ascontiguousarray(Ke, np.float64)
         if Ke.shape != self.edofs.shape + self.edofs.shape[1:]:
             raise ValueError(f"element matrices of shape {Ke.shape} for element dofs {self.edofs.shape}")
-        return self._scatter(Ke, self._nptr, self._ne, self._na, self._off, self.indptr, np.empty(len(self.keys)))
+        f = self._scatter_threads if self._scatter_threads is not None and _sparse_nb.nb.get_num_threads() > 1 \
+            else self._scatter
+        return f(Ke, self._nptr, self._ne, self._na, self._off, self.indptr, np.empty(len(self.keys)))
 
     def add(self, data: np.ndarray, dofs: np.ndarray, Kb: np.ndarray) -> None:
         """Add blocks Kb (B, k, k) with dofs (B, k) (must lie inside the pattern). The data
