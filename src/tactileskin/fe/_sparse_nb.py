@@ -1,5 +1,5 @@
 """Compiled (numba) loops behind fe.assembly: the CSR pattern of interleaved vector dofs and
-the scatter of the element matrices into its data, parallel over node rows.
+the scatter of the element matrices into its data, by node rows (on numba's threads for P2 tets).
 
 The vector pattern is the node graph's with each entry an m x m block: the row of dof
 s*m + i holds the columns t*m + k of the nodes t adjacent to s, so the data position of
@@ -59,45 +59,30 @@ def _scatter(Ke, nptr, ne, na, off, indptr, out, m, A):
     return out
 
 
-_par = nb.njit(cache=True, error_model="numpy", parallel=True)
-
-
-@_par
+@_jit
 def scatter_2_6(Ke, nptr, ne, na, off, indptr, out):
     return _scatter(Ke, nptr, ne, na, off, indptr, out, 2, 6)
 
 
-@_par
+@_jit
 def scatter_3_10(Ke, nptr, ne, na, off, indptr, out):
     return _scatter(Ke, nptr, ne, na, off, indptr, out, 3, 10)
 
 
-@_par
+@_jit
 def scatter_any(Ke, nptr, ne, na, off, indptr, out):
     A = off.shape[2]
     return _scatter(Ke, nptr, ne, na, off, indptr, out, Ke.shape[1] // A, A)
 
 
-# the same loops on this thread: a parallel region starts numba's OpenMP pool, after which a
-# fork()ed child (multiprocessing's default on Linux) hangs in its first parallel region
-@_jit
-def scatter_serial_2_6(Ke, nptr, ne, na, off, indptr, out):
-    return _scatter(Ke, nptr, ne, na, off, indptr, out, 2, 6)
-
-
-@_jit
-def scatter_serial_3_10(Ke, nptr, ne, na, off, indptr, out):
+# on numba's threads for the large P2-tet models only, as the tangent kernel: a parallel region
+# starts numba's OpenMP pool, after which a fork()ed child (multiprocessing's default on Linux)
+# hangs in its first parallel region, so 2D solves stay on this thread
+@nb.njit(cache=True, error_model="numpy", parallel=True)
+def scatter_3_10_threads(Ke, nptr, ne, na, off, indptr, out):
     return _scatter(Ke, nptr, ne, na, off, indptr, out, 3, 10)
 
 
-@_jit
-def scatter_serial_any(Ke, nptr, ne, na, off, indptr, out):
-    A = off.shape[2]
-    return _scatter(Ke, nptr, ne, na, off, indptr, out, Ke.shape[1] // A, A)
-
-
-def scatter(m: int, A: int, parallel: bool):
-    """The scatter loop for m components and A nodes per element, on numba's threads or not."""
-    if parallel:
-        return {(2, 6): scatter_2_6, (3, 10): scatter_3_10}.get((m, A), scatter_any)
-    return {(2, 6): scatter_serial_2_6, (3, 10): scatter_serial_3_10}.get((m, A), scatter_serial_any)
+def scatter(m: int, A: int):
+    """The scatter loop (on this thread) for m components and A nodes per element."""
+    return {(2, 6): scatter_2_6, (3, 10): scatter_3_10}.get((m, A), scatter_any)

@@ -53,8 +53,8 @@ class Pattern:
         self._ne, self._na = (order // A).astype(np.int32), (order % A).astype(np.int32)
         # on numba's threads as the tangent kernel is (P2 tets from PARALLEL_MIN_ELEMENTS), else
         # on this thread: a 2D solve starts no OpenMP pool (a fork()ed child of it hung)
-        self._scatter = _sparse_nb.scatter(m, A, False)
-        self._scatter_threads = (_sparse_nb.scatter(m, A, True)
+        self._scatter = _sparse_nb.scatter(m, A)
+        self._scatter_threads = (_sparse_nb.scatter_3_10_threads
                                  if (m, A) == (3, 10) and E >= PARALLEL_MIN_ELEMENTS else None)
         # free-free block
         is_free = np.zeros(n, bool)
