@@ -400,14 +400,19 @@ class FileCoordinates:
         # a vertical facet (a side, a symmetry plane) holds no height of its own: its edges
         # are its neighbours' (a sensor on a side's line reads the top and bottom facets)
         keep = area > 1e-9 * size ** (geo.dim - 1)
-        if reference is not None and geo.dim == 3:
-            # the solved mesh's walls too (|n_y| < WALL_NY): a vertical line crosses their chords
-            # where they lean, not where the skin's surface is (the disc R 5 on a P1 h = 2 mesh:
-            # at r = 4.95, 128 of 181 lines took a wall chord for the top, and their depth-0.2
-            # sensors went up to 0.48 mm deeper than the CAD's); the reference decides
+        # the steep walls (|n_y| < WALL_NY of their straight facet's normal; none in 2D)
+        wall = np.zeros(len(F), bool)
+        if geo.dim == 3:
             P = F[:, :3, :]
             nrm = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-            keep &= np.abs(nrm[:, 1]) >= WALL_NY * np.linalg.norm(nrm, axis=1)
+            wall = np.abs(nrm[:, 1]) < WALL_NY * np.linalg.norm(nrm, axis=1)
+        if reference is not None:
+            # the solved mesh's walls are no top: a vertical line crosses their chords where
+            # they lean, not where the skin's surface is (the disc R 5 on a P1 h = 2 mesh: at
+            # r = 4.95, 128 of 181 lines took a wall chord for the top, and their depth-0.2
+            # sensors went up to 0.48 mm deeper than the CAD's); the reference decides
+            keep &= ~wall
+        self._wall = wall[keep]
         self._L, self._y, self._kind = L[keep], F[keep][:, :, 1], np.asarray(geo.facet_kind)[keep]
         self._face = None if cad is None or geo.facet_face is None else np.asarray(geo.facet_face)[keep]
         self._curved = F.shape[1] > geo.dim
@@ -559,7 +564,7 @@ class FileCoordinates:
         from tactileskin.mesh.skinfile import line_heights
 
         cad = line_heights(self.cad, self._face[f], np.column_stack([q[pt, 0], y, q[pt, 1]]))
-        wall = np.isnan(cad) & self._steep(f)
+        wall = np.isnan(cad) & self._wall[f]
         y = np.where(np.isnan(cad), y, cad)
         if not wall.any():
             return pt, f, y
@@ -573,14 +578,6 @@ class FileCoordinates:
         hit, keep = np.isfinite(ny), ~wall
         return (np.concatenate([pt[keep], npt[hit]]), np.concatenate([f[keep], nf[hit]]),
                 np.concatenate([y[keep], ny[hit]]))
-
-    def _steep(self, f) -> np.ndarray:
-        """Whether the straight facets f are steep walls (|n_y| < WALL_NY of their normal)."""
-        if self.dim != 3:
-            return np.zeros(len(f), bool)
-        P = np.stack([self._L[f][:, :3, 0], self._y[f][:, :3], self._L[f][:, :3, 1]], axis=2)
-        n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-        return np.abs(n[:, 1]) < WALL_NY * np.linalg.norm(n, axis=1)
 
     def _cross(self, q, f):
         """(hit, y) of the vertical lines through the points q (m, k) and the facets f (m,)."""
