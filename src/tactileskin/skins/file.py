@@ -376,6 +376,7 @@ class FileCoordinates:
     straight = True  # sensors.taxel_s: s is arc length on every depth surface (a side along x)
     local = True     # sensors.resolve: depth, thickness and extent vary with (x, z): self.depths
     reference = None  # (subclasses that set their own fields: skins.dome.DomeCoordinates)
+    _face = None      # the facets' CAD faces (a STEP's: read there), None: the facets' own heights
 
     def __init__(self, geo: FileGeometry, cad=None, reference: "FileCoordinates | None" = None):
         self.geo, self.dim = geo, geo.dim
@@ -462,6 +463,7 @@ class FileCoordinates:
         top, outer, floor, bond = (np.full(n, -np.inf) for _ in range(4))
         lo, hi = self._lo - self.tol, self._lo + self._cell * self._ncell + self.tol
         inside = np.all((q >= lo) & (q <= hi), axis=1)
+        hits, near = [], []
         for a in range(0, n, 4096):  # bounded memory: a few candidate facets per point
             rows = np.flatnonzero(inside[a:a + 4096]) + a
             if not rows.size:
@@ -471,19 +473,25 @@ class FileCoordinates:
             pt = np.repeat(rows, cnt)
             off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
             f = self._owner[np.repeat(self._start[c], cnt) + off]
-            near = pt, f  # every candidate facet of each point
             found = self._cross_curved(q[pt], f) if self._curved else [self._cross(q[pt], f)]
             y = np.concatenate([yy[hit] for hit, yy in found])
-            pt, f = (np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f))
-            if self._face is not None:
-                pt, f, y = self._on_cad(q, pt, f, y, near)
-            np.maximum.at(top, pt, y)
-            out = self._kind[f] == OUTER
-            np.maximum.at(outer, pt[out], y[out])
-            below = y < top[pt] - self.tol
-            np.maximum.at(floor, pt[below], y[below])
-            bonded = below & (self._kind[f] == BONDED)
-            np.maximum.at(bond, pt[bonded], y[bonded])
+            hits.append([np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f)] + [y])
+            if self._face is not None:  # every candidate facet of each point that crossed a wall
+                on = np.isin(pt, hits[-1][0][self._wall[hits[-1][1]]])
+                near.append((pt[on], f[on]))
+        if not hits:
+            hits = [[np.zeros(0, int), np.zeros(0, int), np.zeros(0)]]
+        pt, f, y = (np.concatenate(v) for v in zip(*hits))
+        if self._face is not None:  # all the points' crossings read on the CAD at once: one STEP import
+            pt, f, y = self._on_cad(q, pt, f, y, tuple(np.concatenate(v) for v in zip(*near)) if near
+                                    else (np.zeros(0, int), np.zeros(0, int)))
+        np.maximum.at(top, pt, y)
+        out = self._kind[f] == OUTER
+        np.maximum.at(outer, pt[out], y[out])
+        below = y < top[pt] - self.tol
+        np.maximum.at(floor, pt[below], y[below])
+        bonded = below & (self._kind[f] == BONDED)
+        np.maximum.at(bond, pt[bonded], y[bonded])
         nan = lambda v: np.where(np.isfinite(v), v, np.nan)  # noqa: E731
         return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
                 "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
@@ -644,6 +652,14 @@ class FileCoordinates:
         ParameterError naming the layout, the sensor (`idx`: its index in the layout) and the
         valid range there. With a `reference` (mesh_coordinates) its check decides, and the
         depths it accepts are clamped into this mesh's columns."""
+        if self._face is None:
+            return self._depths(where, lay, s, z, idx, what)
+        from tactileskin.mesh.skinfile import step_open
+
+        with step_open(self.cad):  # the STEP imported once for all the columns read here
+            return self._depths(where, lay, s, z, idx, what)
+
+    def _depths(self, where: str, lay, s, z, idx, what: str = "") -> np.ndarray:
         s = np.atleast_1d(np.asarray(s, float))
         z = np.broadcast_to(np.asarray(z, float), s.shape)
         if self.reference is not None:
