@@ -599,7 +599,7 @@ def test_a_sensor_at_a_step_between_two_top_faces_hangs_from_the_face_not_the_wa
     and read the wall's jump as a slope of 312 (normal (1, 0.0032)), so a depth-0.5 sensor at s
     = 1 (a round grid point) went 0.5 mm sideways under the upper face, 0.0016 mm below the
     surface, and a height 1e-4 mm past it was refused ('leaves the skin through a face that is
-    not bonded'; at s = 1 itself the vertical column meets the lower face's edge, as before).
+    not bonded'; at s = 1 itself the line is the higher face's: test_a_sensor_on_a_steps_edge_...).
     A one-sided difference steeper than a wall is the step, not the surface: the
     other side's is taken, and the sensor hangs straight down from the face it is on."""
     pts = [(-4, 0), (4, 0), (4, 1.5), (1, 1.5), (1, 2.0), (-4, 2.0)]
@@ -674,3 +674,29 @@ def test_a_point_surely_inside_a_faces_domain_is_inside_for_gmsh(tmp_path):
                 if path.name == "shell.step" and g.model.getType(2, f) == "Cylinder":
                     assert sure.mean() > 0.99  # the (u, v) box is the face
     assert sure_in > 4000  # of the 7500 points (5116)
+
+
+def test_a_sensor_on_a_steps_edge_hangs_from_the_higher_face(tmp_path):
+    """On the edge of a step between two top faces (y = 2 for x < 1, 1.5 past the wall at x = 1)
+    the vertical line slides down the wall from the higher face's edge and touches the lower
+    face's edge (y = 1.5) while still in the skin; that edge was read as the line's floor: a
+    height 0.5 at s = 1 was refused ("leaves the skin through a face that is not bonded") and a
+    depth 1 held to 0.5 ("valid: [0, 0.5] mm"), while the depth layout hangs it from the higher
+    face (its top is y = 2 there). It is the higher face's line now, as 1e-4 mm on that side:
+    height 0.5 at y = 0.5 (depth 1.5), depth 1 at y = 1; in 2D (.msh) and 3D (STEP, the same
+    step 4 mm along z)."""
+    import build123d as bd
+
+    pts = [(-4, 0), (4, 0), (4, 1.5), (1, 1.5), (1, 2.0), (-4, 2.0)]
+    msh = _gmsh_polygon(tmp_path / "step.msh", pts, {"bonded": [0], "sides": [1, 5], "outer_surface": [2, 3, 4]})
+    step = tmp_path / "step.step"
+    box = lambda x, w, h: bd.Pos(x, 0, 0) * bd.Box(w, h, 4, align=(bd.Align.CENTER, bd.Align.MIN,  # noqa: E731
+                                                                    bd.Align.CENTER))
+    bd.export_step(box(-1.5, 5, 2) + box(2.5, 3, 1.5), str(step))
+    for path, z in ((msh, {}), (step, {"z": [0.3]})):
+        lays = [{"name": "h", "kind": "points", "s": [1.0, 0.9999], "height": 0.5, **z},
+                {"name": "d", "kind": "points", "s": [1.0], "depth": 1.0, **z}]
+        st = sensors.sites_for(Scene(skin="file", skin_file=str(path), indenter="flat", sensors=lays))
+        assert np.allclose(st.xyz[:, :2], [[1.0, 0.5], [0.9999, 0.5], [1.0, 1.0]], rtol=0, atol=1e-9), path.name
+        assert np.allclose(st.depth, [1.5, 1.5, 1.0], rtol=0, atol=1e-9)
+        assert np.allclose(st.normal[:, :2], [0.0, 1.0], rtol=0, atol=1e-12)

@@ -450,7 +450,33 @@ class FileCoordinates:
     def column(self, s, z=None) -> dict:
         """Heights (mm, NaN where none) on the vertical line through each (s, z): `top` (the
         highest boundary), `outer` (the highest contact surface), `floor` (the first boundary
-        under the top) and `bonded` (whether that floor is a bonded surface)."""
+        under the top) and `bonded` (whether that floor is a bonded surface). A line along a
+        wall (a step's edge between two top faces) meets the boundary an odd number of times:
+        it slides down the wall from the higher face's edge and touches the lower face's edge
+        while still in the skin, and that edge was its floor: a height there was refused ("a
+        face that is not bonded") and a depth held to the step's height. Such a line is the
+        higher face's (its top is that face's edge): its floor is read just beside the wall on
+        that side (self.tol away, where the line meets the boundary an even number of times)."""
+        col, odd = self._column(s, z)
+        if not odd.any():
+            return col
+        i = np.flatnonzero(odd)
+        s = np.atleast_1d(np.asarray(s, float))[i]
+        z = None if self.dim == 2 else np.broadcast_to(np.asarray(0.0 if z is None else z, float), odd.shape)[i]
+        left = np.ones(len(i), bool)
+        sides = [(1.0, 0.0), (-1.0, 0.0)] + ([(0.0, 1.0), (0.0, -1.0)] if self.dim == 3 else [])
+        for ds, dz in sides:
+            nb, nb_odd = self._column(s + ds * self.tol, None if z is None else z + dz * self.tol)
+            # the same top (to the slope of a wall over that step, as _top_normal): the higher face
+            take = left & ~nb_odd & np.isfinite(nb["floor"]) & \
+                (np.abs(nb["top"] - col["top"][i]) <= self.tol / WALL_NY)
+            col["floor"][i[take]], col["bonded"][i[take]] = nb["floor"][take], nb["bonded"][take]
+            left &= ~take
+        return col
+
+    def _column(self, s, z=None) -> tuple:
+        """(column's dict, whether each line meets the boundary an odd number of times: its
+        distinct crossings, those within tol one)."""
         s = np.atleast_1d(np.asarray(s, float))
         x = self.x_top + s
         if self.geo.symmetric:
@@ -492,9 +518,22 @@ class FileCoordinates:
         np.maximum.at(floor, pt[below], y[below])
         bonded = below & (self._kind[f] == BONDED)
         np.maximum.at(bond, pt[bonded], y[bonded])
+        # a line crossing a closed skin meets its boundary an even number of times; a vertex
+        # shared by facets is one crossing (its facets' heights within tol). Only lines of 3 or
+        # more crossings are sorted (a line through the top and the floor has 2)
+        odd = np.zeros(n, bool)
+        cnt = np.bincount(pt, minlength=n)
+        many = cnt[pt] >= 3
+        if many.any():
+            p, yy = pt[many], y[many]
+            o = np.lexsort((yy, p))
+            p, yy = p[o], yy[o]
+            new = np.ones(len(p), bool)
+            new[1:] = (p[1:] != p[:-1]) | (yy[1:] - yy[:-1] > self.tol)
+            odd = np.bincount(p[new], minlength=n) % 2 == 1
         nan = lambda v: np.where(np.isfinite(v), v, np.nan)  # noqa: E731
         return {"top": nan(top), "outer": nan(outer), "floor": nan(floor),
-                "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}
+                "bonded": np.isfinite(floor) & (bond >= floor - self.tol)}, odd
 
     def _query(self, s, z):
         """The points (m, k) the columns are read at: x (and z), mirrored on a half model."""
