@@ -390,7 +390,7 @@ def test_a_taxel_layout_reads_each_point_of_its_lines_once(tmp_path, monkeypatch
     half tube's slope and a sensor on its flat top took 284 + 25 reads; now each line reads its
     top, its 2 slope points and its EXIT_SAMPLES samples (the flat top's: one column), and every
     point lies where it did: 0.5 along the radial of R 8 from the surface point over its s."""
-    from tactileskin.skins.file import EXIT_SAMPLES, FileCoordinates
+    from tactileskin.skins.file_coordinates import EXIT_SAMPLES, FileCoordinates
 
     path = _half_tube(tmp_path / "tube.msh")
     lays = [{"name": "tx", "kind": "points", "s": [1.0, 5.0], "depth": 0.5, "taxel": 1.0, "taxel_points": 3},

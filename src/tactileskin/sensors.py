@@ -12,7 +12,7 @@ tables). Positions are in the skin's own coordinates (`SectionCoordinates` for t
 A pad's s is x and its depth along -y (`FlatCoordinates`); a user's file skin's s is x - x_top
 and z that of its contact surface's point over (x, z), its depth along that surface's inward
 normal n there and its height along the same line from where it leaves the skin through the
-bonded face, its plane along the surface there (skins.file.FileCoordinates, the dome's too; its
+bonded face, its plane along the surface there (skins.file_coordinates.FileCoordinates, the dome's too; its
 n has a z part where the surface slopes along z). So on every skin a sensor at depth d lies d
 from the surface along its plane's normal (Sites.normal_depth = depth, sensors.csv's
 normal_depth_mm; a file skin's and the dome's depth was vertical, d cos theta along n under a
@@ -405,7 +405,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
     """Sites of the layouts in the skin coordinates `coords`; a sensor (or a taxel's edge)
     outside the skin is a ParameterError naming the layout and the valid range."""
     t, smax = coords.thickness, coords.s_max
-    local = getattr(coords, "local", False)  # skins.file.FileCoordinates: checks its own points
+    local = getattr(coords, "local", False)  # skins.file_coordinates.FileCoordinates: checks its own points
     ids, names, S, Z, D, layout_of = [], [], [], [], [], []
     for lay in lays:
         where = f"sensor layout {lay.name!r}"

@@ -12,7 +12,7 @@ sphere or a Braille dot there presses half on the finger and half on the dome. s
 length along the bone's ellipse (a - t, b - t) from its top, by the angle of (x, y) (so it
 also parametrises the bone under the dome); the 3D profile's section plane is z = 0.
 
-Sensors (`DomeCoordinates`): a user's file skin's normal lines (skins.file.FileCoordinates):
+Sensors (`DomeCoordinates`): a user's file skin's normal lines (skins.file_coordinates.FileCoordinates):
 s = x and z (in [-dome_length, dome_tip]) of the outer surface's point, depth along its inward
 normal there (the outer body's exact gradient), height along that line from where it meets the
 bone, the sensor plane along the outer surface there (normal the surface's, out of the plane z =
@@ -33,7 +33,8 @@ import numpy as np
 
 from tactileskin.errors import ParameterError, check_range
 from tactileskin.skins.base import Skin
-from tactileskin.skins.file import FileCoordinates, FileGeometry, boundary_facets
+from tactileskin.skins.file import boundary_facets
+from tactileskin.skins.file_coordinates import FileCoordinates, FileGeometry
 from tactileskin.skins.registry import register
 
 DEFAULT_LENGTH = 10.0
