@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tactileskin.array import chart, maps, surrogate
+from tactileskin.array import chart, config, maps, surrogate
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille
 from tactileskin.scene import Scene
@@ -77,7 +77,7 @@ def test_a_digit_is_the_number_sign_and_its_a_to_j_cell_in_a_two_cell_frame():
             surrogate.char_centres(bad)
     with pytest.raises(ParameterError, match="letters"):
         chart.ChartConfig(letters="ab#")
-    assert chart.ChartConfig().letters == chart.LETTERS + chart.DIGITS
+    assert chart.ChartConfig().letters == config.LETTERS + config.DIGITS
 
 
 def test_extruded_profile_is_uniform_along_z_and_mirrored():
@@ -782,8 +782,8 @@ def test_chart_mesh_follows_the_3d_default_where_that_is_finer():
     got = {t: cfg.mesh_for(t) for t in cfg.thicknesses}
     for t, m in got.items():
         preset = presets.mesh(3, "default", braille=True, thickness=t)
-        finer = preset[0] / preset[1] < chart.CHART_MESH[0] / chart.CHART_MESH[1]
-        assert m == (tuple(float(v) for v in preset) if finer else chart.CHART_MESH), t
+        finer = preset[0] / preset[1] < config.CHART_MESH[0] / config.CHART_MESH[1]
+        assert m == (tuple(float(v) for v in preset) if finer else config.CHART_MESH), t
         sc = chart.dot_scene(t, "silicone", cfg)
         assert (sc.mesh_size, sc.refinement) == m
     assert got[1.0] == (0.8, 8.0) and got[3.0] == (1.2, 8.0)

@@ -17,7 +17,7 @@ SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille charac
 
 
 def set_title(set_: str, cfg) -> str:
-    from tactileskin.array.chart import DIGITS, LETTERS
+    from tactileskin.array.config import DIGITS, LETTERS
 
     have = set(cfg.letters)
     chars = {frozenset(LETTERS + DIGITS): "a-z, 0-9", frozenset(LETTERS): "a-z", frozenset(DIGITS): "0-9"}.get(
