@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 
 
 def available_cpus() -> int:
@@ -27,6 +28,47 @@ def user_setting(large: bool) -> tuple[str, str] | None:
         if value:
             return name, value
     return None
+
+
+# set in a fork()ed child (multiprocessing's default on Linux: a Pool.map of solves) whose parent
+# had started numba's thread pool (any solve does, via numba_threads) or run PARDISO on several
+# threads: GNU OpenMP's threads do not survive fork() (numba terminates such a child at its first
+# parallel region, "fork() called from a process already using GNU OpenMP"; PARDISO on MKL's GNU
+# threading layer waited for them), so there the compiled loops and PARDISO run on one thread
+_parent_threads = False   # this process started them
+_forked_from_threads = False
+
+
+def _after_fork_in_child() -> None:
+    global _forked_from_threads
+    parallel = sys.modules.get("numba.np.ufunc.parallel")
+    if _parent_threads or (parallel is not None and getattr(parallel, "_is_initialized", True)):
+        _forked_from_threads = True
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork_in_child)
+
+
+def started_threads() -> None:
+    """Note that this process started OpenMP threads (PARDISO on several threads)."""
+    global _parent_threads
+    _parent_threads = True
+
+
+def forked_from_threads() -> bool:
+    """True in a fork()ed child of a process that had started numba's or MKL's threads (and in
+    its own fork()ed children): its compiled loops and PARDISO run on one thread."""
+    return _forked_from_threads
+
+
+def numba_parallel_threads() -> int:
+    """Threads numba's parallel loops of this thread may use: numba.get_num_threads(), or 1 in
+    a fork()ed child of a process that had started numba's or MKL's threads (the loops' serial
+    twins then: the same bits)."""
+    import numba
+
+    return 1 if _forked_from_threads else numba.get_num_threads()
 
 
 @contextlib.contextmanager

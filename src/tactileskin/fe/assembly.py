@@ -14,6 +14,7 @@ import scipy.sparse as sp
 
 from tactileskin.fe import _sparse_nb
 from tactileskin.fe.kernels import PARALLEL_MIN_ELEMENTS
+from tactileskin.threads import numba_parallel_threads
 
 
 def vector_dofs(scalar_dofs: np.ndarray, m: int) -> np.ndarray:
@@ -78,7 +79,7 @@ class Pattern:
         Ke = np.ascontiguousarray(Ke, np.float64)
         if Ke.shape != self.edofs.shape + self.edofs.shape[1:]:
             raise ValueError(f"element matrices of shape {Ke.shape} for element dofs {self.edofs.shape}")
-        f = self._scatter_threads if self._scatter_threads is not None and _sparse_nb.nb.get_num_threads() > 1 \
+        f = self._scatter_threads if self._scatter_threads is not None and numba_parallel_threads() > 1 \
             else self._scatter
         return f(Ke, self._nptr, self._ne, self._na, self._off, self.indptr, np.empty(len(self.keys)))
 

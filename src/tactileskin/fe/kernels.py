@@ -34,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from tactileskin.fe import _kernels_nb
+from tactileskin.threads import numba_parallel_threads
 
 # P2 tets from which the tangent runs on numba's threads (tactileskin.threads.numba_threads;
 # fe.model sets them per solve): the default 3D dot at t = 3 mm, 11,900 elements, 67 -> 37 ms
@@ -99,7 +100,7 @@ def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray, out: np.ndarray | Non
     D must have minor symmetry (the material part is evaluated in Voigt pairs) and, in the
     mixed formulation, major symmetry (the rank-one terms use AA F for both sides); any
     D = 2 dS/dC of a hyperelastic S has both. The algebra: fe._kernels_nb. P2 tets run on
-    numba's threads (numba.get_num_threads()) from PARALLEL_MIN_ELEMENTS elements."""
+    numba's threads (threads.numba_parallel_threads()) from PARALLEL_MIN_ELEMENTS elements."""
     E, Q, A, m = kin.G.shape
     if out is not None and (out.shape != (E, A * m, A * m) or out.dtype != np.float64
                             or not out.flags.c_contiguous):   # the loops write without bounds checks
@@ -107,7 +108,7 @@ def tangent(kin: Kinematics, S: np.ndarray, D: np.ndarray, out: np.ndarray | Non
     theta = kin.theta if kin.mixed else np.empty(0)
     args = (kin.G, kin.w, kin.F, kin.Fbar, kin.Finv, kin.alpha, kin.J,
             _c(theta), _c(S), _c(D), kin.mixed, np.empty((E, A * m, A * m)) if out is None else out)
-    threads = _kernels_nb.nb.get_num_threads()
+    threads = numba_parallel_threads()
     if (m, A) == (3, 10) and threads > 1 and E >= PARALLEL_MIN_ELEMENTS:
         return _kernels_nb.tangent_3_10_parallel(*args, 4 * threads)
     return _kernels_nb.entry("tangent", kin.G)(*args)

@@ -50,7 +50,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from tactileskin.threads import available_cpus, user_setting
+from tactileskin.threads import available_cpus, forked_from_threads, started_threads, user_setting
 
 log = logging.getLogger(__name__)
 
@@ -187,7 +187,10 @@ class _Pardiso:
         p = lambda v: ctypes.byref(i32(v))  # noqa: E731
         i32p = ctypes.POINTER(i32)
         setter = getattr(self.lib, "MKL_Set_Num_Threads_Local", None)
-        prev = setter(i32(self.threads)) if setter is not None else None
+        threads = 1 if forked_from_threads() else self.threads   # (tactileskin.threads)
+        if threads > 1:
+            started_threads()
+        prev = setter(i32(threads)) if setter is not None else None
         try:
             self._pardiso(phase, a, b, x, err, p, i32p)
         finally:

@@ -431,10 +431,11 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     eigenproblem of C - I by Jacobi rotations, the same formulas and guards; ~3x cheaper than
     the eigh path, which is its oracle: same values to rounding, identical ok flags,
     tests/test_hyperfoam_nb.py). tangent=False skips D and returns (S, None, ok). From
-    PARALLEL_MIN_POINTS points on numba's threads (numba.get_num_threads(); the same bits)."""
+    PARALLEL_MIN_POINTS points on numba's threads (threads.numba_parallel_threads(); the same bits)."""
     C = np.asarray(C, dtype=float)
     _check_shape("C", C, 3)
     from tactileskin.materials import _hyperfoam_nb as nb
+    from tactileskin.threads import numba_parallel_threads
 
     lead, n, Ck, dk, has_detF = _kernel_inputs(C, 3, detF)
     Ck, dk = np.ascontiguousarray(Ck), np.ascontiguousarray(dk)   # one compiled specialisation
@@ -443,7 +444,7 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     ok = np.empty(n, dtype=bool)
     args = (Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
             float(mat.beta), S, D, ok, tangent)
-    threads = nb.numba.get_num_threads()
+    threads = numba_parallel_threads()
     if threads > 1 and n >= PARALLEL_MIN_POINTS:
         nb.solid_kernel_parallel(*args, 4 * threads)
     else:

@@ -1,0 +1,82 @@
+"""A child fork()ed after a 3D solve (multiprocessing's default start method on Linux: a user's
+Pool.map of solves) solves 3D too, with the parent's results. Each case runs in its own Python
+(a broken child must not take the test session with it); the child answers through a Queue
+with a timeout and is killed if it does not."""
+
+import multiprocessing
+import os
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),
+                                reason="no fork on this platform")
+
+_COMMON = """
+import multiprocessing as mp, sys
+import numba
+from tactileskin.scene import Scene
+from tactileskin.mesh import build_mesh
+from tactileskin.fe import solve
+from tactileskin.fe.solver import SolverOptions
+SC = Scene(dim=3, thickness=1, material='silicone', indenter='braille', braille_text='',
+           mesh_size=1.0, refinement=2)
+
+def in_child(target, *args):
+    ctx = mp.get_context('fork')
+    q = ctx.Queue()
+    p = ctx.Process(target=target, args=(q,) + args, daemon=True)
+    p.start()
+    for _ in range(60):   # 60 s, or until the child dies without an answer
+        try:
+            return q.get(timeout=1)
+        except Exception:
+            if not p.is_alive():
+                break
+    print('no answer from the forked child; exit code', p.exitcode, file=sys.stderr)
+    p.kill()
+    sys.exit(1)
+"""
+
+# The threaded compiled loops (from 0 elements / points here: the coarse mesh, ~1,350 tets,
+# is below their thresholds) and PARDISO on 2 threads in the parent; the child gets the
+# parent's mesh, so only its solve is tested. Numba terminated such a child at its first
+# parallel region ("fork() called from a process already using GNU OpenMP"), and PARDISO on
+# MKL's GNU threading layer waited forever for the parent's threads.
+_THREADS = _COMMON + """
+from tactileskin.fe import kernels
+from tactileskin.materials import hyperfoam
+kernels.PARALLEL_MIN_ELEMENTS = 0
+hyperfoam.PARALLEL_MIN_POINTS = 0
+OPTS = SolverOptions(threads=2)
+
+def child(q, mesh):
+    r = solve(SC, mesh, options=OPTS)
+    q.put((float(r.peak), r.stats['newton_iterations']))
+
+if __name__ == '__main__':
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        sys.exit(3)
+    mesh = build_mesh(SC)
+    r = solve(SC, mesh, options=OPTS)
+    peak, newton = in_child(child, mesh)
+    # the same Newton path; PARDISO's rounding on 1 thread instead of 2
+    ok = newton == r.stats['newton_iterations'] and abs(peak - r.peak) <= 1e-12 * abs(r.peak)
+    print(r.peak, peak, r.stats['newton_iterations'], newton, file=sys.stderr)
+    sys.exit(0 if ok else 1)
+"""
+
+
+def _run(tmp_path, script: str):
+    path = tmp_path / "fork_after_3d.py"
+    path.write_text(script)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    r = subprocess.run([sys.executable, str(path)], env=env, capture_output=True, text=True, timeout=300)
+    if r.returncode == 3:
+        pytest.skip("numba has one thread here")
+    assert r.returncode == 0, r.stderr[-2000:]
+
+
+def test_a_forked_child_of_a_threaded_3d_solve_solves_on_one_thread(tmp_path):
+    _run(tmp_path, _THREADS)
