@@ -80,3 +80,36 @@ def _run(tmp_path, script: str):
 
 def test_a_forked_child_of_a_threaded_3d_solve_solves_on_one_thread(tmp_path):
     _run(tmp_path, _THREADS)
+
+
+# gmsh's OpenCASCADE starts a thread pool in the parent's 3D meshing (the surface
+# triangulations behind the Distance size fields); the child's own 3D meshing waited forever
+# for the parent's pool thread (mesh._gmsh: the child meshes in a fresh Python instead)
+_MESH = _COMMON + """
+import numpy as np
+
+def child(q):
+    m = build_mesh(SC)
+    q.put((m.mesh.doflocs, m.mesh.t, {k: v for k, v in m.boundaries.items()}))
+
+if __name__ == '__main__':
+    m = build_mesh(SC)
+    p, t, b = in_child(child)
+    same = (np.array_equal(p, m.mesh.doflocs) and np.array_equal(t, m.mesh.t)
+            and b.keys() == m.boundaries.keys() and all(np.array_equal(b[k], m.boundaries[k]) for k in b))
+    sys.exit(0 if same else 1)
+"""
+
+
+def test_a_forked_child_of_a_3d_mesh_meshes_the_same_3d_mesh(tmp_path):
+    _run(tmp_path, _MESH)
+
+
+def test_a_fresh_process_raises_the_typed_error_with_its_fields():
+    from tactileskin.errors import ParameterError, check_range
+    from tactileskin.mesh import _gmsh
+
+    with pytest.raises(ParameterError) as e:
+        _gmsh.in_fresh_process(check_range, "depth", 5.0, 0.0, 1.0, unit="mm")
+    assert (e.value.name, e.value.value) == ("depth", 5.0) and "depth=5.0" in str(e.value)
+    assert _gmsh.in_fresh_process(check_range, "depth", 0.5, 0.0, 1.0) == 0.5

@@ -19,4 +19,9 @@ def build_mesh(scene, *, cell: str = "tri", **overrides) -> SkinMesh:
     all-quadrilateral mesh (MeshQuad2, 9-node) instead of triangles."""
     if cell not in ("tri", "quad") or (cell == "quad" and scene.dim == 3):
         raise ParameterError("cell", cell, "'tri' in 3D (tetrahedra); 'quad' is 2D only")
+    if scene.dim == 3:
+        from tactileskin.mesh import _gmsh
+
+        if _gmsh.forked_after_3d_mesh():  # gmsh would wait for the parent's threads (see _gmsh)
+            return _gmsh.in_fresh_process(build_mesh, scene, cell=cell, **overrides)
     return scene.skin_kind.build_mesh(scene, cell=cell, **overrides)

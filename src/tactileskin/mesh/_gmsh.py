@@ -13,6 +13,10 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import os
+import pickle
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -21,6 +25,12 @@ from tactileskin.errors import MeshError, TactileSkinError
 
 logger = logging.getLogger(__name__)
 _LOCK = threading.Lock()
+# pid of the process that made a 3D mesh: gmsh's OpenCASCADE starts a thread pool there (the
+# surface triangulations behind the Distance size fields), which does not survive fork(): a
+# child fork()ed after it (multiprocessing's default on Linux, a Pool.map of solves) waited
+# forever for the parent's pool thread in its own 3D meshing (mesh.build_mesh meshes there in
+# a fresh Python instead, in_fresh_process)
+_meshed_3d_in: int | None = None
 
 # gmsh element type ids
 LINE2, LINE3, TRI3, TRI6, TET4, TET10, QUAD4, QUAD9 = 1, 8, 2, 9, 4, 11, 3, 10
@@ -67,6 +77,7 @@ def session(name: str, params: dict):
                 raise MeshError(f"gmsh failed to mesh {name} with {params}: {e}"
                                 + (f" (gmsh log: {' | '.join(log)})" if log else "")) from e
             finally:
+                _note_3d(gmsh)
                 for msg in _log(gmsh):
                     if msg.startswith("Warning"):
                         logger.warning("gmsh (%s): %s", name, msg)
@@ -76,6 +87,69 @@ def session(name: str, params: dict):
             if owned:
                 with _signals_kept():
                     gmsh.finalize()
+
+
+def _note_3d(gmsh) -> None:
+    global _meshed_3d_in
+    if _meshed_3d_in is None and gmsh.model.getDimension() == 3:
+        _meshed_3d_in = os.getpid()
+
+
+def forked_after_3d_mesh() -> bool:
+    """True in a fork()ed child (or a later descendant) of a process that made a 3D mesh."""
+    return _meshed_3d_in is not None and _meshed_3d_in != os.getpid()
+
+
+# run in a fresh Python by in_fresh_process: (sys.path, log level, (func, args, kwargs)) on
+# stdin; (ok, result or exception as (type, message, attributes), log records) on the saved
+# stdout (stray prints go to stderr)
+_FRESH = """
+import logging, os, pickle, sys
+out = os.fdopen(os.dup(1), "wb")
+os.dup2(2, 1)
+sys.path[:0] = pickle.load(sys.stdin.buffer)
+level = pickle.load(sys.stdin.buffer)
+records = []
+class Keep(logging.Handler):
+    def emit(self, r):
+        r.msg, r.args, r.exc_info, r.exc_text = r.getMessage(), None, None, None
+        records.append(r)
+log = logging.getLogger("tactileskin")
+log.setLevel(level)
+log.addHandler(Keep())
+func, args, kwargs = pickle.load(sys.stdin.buffer)
+try:
+    res = (True, func(*args, **kwargs))
+except Exception as e:
+    res = (False, (type(e), str(e), dict(vars(e))))
+pickle.dump(res + (records,), out)
+"""
+
+
+def in_fresh_process(func, *args, **kwargs):
+    """func(*args, **kwargs) in a new Python (not fork()ed: no inherited thread pools), its
+    log records re-emitted here and its exception (type, message, attributes) raised here.
+    A subprocess, not multiprocessing: a Pool's workers are daemons, which may not start
+    multiprocessing children."""
+    payload = b"".join(pickle.dumps(x) for x in ([p for p in sys.path if p],
+                                                 logging.getLogger("tactileskin").getEffectiveLevel(),
+                                                 (func, args, kwargs)))
+    r = subprocess.run([sys.executable, "-c", _FRESH], input=payload, capture_output=True)
+    try:
+        ok, value, records = pickle.loads(r.stdout)
+    except Exception:
+        err = r.stderr.decode(errors="replace").strip().splitlines()[-3:]
+        raise MeshError(f"meshing in a fresh Python (this process was fork()ed after a 3D mesh) "
+                        f"failed, exit code {r.returncode}: {' | '.join(err)}") from None
+    for rec in records:
+        logging.getLogger(rec.name).handle(rec)
+    if ok:
+        return value
+    cls, msg, attrs = value
+    e = cls.__new__(cls)   # no __init__: ParameterError's takes (name, value, valid), not the message
+    Exception.__init__(e, msg)
+    e.__dict__.update(attrs)
+    raise e
 
 
 def _log(gmsh) -> list[str]:
