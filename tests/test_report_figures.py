@@ -343,3 +343,65 @@ def test_every_format_of_a_figure_has_the_constrained_layout_of_the_first(tmp_pa
     assert all(p == pos[0] for p in pos), pos
     default = plt.rcParams["figure.subplot.left"]
     assert abs(pos[0][0] - default) > 0.02  # constrained layout moved the axes for the label
+
+
+def _small_grid():
+    recs, rows = [], []
+    s = np.linspace(0, 8, 41)
+    for t in (1.0, 3.0):
+        for ind, pk in (("flat", 0.5), ("curved", 0.4)):
+            p = pk / (1 + t) * np.exp(-(s / (1 + t / 2)) ** 2)
+            recs.append(CaseRecord(Scene(thickness=t, material="silicone", indenter=ind), s, p, {}, Path(".")))
+            rows.append(dict(status="ok", material="silicone", thickness_mm=t, indenter=ind, braille_text="",
+                             peak_mpa=float(p.max()), span_mm=1.0 + t, auc_mpa_mm=float(np.trapezoid(p, s))))
+    return recs, rows
+
+
+def _drawn(monkeypatch):
+    """Count all_figures' calls (the drawing) while it still draws."""
+    calls = []
+    real = figures.all_figures
+    monkeypatch.setattr(figures, "all_figures", lambda *a: (calls.append(1), real(*a))[1])
+    return calls
+
+
+def test_a_rerun_with_the_same_inputs_writes_the_kept_figures_without_drawing(tmp_path, monkeypatch):
+    """A cached rerun drew every figure again (3.4 s of a preview sweep's ~11 s): the files are
+    kept in the cache under their inputs' digest and copied, byte for byte, in the same order."""
+    from tactileskin.cache import ResultCache
+    from tactileskin.report import outputs
+
+    recs, rows = _small_grid()
+    cache = ResultCache(tmp_path / "cache")
+    calls = _drawn(monkeypatch)
+    first = outputs._figures(recs, rows, tmp_path / "a", cache)
+    again = outputs._figures(recs, rows, tmp_path / "b", cache)
+    assert len(calls) == 1  # drawn once
+    assert [p.name for p in again] == [p.name for p in first] and len(first) == 11
+    assert all(p.parent == tmp_path / "b" for p in again)
+    assert [p.read_bytes() for p in again] == [p.read_bytes() for p in first]
+
+
+def test_a_changed_input_or_a_damaged_kept_figure_is_drawn_again(tmp_path, monkeypatch):
+    from tactileskin.cache import ResultCache
+    from tactileskin.report import outputs
+
+    recs, rows = _small_grid()
+    cache = ResultCache(tmp_path / "cache")
+    calls = _drawn(monkeypatch)
+    first = {p.name: p.read_bytes() for p in outputs._figures(recs, rows, tmp_path / "a", cache)}
+    # one number of one row changed: another key, the figures drawn again and differing
+    rows2 = [dict(r) for r in rows]
+    rows2[0]["peak_mpa"] *= 1.5
+    changed = {p.name: p.read_bytes() for p in outputs._figures(recs, rows2, tmp_path / "b", cache)}
+    assert len(calls) == 2 and changed["fig11_peak.png"] != first["fig11_peak.png"]
+    # a profile point changed (the records, not the rows): drawn again
+    recs2 = [CaseRecord(r.scene, r.s, r.pressure * (1.1 if k == 0 else 1.0), r.summary, r.path)
+             for k, r in enumerate(recs)]
+    outputs._figures(recs2, rows, tmp_path / "c", cache)
+    assert len(calls) == 3
+    # the kept copy of the first figures damaged: not used, drawn again as they were
+    kept = cache.root / f"figures-{figures.figures_key(recs, rows)}" / "fig11_peak.png"
+    kept.write_bytes(kept.read_bytes()[:-10] + b"0123456789")
+    again = {p.name: p.read_bytes() for p in outputs._figures(recs, rows, tmp_path / "d", cache)}
+    assert len(calls) == 4 and again == first

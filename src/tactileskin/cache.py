@@ -318,6 +318,11 @@ class CaseLock:
                 self._fd = None
 
 
+# the list of a derived entry's files (load_files), not cache.json: a folder holding a
+# cache.json is a solved case's entry
+DERIVED_MANIFEST = "files.json"
+
+
 class ResultCache:
     def __init__(self, root: str | Path):
         self.root = Path(root)
@@ -428,6 +433,47 @@ class ResultCache:
                 encoding="utf-8")
             fileio.fix_tree_modes(tmp)
         return final
+
+    # --- files derived from entries (a sweep's figures) -------------------------------------
+    def load_files(self, name: str) -> list[tuple[str, bytes]] | None:
+        """The (file name, bytes) of the derived entry `name` (store_files), in their order, or
+        None when there is none or it is damaged (a file missing or its bytes changed: not
+        used, and replaced by the next store_files)."""
+        if code_changes():
+            return None  # not the code the name's digest names (logged): not reused
+        p = self.root / name
+        try:
+            meta = json.loads((p / DERIVED_MANIFEST).read_text(encoding="utf-8"))
+            if meta.get("schema") != SCHEMA_VERSION or meta.get("key") != name:
+                return None
+            out = []
+            for fname, digest in meta["files"]:
+                if Path(fname).name != fname or fname == DERIVED_MANIFEST:
+                    return None
+                data = (p / fname).read_bytes()
+                if hashlib.sha256(data).hexdigest() != digest:
+                    log.warning("cache entry %s is damaged (the bytes of %s changed); not used", p, fname)
+                    return None
+                out.append((fname, data))
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            return None
+        return out or None
+
+    def store_files(self, name: str, paths: list[Path]) -> None:
+        """Keep copies of `paths` (files this run wrote) as the derived entry `name`, atomically."""
+        if code_changes():
+            return  # not the code the name's digest names (logged)
+        final = self.root / name
+        with fileio.os_errors(final), staging.staged_dir(final) as tmp:
+            files = []
+            for f in paths:
+                data = Path(f).read_bytes()
+                (tmp / Path(f).name).write_bytes(data)
+                files.append([Path(f).name, hashlib.sha256(data).hexdigest()])
+            (tmp / DERIVED_MANIFEST).write_text(json.dumps(
+                {"schema": SCHEMA_VERSION, "key": name, "version": __version__, "files": files}, indent=2) + "\n",
+                encoding="utf-8")
+            fileio.fix_tree_modes(tmp)
 
     def lock(self, key: str, *, blocking: bool) -> CaseLock | None:
         """Take the case's lock; None if another process holds it and not blocking."""

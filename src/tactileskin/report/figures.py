@@ -267,6 +267,45 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     return _save(fig, out, "metrics_vs_thickness")
 
 
+FIGURES_SCHEMA = 1  # the layout of figures_key's payload
+
+
+def figures_key(records, rows) -> str:
+    """A name for the figures all_figures draws of (records, rows): the SHA-256 of everything
+    they are drawn from (every row's fields; each record's case, variant, scene, profile and
+    summary), the code that draws them (cache.code_digest: this module's bytes among the
+    package's), matplotlib's version and settings, and the font files it draws with. Equal
+    keys give byte-identical files (save_reproducibly), so a cached rerun copies the files
+    from the cache (report.outputs) instead of drawing them again (~3 s of a preview sweep)."""
+    import hashlib
+    import json
+    from importlib import metadata
+
+    import matplotlib
+    from matplotlib import font_manager
+
+    from tactileskin.cache import code_digest
+
+    h = hashlib.sha256()
+
+    def add(x) -> None:
+        h.update(json.dumps(x, sort_keys=True, default=repr).encode() + b"\0")
+
+    # as _plt sets them for the drawing, whether or not this process drew a figure before
+    rc = {k: repr(v) for k, v in {**matplotlib.rcParams, "svg.fonttype": "none", "pdf.fonttype": 3}.items()
+          if not k.startswith("backend")}  # Agg draws every figure here
+    fonts = sorted({font_manager.findfont(font_manager.FontProperties(family=[f]))
+                    for f in [*matplotlib.rcParams["font.family"], "DejaVu Sans"]})
+    add([FIGURES_SCHEMA, code_digest(), matplotlib.__version__, metadata.version("pillow"), rc,
+         [(f, Path(f).stat().st_size) for f in fonts]])
+    add(list(rows))
+    for r in records:
+        add([r.case, getattr(r, "variant", ""), r.scene.to_dict(), r.summary])
+        h.update(np.ascontiguousarray(r.s, dtype=float).tobytes() + b"\0"
+                 + np.ascontiguousarray(r.pressure, dtype=float).tobytes() + b"\0")
+    return h.hexdigest()[:24]
+
+
 def all_figures(records, rows, out: Path) -> list[Path]:
     """Every sweep figure; like the bar and thickness figures (rows of status ok), Fig. 10
     draws the ok results only: a suspect profile is not a result to compare with (it is in

@@ -136,8 +136,28 @@ def _write_sensors(path: Path, records) -> None:
         atomic_write_text(path, out.getvalue())
 
 
+def _figures(records, rows, out: Path, cache) -> list[Path]:
+    """all_figures into `out`; their files are kept in the cache under their inputs' digest
+    (figures.figures_key), and a sweep whose figures are there already (a cached rerun) writes
+    those bytes instead of drawing them again. An entry whose bytes changed is not used."""
+    from tactileskin.errors import TactileSkinError
+    from tactileskin.fileio import atomic_write_bytes
+    from tactileskin.report.figures import all_figures, figures_key
+
+    name = f"figures-{figures_key(records, rows)}"
+    kept = cache.load_files(name)
+    if kept is not None:
+        return [atomic_write_bytes(out / fname, data) for fname, data in kept]
+    paths = all_figures(records, rows, out)
+    if paths:
+        try:
+            cache.store_files(name, paths)
+        except (TactileSkinError, OSError) as e:  # the figures are written; only the copy is lost
+            log.warning("the figures were not kept in the cache %s: %s", cache.root, e)
+    return paths
+
+
 def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
-    from tactileskin.report.figures import all_figures
     from tactileskin.report.markdown import build_report
 
     records, rows, failures = collect(outcomes, cache)
@@ -158,7 +178,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     _write_parquet(out / "profiles.parquet", ["case", "s_mm", "pressure_mpa"], prof)
 
     _write_sensors(out / "sensors.csv", records)
-    figures = all_figures(records, rows, out) if records and figures else []
+    figures = _figures(records, rows, out, cache) if records and figures else []
     renders = []
     if render and records:
         from tactileskin.report.render import render_case
