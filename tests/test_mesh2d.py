@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import collections
 import threading
 
 import meshio
@@ -260,9 +261,14 @@ def test_off_main_thread():
     assert out["m"].mesh.nelements > 0
 
 
-def test_meshes_are_reproducible():
-    # the result cache is keyed by the scene: the same scene must give the same mesh
+def test_meshes_are_reproducible(monkeypatch):
+    # the result cache is keyed by the scene: the same scene must give the same mesh (gmsh's,
+    # each time: the memo of meshes made in this process, emptied, serves neither)
+    from tactileskin.mesh import section2d
+
+    monkeypatch.setattr(section2d, "_MEMO", collections.OrderedDict(), raising=False)
     a = build_mesh(Scene(thickness=3.0), mesh_size=1.0)
+    monkeypatch.setattr(section2d, "_MEMO", collections.OrderedDict(), raising=False)
     b = build_mesh(Scene(thickness=3.0), mesh_size=1.0)
     np.testing.assert_array_equal(a.mesh.doflocs, b.mesh.doflocs)
     np.testing.assert_array_equal(a.mesh.t, b.mesh.t)
@@ -315,8 +321,40 @@ def test_quadrilateral_option_is_2d_only():
         build_mesh(Scene(thickness=3.0, dim=3), cell="quad")
 
 
-def test_gmsh_is_silent(capfd):
+def test_gmsh_is_silent(capfd, monkeypatch):
     # library code never prints: gmsh's own terminal output is off unless logging is DEBUG
+    from tactileskin.mesh import section2d
+
+    monkeypatch.setattr(section2d, "_MEMO", collections.OrderedDict(), raising=False)  # gmsh runs
     build_mesh(Scene(thickness=3.0), mesh_size=1.0)
     out, err = capfd.readouterr()
     assert out == "" and err == ""
+
+
+def test_a_mesh_of_the_same_content_is_meshed_once_per_process(monkeypatch):
+    """The paper sweep's 18 2D cases have 6 meshes (the material, and the indenter beyond its
+    contact zone, do not enter one): each was meshed anew per case. Built once now, the same
+    mesh given back, its arrays equal to gmsh's own; another thickness or size is meshed."""
+    from tactileskin.mesh import _gmsh, section2d
+
+    monkeypatch.setattr(section2d, "_MEMO", collections.OrderedDict(), raising=False)
+    runs = []
+    real = _gmsh.session
+    monkeypatch.setattr(_gmsh, "session", lambda *a: (runs.append(a[0]), real(*a))[1])
+    a = build_mesh(Scene(thickness=1.0, material="silicone", indenter="flat"), mesh_size=1.0)
+    a.boundaries["symmetry"] = a.boundaries["symmetry"][:1]  # the caller's copy, not the memo's
+    b = build_mesh(Scene(thickness=1.0, material="polyurethane", indenter="curved"), mesh_size=1.0)
+    assert len(runs) == 1
+    monkeypatch.setattr(section2d, "_MEMO", collections.OrderedDict(), raising=False)
+    fresh = build_mesh(Scene(thickness=1.0, material="polyurethane", indenter="curved"), mesh_size=1.0)
+    assert len(runs) == 2
+    for x in ("p", "t", "doflocs"):
+        np.testing.assert_array_equal(getattr(b.mesh, x), getattr(fresh.mesh, x))
+    assert b.boundaries.keys() == fresh.boundaries.keys()
+    for name in fresh.boundaries:
+        np.testing.assert_array_equal(b.boundaries[name], fresh.boundaries[name])
+        np.testing.assert_array_equal(b.mesh.boundaries[name], fresh.mesh.boundaries[name])
+    assert b.sizes == fresh.sizes and b.section == fresh.section
+    build_mesh(Scene(thickness=1.0), mesh_size=1.2)
+    build_mesh(Scene(thickness=3.0), mesh_size=1.0)
+    assert len(runs) == 4
