@@ -59,3 +59,35 @@ def test_render_axes_scale_bar_colour_bar_and_outline(case, tmp_path):
 @pytest.mark.parametrize("extent, bar", [(12.0, 2.0), (30.0, 5.0), (4.0, 0.5), (0.9, 0.1)])
 def test_scale_bar_is_a_round_fifth(extent, bar):
     assert scale_bar_length(extent) == pytest.approx(bar)
+
+
+def test_a_2d_render_is_kept_in_the_cache_and_copied_on_a_rerun(case, tmp_path):
+    """A cached rerun rendered the Fig. 9 cases again (~0.8 s of a preview sweep): the render
+    is kept under the digest of its result.vtu, scene, title and name, and copied, with the
+    bytes a fresh render has; another result is rendered anew."""
+    import meshio
+
+    from tactileskin.cache import CaseRecord, ResultCache
+    from tactileskin.report import outputs
+
+    sc, vtu = case
+    rec = CaseRecord(sc, np.zeros(2), np.zeros(2), {}, vtu.parent, case="c")
+    cache = ResultCache(tmp_path / "cache")
+    calls = []
+
+    def counted(*a, **kw):
+        calls.append(1)
+        return render_case(*a, **kw)
+
+    first = outputs._render(counted, vtu, tmp_path / "a" / "fig9_c.png", rec, cache)
+    again = outputs._render(counted, vtu, tmp_path / "b" / "fig9_c.png", rec, cache)
+    fresh = render_case(vtu, tmp_path / "fresh.png", title="c", scene=sc)
+    assert len(calls) == 1 and again.parent == tmp_path / "b"
+    assert again.read_bytes() == first.read_bytes() == fresh.read_bytes()
+    m = meshio.read(vtu)
+    m.point_data["displacement_mm"] = 0.5 * m.point_data["displacement_mm"]
+    other = tmp_path / "other" / "result.vtu"
+    other.parent.mkdir()
+    m.write(other)
+    changed = outputs._render(counted, other, tmp_path / "c" / "fig9_c.png", rec, cache)
+    assert len(calls) == 2 and changed.read_bytes() != first.read_bytes()

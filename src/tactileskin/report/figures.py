@@ -270,13 +270,11 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
 FIGURES_SCHEMA = 1  # the layout of figures_key's payload
 
 
-def figures_key(records, rows) -> str:
-    """A name for the figures all_figures draws of (records, rows): the SHA-256 of everything
-    they are drawn from (every row's fields; each record's case, variant, scene, profile and
-    summary), the code that draws them (cache.code_digest: this module's bytes among the
-    package's), matplotlib's version and settings, and the font files it draws with. Equal
-    keys give byte-identical files (save_reproducibly), so a cached rerun copies the files
-    from the cache (report.outputs) instead of drawing them again (~3 s of a preview sweep)."""
+def drawing_digest() -> str:
+    """SHA-256 of what, besides its data, a matplotlib figure of this package is drawn by: the
+    package code (cache.code_digest: the figure and render modules' bytes among the rest),
+    matplotlib's and Pillow's versions, matplotlib's settings (as _plt sets them) and the font
+    files it draws with."""
     import hashlib
     import json
     from importlib import metadata
@@ -286,18 +284,30 @@ def figures_key(records, rows) -> str:
 
     from tactileskin.cache import code_digest
 
-    h = hashlib.sha256()
-
-    def add(x) -> None:
-        h.update(json.dumps(x, sort_keys=True, default=repr).encode() + b"\0")
-
     # as _plt sets them for the drawing, whether or not this process drew a figure before
     rc = {k: repr(v) for k, v in {**matplotlib.rcParams, "svg.fonttype": "none", "pdf.fonttype": 3}.items()
           if not k.startswith("backend")}  # Agg draws every figure here
     fonts = sorted({font_manager.findfont(font_manager.FontProperties(family=[f]))
                     for f in [*matplotlib.rcParams["font.family"], "DejaVu Sans"]})
-    add([FIGURES_SCHEMA, code_digest(), matplotlib.__version__, metadata.version("pillow"), rc,
-         [(f, Path(f).stat().st_size) for f in fonts]])
+    payload = [FIGURES_SCHEMA, code_digest(), matplotlib.__version__, metadata.version("pillow"), rc,
+               [(f, Path(f).stat().st_size) for f in fonts]]
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
+
+
+def figures_key(records, rows) -> str:
+    """A name for the figures all_figures draws of (records, rows): the SHA-256 of everything
+    they are drawn from (every row's fields; each record's case, variant, scene, profile and
+    summary) and by (drawing_digest). Equal keys give byte-identical files (save_reproducibly),
+    so a cached rerun copies the files from the cache (report.outputs) instead of drawing them
+    again (~3 s of a preview sweep)."""
+    import hashlib
+    import json
+
+    h = hashlib.sha256(drawing_digest().encode() + b"\0")
+
+    def add(x) -> None:
+        h.update(json.dumps(x, sort_keys=True, default=repr).encode() + b"\0")
+
     add(list(rows))
     for r in records:
         add([r.case, getattr(r, "variant", ""), r.scene.to_dict(), r.summary])

@@ -157,6 +157,32 @@ def _figures(records, rows, out: Path, cache) -> list[Path]:
     return paths
 
 
+def _render(render_case, vtu: Path, png: Path, rec, cache) -> Path:
+    """render_case of a case into `png`; a 2D render (matplotlib, the same bytes for the same
+    inputs) is kept in the cache under the digest of its result.vtu, scene, title and file
+    name (figures.drawing_digest for the rest) and copied on a rerun instead of drawn."""
+    import hashlib
+    import json
+
+    from tactileskin.errors import TactileSkinError
+    from tactileskin.fileio import atomic_write_bytes, file_sha256
+    from tactileskin.report.figures import drawing_digest
+
+    if rec.scene.dim != 2:  # pyvista's off-screen render: not known to repeat its bytes
+        return render_case(vtu, png, title=rec.case, scene=rec.scene)
+    payload = [drawing_digest(), file_sha256(vtu), rec.scene.to_dict(), rec.case, png.name]
+    name = "render-" + hashlib.sha256(json.dumps(payload, sort_keys=True, default=repr).encode()).hexdigest()[:24]
+    kept = cache.load_files(name)
+    if kept is not None and [f for f, _ in kept] == [png.name]:
+        return atomic_write_bytes(png, kept[0][1])
+    path = render_case(vtu, png, title=rec.case, scene=rec.scene)
+    try:
+        cache.store_files(name, [path])
+    except (TactileSkinError, OSError) as e:  # the render is written; only the copy is lost
+        log.warning("the render %s was not kept in the cache %s: %s", png.name, cache.root, e)
+    return path
+
+
 def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
     from tactileskin.report.markdown import build_report
 
@@ -198,7 +224,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
                     if name in used:  # two case ids made alike by the substitution ('gel-ä', 'gel-ö')
                         name += "-" + hashlib.sha256(rec.case.encode()).hexdigest()[:8]
                     used.add(name)
-                    renders.append(render_case(vtu, out / f"fig9_{name}.png", title=rec.case, scene=sc))
+                    renders.append(_render(render_case, vtu, out / f"fig9_{name}.png", rec, cache))
                 except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
                     log.warning("render of %s failed: %s", rec.case, e)
     report = build_report(rows, records, failures, figures, renders, wall_s,
