@@ -405,3 +405,15 @@ def test_a_changed_input_or_a_damaged_kept_figure_is_drawn_again(tmp_path, monke
     kept.write_bytes(kept.read_bytes()[:-10] + b"0123456789")
     again = {p.name: p.read_bytes() for p in outputs._figures(recs, rows, tmp_path / "d", cache)}
     assert len(calls) == 4 and again == first
+
+
+def test_the_figures_key_does_not_import_pyplot():
+    """A cached rerun draws nothing, but reading rcParams["backend"] for the key imported
+    pyplot (~0.5 s of the rerun's ~2 s)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from tactileskin.report import figures; figures.drawing_digest(); "
+            "print('matplotlib.pyplot' in sys.modules)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip() == "False"
