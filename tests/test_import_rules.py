@@ -41,6 +41,18 @@ def test_only_the_file_indenter_uses_trimesh():
     assert users == ["file.py"]
 
 
+def test_scenes_and_the_cli_import_no_scipy_optimize():
+    """The sweep's main process imported scipy.optimize (~0.3 s idle, 0.7 s loaded) with the
+    fingertip geometry for brentq, which only the solving workers call: imported where used."""
+    code = ("import sys; import tactileskin.cli.sweep; from tactileskin.scene import Scene; "
+            "from tactileskin.sweep import case_ids, expand_grid; "
+            "assert len(case_ids(expand_grid(base=Scene(), quality='preview'))) == 18; "
+            "print('scipy.optimize' in sys.modules)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "False"
+
+
 @pytest.mark.slow
 def test_the_main_job_runs_without_pyvista(tmp_path):
     """pyvista/VTK (566 MB) is the optional `render` extra: a sweep with its report, figures

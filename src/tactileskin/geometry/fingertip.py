@@ -17,7 +17,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from tactileskin import params
 from tactileskin.errors import ParameterError, check_range
@@ -144,12 +143,16 @@ class Section:
     @functools.cached_property
     def u_outer_end(self) -> float:
         """Contour parameter where the outer contour meets the nail edge."""
+        from scipy.optimize import brentq  # here: importing scipy.optimize is ~0.3 s a sweep's main process never needs
+
         ft = self.fingertip
         return brentq(lambda u: _polar(ft.outer(u)) - ft.nail_angle, 0.0, math.pi)
 
     @functools.cached_property
     def u_interface_end(self) -> float:
         """Contour parameter where the bone interface meets the nail edge."""
+        from scipy.optimize import brentq
+
         th = self.fingertip.nail_angle
         return brentq(lambda u: _polar(self.interface(u)) - th, 0.0, math.pi)
 
