@@ -145,3 +145,16 @@ def test_rows_centre_reads_the_row_through_the_peak(tmp_path, capsys):
     assert summ["width_px"] == 1 and summ["warnings"] == [] and abs(summ["metrics_two_sided"]["peak"] - 0.5) < 0.003
     assert main(["film", "analyze", str(scan), "--rows", "middle", "--out", str(tmp_path / "bad")]) == 2
     assert not (tmp_path / "bad").exists()
+
+
+def test_a_line_a_few_pixels_wide_exits_3_naming_its_width_and_a_dpi(tmp_path, capsys):
+    """A 0.4 mm line at 8 px/mm under 1.5 px blur read its peak 36 % low with exit 0: now exit 3, the reason
+    naming its width in px and mm and the dpi to scan at."""
+    scan = save_scan(render_scan(gaussian_profile(0.5, 1.0), paper_eq8(), width_mm=0.4, blur_px=1.5,
+                                 background_gs=245), tmp_path / "scan.png")
+    assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 3
+    summary = json.loads((tmp_path / "film" / "summary.json").read_text())
+    said = [w for w in summary["warnings"] if "resolution is too coarse" in w]
+    assert len(said) == 1 and " px (0.4" in said[0] and " mm) wide across the strip (y)" in said[0]
+    assert " dpi or more" in said[0] and "suspect profile (exit status 3): 1 reason(s)" in capsys.readouterr().err
+    assert summary["metrics_two_sided"]["peak"] < 0.7 * 0.5  # the premise: > 30 % low

@@ -482,6 +482,60 @@ ROW_NOISE = 0.05
 FEW_ROWS = 3
 
 
+# A press a few pixels wide (a line 0.3-0.5 mm wide at 8 px/mm, a dot) is spread by the scanner's blur into
+# the white film beside it, and its profile reads low with no other sign: lines under 1-1.5 px blur read their
+# peak and area 14-69 % low, status ok. Judged on its half-maximum width in px (the blur is not known) across the
+# strip (the rows' mean over the columns of the profile's peak, on the whole scan) and along it (the profile):
+# flagged below RESOLUTION_PX across, ALONG_PX along (a round spot loses to the blur both ways, a press narrow
+# along only one), or below FLAT_RESOLUTION_PX where the top is flat (its width at 90 % of the maximum
+# >= FLAT_SHARE x that at half: the press spans the blur, its middle rows read the full pressure). Measured
+# over lines 0.2-3 mm wide (a Gaussian sd 1 mm along), presses sd 0.1-0.5 mm along a 5 mm strip, Hertzian and
+# Gaussian spots a = 0.2-3 mm read --rows centre, at 4, 8, 11.8 (300 dpi) and 16 px/mm, 0-2 px blur, 0/3 GS,
+# 0.2-0.9 MPa/mm: of the readings > 10 % low (peak or area) all 344 lines, 300 of 306 narrow presses and 397 of
+# 417 spots are flagged (not: 16 spots 12-15 px wide and 6 presses 10-12 px wide under 2 px blur, 10-15 % low:
+# that wide they read within 1 % on a sharp scan); of those within 10 % and unwarned, 209 of 615 lines, 179 of
+# 275 narrow presses and 261 of 1152 spots are flagged, 92 % of them under <= 1 px blur (a press this narrow
+# reads right only on a sharp scan). Flat-topped readings > 10 % low were < 3.6 px wide, round-topped ones up
+# to 15 px. Uniform 5-10 mm strips: none flagged (1200)
+RESOLUTION_PX, ALONG_PX, FLAT_RESOLUTION_PX, FLAT_SHARE = 12.0, 10.0, 6.0, 0.65
+
+
+def _run_width(v: np.ndarray, i: int, frac: float) -> float | None:
+    """Width in samples (linear interpolation) of the contiguous run about sample i at >= frac * v[i], or None
+    if it reaches either end (the press's extent there is not seen)."""
+    thr = frac * v[i]
+    a, b = i, i
+    while a > 0 and v[a - 1] >= thr:
+        a -= 1
+    while b < v.size - 1 and v[b + 1] >= thr:
+        b += 1
+    if a == 0 or b == v.size - 1:
+        return None
+    return float((b - a) + (v[a] - thr) / (v[a] - v[a - 1]) + (v[b] - thr) / (v[b] - v[b + 1]))
+
+
+def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis: str) -> str:
+    """The warning for a press too few pixels wide across the strip (the row means `across`, peak row k) or
+    along it (the profile) for the scan's blur (RESOLUTION_PX), naming its width and the dpi that would give
+    enough pixels, else ""."""
+    for where, v, i, rounded in (("across", across, k, RESOLUTION_PX), ("along", prof, int(np.argmax(prof)), ALONG_PX)):
+        if v[i] <= 0:
+            continue
+        w50, w90 = _run_width(v, i, 0.5), _run_width(v, i, 0.9)
+        if w50 is None:
+            continue
+        need = FLAT_RESOLUTION_PX if w90 is not None and w90 >= FLAT_SHARE * w50 else rounded
+        if w50 < need:
+            ppm = px_per_mm * need / w50
+            return (f"the scan's resolution is too coarse for this press: it is {w50:.1f} px ({w50 / px_per_mm:.3g} mm) "
+                    f"wide {where} the strip ({'y' if (where == 'across') == (axis == 'x') else 'x'}) at half its "
+                    f"maximum, under the {need:g} px a reading within the film's 10 % needs (the scanner's blur "
+                    f"spreads a narrower press into the film beside it: 0.3-0.5 mm lines at 8 px/mm read 14-69 % "
+                    f"low), so the peak and area read low; scan at {math.ceil(25.4 * ppm)} dpi or more "
+                    f"({ppm:.3g} px/mm: {need:g} px over it)")
+    return ""
+
+
 def _row_reach(n: int) -> float:
     """How many sd the largest of n samples of one noise reads above their common level, at most
     (90 % of the time: the normal quantile 0.9 ** (1 / n)), and at least 2."""
@@ -646,6 +700,19 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     if round_:
         warnings.append(round_)
         log.warning("%s", round_)
+    # the press's width across from the whole scan (the region found may be its middle rows), over the
+    # columns of its peak (>= PEAK_WINDOW of it: a round press's section through its centre, not the mean of
+    # its narrower chords, which put a = 1 mm at 8 px/mm 11.6 px for its 13.9), about the region's strongest row
+    oriented = gray if axis == "x" else gray.T
+    c_lo = x0 if axis == "x" else y0
+    r_lo = y0 if axis == "x" else x0
+    cols = np.flatnonzero(prof >= PEAK_WINDOW * float(np.max(prof))) + c_lo
+    across_rows = cal.pressure(oriented[:, cols]).mean(axis=1)
+    k_across = r_lo + int(np.argmax(across_rows[r_lo:r_lo + pmap.shape[0]]))
+    narrow = _narrow(across_rows, k_across, prof, px_per_mm, axis)
+    if narrow:
+        warnings.append(narrow)
+        log.warning("%s", narrow)
     top = float(np.max(prof))
     n_top = int(np.sum(prof >= top - 3.0 * row_noise)) if row_noise is not None else 0
     if n_top and row_noise * _row_reach(n_top) > 2.0 * ROW_NOISE * top:
