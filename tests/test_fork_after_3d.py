@@ -113,3 +113,17 @@ def test_a_fresh_process_raises_the_typed_error_with_its_fields():
         _gmsh.in_fresh_process(check_range, "depth", 5.0, 0.0, 1.0, unit="mm")
     assert (e.value.name, e.value.value) == ("depth", 5.0) and "depth=5.0" in str(e.value)
     assert _gmsh.in_fresh_process(check_range, "depth", 0.5, 0.0, 1.0) == 0.5
+
+
+def test_a_fresh_process_raises_an_os_error_with_its_errno_and_file_name(tmp_path):
+    # an OSError's errno, strerror and file name are not in its __dict__: they were lost
+    # (errno None), and code that tells a missing file by errno could not here
+    import errno
+
+    from tactileskin.mesh import _gmsh
+
+    missing = str(tmp_path / "no_such.msh")
+    with pytest.raises(FileNotFoundError) as e:
+        _gmsh.in_fresh_process(open, missing)
+    assert (e.value.errno, e.value.filename) == (errno.ENOENT, missing)
+    assert e.value.strerror and str(e.value) == f"[Errno {errno.ENOENT}] {e.value.strerror}: {missing!r}"

@@ -121,7 +121,11 @@ func, args, kwargs = pickle.load(sys.stdin.buffer)
 try:
     res = (True, func(*args, **kwargs))
 except Exception as e:
-    res = (False, (type(e), str(e), dict(vars(e))))
+    attrs = dict(vars(e))
+    if isinstance(e, OSError):  # not in its __dict__
+        attrs.update((k, getattr(e, k)) for k in ("errno", "strerror", "filename", "filename2")
+                     if getattr(e, k) is not None)
+    res = (False, (type(e), str(e), attrs))
 pickle.dump(res + (records,), out)
 """
 
@@ -148,7 +152,8 @@ def in_fresh_process(func, *args, **kwargs):
     cls, msg, attrs = value
     e = cls.__new__(cls)   # no __init__: ParameterError's takes (name, value, valid), not the message
     Exception.__init__(e, msg)
-    e.__dict__.update(attrs)
+    for k, v in attrs.items():
+        setattr(e, k, v)   # not __dict__: an OSError's errno and file name are descriptors
     raise e
 
 
