@@ -700,3 +700,34 @@ def test_a_sensor_on_a_steps_edge_hangs_from_the_higher_face(tmp_path):
         assert np.allclose(st.xyz[:, :2], [[1.0, 0.5], [0.9999, 0.5], [1.0, 1.0]], rtol=0, atol=1e-9), path.name
         assert np.allclose(st.depth, [1.5, 1.5, 1.0], rtol=0, atol=1e-9)
         assert np.allclose(st.normal[:, :2], [0.0, 1.0], rtol=0, atol=1e-12)
+
+
+def test_the_inside_shortcut_is_not_taken_on_a_face_bounded_by_a_spline(tmp_path):
+    """_face_domain samples each boundary curve at 33 parameters and takes the polygon through
+    them, 4 x its chords' sagitta inside, as surely inside the trimmed face. A B-spline edge can
+    hide its shape between those samples: a wavy edge y = 1 + 0.1 sin(2 pi 16 x / 10) (its
+    samples all on y = 1: read as a straight line, margin 1e-5) or a notch narrower than their
+    spacing; points in its troughs, outside the face for gmsh, were said inside (a sensor on a
+    surface that is not there). Only analytic curves (lines, circles, ellipses) on analytic
+    faces, whose (u, v) curves the samples follow, make the polygon; a face bounded by any
+    other is asked of gmsh, as before."""
+    import build123d as bd
+
+    from tactileskin.mesh import _gmsh, skinfile
+
+    wave = lambda x: 1.0 + 0.1 * np.sin(2 * np.pi * 16 * x / 10)  # noqa: E731
+    sp = bd.Spline(*[bd.Vector(x, wave(x)) for x in np.linspace(0, 10, 321)])
+    face = bd.make_face([sp, bd.Line(sp @ 1, (10, -2)), bd.Line((10, -2), (0, -2)), bd.Line((0, -2), sp @ 0)])
+    path = tmp_path / "wavy.step"
+    bd.export_step(bd.extrude(face, 2), str(path))
+    x = np.linspace(0.0, 10.0, 2001)
+    x = x[wave(x) < 0.95]  # the troughs, at y = 0.96: outside the face
+    xyz = np.column_stack([x, np.full(len(x), 0.96), np.zeros(len(x))])
+    with _gmsh.session("test", {}) as g:
+        skinfile._import_step(g, path)
+        f = next(f for _, f in g.model.getEntities(2) if np.allclose(np.array(g.model.getBoundingBox(2, f))[[2, 5]], 0))
+        uv = np.array(g.model.getParametrization(2, f, xyz.ravel())).reshape(-1, 2)
+        out = np.array([g.model.isInside(2, f, p, parametric=True) <= 0 for p in uv])
+        assert out.all()  # the premise: gmsh says they are off the face
+        sure = skinfile._surely_inside(skinfile._face_domain(g, f), uv)
+    assert not np.any(sure & out), int(np.sum(sure & out))

@@ -69,6 +69,11 @@ SYMMETRY_LENGTH = 1e-4
 # samples along each boundary curve of a CAD face for the polygon of its (u, v) domain
 # (_face_domain): a point well inside it needs no isInside query
 DOMAIN_SAMPLES = 16
+# the faces and curves (gmsh's getType) whose (u, v) curves those samples follow (smooth, at
+# most a period a turn): a B-spline edge can hide a wave or a notch between them (a wave of
+# 16 periods read as a straight line), so a face bounded by one is asked of gmsh
+DOMAIN_FACES = ("Plane", "Cylinder", "Cone", "Sphere", "Torus")
+DOMAIN_CURVES = ("Line", "Circle", "Ellipse")
 RULE_FORMS = "'normal:-y' (optionally ':TOL_DEG'), 'normal:+x', ... or 'plane:y=0' (x, y or z)"
 _VALID_FILE = "a gmsh .msh with named physical groups or a STEP (.step/.stp) of the skin solid, in mm"
 
@@ -591,10 +596,15 @@ def _face_domain(gmsh, face: int):
     (DOMAIN_SAMPLES chords a curve, one where it is straight in (u, v)) and how far inside it a
     point is surely inside the trimmed face (4 x the chords' largest sagitta, measured at their
     midpoints, + 1e-6 of the domain's size); None where the curves do not close (a periodic
-    face's seam is not among them): every point is then asked of gmsh."""
+    face's seam is not among them) or a face or curve not of DOMAIN_FACES / DOMAIN_CURVES:
+    every point is then asked of gmsh."""
     try:
         segs, ends, dev = [], [], 0.0
+        if gmsh.model.getType(2, face) not in DOMAIN_FACES:
+            return None
         for _, c in gmsh.model.getBoundary([(2, face)], oriented=False):
+            if gmsh.model.getType(1, abs(c)) not in DOMAIN_CURVES:
+                return None
             lo, hi = gmsh.model.getParametrizationBounds(1, abs(c))
             t = np.linspace(lo[0], hi[0], 2 * DOMAIN_SAMPLES + 1)
             uv = np.asarray(gmsh.model.reparametrizeOnSurface(1, abs(c), t, face), float).reshape(-1, 2)
