@@ -496,3 +496,19 @@ def test_a_narrow_line_s_blurred_edges_are_not_taken_for_pixel_noise():
     assert noisy.metrics["peak"] > clean.metrics["peak"] + 0.1 * 0.2
     assert any("pixel noise" in x for x in noisy.warnings) and any("resolution" in x for x in noisy.warnings)
     assert not any("pixel noise" in x for x in clean.warnings)
+
+
+def test_a_uniform_narrow_line_s_edge_step_fit_warns_nothing_on_stderr():
+    """A uniform line 3 px wide (its edge rows one gray level along it) gives the edge-step fit
+    of _row_noise(shape=True) a constant neighbours' mean: np.polyfit's RankWarning ('Polyfit may
+    be poorly conditioned', with scan.py's path and source line) reached the CLI's stderr. With
+    nothing to fit against, the step is a constant: the reading is the same, with no warning."""
+    import warnings
+
+    img = np.full((40, 160), 245, np.uint8)
+    img[19, 40:120], img[20, 40:120], img[21, 40:120] = 200, 150, 200
+    for rows in ("all", "centre"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            fp = analyze_scan(img, rows=rows)
+        assert len(fp.warnings) == 1 and "resolution is too coarse" in fp.warnings[0], fp.warnings

@@ -564,8 +564,11 @@ def _row_noise(pmap: np.ndarray, k: int, shape: bool = False) -> float | None:
     d = row[keep] - m
     if shape and d.size >= SHAPE_COLUMNS:  # the residual of a line fitted to d against m, its 2 parameters
         # taken from the count (over fewer columns, a dot's, the fit took real noise with it: kept as it is)
-        fit = np.polyval(np.polyfit(m, d, 1), m)
-        return float(np.std(d - fit) * np.sqrt(d.size / (d.size - 2)) / np.sqrt(1 + 1 / len(nb)))
+        if np.ptp(m) > 1e-9 * np.abs(m).max():
+            fit, dof = np.polyval(np.polyfit(m, d, 1), m), 2
+        else:  # a constant m (a uniform line's edges, one gray level): the step is a constant
+            fit, dof = d.mean(), 1  # (polyfit warned, 'poorly conditioned', on the CLI's stderr)
+        return float(np.std(d - fit) * np.sqrt(d.size / (d.size - dof)) / np.sqrt(1 + 1 / len(nb)))
     return float(np.std(d) / np.sqrt(1 + 1 / len(nb)))
 
 
