@@ -15,9 +15,8 @@ from __future__ import annotations
 
 import math
 
-import build123d as bd
-
 from tactileskin.errors import ParameterError
+from tactileskin.geometry.occ import bd
 from tactileskin.geometry.solids import box, check_solid, occ_guard
 
 BONE_STEM = 5.0  # mm of bone core beyond the skin's end z = -L (held by the mold)

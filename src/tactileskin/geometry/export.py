@@ -17,12 +17,12 @@ import math
 import time
 from pathlib import Path
 
-import build123d as bd
 import numpy as np
 import trimesh
 
 from tactileskin import fileio, outdir, staging
 from tactileskin.errors import CadError, ParameterError
+from tactileskin.geometry.occ import bd
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import format_params, occ_guard
 

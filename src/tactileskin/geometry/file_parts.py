@@ -29,11 +29,11 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import build123d as bd
 import numpy as np
 
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.molds import MoldParams
+from tactileskin.geometry.occ import bd
 from tactileskin.geometry.pad_parts import face_down_mold
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import check_solid, occ_guard

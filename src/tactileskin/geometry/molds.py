@@ -32,12 +32,12 @@ import logging
 import math
 from dataclasses import dataclass
 
-import build123d as bd
 import numpy as np
 
 from tactileskin import params
 from tactileskin.errors import CadError, ParameterError
 from tactileskin.geometry.fingertip import Section
+from tactileskin.geometry.occ import bd
 from tactileskin.geometry.solids import _single, base_face, box, check_solid, contour_solid, occ_guard
 
 log = logging.getLogger(__name__)

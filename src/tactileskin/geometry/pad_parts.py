@@ -12,10 +12,9 @@ z in [-L/2, L/2]. The mold casts the pad face down:
 
 from __future__ import annotations
 
-import build123d as bd
-
 from tactileskin.errors import ParameterError
 from tactileskin.geometry.molds import MoldParams, vertical_cylinder
+from tactileskin.geometry.occ import bd
 from tactileskin.geometry.parts import Part
 from tactileskin.geometry.solids import box, check_solid, occ_guard
 

@@ -10,13 +10,12 @@ import logging
 import time
 from dataclasses import dataclass, field
 
-import build123d as bd
-
 from tactileskin import params
 from tactileskin.errors import ParameterError
 from tactileskin.geometry import braille as _braille
 from tactileskin.geometry.fingertip import Fingertip
 from tactileskin.geometry.indenters import KINDS, PAPER_KINDS, get_kind, make_indenter
+from tactileskin.geometry.occ import bd
 
 log = logging.getLogger(__name__)
 

@@ -21,7 +21,6 @@ import contextlib
 import logging
 import math
 
-import build123d as bd
 import numpy as np
 
 from tactileskin import params
@@ -30,6 +29,7 @@ from tactileskin.geometry.fingertip import Section
 from tactileskin.geometry.indenters.sphere import CAP
 from tactileskin.geometry.indenters import (BrailleIndenter, CylinderIndenter, FlatIndenter, Indenter,
                                             SphereIndenter)
+from tactileskin.geometry.occ import bd
 
 log = logging.getLogger(__name__)
 

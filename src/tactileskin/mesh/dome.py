@@ -32,7 +32,7 @@ def outer_level(p: np.ndarray, a: float, b: float, c: float) -> np.ndarray:
 def build_dome_mesh(scene, *, mesh_size=None, refinement=None, order=None) -> SkinMesh:
     from tactileskin.geometry.dome_parts import skin_solid
 
-    import build123d as bd
+    from tactileskin.geometry.occ import bd
 
     sec = scene.section()
     a, b, c, length, t = sec.a, sec.b, sec.c, sec.length, sec.thickness

@@ -61,7 +61,7 @@ def _read(path: Path):
     suffix = path.suffix.lower()
     try:
         if suffix in STEP_SUFFIXES:
-            import build123d as bd
+            from tactileskin.geometry.occ import bd
 
             shape = bd.import_step(str(path))
             verts, tris = shape.tessellate(STEP_TOLERANCE, 0.1)
