@@ -533,7 +533,7 @@ def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis
                     f"spreads a narrower press into the film beside it: 0.3-0.5 mm lines at 8 px/mm read 14-69 % "
                     f"low), so the peak and area may read low (by how much depends on the scanner's blur, which "
                     f"a scan does not tell); scan at {math.ceil(25.4 * ppm)} dpi or more ({ppm:.3g} px/mm: "
-                    f"{need:g} px over it)")
+                    f"{need:g} px over it; give the new scan's scale with --px-per-mm)")
     return ""
 
 
