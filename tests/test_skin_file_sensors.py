@@ -731,3 +731,23 @@ def test_the_inside_shortcut_is_not_taken_on_a_face_bounded_by_a_spline(tmp_path
         assert out.all()  # the premise: gmsh says they are off the face
         sure = skinfile._surely_inside(skinfile._face_domain(g, f), uv)
     assert not np.any(sure & out), int(np.sum(sure & out))
+
+
+def test_an_error_inside_an_open_step_import_is_not_called_gmsh_s(tmp_path):
+    """A placement pass holds its STEP import open in one gmsh session (skinfile.step_open): an
+    error of the block's own (a bug, a MemoryError) came out as 'MeshError: gmsh failed to mesh
+    skinstep-columns'; it is raised as it is now, and gmsh's own errors still become MeshError."""
+    from tactileskin.errors import MeshError
+    from tactileskin.geometry.occ import bd
+    from tactileskin.mesh import skinfile
+
+    path = tmp_path / "block.step"
+    bd.export_step(bd.Box(4, 2, 4), str(path))
+    with pytest.raises(KeyError, match="x"):
+        with skinfile.step_open(path):
+            raise KeyError("x")
+    with pytest.raises(MeshError, match="skinstep-columns"):
+        with skinfile.step_open(path):
+            raise Exception("as gmsh's API raises")  # noqa: TRY002
+    with skinfile.step_open(path):  # the import is closed after each: a new one opens
+        pass

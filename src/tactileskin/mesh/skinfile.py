@@ -580,6 +580,7 @@ def step_open(path):
             raise MeshError(f"line_heights of {path} inside an open import of {_OPEN.path}")
         yield
         return
+    caught = None
     with _gmsh.session("skinstep-columns", {"skin_file": path}) as gmsh:
         _import_step(gmsh, Path(path))
         lo, hi = np.split(np.array(gmsh.model.getBoundingBox(-1, -1)), 2)
@@ -587,8 +588,14 @@ def step_open(path):
         _OPEN.path = path
         try:
             yield
+        except Exception as e:
+            if type(e) is Exception:  # gmsh's API raises plain Exception: the session's MeshError
+                raise
+            caught = e  # the block's own error (a bug, MemoryError): not gmsh's, raised as it is
         finally:
             _OPEN.path = None
+    if caught is not None:
+        raise caught
 
 
 def _face_domain(gmsh, face: int):
