@@ -156,5 +156,5 @@ def test_a_line_a_few_pixels_wide_exits_3_naming_its_width_and_a_dpi(tmp_path, c
     summary = json.loads((tmp_path / "film" / "summary.json").read_text())
     said = [w for w in summary["warnings"] if "resolution is too coarse" in w]
     assert len(said) == 1 and " px (0.4" in said[0] and " mm) wide across the strip (y)" in said[0]
-    assert " dpi or more" in said[0] and "--px-per-mm" in said[0] and "suspect profile (exit status 3): 1 reason(s)" in capsys.readouterr().err
+    assert " dpi or more" in said[0] and "--px-per-mm" in said[0] and "span" not in said[0] and "suspect profile (exit status 3): 1 reason(s)" in capsys.readouterr().err
     assert summary["metrics_two_sided"]["peak"] < 0.7 * 0.5  # the premise: > 30 % low

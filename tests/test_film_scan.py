@@ -479,6 +479,18 @@ def test_a_press_a_few_pixels_wide_is_flagged_as_under_resolved():
     assert wide.warnings == [] and wide.metrics["auc"] == pytest.approx(0.5 * np.pi * 2.0 / 2, rel=0.1)
 
 
+def test_a_press_narrow_along_the_strip_is_told_its_span_reads_long():
+    """Blur widens a press narrow along the strip (the profile's own direction): sd 0.15 mm (5 px at half
+    its maximum at 8 px/mm) under 2 px blur reads its span 1.02 mm against the true 0.64 mm (+59 %), so
+    the resolution warning says the span may read long there; across the strip it does not say so."""
+    truth = 2 * 0.15 * np.sqrt(2 * np.log(10))   # where the Gaussian is >= 10 % of its peak
+    fp = analyze_scan(render_scan(gaussian_profile(0.5, 0.15), paper_eq8(), width_mm=5.0, blur_px=2.0,
+                                  background_gs=245.0))
+    assert fp.metrics["span_mm"] > 1.3 * truth   # the premise
+    said = [x for x in fp.warnings if "resolution is too coarse" in x]
+    assert len(said) == 1 and "wide along the strip" in said[0] and "the span long" in said[0], fp.warnings
+
+
 def test_a_narrow_line_s_blurred_edges_are_not_taken_for_pixel_noise():
     """A line 2-3 px wide is found as a row or two whose neighbours are its blurred edges: their step below
     it scales with the profile along it and was read as pixel noise, 5 % of the peak on a noise-free 0.3 mm

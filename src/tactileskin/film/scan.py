@@ -531,8 +531,8 @@ def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis
                     f"wide {where} the strip ({'y' if (where == 'across') == (axis == 'x') else 'x'}) at half its "
                     f"maximum, under the {need:g} px a reading within the film's 10 % needs (the scanner's blur "
                     f"spreads a narrower press into the film beside it: 0.3-0.5 mm lines at 8 px/mm read 14-69 % "
-                    f"low), so the peak and area may read low (by how much depends on the scanner's blur, which "
-                    f"a scan does not tell); scan at {math.ceil(25.4 * ppm)} dpi or more ({ppm:.3g} px/mm: "
+                    f"low), so the peak and area may read low{' and the span long' if where == 'along' else ''} (by "
+                    f"how much depends on the scanner's blur, which a scan does not tell); scan at {math.ceil(25.4 * ppm)} dpi or more ({ppm:.3g} px/mm: "
                     f"{need:g} px over it; give the new scan's scale with --px-per-mm)")
     return ""
 
