@@ -132,7 +132,9 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     cfg = chart.config
     trust = letters_trust(chart, validation) if "letters" in cfg.sets else {}
     notes = suspect(chart, validation, trust)
+    measured = list(getattr(chart, "measured", None) or [])  # flags a measured error covers (chart.blank_note)
     lines = ["## Sensor-array design chart", "", *(["**Suspect:** " + n for n in notes] + [""] if notes else []),
+             *(["**Measured:** " + n for n in measured] + [""] if measured else []),
              f"Skin: {_skins(cfg)}. Sensor plane: " + _sensor_plane(cfg) + ", map P(s, z) of 3D single-dot solves "
              f"(mesh {_meshes(cfg)})" + ("; flat and curved: 2D " + ("bone profiles" if _on_bone(cfg) else "profiles at that depth")
                                             + " extruded along z"
