@@ -96,16 +96,8 @@ def agmres(A, psolve, b, rtol, maxiter, U=None):
         h += h2
         OPS["orthogonalisation"].append(time.perf_counter() - t)
         hn = float(np.linalg.norm(w))
-        col = np.concatenate([h, [hn]])
-        for j in range(k):
-            col[j], col[j + 1] = cs[j] * col[j] + sn[j] * col[j + 1], -sn[j] * col[j] + cs[j] * col[j + 1]
-        r = float(np.hypot(col[k], col[k + 1]))
-        if r == 0.0:
+        if not L.givens_column(h, hn, k, H, cs, sn, g):
             break
-        cs[k], sn[k] = col[k] / r, col[k + 1] / r
-        col[k], col[k + 1] = r, 0.0
-        H[:k + 2, k] = col
-        g[k + 1], g[k] = -sn[k] * g[k], cs[k] * g[k]
         if abs(g[k + 1]) <= rtol * bn or hn == 0.0:
             k += 1
             break

@@ -237,6 +237,25 @@ class _Pardiso:
 
 # -- GMRES with a reused factorisation --------------------------------------------------------
 
+def givens_column(h: np.ndarray, hn: float, k: int, H: np.ndarray, cs: np.ndarray, sn: np.ndarray,
+                  g: np.ndarray) -> bool:
+    """GMRES's k-th Hessenberg column (h, hn) through the previous Givens rotations and a new
+    one that zeroes hn, stored in H[:k + 2, k], cs[k], sn[k]; the residual vector g rotated
+    (|g[k + 1]| is the new residual norm). False at a breakdown (the column is zero)."""
+    col = np.concatenate([h, [hn]])
+    for j in range(k):
+        col[j], col[j + 1] = cs[j] * col[j] + sn[j] * col[j + 1], -sn[j] * col[j] + cs[j] * col[j + 1]
+    r = float(np.hypot(col[k], col[k + 1]))
+    if r == 0.0:
+        return False
+    cs[k], sn[k] = col[k] / r, col[k + 1] / r
+    col[k], col[k + 1] = r, 0.0
+    H[:k + 2, k] = col
+    g[k + 1] = -sn[k] * g[k]
+    g[k] = cs[k] * g[k]
+    return True
+
+
 def gmres(matvec, psolve, b: np.ndarray, rtol: float, maxiter: int):
     """Right-preconditioned GMRES (x0 = 0, no restart): minimises |b - A x| over the Krylov
     space of A M^-1, so the residual it reports is the true one (up to rounding).
@@ -262,17 +281,8 @@ def gmres(matvec, psolve, b: np.ndarray, rtol: float, maxiter: int):
         w -= h2 @ Vk
         h += h2
         hn = float(np.linalg.norm(w))
-        col = np.concatenate([h, [hn]])
-        for j in range(k):              # previous Givens rotations
-            col[j], col[j + 1] = cs[j] * col[j] + sn[j] * col[j + 1], -sn[j] * col[j] + cs[j] * col[j + 1]
-        r = float(np.hypot(col[k], col[k + 1]))
-        if r == 0.0:
+        if not givens_column(h, hn, k, H, cs, sn, g):
             break
-        cs[k], sn[k] = col[k] / r, col[k + 1] / r
-        col[k], col[k + 1] = r, 0.0
-        H[:k + 2, k] = col
-        g[k + 1] = -sn[k] * g[k]
-        g[k] = cs[k] * g[k]
         if abs(g[k + 1]) <= rtol * bn or hn == 0.0:
             k += 1
             break
