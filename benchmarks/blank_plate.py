@@ -12,8 +12,9 @@ result cache in --cache (a rerun only reads).
         [--thickness 3,5] [--materials silicone,polyurethane] [--meshes 1.2/1,0.8/1,0.6/1,0.6/2] [--height 0.4]
 
 Prints a markdown table (benchmarks/results/blank_plate.md holds a run's); --write writes the
-coarsest mesh's errors against the reference to src/tactileskin/data/blank_plate.json (the rows
-array.chart.blank_measured reads: there they cover the blank solve's coarse_mesh flag).
+coarsest mesh's errors against the reference, with the next finer mesh's (reference_shift), to
+src/tactileskin/data/blank_plate.json, replacing the rows of the materials and thicknesses run
+(the rows array.chart.blank_measured reads: there they cover the blank solve's coarse_mesh flag).
 """
 
 from __future__ import annotations
@@ -32,8 +33,10 @@ ABOUT = ("Measured error of the sensor-array chart's blank Braille plate (array.
          "the whole pad at depth - dot height, mesh [mesh_size, refinement]) against the finer reference_mesh: the "
          "largest pointwise difference (max_error) and the relative L2 norm (l2_error) over the reference map's peak "
          "inside |s|, |z| <= extent_mm, of the bone map (sensor_height_mm null) or of the map that height above the "
-         "bone (P = -tr(sigma) / 3; --sensor-height). A row within surrogate.TOLERANCE covers the blank solve's "
-         "coarse_mesh flag for a chart reading within its extent at that height (array.chart.blank_measured). "
+         "bone (P = -tr(sigma) / 3; --sensor-height); reference_shift: the same of the next finer mesh measured against "
+         "the reference (its last refinement step, standing for the reference's own error). A row whose max_error "
+         "plus reference_shift is within surrogate.TOLERANCE covers the blank solve's coarse_mesh flag for a chart "
+         "reading within its extent at that height (array.chart.blank_measured). "
          "Written by benchmarks/blank_plate.py --write.")
 
 
@@ -64,12 +67,16 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", default="3,5")
     ap.add_argument("--materials", default="silicone,polyurethane")
-    ap.add_argument("--meshes", default="1.2/1,0.8/1,0.6/1,0.6/2", help="mesh_size/refinement, the finest last")
+    ap.add_argument("--meshes", default="1.2/1,0.8/1,0.6/1,0.6/2",
+                    help="mesh_size/refinement, the finest last (at least two: the chart's and the reference)")
     ap.add_argument("--heights", default="0.4,1", help="--sensor-height values of the maps at depth (mm)")
     ap.add_argument("--cache", required=True)
     ap.add_argument("--write", action="store_true", help=f"write the first mesh's rows to {DATA.name}")
+    ap.add_argument("--data", type=Path, default=DATA, help="the file --write writes (default: the package's)")
     a = ap.parse_args(argv)
     meshes = [tuple(float(v) for v in m.split("/")) for m in a.meshes.split(",")]
+    if a.write and len(meshes) < 3:
+        ap.error("--write needs three meshes or more: the chart's, the next finer (reference_shift), the reference")
     cfg = ChartConfig(thicknesses=tuple(float(t) for t in a.thickness.split(",")))
     extent = cfg.read_extent
     print(f"Blank plate (flat plate over the whole pad) at the plate's depth; errors inside |s|, |z| <= {extent:g} mm "
@@ -103,16 +110,23 @@ def main(argv=None) -> int:
                       f"| {status} | {eb[2]:.4g} | {eb[0]:.2%} | {eb[1]:.2%} | "
                       + " | ".join(f"{e[2]:.4g} | {e[0]:.2%} | {e[1]:.2%}" for e in ed) + " |", flush=True)
                 if m == meshes[0]:
+                    shift = ([errors(bone_map_of(recs[meshes[-2]]), rb, extent)]
+                             + [errors(at(recs[meshes[-2]], h), rd[h], extent) for h in heights])
                     rows += [{"material": material, "skin": "pad", "thickness_mm": t, "depth_mm": float(blank.indentation),
                               "mesh": list(m), "pad_mm": [blank.pad_width, blank.pad_length], "rate": blank.rate,
                               "extent_mm": extent, "sensor_height_mm": h, "max_error": round(e[0], 4),
                               "l2_error": round(e[1], 4), "reference_mesh": list(meshes[-1]),
+                              "reference_shift": round(sh[0], 4), "shift_mesh": list(meshes[-2]),
                               "source": f"benchmarks/blank_plate.py, {_dt.date.today().isoformat()}"}
-                             for h, e in zip([None, *heights], [eb, *ed])]
+                             for h, e, sh in zip([None, *heights], [eb, *ed], shift)]
     if a.write:
         from tactileskin.fileio import atomic_write_text
 
-        atomic_write_text(DATA, json.dumps({"about": ABOUT, "cases": rows}, indent=2, ensure_ascii=False) + "\n")
+        # the rows of the materials and thicknesses measured here replace theirs; the others stay
+        done = {(r["material"], r["thickness_mm"]) for r in rows}
+        kept = [r for r in json.loads(a.data.read_text(encoding="utf-8"))["cases"]
+                if (r["material"], r["thickness_mm"]) not in done] if a.data.exists() else []
+        atomic_write_text(a.data, json.dumps({"about": ABOUT, "cases": kept + rows}, indent=2, ensure_ascii=False) + "\n")
     return 0
 
 
