@@ -117,3 +117,22 @@ def test_the_conditions_say_what_each_classifier_knows():
     assert ("rules: template: the nearest of every stimulus's noise-free readings at 4x4 offsets, a reader "
             "that knows each stimulus's response but not its position; lda: a linear discriminant trained on 16 noisy "
             "readings per stimulus, as a decoder trained on readings would be (the tables: template; the CSV: both);") in md
+
+
+def test_a_letters_chart_past_the_dot_height_names_the_pad_size_its_maps_hold_for():
+    """Past the dot height the letters' plate presses the whole pad, and the maps depend on the
+    pad's size (a 40 x 40 mm pad's plate pressure is 2.0-2.3x the 20 x 20 mm pad's): the report
+    did not say so. Below the dot height (t = 1: 0.2 mm, or a cap of 0.4 mm) nothing changes."""
+    def md(t, cap=None, sets=("letters",)):
+        ch = Chart(ChartConfig(thicknesses=t, pitches=(0.75,), noise_fs=(0.01,), sets=sets, max_depth=cap))
+        for s in sets:
+            ch.labels[s] = ["a", "b"]
+        return " ".join(markdown(ch).split())
+
+    text = md((1.0, 3.0))
+    assert "At t = 3 mm the Braille plate presses the whole 20 x 20 mm pad" in text
+    assert "t = 1, 3" not in text
+    assert "presses the whole" not in md((1.0,))
+    assert "presses the whole" not in md((3.0,), cap=0.4)
+    assert "At t = 3 mm the Braille plate presses the whole" in md((3.0,), cap=0.55)
+    assert "presses the whole" not in md((3.0,), sets=("paper",))

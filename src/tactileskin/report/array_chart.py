@@ -110,6 +110,28 @@ def _on_bone(cfg) -> bool:
     return cfg.sensor_depth is None and cfg.sensor_height is None
 
 
+def _pad_text(cfg) -> str:
+    """Where the letters' Braille plate touches the pad, the maps are the pad's size's: a bonded,
+    nearly incompressible layer pressed over its whole top is stiffer the wider it is, and no
+    pad converges to a larger skin's (benchmarks/results/blank_pad_length.md)."""
+    if "letters" not in cfg.sets or cfg.skin != "pad":
+        return ""
+    from tactileskin.geometry.braille import get_standard
+    from tactileskin.scene import Scene
+    from tactileskin.skins.pad import DEFAULT_LENGTH, DEFAULT_WIDTH
+
+    h = get_standard(cfg.standard).height
+    past = [t for t in cfg.thicknesses
+            if (cfg.depth_for(t) if cfg.depth_for(t) is not None else Scene.depth_fraction * t) > h + 1e-12]
+    if not past:
+        return ""
+    ts = ", ".join(f"{t:g}" for t in past)
+    return (f" At t = {ts} mm the Braille plate presses the whole {DEFAULT_WIDTH:g} x {DEFAULT_LENGTH:g} mm pad: "
+            "those maps hold for this pad's size only (a bonded skin pressed over its whole top is stiffer the "
+            "wider it is: a 40 x 40 mm pad's mean plate pressure is 2.0-2.3x this one's; "
+            "benchmarks/results/blank_pad_length.md).")
+
+
 def _cap_text(cfg) -> str:
     """The depth cap's sentence: it keeps the Braille plate off only below the dot height (a
     cap of 0.55 mm read 'below the dot height, so the plate never touches' while the notes
@@ -162,7 +184,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
     lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
               "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c: the coarsest pitch that samples the map without aliasing, not a limit on telling known stimuli apart (the accuracy tables below say that). The paper's rule (half the 1.5 mm span of the Braille pressure at t = 1) gives 0.75 mm at t = 1. "
               "Depth (each stimulus's travel into the skin from first touch: depth control, not force): 20 % of t"
-              + _cap_text(cfg) + ".", ""]
+              + _cap_text(cfg) + "." + _pad_text(cfg), ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
             # the noise also in MPa and the taxels a pitch takes: a header "noise" with fractions
