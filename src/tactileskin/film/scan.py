@@ -615,28 +615,39 @@ def _row_reach(n: int) -> float:
 SHAPE_COLUMNS = 10  # _row_noise(shape=True): the fewest columns to fit a press's edge step over
 
 
-def _row_noise(pmap: np.ndarray, k: int, shape: bool = False) -> float | None:
+def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> float | None:
     """The pixel noise (sd) of row k: the spread of the row less its neighbours' mean over the columns at
     >= SPAN_LEVEL of its largest (the curvature across, nearly constant along them, drops out of the
     spread), / sqrt(1 + 1/n) for the neighbours' own noise; None without a neighbour or 3 such columns.
+    clip: the film's (lowest, highest) reading: a column where the row or both neighbours read one is left out
+    (a dot's edge whose neighbours read 0: the difference there is the row itself, not noise).
     shape: less first the part of that difference proportional to the neighbours' mean (a press a few
     pixels wide: its neighbours are its blurred edges, whose step below it scales with the profile along
     it, and was read as noise: a noise-free 0.3 mm line at 8 px/mm, 5 % of its peak)."""
     nb = [j for j in (k - 1, k + 1) if 0 <= j < pmap.shape[0]]
     row = pmap[k]
     keep = row >= SPAN_LEVEL * row.max()
+    if clip is not None and nb:  # (one neighbour clipped still holds the other's reading and the row's noise)
+        inside = (pmap[[k] + nb] > clip[0]) & (pmap[[k] + nb] < clip[1])
+        keep &= inside[0] & inside[1:].any(axis=0)
     if not nb or keep.sum() < 3:
         return None
     m = pmap[nb][:, keep].mean(axis=0)
     d = row[keep] - m
     if shape and d.size >= SHAPE_COLUMNS:  # the residual of a line fitted to d against m, its 2 parameters
-        # taken from the count (over fewer columns, a dot's, the fit took real noise with it: kept as it is)
+        # taken from the count
         if np.ptp(m) > 1e-9 * np.abs(m).max():
             fit, dof = np.polyval(np.polyfit(m, d, 1), m), 2
         else:  # a constant m (a uniform line's edges, one gray level): the step is a constant
             fit, dof = d.mean(), 1  # (polyfit warned, 'poorly conditioned', on the CLI's stderr)
         return float(np.std(d - fit) * np.sqrt(d.size / (d.size - dof)) / np.sqrt(1 + 1 / len(nb)))
-    return float(np.std(d) / np.sqrt(1 + 1 / len(nb)))
+    spread = float(np.std(d))  # less the step as a constant
+    if shape:  # a dot's few columns: a line's two parameters took real noise with them; the step as a share
+        # of m instead where that leaves less (a round press's rows beside its centre are a share of it: a
+        # Gaussian's exactly), one parameter either way
+        c = float(m @ d / (m @ m)) if m @ m > 0 else 0.0
+        spread = min(spread, float(np.sqrt(np.mean((d - c * m) ** 2))))
+    return spread / float(np.sqrt(1 + 1 / len(nb)))
 
 
 def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: float = PX_PER_MM,
@@ -718,7 +729,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         c_lo, c_hi = (x0, x1) if axis == "x" else (y0, y1)
         # the rows beside it on the image (the region found may be a row or two), for its noise
         beside = cal.pressure(oriented[max(r - 1, 0):r + 2, c_lo:c_hi]), r - max(r - 1, 0)
-        row_noise = _row_noise(*beside)
+        row_noise = _row_noise(*beside, clip=cal.p_range)
         near = max(r - 2, 0), min(r + 3, oriented.shape[0])  # 5 rows about it: their mean's noise / sqrt(5)
     if rows == "centre":
         region, pmap = region[k:k + 1], pmap[k:k + 1]
@@ -801,7 +812,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         if row_noise is not None and " wide across " in narrow:
             # the rows beside a press this narrow are its blurred edges: their step, not noise (the
             # resolution warning says why it reads wrong); the noise left once that step is fitted out
-            shaped = _row_noise(*beside, shape=True)
+            shaped = _row_noise(*beside, shape=True, clip=cal.p_range)
             row_noise = None if shaped is None else shaped / math.sqrt(pmap.shape[0])  # one row or their mean
     top = float(np.max(prof))
     n_top = int(np.sum(prof >= top - 3.0 * row_noise)) if row_noise is not None else 0
