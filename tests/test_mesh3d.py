@@ -273,3 +273,32 @@ def test_a_skins_size_plan_is_the_plan_its_mesh_is_made_by(fields):
 
     sc = Scene(**fields)
     assert sc.skin_kind.size_plan(sc).as_dict() == sc.skin_kind.build_mesh(sc).sizes
+
+
+def _t5_dot_plan(**kw):
+    from tactileskin.mesh import sizing
+
+    sc = Scene(thickness=5.0, dim=3, indenter="braille", braille_text="")
+    sec = sc.section()
+    return sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True, **kw)
+
+
+@pytest.mark.parametrize("k, s", [(2.0, 1.0), (3.0, 1.0), (1.0, 1.5), (10.0, 10.0)])
+def test_the_spot_and_strip_factors_scale_only_the_contact_sizes(monkeypatch, k, s):
+    """benchmarks/spot_scale_t5.py's knobs: the contact spot's size times k (at most half the
+    far size), the plate strip's times s (at most the far size); the bone balls and the bone
+    ROI keep theirs, and the defaults (k = s = 1, what the presets were measured at) are the plan."""
+    from tactileskin.mesh import sizing
+
+    kw = {"mesh_size": 1.6, "refinement": 8.0}
+    base = _t5_dot_plan(**kw)
+    assert sizing.SPOT_FACTOR == 1.0 and sizing.STRIP_FACTOR == 1.0
+    assert base.strip == base.strip_roi == pytest.approx(np.sqrt(0.2 * 1.6))
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", k)
+    monkeypatch.setattr(sizing, "STRIP_FACTOR", s)
+    p = _t5_dot_plan(**kw)
+    assert p.patches[0][4] == pytest.approx(min(0.8, base.patches[0][4] * k))
+    assert p.strip == pytest.approx(min(1.6, base.strip * s))
+    assert p.bone_patches == base.bone_patches and p.strip_roi == base.strip_roi
+    assert p.roi_layer == base.roi_layer
+    assert (p.estimate < base.estimate) == (k > 1.0 or s > 1.0)

@@ -75,7 +75,8 @@ class SizePlan:
     # `fine`, equal to `coarse` when the plate does not touch).
     patches: tuple = ()
     bone_patches: tuple = ()
-    strip: float = 0.0                 # local plan: size on the plate strip and bone ROI (0: none)
+    strip: float = 0.0                 # local plan: size on the plate strip (0: none) ...
+    strip_roi: float = 0.0             # ... and on the bone ROI then
 
     def as_dict(self) -> dict:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -228,6 +229,16 @@ PATCH_RADIUS = 1.25
 BONE_SCALE_MAX = 2.3
 
 
+# Factors on the contact spot's size (at most half the far size) and on the plate strip's
+# (the bone balls and bone ROI keep theirs), for benchmarks/spot_scale_t5.py. The presets'
+# errors (data/presets.json "cases3d") were measured at 1, 1. At t = 5 mm, 1.6 / 8, k = 1.5-3
+# saved 2-5 % of the dofs and up to 19 % of the Newton iterations but moved the silicone dot's
+# bone map by 4.5-4.6 % (L2), as much as the default's whole map error against 0.8 / 8
+# (benchmarks/results/spot_scale_t5.md): not adopted.
+SPOT_FACTOR = 1.0
+STRIP_FACTOR = 1.0
+
+
 def bone_scale(thickness: float, base_radius: float) -> float:
     """Bone patch size / dot patch size of the local plan at a skin thickness."""
     return min(max(1.0, thickness / (2.0 * max(base_radius, 1e-9))), BONE_SCALE_MAX)
@@ -295,9 +306,10 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
         # a spot much wider than a dot (a flat file face) still gets the strip plan's ratio 2
         h = max(fine, min(0.5 * coarse, fine * patch_scale(a)))
         hb = min(coarse, h * bone_scale(t, a))
+        hs = max(h, min(0.5 * coarse, h * SPOT_FACTOR))
         po, n = _dot_frame(section, x)
         pb = po - t * n
-        for balls, c, r, size in ((patches, po, PATCH_RADIUS * a, h), (bones, pb, a + t, hb)):
+        for balls, c, r, size in ((patches, po, PATCH_RADIUS * a, hs), (bones, pb, a + t, hb)):
             if c[0] < x0 - r or z < z0 - r or z > z1 + r:
                 continue  # the ball misses the meshed part (x >= x0, z0 <= z <= z1)
             balls.append((float(c[0]), float(c[1]), float(z), float(r), float(size)))
@@ -306,20 +318,24 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     strip = 0.0
     w = 0.0
     plate = ind.plate_depth(scene.indentation)
+    strip_roi = 0.0
     if plate > 0.0:
-        strip = math.sqrt(fine * coarse)
+        strip_roi = math.sqrt(fine * coarse)
+        strip = min(coarse, strip_roi * STRIP_FACTOR)
         w = _plate_halfwidth(section, plate)
     s_fine = strip if strip else coarse
+    r_fine = strip_roi if strip_roi else coarse
     roi = min(ROI_S, section.interface_length)
-    p = SizePlan(coarse, fine, g, w, (z0, z1), OUTER_LAYER * s_fine, roi, ROI_LAYER * s_fine,
-                 (coarse - s_fine) / g, 0, tuple(patches), tuple(bones), strip)
+    p = SizePlan(coarse, fine, g, w, (z0, z1), OUTER_LAYER * s_fine, roi, ROI_LAYER * r_fine,
+                 (coarse - s_fine) / g, 0, tuple(patches), tuple(bones), strip, strip_roi)
     sides = 2.0 if full else 1.0
     if strip:
         pe = dataclasses.replace(p, coarse=min(coarse, t), fine=min(strip, t))
+        pr = dataclasses.replace(p, coarse=min(coarse, t), fine=min(strip_roi, t))
         kappa = 1.0 / max(section.min_radius_of_curvature - t, 0.1 * t)
         excess += sides * lz * (section.outer_length_to_x(w + p.transition) * _strip(pe, p.outer_layer, t, 3)
-                                + roi * _strip(pe, p.roi_layer, t, 3, kappa=kappa)
-                                + (_strip(pe, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
+                                + roi * _strip(pr, p.roi_layer, t, 3, kappa=kappa)
+                                + (_strip(pr, p.roi_layer, t, 3, cap=True) if roi < section.interface_length else 0.0))
     n = int(_CELLS_PER_UNIT[3] * (sides * _area(section) * lz / min(coarse, t) ** 3 + excess))
     return dataclasses.replace(p, estimate=n)
 
@@ -433,7 +449,7 @@ def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
     surface and inside the ball, graded outside both); Min over the balls and, if the plate
     touches, the strip's box and the bone ROI at size `strip`."""
     f = gmsh.model.mesh.field
-    smallest = min([b[4] for b in p.patches + p.bone_patches] + [p.strip or p.coarse])
+    smallest = min([b[4] for b in p.patches + p.bone_patches] + [p.strip or p.coarse, p.strip_roi or p.coarse])
     sampling = int(min(200, max(60, 2.0 * 10.0 / smallest)))
     dists = {}
 
@@ -477,7 +493,7 @@ def _apply_local(gmsh, p: SizePlan, outer: list[int], interface_roi: list[int], 
             f.setNumber(box, k, v)
         contact = f.add("Max")
         f.setNumbers(contact, "FieldsList", [near_outer, box])
-        parts += [contact, threshold(interface_roi, p.strip, p.roi_layer)]
+        parts += [contact, threshold(interface_roi, p.strip_roi or p.strip, p.roi_layer)]
     mn = f.add("Min")
     f.setNumbers(mn, "FieldsList", parts)
     f.setAsBackgroundMesh(mn)
