@@ -102,3 +102,30 @@ def test_every_imported_library_is_a_declared_dependency():
         if not names & declared:
             missing.append(m)
     assert missing == []
+
+
+@pytest.mark.slow
+def test_a_cached_sweep_writes_its_report_without_the_solver(tmp_path):
+    """The report's run settings list SolverOptions' defaults: taken from tactileskin.fe.solver,
+    they imported the solver (numba, scikit-fem; ~0.3 s idle, 0.8 s loaded) into every sweep's
+    main process, which never solves. A cached rerun writes its tables, figures, render and
+    report with none of them loaded, and the report still lists the solver's own defaults."""
+    import dataclasses
+
+    from tactileskin.cli import main
+    from tactileskin.fe.solver import SolverOptions
+
+    out = tmp_path / "o"
+    args = ["sweep", "-t", "1", "-i", "flat", "-m", "polyurethane", "--quality", "preview", "--serial",
+            "-o", str(out)]
+    assert main(args) == 0
+    code = ("import sys\nfrom tactileskin.cli import main\n"
+            f"rc = main({args!r})\n"
+            "print('loaded:', ','.join(m for m in ('tactileskin.fe', 'numba', 'skfem') if m in sys.modules))\n"
+            "sys.exit(rc)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.stdout.splitlines()[-1] == "loaded: "
+    report = (out / "report.md").read_text(encoding="utf-8")
+    for f in dataclasses.fields(SolverOptions):
+        assert f"{f.name} = {getattr(SolverOptions(), f.name)!r}" in report

@@ -526,7 +526,7 @@ def run_settings(scenes) -> list[str]:
     import dataclasses
     import platform
 
-    from tactileskin.fe.solver import EASY_ITERATIONS, SHORT_STEP, SolverOptions
+    from tactileskin.solver_options import EASY_ITERATIONS, SHORT_STEP, SolverOptions
 
     scenes = list(scenes)
     out = ["## Run settings", "",
