@@ -9,6 +9,8 @@ The machine may be shared: the 1-minute load average before each run is printed 
 and the CPU seconds (user + sys of the command and its workers) are a steadier measure.
 
     .venv/bin/python benchmarks/sweep_command.py [--runs 3] [--modes preview,preview-cached,default]
+        (mode -resolve1: a finished sweep rerun with one case's cache entry removed, solved again)
+    .venv/bin/python benchmarks/sweep_command.py --compare OLD/src,NEW/src [--modes preview]  # A/B, interleaved
     .venv/bin/python benchmarks/sweep_command.py --phases [--cached] [--quality preview]   # one run, per phase
 """
 
@@ -31,15 +33,47 @@ from pathlib import Path
 EXTRA = {"default": ["--braille-dim", "2"]}
 
 
-def run_command(out: Path, quality: str) -> tuple[float, float, float]:
-    """(wall s, CPU s of the command and its children, load average before) of one sweep."""
+def _become_subreaper() -> bool:
+    """Make this process the reaper of its orphaned descendants (Linux): a forkserver (dask's
+    multiprocessing-method) outlives the command briefly and is reaped by init, and its CPU
+    time, its workers' included, would be missing from RUSAGE_CHILDREN."""
+    try:
+        import ctypes
+
+        return ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0) == 0  # PR_SET_CHILD_SUBREAPER
+    except (OSError, AttributeError):
+        return False
+
+
+SUBREAPER = _become_subreaper()
+
+
+def _reap_orphans(timeout: float = 60.0) -> None:
+    """Wait for the command's orphaned descendants, so that their CPU time is counted."""
+    t_end = time.monotonic() + timeout
+    while time.monotonic() < t_end:
+        try:
+            pid, _ = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            time.sleep(0.05)
+    print(f"warning: descendants of the command still ran {timeout:g} s after it; their CPU is not counted",
+          file=sys.stderr)
+
+
+def run_command(out: Path, quality: str, src: str | None = None) -> tuple[float, float, float]:
+    """(wall s, CPU s of the command and its children, load average before) of one sweep;
+    `src`: the tactileskin source folder to run (PYTHONPATH), else the one installed."""
+    env = dict(os.environ, PYTHONPATH=src) if src else None
     load = os.getloadavg()[0]
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     p = subprocess.run([sys.executable, "-m", "tactileskin", "sweep", "--out", str(out), "--quality", quality,
                         *EXTRA.get(quality, [])],
-                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
     wall = time.perf_counter() - t0
+    _reap_orphans()
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode not in (0, 3):
         sys.exit(f"sweep failed ({p.returncode}): {p.stderr[-2000:]}")
@@ -47,25 +81,46 @@ def run_command(out: Path, quality: str) -> tuple[float, float, float]:
     return wall, cpu, load
 
 
-def timings(runs: int, modes: list[str], root: Path) -> None:
-    print("| command | wall s, median (runs) | CPU s, median | load before |")
-    print("|---|---|---|---|")
+# the case whose cache entry `-resolve1` removes: solved again, to the same numbers (no render)
+RESOLVED_CASE = "t1-silicone-curved-2d"
+
+
+def _drop_entry(out: Path, case: str) -> None:
+    """Remove a finished sweep's cache entry of `case` (results.csv names its key)."""
+    import csv
+
+    with open(out / "results.csv", encoding="utf-8") as f:
+        key = next(r["key"] for r in csv.DictReader(f) if r["case"] == case)
+    shutil.rmtree(out / "cache" / key)
+
+
+def timings(runs: int, modes: list[str], root: Path, srcs: list[str | None]) -> None:
+    """Per mode, `runs` runs of each source folder in `srcs`, interleaved (a, b, a, b, ...) so
+    that a shared machine's load falls on both alike."""
+    print("| command | code | wall s, median (runs) | CPU s, median (runs) | load before |")
+    print("|---|---|---|---|---|")
     for mode in modes:
         quality = mode.split("-")[0]
-        walls, cpus, loads = [], [], []
+        walls, cpus, loads = ({j: [] for j in range(len(srcs))} for _ in range(3))
         for k in range(runs):
-            out = root / f"{quality}-{k}"
-            if mode.endswith("-cached"):
-                if not out.exists():
-                    run_command(out, quality)  # fills the cache; not timed
-            else:
-                shutil.rmtree(out, ignore_errors=True)
-            w, c, ld = run_command(out, quality)
-            walls.append(w)
-            cpus.append(c)
-            loads.append(ld)
-        print(f"| {mode} | {statistics.median(walls):.1f} ({', '.join(f'{w:.1f}' for w in walls)}) "
-              f"| {statistics.median(cpus):.1f} | {', '.join(f'{x:.1f}' for x in loads)} |", flush=True)
+            for j, src in enumerate(srcs):
+                out = root / f"{quality}-{j}-{k}"
+                if mode.endswith("-cached") or mode.endswith("-resolve1"):
+                    if not out.exists():
+                        run_command(out, quality, src)  # fills the cache; not timed
+                    if mode.endswith("-resolve1"):
+                        _drop_entry(out, RESOLVED_CASE)
+                else:
+                    shutil.rmtree(out, ignore_errors=True)
+                w, c, ld = run_command(out, quality, src)
+                walls[j].append(w)
+                cpus[j].append(c)
+                loads[j].append(ld)
+        for j, src in enumerate(srcs):
+            print(f"| {mode} | {src or 'installed'} | {statistics.median(walls[j]):.2f} "
+                  f"({', '.join(f'{w:.2f}' for w in walls[j])}) | {statistics.median(cpus[j]):.2f} "
+                  f"({', '.join(f'{c:.2f}' for c in cpus[j])}) | {', '.join(f'{x:.1f}' for x in loads[j])} |",
+                  flush=True)
 
 
 def phases(quality: str, root: Path, cached: bool = False) -> None:
@@ -129,6 +184,8 @@ def main() -> None:
     ap.add_argument("--phases", action="store_true", help="one run with a per-phase timeline instead")
     ap.add_argument("--quality", default="preview")
     ap.add_argument("--cached", action="store_true", help="with --phases: time a cached rerun")
+    ap.add_argument("--compare", default=None,
+                    help="comma-separated tactileskin source folders (PYTHONPATH) to time interleaved")
     ap.add_argument("--dir", default=None, help="folder for the outputs (default: a new temporary one)")
     a = ap.parse_args()
     root = Path(a.dir) if a.dir else Path(tempfile.mkdtemp(prefix="sweep_command-"))
@@ -136,7 +193,7 @@ def main() -> None:
     if a.phases:
         phases(a.quality, root, a.cached)
     else:
-        timings(a.runs, a.modes.split(","), root)
+        timings(a.runs, a.modes.split(","), root, a.compare.split(",") if a.compare else [None])
 
 
 if __name__ == "__main__":
