@@ -428,3 +428,28 @@ def test_the_figures_key_does_not_import_pyplot():
             "print('matplotlib.pyplot' in sys.modules)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert r.stdout.strip() == "False"
+
+
+def test_a_resolved_case_with_the_same_results_keeps_its_figures(tmp_path):
+    """The figures' key hashed every row and summary field, the solve's wall time among them:
+    a case solved again (its cache entry lost, another cache) with the same numbers drew
+    every figure again (~3.4 s of a preview sweep). No figure draws a wall time (the
+    drawings are byte-identical), so it is not in the key; a number the figures draw is."""
+    recs, rows = _small_grid()
+
+    def timed(wall):
+        rs = [CaseRecord(r.scene, r.s, r.pressure, {**r.summary, "wall_s": wall + k}, r.path)
+              for k, r in enumerate(recs)]
+        return rs, [dict(r, wall_s=wall + k) for k, r in enumerate(rows)]
+
+    a, b = timed(1.0), timed(7.5)
+    assert figures.figures_key(*a) == figures.figures_key(*b)
+    drawn_a = {p.name: p.read_bytes() for p in figures.all_figures(*a, tmp_path / "a")}
+    drawn_b = {p.name: p.read_bytes() for p in figures.all_figures(*b, tmp_path / "b")}
+    assert drawn_a == drawn_b and len(drawn_a) == 11
+    peak = [dict(r) for r in a[1]]
+    peak[0]["peak_mpa"] *= 1.001
+    assert figures.figures_key(a[0], peak) != figures.figures_key(*a)
+    summ = [CaseRecord(r.scene, r.s, r.pressure, {**r.summary, "peak_mpa": 0.1}, r.path) if k == 0 else r
+            for k, r in enumerate(a[0])]
+    assert figures.figures_key(summ, a[1]) != figures.figures_key(*a)

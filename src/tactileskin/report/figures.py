@@ -267,7 +267,15 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     return _save(fig, out, "metrics_vs_thickness")
 
 
-FIGURES_SCHEMA = 1  # the layout of figures_key's payload
+FIGURES_SCHEMA = 2  # the layout of figures_key's payload
+
+# row and summary fields no figure draws that change between two solves of the same case (the
+# solve's wall time): in the key, a case solved again with the same numbers redrew every figure
+UNDRAWN_FIELDS = frozenset({"wall_s"})
+
+
+def _drawn_fields(d: dict) -> dict:
+    return {k: v for k, v in d.items() if k not in UNDRAWN_FIELDS}
 
 
 def drawing_digest() -> str:
@@ -299,9 +307,9 @@ def drawing_digest() -> str:
 def figures_key(records, rows) -> str:
     """A name for the figures all_figures draws of (records, rows): the SHA-256 of everything
     they are drawn from (every row's fields; each record's case, variant, scene, profile and
-    summary) and by (drawing_digest). Equal keys give byte-identical files (save_reproducibly),
-    so a cached rerun copies the files from the cache (report.outputs) instead of drawing them
-    again (~3 s of a preview sweep)."""
+    summary, but for UNDRAWN_FIELDS) and by (drawing_digest). Equal keys give byte-identical
+    files (save_reproducibly), so a cached rerun copies the files from the cache
+    (report.outputs) instead of drawing them again (~3 s of a preview sweep)."""
     import hashlib
     import json
 
@@ -310,9 +318,9 @@ def figures_key(records, rows) -> str:
     def add(x) -> None:
         h.update(json.dumps(x, sort_keys=True, default=repr).encode() + b"\0")
 
-    add(list(rows))
+    add([_drawn_fields(r) for r in rows])
     for r in records:
-        add([r.case, getattr(r, "variant", ""), r.scene.to_dict(), r.summary])
+        add([r.case, getattr(r, "variant", ""), r.scene.to_dict(), _drawn_fields(r.summary)])
         h.update(np.ascontiguousarray(r.s, dtype=float).tobytes() + b"\0"
                  + np.ascontiguousarray(r.pressure, dtype=float).tobytes() + b"\0")
     return h.hexdigest()[:24]
