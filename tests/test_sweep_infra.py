@@ -1,6 +1,7 @@
 """Sweep plumbing that does not need a solve: grids, parsing, the atomic cache, discrimination."""
 
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -252,3 +253,58 @@ def test_expand_grid_refuses_a_repeated_axis_value():
     with pytest.raises(ParameterError, match="thicknesses.*listed twice"):
         expand_grid(thicknesses=[1.0, 3.0, 1.0])
     assert len(expand_grid(thicknesses=[1.0, 3.0], materials=["silicone"], indenters=["flat"])) == 2
+
+
+def _worker_state():
+    """(solver loaded before any case, BLAS threads, Python's SIGINT and SIGTERM handling) of a
+    sweep worker (run there by client.run)."""
+    import signal
+    import sys
+
+    from threadpoolctl import threadpool_info
+
+    blas = sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+    default = (signal.getsignal(signal.SIGINT) is signal.default_int_handler
+               and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
+    return "tactileskin.fe" in sys.modules, blas, default
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
+def test_local_workers_are_forked_with_the_solver_loaded_and_one_blas_thread(monkeypatch):
+    """Spawned workers each imported numpy, dask, numba, scikit-fem and the package again
+    (~2 s CPU each on a loaded machine, ~4 of a preview sweep's ~20 s): they are fork()ed
+    from this process, which loads the solver first. As the spawned ones, they keep one BLAS
+    thread (OPENBLAS_NUM_THREADS=1 before numpy loaded), not this process's count, and
+    Python's own signal handling, not this process's handlers (the CLI's)."""
+    import signal
+
+    from threadpoolctl import threadpool_limits
+
+    from tactileskin import threads
+    from tactileskin.sweep import _Runner
+
+    # as in a fresh process (another test here may have solved on threads: then it spawns)
+    monkeypatch.setattr(threads, "threads_started", lambda: False)
+    before = signal.signal(signal.SIGTERM, lambda *a: None)
+    runner = _Runner([], [], serial=False, scheduler=None, workers=2)
+    try:
+        with threadpool_limits(limits=2, user_api="blas"):
+            client = runner._start(2)
+        states = list(client.run(_worker_state).values())
+    finally:
+        runner.close()
+        signal.signal(signal.SIGTERM, before)
+    assert states == [(True, [1], True)] * 2, states
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
+def test_a_process_that_started_solver_threads_spawns_its_workers(monkeypatch):
+    """A fork()ed child of a process that had run numba's or MKL's threads (a notebook's lone 3D
+    solve before its sweep) runs its compiled loops and PARDISO on one thread (threads.py):
+    its 3D cases would lose their share of the cores, so such a process spawns its workers."""
+    from tactileskin import sweep, threads
+
+    monkeypatch.setattr(threads, "_parent_threads", False)
+    fresh = sweep.worker_start_method()
+    monkeypatch.setattr(threads, "_parent_threads", True)
+    assert (fresh, sweep.worker_start_method()) == ("fork", "spawn")

@@ -21,6 +21,7 @@ from __future__ import annotations
 import itertools
 import logging
 import os
+import sys
 import time
 import traceback
 from collections import Counter, defaultdict
@@ -456,9 +457,16 @@ class _Runner:
         # PARDISO threads (read at solve time) go to the workers alone, by `env`, and
         # MKL_NUM_THREADS=1 is not set here, or a later lone solve or sweep in this process
         # would take it for the user's choice
+        method = worker_start_method()
+        if method == "fork":
+            # loaded once here rather than by each spawned worker (numpy, dask, numba, scikit-fem
+            # and the package: ~1 s CPU per worker idle, ~2 s loaded; preview sweep ~20 -> ~15 s CPU)
+            import tactileskin.fe  # noqa: F401
+            import tactileskin.mesh  # noqa: F401
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": None,
-                              "distributed.worker.profile.enabled": False}):
+                              "distributed.worker.profile.enabled": False,
+                              "distributed.worker.multiprocessing-method": method}):
             # quiet: CRITICAL. On a loaded machine a worker's heartbeat can race the
             # scheduler's shutdown after the last result and log a CommClosedError traceback
             # at ERROR (seen on `./dev run`); a worker that dies during a case still reaches
@@ -482,6 +490,10 @@ class _Runner:
             finally:
                 _restore_environ(self._environ)
         self.client = Client(self.cluster)
+        if method == "fork":
+            from tactileskin.sweep_worker import ForkedWorker
+
+            self.client.register_plugin(ForkedWorker())
         return self.client
 
     def close(self) -> None:
@@ -492,6 +504,17 @@ class _Runner:
         _restore_environ(self._environ)  # a worker its nanny restarted set them again
         for name, level in self._log_levels.items():
             logging.getLogger(name).setLevel(level)
+
+
+def worker_start_method() -> str:
+    """How the local cluster starts its workers: fork() on Linux, where the package is fork-safe
+    (threads.py's fork handler, mesh._gmsh.in_fresh_process) and a worker then needs no imports
+    of its own; else dask's default, spawn (fork() is unsafe on macOS, absent on Windows). Also
+    spawn where this process started numba's or PARDISO's threads (a notebook's solve before
+    its sweep): a child fork()ed from it solves on one thread (threads.forked_from_threads)."""
+    from tactileskin.threads import threads_started
+
+    return "fork" if sys.platform.startswith("linux") and not threads_started() else "spawn"
 
 
 def _restore_environ(saved: dict) -> None:

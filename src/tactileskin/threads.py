@@ -39,10 +39,16 @@ _parent_threads = False   # this process started them
 _forked_from_threads = False
 
 
+def threads_started() -> bool:
+    """True if this process started numba's thread pool or PARDISO's threads: a child fork()ed
+    now would run its compiled loops and PARDISO on one thread (forked_from_threads)."""
+    parallel = sys.modules.get("numba.np.ufunc.parallel")
+    return _parent_threads or (parallel is not None and getattr(parallel, "_is_initialized", True))
+
+
 def _after_fork_in_child() -> None:
     global _forked_from_threads
-    parallel = sys.modules.get("numba.np.ufunc.parallel")
-    if _parent_threads or (parallel is not None and getattr(parallel, "_is_initialized", True)):
+    if threads_started():
         _forked_from_threads = True
 
 
