@@ -302,9 +302,16 @@ def test_a_process_that_started_solver_threads_spawns_its_workers(monkeypatch):
     """A fork()ed child of a process that had run numba's or MKL's threads (a notebook's lone 3D
     solve before its sweep) runs its compiled loops and PARDISO on one thread (threads.py):
     its 3D cases would lose their share of the cores, so such a process spawns its workers."""
+    import types
+
     from tactileskin import sweep, threads
 
+    # as a fresh process (another test here may have run numba's parallel loops)
     monkeypatch.setattr(threads, "_parent_threads", False)
+    monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
     fresh = sweep.worker_start_method()
-    monkeypatch.setattr(threads, "_parent_threads", True)
-    assert (fresh, sweep.worker_start_method()) == ("fork", "spawn")
+    monkeypatch.setattr(threads, "_parent_threads", True)  # PARDISO on threads
+    after_pardiso = sweep.worker_start_method()
+    monkeypatch.setattr(threads, "_parent_threads", False)
+    monkeypatch.setitem(sys.modules, "numba.np.ufunc.parallel", types.SimpleNamespace(_is_initialized=True))
+    assert (fresh, after_pardiso, sweep.worker_start_method()) == ("fork", "spawn", "spawn")
