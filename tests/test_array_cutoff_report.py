@@ -121,7 +121,7 @@ def test_the_conditions_say_what_each_classifier_knows():
 
 def test_a_letters_chart_past_the_dot_height_names_the_pad_size_its_maps_hold_for():
     """Past the dot height the letters' plate presses the whole pad, and the maps depend on the
-    pad's size (a 40 x 40 mm pad's plate pressure is 2.0-2.3x the 20 x 20 mm pad's): the report
+    pad's size (a 40 x 40 mm pad's plate pressure is 2.0-2.5x the 20 x 20 mm pad's): the report
     did not say so. Below the dot height (t = 1: 0.2 mm, or a cap of 0.4 mm) nothing changes."""
     def md(t, cap=None, sets=("letters",)):
         ch = Chart(ChartConfig(thicknesses=t, pitches=(0.75,), noise_fs=(0.01,), sets=sets, max_depth=cap))
@@ -136,3 +136,25 @@ def test_a_letters_chart_past_the_dot_height_names_the_pad_size_its_maps_hold_fo
     assert "presses the whole" not in md((3.0,), cap=0.4)
     assert "At t = 3 mm the Braille plate presses the whole" in md((3.0,), cap=0.55)
     assert "presses the whole" not in md((3.0,), sets=("paper",))
+
+
+def test_the_pad_size_sentence_s_pressure_ratio_is_the_measured_one_at_the_thicknesses_it_names():
+    """The sentence names t = 3 and 5 mm, and said a 40 x 40 mm pad's mean plate pressure is 2.0-2.3x the
+    20 x 20 mm pad's: that is t = 5's range; at t = 3 silicone's is 2.50x (0.0684 / 0.0274 MPa,
+    benchmarks/results/blank_pad_length.md). The range is read from the results' 1.2 / 1 rows."""
+    import re
+    from pathlib import Path
+
+    md_file = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "blank_pad_length.md"
+    mean = {}
+    for line in md_file.read_text(encoding="utf-8").splitlines():
+        c = [x.strip() for x in line.strip("|").split("|")]
+        if len(c) > 7 and c[2] == "1.2 / 1" and c[3] in ("20 x 20", "40 x 40"):
+            mean[(c[0], c[1], c[3])] = float(c[7])
+    ratios = [mean[(m, t, "40 x 40")] / mean[(m, t, "20 x 20")] for m, t, p in mean if p == "20 x 20"]
+    assert len(ratios) == 4
+    ch = Chart(ChartConfig(thicknesses=(3.0, 5.0), pitches=(0.75,), noise_fs=(0.01,), sets=("letters",)))
+    ch.labels["letters"] = ["a", "b"]
+    text = " ".join(markdown(ch).split())
+    lo, hi = re.search(r"mean plate pressure is ([\d.]+)-([\d.]+)x", text).groups()
+    assert (float(lo), float(hi)) == (round(min(ratios), 1), round(max(ratios), 1)), (ratios, lo, hi)

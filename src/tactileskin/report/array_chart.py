@@ -128,7 +128,7 @@ def _pad_text(cfg) -> str:
     ts = ", ".join(f"{t:g}" for t in past)
     return (f" At t = {ts} mm the Braille plate presses the whole {DEFAULT_WIDTH:g} x {DEFAULT_LENGTH:g} mm pad: "
             "those maps hold for this pad's size only (a bonded skin pressed over its whole top is stiffer the "
-            "wider it is: a 40 x 40 mm pad's mean plate pressure is 2.0-2.3x this one's; "
+            "wider it is: a 40 x 40 mm pad's mean plate pressure is 2.0-2.5x this one's at t = 3 and 5 mm; "
             "benchmarks/results/blank_pad_length.md).")
 
 
