@@ -563,3 +563,23 @@ def test_a_noise_free_tiny_dot_is_not_told_pixel_noise():
             fp = analyze_scan(_spot(peak, size, kind, blur=blur, seed=0, ppm=ppm, noise=0.0, dx=0.07, dy=0.05),
                               px_per_mm=ppm, rows="centre")
             assert not any("pixel noise" in x for x in fp.warnings), (size, kind, ppm, blur, peak, fp.warnings)
+
+
+def test_the_blur_bound_reads_the_press_s_own_edges_not_a_sharper_mark_elsewhere_on_the_scan():
+    """The blur a round-topped press's edges allow (scan._blur_bound) took the steepest gray step anywhere on the
+    scan's column through it: a darker press 3.5 mm away across (a Hertzian dot a = 0.5 mm at 0.9 MPa/mm, under
+    the same 2 px blur) or a sharp pen line there put the bound below 2 px, and a Gaussian spot sd 0.3 mm at
+    16 px/mm under 2 px blur, its peak 15 % low, lost its resolution warning. The bound is now taken over the
+    press's own edge: from its peak to the white film beside it, before any other activated or darker area."""
+    spot = _spot(0.5, 0.3, "gauss", blur=2.0, seed=0, ppm=16.0, noise=0.0, dx=0.07, dy=0.05)
+    box = (100, 60, 220, 140)
+    alone = analyze_scan(spot, px_per_mm=16.0, rows="centre", box_px=box)
+    assert alone.metrics["peak"] < 0.9 * 0.5
+    assert any("a blur of up to 2 px" in x for x in alone.warnings), alone.warnings
+    dot = np.minimum(spot, _spot(0.9, 0.5, "hertz", blur=2.0, seed=0, ppm=16.0, noise=0.0, dx=0.07, dy=-3.5))
+    pen = spot.copy()
+    pen[56:58, :] = 30  # a pen line 2.5 mm above the spot, outside the box
+    for img in (dot, pen):
+        fp = analyze_scan(img, px_per_mm=16.0, rows="centre", box_px=box)
+        assert fp.metrics["peak"] == pytest.approx(alone.metrics["peak"], abs=1e-3)
+        assert any("a blur of up to 2 px" in x for x in fp.warnings), fp.warnings

@@ -503,7 +503,7 @@ RESOLUTION_PX, ALONG_PX, FLAT_RESOLUTION_PX, FLAT_SHARE = 12.0, 10.0, 6.0, 0.65
 # takes off, or the less its edges on the scan allow (_blur_bound; a Gaussian has no sharp edge, a Hertzian spot
 # does), flagged above BLUR_LOSS (9 %: the Gaussian reading of a pixel-sampled spot's width put 10.2-10.5 % low at
 # 9.9 %). benchmarks/film_resolution.py: readings > 10 % low unflagged 20 -> 2 of 1139, within 10 % flagged 774 ->
-# 855 of 2245 (12 more on sharp scans); the noise check's sets are unchanged (benchmarks/film_row_noise.py)
+# 856 of 2245 (12 more on sharp scans); the noise check's sets are unchanged (benchmarks/film_row_noise.py)
 BLUR_PX, BLUR_LOSS = 2.0, 0.09
 
 
@@ -521,13 +521,15 @@ def _run_width(v: np.ndarray, i: int, frac: float) -> float | None:
     return float((b - a) + (v[a] - thr) / (v[a] - v[a - 1]) + (v[b] - thr) / (v[b] - v[b + 1]))
 
 
-def _blur_bound(g: np.ndarray, i: int) -> float:
+def _blur_bound(g: np.ndarray, v: np.ndarray, i: int) -> float:
     """An upper bound (px) on the sd of the scan's Gaussian blur from a grayscale profile g darkest near sample
-    i: blurred, an edge rising by dG from the press to the white film beside it is nowhere steeper than
-    dG / (sd sqrt(2 pi)) (its steepest blurred step), whatever the press's own shape; the smaller of the
-    two sides' dG / (steepest step x sqrt(2 pi)). inf where neither side rises."""
+    i (v: its pressure): blurred, an edge rising by dG from the press to the white film beside it is nowhere
+    steeper than dG / (sd sqrt(2 pi)) (its steepest blurred step), whatever the press's own shape; the smaller of
+    the two sides' dG / (steepest step x sqrt(2 pi)), each over the press's own edge (_own_edge: a darker press or
+    a pen mark further on the scan has steeper steps under the same blur). inf where neither side rises."""
     out = math.inf
-    for side in (g[i::-1], g[i:]):  # from the press outwards
+    for gs, vs in ((g[i::-1], v[i::-1]), (g[i:], v[i:])):  # from the press outwards
+        side = gs[:_own_edge(gs, vs)]
         if side.size < 2:
             continue
         rise = float(side.max() - side[0])
@@ -535,6 +537,18 @@ def _blur_bound(g: np.ndarray, i: int) -> float:
         if rise > 0 and step > 0:
             out = min(out, rise / (step * math.sqrt(2 * math.pi)))
     return out
+
+
+def _own_edge(g: np.ndarray, v: np.ndarray) -> int:
+    """How many samples of a gray profile g (pressure v) from a press outwards are its own edge: up to the first
+    one, past where v first reads 0 (the film beside it), that is activated again or darker than the lightest
+    gray before it by half the rise to that (another press, a pen mark); all of them where v never reads 0."""
+    zero = np.flatnonzero(v <= 0)
+    if zero.size == 0:
+        return g.size
+    top = np.maximum.accumulate(g)
+    other = (np.arange(g.size) > zero[0]) & ((v > 0) | (top - g > 0.5 * (top - g[0])))
+    return int(np.argmax(other)) if other.any() else g.size
 
 
 # a Gaussian's sd over its width at half its maximum, and at 90 % of it
@@ -568,7 +582,7 @@ def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis
         if w50 is None:
             continue
         flat = w90 is not None and w90 >= FLAT_SHARE * w50
-        ends[where] = i, (w50, w90 if w90 is not None else 0.0), flat
+        ends[where] = i, (w50, w90 if w90 is not None else 0.0), flat, v
         need = FLAT_RESOLUTION_PX if flat else rounded
         if w50 < need:
             return _narrow_text(where, w50, need, px_per_mm * need / w50, px_per_mm, axis)
@@ -577,8 +591,8 @@ def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis
     # wider than those: a round-topped press still reads low where the blur is a large part of its width (a
     # Gaussian spot 12-15 px wide under 2 px blur, 10-15 % low); the blur is BLUR_PX at most, less where a
     # steep edge on the scan bounds it
-    blur = min([BLUR_PX] + [_blur_bound(np.asarray(g, float), ends[w][0]) for w, g in zip(("across", "along"), grays)
-                            if w in ends])
+    blur = min([BLUR_PX] + [_blur_bound(np.asarray(g, float), ends[w][3], ends[w][0])
+                            for w, g in zip(("across", "along"), grays) if w in ends])
     widths = [None if ends.get(w, (0, 0, True))[2] else ends[w][1] for w in ("across", "along")]
     loss = _blur_loss(widths, blur)
     if loss <= BLUR_LOSS:
