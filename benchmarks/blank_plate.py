@@ -35,7 +35,8 @@ ABOUT = ("Measured error of the sensor-array chart's blank Braille plate (array.
          "inside |s|, |z| <= extent_mm, of the bone map (sensor_height_mm null) or of the map that height above the "
          "bone (P = -tr(sigma) / 3; --sensor-height); reference_shift: the same of the next finer mesh measured against "
          "the reference (its last refinement step, standing for the reference's own error). A row whose max_error "
-         "plus reference_shift is within surrogate.TOLERANCE covers the blank solve's coarse_mesh flag for a chart "
+         "plus the reference's own error estimated from reference_shift (array.chart.reference_error: that step at "
+         "the measured order) is within surrogate.TOLERANCE covers the blank solve's coarse_mesh flag for a chart "
          "reading within its extent at that height (array.chart.blank_measured). "
          "Written by benchmarks/blank_plate.py --write.")
 

@@ -23,7 +23,7 @@ def _row(b, max_error, shift=None):
          "extent_mm": CFG.read_extent, "sensor_height_mm": None, "max_error": max_error, "l2_error": 0.01,
          "reference_mesh": [0.42, 2.0]}
     if shift is not None:
-        r["reference_shift"] = shift
+        r["reference_shift"], r["shift_mesh"] = shift, [0.6, 2.0]
     return r
 
 
@@ -48,3 +48,14 @@ def test_the_t3_rows_are_measured_against_the_finer_reference():
 
 def test_polyurethane_1mm_above_the_bone_is_not_shown_within_the_tolerance():
     assert blank_measured(_blank(3.0, "polyurethane"), CFG.read_extent, 3.0 - 1.0) is None
+
+
+def test_the_reference_s_own_error_is_its_last_step_at_the_measured_order():
+    """reference_shift (0.6 / 2 against 0.42 / 2) was added as the reference's own error, which holds at order 2
+    (0.96 x the step at a 1.43 size ratio); this max norm was measured converging at order ~1.5
+    (benchmarks/results/blank_plate.md: 1.2 -> 0.8 -> 0.6 / 1, 4.30 / 2.39 / 1.59 %), where the error is 1.41 x
+    the step: silicone's map 0.4 mm above the bone, 3.85 % + 1.41 x 1.05 % = 5.3 %, is not shown within 5 %
+    (it was covered at 3.85 + 1.05 = 4.90 %); the bone maps (4.2 / 3.3 %) still are."""
+    assert blank_measured(_blank(3.0, "silicone"), CFG.read_extent, 3.0 - 0.4) is None
+    for material in ("silicone", "polyurethane"):
+        assert blank_measured(_blank(3.0, material), CFG.read_extent) is not None
