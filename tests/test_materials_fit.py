@@ -296,3 +296,26 @@ def test_a_law_that_misses_the_test_by_more_than_10_percent_is_a_suspect_fit():
     assert any("misses the test by up to" in w for w in neo.warnings)
     yeoh = fit("yeoh", lam, P, terms=2)
     assert yeoh.quality["max_rel_err"] < 1e-3 and not any("misses the test" in w for w in yeoh.warnings)
+
+
+def test_a_fit_whose_law_no_material_file_may_hold_is_refused_not_written(tmp_path, capsys):
+    """Stretches 1.05-2.0 typed under a `strain` header (read as stretch 2.05-3.0): the Yeoh fit
+    ran its c10 to the bound, mu0 = 2e-12 MPa, and was written (exit 3); every solve then refused
+    the file (mu0 outside [1e-6, 1e4] MPa). The fit is refused with its mu0 and that range named,
+    and nothing is written."""
+    from tactileskin.materials.fit import FitError
+    from tactileskin.materials.laws import MU0_RANGE
+
+    lam = np.linspace(1.05, 2.0, 12)
+    P, _ = uniaxial_nominal(Yeoh((0.015, 0.001), 1.5), lam, None)
+    with pytest.raises(FitError, match=r"mu0.*\[1e-06, 10000\] MPa"):
+        fit("yeoh", lam + 1.0, P)
+    csv = tmp_path / "gel.csv"
+    csv.write_text("strain,nominal_stress_mpa\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(lam, P)))
+    out = tmp_path / "gel.toml"
+    assert main(["material", "fit", str(csv), "--law", "yeoh", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "mu0" in err and len(err.strip().splitlines()) == 1 and not out.exists()
+    # within the range: written and read back by a solve's loader, as before
+    f = fit("yeoh", lam, P)
+    assert MU0_RANGE[0] <= f.law.mu0 <= MU0_RANGE[1]

@@ -264,6 +264,7 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
         raise FitError(f"fit of {law} explains none of the data (R^2 = {q['r2']:.3g}, RMSE "
                        f"{q['rmse_mpa']:.3g} MPa): try another law, or check the data's columns and units")
     _check_stable(law, mat, lam, nu)
+    _check_loadable(law, mat, lam)
     q["nfev"] = int(sol.nfev)
     q["warnings"] = extrapolation_warnings(mat, lam, P, nu)
     if q["max_rel_err"] > MAX_REL_ERR:
@@ -344,6 +345,22 @@ def _check_stable(law: str, mat, lam, nu) -> None:
         raise FitError(f"the fitted {law} law is not stable: its uniaxial stress does not rise with stretch "
                        f"at stretch {at:.3g} ({mat.to_dict() if hasattr(mat, 'to_dict') else mat}); "
                        "try another law or fewer terms")
+
+
+def _check_loadable(law: str, mat, lam) -> None:
+    """Refuse a fitted law whose small-strain moduli a material file may not hold
+    (laws.law_from_dict): written, it would be refused by every solve that reads it."""
+    from tactileskin.materials.laws import MAX_BULK_OVER_SHEAR, MU0_RANGE
+
+    lo, hi = MU0_RANGE
+    if not lo <= mat.mu0 <= hi:
+        raise FitError(f"the fitted {law} law's small-strain shear modulus mu0 = {mat.mu0:.3g} MPa is outside "
+                       f"[{lo:g}, {hi:g}] MPa, which a material file may hold (the test's stretch runs "
+                       f"{float(lam.min()):.4g}-{float(lam.max()):.4g}): check the columns and units "
+                       "(stretch = 1 + strain, stress in MPa), or fit a simpler law")
+    if not mat.K0 / mat.mu0 <= MAX_BULK_OVER_SHEAR:
+        raise FitError(f"the fitted {law} law's K0 / mu0 = {mat.K0 / mat.mu0:.4g} is above the "
+                       f"{MAX_BULK_OVER_SHEAR:g} a material file may hold: give a smaller --nu")
 
 
 def _alpha_seeds(terms):
