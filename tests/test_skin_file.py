@@ -601,3 +601,25 @@ def test_a_p2_msh_whose_crown_node_is_on_the_axis_is_not_highest_off_it(tmp_path
                         {"bonded": [0], "sides": [1, 3], "outer_surface": [2]}, order=2)
     with pytest.raises(ParameterError, match="highest on the indenters' axis"):
         Scene(skin="file", skin_file=str(off), indenter="flat", depth=0.05)
+
+
+@pytest.mark.parametrize("indenter", ["sphere", "cylinder"])
+def test_an_indenter_on_a_curved_step_top_touches_at_once(tmp_path, indenter):
+    """A 12 x 12 mm pad 2 mm thick with an R 3 cap 0.8 mm high on top (STEP): a sphere or
+    cylinder starts on the cap's top, on the axis, and touches at once. The first-contact travel
+    was read on the coarse mesh's contact nodes alone, none on the axis (the highest 0.11 mm
+    under the top, 0.54 mm off it): 0.163 mm for the R 2.5 sphere, and a 0.1 mm indentation was
+    refused as 'no contact'."""
+    import build123d as bd
+
+    from tactileskin.geometry.indenters import first_contact_travel, require_contact
+
+    pad = bd.Box(12.0, 2.0, 12.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    cap = bd.Pos(0, -0.2, 0) * bd.Sphere(3.0) & bd.Pos(0, 2.0, 0) * bd.Box(
+        20.0, 20.0, 20.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    path = tmp_path / "domepad.step"
+    bd.export_step(pad + cap, str(path))
+    scene = Scene(skin="file", skin_file=str(path), indenter=indenter, indenter_radius=2.5, depth=0.1)
+    assert scene.thickness == pytest.approx(2.8, abs=1e-9)
+    assert first_contact_travel(scene) == pytest.approx(0.0, abs=1e-9)
+    require_contact(scene)  # no ParameterError

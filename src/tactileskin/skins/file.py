@@ -306,9 +306,12 @@ class FileSection:
         raise ParameterError("s", s, "no points by s on a file skin", "its bonded surface has no path")
 
     def outer_points(self, n: int = 200) -> np.ndarray:
-        """(x, y) of the outer surface's nodes (in 3D projected along z: a first-contact
-        estimate that can only be early)."""
-        return self.geo.outer_xy
+        """(x, y) of the outer surface's nodes (in 3D projected along z) and of its top point,
+        where the indenters start: a first-contact estimate. The top is a STEP's CAD point on
+        the axis, which its coarse mesh's nodes miss (under a curved top they lie lower, and a
+        sphere seemed to touch only after their sag)."""
+        top = np.asarray(self.geo.top_point[:2], float)[None, :]
+        return np.vstack([self.geo.outer_xy, top])
 
     def area(self) -> float:
         raise ParameterError("skin", "file", "a built-in skin", "a file skin has no section area")
