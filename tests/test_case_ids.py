@@ -63,6 +63,17 @@ def test_material_files_are_named_by_their_file(tmp_path):
     assert case_ids(scenes[:1]) == [scenes[0].label()] == ["t3-soft-flat-2d"]
 
 
+def test_a_pad_sweeps_ids_name_the_pad_as_solve_does():
+    """A sweep of a 2D pad named its cases 't2-silicone-braille-2d', as the fingertip's, while
+    `solve` of the same scene says 'pad20x20-t2-silicone-braille-2d'; results.csv and the report
+    (neither has a skin column) then did not say the cases were a pad's."""
+    scenes = [Scene(skin="pad", pad_width=20.0, thickness=t, indenter="braille") for t in (1.5, 2.0)]
+    assert case_ids(scenes) == [s.label() for s in scenes] == ["pad20x20-t1.5-silicone-braille-2d",
+                                                               "pad20x20-t2-silicone-braille-2d"]
+    two = [Scene(skin="pad", pad_width=w, thickness=2.0) for w in (20.0, 30.0)]
+    assert case_ids(two) == ["pad20x20-t2-silicone-flat-2d", "pad30x20-t2-silicone-flat-2d"]
+
+
 def test_two_depth_sweep_writes_two_rows_profiles_and_bars(tmp_path, capsys, monkeypatch):
     out = tmp_path / "out"
     args = ["sweep", "--out", str(out), "--thickness", "1", "--material", "polyurethane",

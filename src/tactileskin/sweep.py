@@ -253,7 +253,9 @@ def load_spec(path: str | Path) -> dict:
 # --- case ids -----------------------------------------------------------------------------
 
 def _base_id(sc: Scene) -> str:
-    return f"t{sc.thickness:g}-{sc.material_tag()}-{sc.indenter_label()}-{sc.dim}d"
+    # the skin's prefix too ("pad20x20-", "" for the fingertip): results.csv and the report
+    # have no skin column, and `solve` names the same scene so
+    return sc.label()
 
 
 # Fields outside the base id that change a result, with the suffix naming each value.
@@ -269,12 +271,11 @@ _ID_FIELDS = (
     (lambda s: s.braille_standard, lambda s: s.braille_standard),
     (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
     (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name),  # two files, one name
-    (lambda s: (s.pad_width, s.pad_length), lambda s: s.skin_kind.label(s).rstrip("-") or s.skin),
 )
 
 
 def case_variants(scenes: Sequence[Scene]) -> list[str]:
-    """Per scene, the suffix that tells it apart from scenes with the same base id (thickness,
+    """Per scene, the suffix that tells it apart from scenes with the same base id (skin, thickness,
     material, indenter, Braille text, dim): "" for a scene whose base id is unique, else the
     values of every field that differs within some group of equal base ids, e.g. "d0.2" or
     "d0.2-r2" (the same fields for all such scenes, so their ids read alike)."""
