@@ -319,3 +319,21 @@ def test_a_fit_whose_law_no_material_file_may_hold_is_refused_not_written(tmp_pa
     # within the range: written and read back by a solve's loader, as before
     f = fit("yeoh", lam, P)
     assert MU0_RANGE[0] <= f.law.mu0 <= MU0_RANGE[1]
+
+
+def test_a_headerless_strain_column_or_swapped_columns_are_named_as_such(tmp_path):
+    """Two unnamed columns are read as (stretch, stress): a tension test given as (strain,
+    stress), or as (stress, stretch), reads as compression under positive stress. The error
+    asked only whether the stress column had its sign; it now names the likelier slips too, a
+    strain column without its header and swapped columns (and a compression test's magnitude)."""
+    lam = np.linspace(1.05, 2.0, 12)
+    P, _ = uniaxial_nominal(NeoHookean(0.03, 1.5), lam, None)
+    f = tmp_path / "t.csv"
+    for first, second in ((lam - 1.0, P), (P, lam)):
+        f.write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(first, second)))
+        s, p = read_uniaxial_csv(f)
+        with pytest.raises(FitDataError, match=r"at or below 1 throughout.*strain.*header.*swapped.*minus sign"):
+            fit("neo_hookean", s, p)
+    # a tension test with negative stress keeps the sign question alone
+    with pytest.raises(FitDataError, match=r"with its sign\?\)$"):
+        fit("neo_hookean", lam, -P)

@@ -176,9 +176,14 @@ def check_data(stretch, stress, n_params: int):
     # an elastomer pulls back: positive nominal stress in tension, negative in compression
     wrong = int(np.sum(P * (lam - 1.0) < 0.0))
     if wrong > lam.size // 2:
+        hint = "is the stress column the nominal stress of this test, with its sign?"
+        if np.all(lam <= 1.0) and np.all(P >= 0.0):
+            # what two unnamed columns (read as stretch, stress) of a tension test look like
+            hint = ("the stretch column is at or below 1 throughout under positive stress: is it a strain without its "
+                    "'strain' header, are the columns swapped (stretch first), or is this a compression test "
+                    "whose stress needs its minus sign?")
         raise FitDataError("stress", f"of the wrong sign at {wrong} of {lam.size} points",
-                           "positive in tension (stretch > 1), negative in compression (MPa)",
-                           "is the stress column the nominal stress of this test, with its sign?")
+                           "positive in tension (stretch > 1), negative in compression (MPa)", hint)
     order = np.argsort(lam)
     return lam[order], P[order]
 
