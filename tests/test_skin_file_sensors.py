@@ -751,3 +751,29 @@ def test_an_error_inside_an_open_step_import_is_not_called_gmsh_s(tmp_path):
             raise Exception("as gmsh's API raises")  # noqa: TRY002
     with skinfile.step_open(path):  # the import is closed after each: a new one opens
         pass
+
+
+def test_a_sensor_just_inside_a_curved_rim_hangs_from_the_face_it_is_under(tmp_path):
+    """A 12 x 12 x 2 mm pad with an R 3 cap 0.8 mm high (its rim r = 2.04 mm) as STEP. Within
+    ~0.1 mm inside the rim the vertical line crossed the coarse mesh's flat-top chords (their
+    polygon lies inside the rim), missed that face's trimmed CAD and kept the chord's height:
+    the top read 2.0 for the cap's 2.036-2.080 and the normal +y for a 40-43 degree slope, so a
+    sensor at depth 1 and s = 2 lay at x = 2 where the normal puts it at x = 1.33. Points now
+    read the cap's CAD there, as elsewhere on it."""
+    import build123d as bd
+
+    pad = bd.Box(12.0, 2.0, 12.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    cap = bd.Pos(0, -0.2, 0) * bd.Sphere(3.0) & bd.Pos(0, 2.0, 0) * bd.Box(
+        20.0, 20.0, 20.0, align=(bd.Align.CENTER, bd.Align.MIN, bd.Align.CENTER))
+    path = tmp_path / "domepad.step"
+    bd.export_step(pad + cap, str(path))
+    r = np.array([1.95, 2.0, 2.03])
+    a = np.radians([0.0, 20.0, 30.0])
+    x, z = (np.outer(r, np.cos(a)).ravel(), np.outer(r, np.sin(a)).ravel())
+    for depth in (0.0, 1.0):
+        lays = [{"name": f"p{i}", "kind": "points", "s": [float(xi)], "z": [float(zi)], "depth": depth}
+                for i, (xi, zi) in enumerate(zip(x, z))]
+        xyz = sensors.sites_for(Scene(skin="file", skin_file=str(path), sensors=lays)).xyz
+        surf = np.column_stack([x, -0.2 + np.sqrt(9.0 - x**2 - z**2), z])
+        n = (surf - np.array([0.0, -0.2, 0.0])) / 3.0  # the cap's outward normal
+        assert np.abs(xyz - (surf - depth * n)).max() < 1e-6

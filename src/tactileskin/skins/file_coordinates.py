@@ -203,8 +203,8 @@ class FileCoordinates:
             found = self._cross_curved(q[pt], f) if self._curved else [self._cross(q[pt], f)]
             y = np.concatenate([yy[hit] for hit, yy in found])
             hits.append([np.concatenate([v[hit] for hit, _ in found]) for v in (pt, f)] + [y])
-            if self._face is not None:  # every candidate facet of each point that crossed a wall
-                on = np.isin(pt, hits[-1][0][self._wall[hits[-1][1]]])
+            if self._face is not None:  # every candidate facet of each point that crossed a facet
+                on = np.isin(pt, hits[-1][0])
                 near.append((pt[on], f[on]))
         if not hits:
             hits = [[np.zeros(0, int), np.zeros(0, int), np.zeros(0)]]
@@ -309,23 +309,45 @@ class FileCoordinates:
         mesh's, not the skin's: inside a curved rim the lines crossed a disc's wall chords (0.308 mm
         apart at r = 4.99 of R 5) and missed its top and bottom chords. Those points' lines are
         read on the CAD faces of the facets `near` (pt, f) them instead (the trimmed face's, or none)."""
-        from tactileskin.mesh.skinfile import line_heights
+        from tactileskin.mesh.skinfile import line_heights, step_open
 
         cad = line_heights(self.cad, self._face[f], np.column_stack([q[pt, 0], y, q[pt, 1]]))
-        wall = np.isnan(cad) & self._wall[f]
-        y = np.where(np.isnan(cad), y, cad)
-        if not wall.any():
+        miss = np.isnan(cad)
+        wall = miss & self._wall[f]
+        y = np.where(miss, y, cad)
+        if not miss.any():
             return pt, f, y
         # one probe per point and face near it, at the height of one of that face's chords there
         npt, nf = near
-        on = np.isin(npt, pt[wall])
+        on = np.isin(npt, pt[miss])
         pairs = np.unique(np.column_stack([npt[on], self._face[nf[on]]]), axis=0, return_index=True)[1]
         npt, nf = npt[on][pairs], nf[on][pairs]
-        ny = line_heights(self.cad, self._face[nf], np.column_stack([q[npt, 0], self._y[nf].mean(axis=1),
-                                                                     q[npt, 1]]))
-        hit, keep = np.isfinite(ny), ~wall
+        with step_open(self.cad):
+            ny = line_heights(self.cad, self._face[nf], np.column_stack([q[npt, 0], self._y[nf].mean(axis=1),
+                                                                         q[npt, 1]]))
+            y, f = self._off_trim(pt, f, y, miss & ~wall, npt, nf, ny)
+        hit = np.isfinite(ny) & np.isin(npt, pt[wall])
+        keep = ~wall
         return (np.concatenate([pt[keep], npt[hit]]), np.concatenate([f[keep], nf[hit]]),
                 np.concatenate([y[keep], ny[hit]]))
+
+    def _off_trim(self, pt, f, y, off, npt, nf, ny) -> tuple:
+        """(y, f) with each crossing `off` (a chord that is no wall, whose trimmed face the line
+        misses) read on another face of the same kind near its point where the line meets it
+        within the chord's size (the nearest such): inside a curved rim between two top faces the
+        lower face's chords stick out past their face, under the higher face, and the line kept
+        their height (a pad's flat top read 0.04-0.08 mm under an R 3 cap within 0.1 mm of its rim,
+        and flat). Where none is met the chord's height stays (a line grazing its face's trim)."""
+        y, f = y.copy(), f.copy()
+        for i in np.flatnonzero(off):
+            c = (npt == pt[i]) & np.isfinite(ny) & (self._face[nf] != self._face[f[i]]) & \
+                (self._kind[nf] == self._kind[f[i]]) & ~self._wall[nf]
+            size = float(np.ptp(self._L[f[i]], axis=0).max())
+            c &= np.abs(ny - y[i]) <= size
+            if c.any():
+                j = np.flatnonzero(c)[np.argmin(np.abs(ny[c] - y[i]))]
+                y[i], f[i] = ny[j], nf[j]
+        return y, f
 
     def _cross(self, q, f):
         """(hit, y) of the vertical lines through the points q (m, k) and the facets f (m,)."""
