@@ -117,3 +117,30 @@ def test_the_contact_point_row_is_dropped_and_a_falling_force_is_refused():
     falling = [0.01, 0.008, 0.005, 0.002, 0.001]
     with pytest.raises(FitDataError, match=r"R\^2 = -1.75.*falls with depth"):
         fit_indentation("neo_hookean", [0.05, 0.1, 0.15, 0.2, 0.22], falling, radius=R, thickness=2.0)
+
+
+def test_a_force_column_off_by_a_unit_is_flagged_or_refused_as_the_uniaxial_fits_are(tmp_path, capsys):
+    """A Sylgard-like layer (mu 0.1 MPa) whose forces were logged in mN fitted mu = 100 MPa and
+    was written with exit 0; the uniaxial fit marks a modulus that stiff suspect (kPa for MPa).
+    Forces in uN of a soft gel (mu 0.03 MPa) fitted mu = 3e-8 MPa, written, then refused by
+    every solve (mu0 outside [1e-6, 1e4] MPa). Now: the first is a suspect fit naming the force
+    unit (exit 3), the second is refused, nothing written (exit 2)."""
+    from tactileskin.materials.fit import SOFT_MU_MAX, FitError
+
+    d = np.linspace(0.02, 0.2, 8)
+    mN = bonded_sphere_force(0.3, d, R, T) * 1e3
+    f = fit_indentation("neo_hookean", d, mN, radius=R, thickness=T)
+    assert f.law.mu > SOFT_MU_MAX and any("force column in mN" in w for w in f.warnings)
+    assert fit_indentation("neo_hookean", d, mN / 1e3, radius=R, thickness=T).warnings == []
+    csv = tmp_path / "ind.csv"
+    csv.write_text("depth_mm,force_n\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(d, mN)))
+    assert main(["material", "fit", str(csv), "--test", "indentation", "--radius", str(R), "--thickness", str(T),
+                 "--law", "neo_hookean", "-o", str(tmp_path / "mN.toml")]) == 3
+    assert "force column in mN" in capsys.readouterr().out and (tmp_path / "mN.toml").exists()
+    uN = bonded_sphere_force(0.09, d, R, T) * 1e-6
+    with pytest.raises(FitError, match=r"mu0.*\[1e-06, 10000\] MPa"):
+        fit_indentation("neo_hookean", d, uN, radius=R, thickness=T)
+    csv.write_text("depth_mm,force_n\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(d, uN)))
+    assert main(["material", "fit", str(csv), "--test", "indentation", "--radius", str(R), "--thickness", str(T),
+                 "--law", "neo_hookean", "-o", str(tmp_path / "uN.toml")]) == 2
+    assert not (tmp_path / "uN.toml").exists()

@@ -70,12 +70,12 @@ def fit(data, law, out, nu, terms, name, test="uniaxial", radius=None, thickness
         source = (f"fit of {law} to {Path(data).name} (sphere indentation, R = {radius:g} mm, bonded layer t = "
                   f"{thickness:g} mm, Hertz with the Dimitriadis 2002 bonded correction, {q['n_points']} points, "
                   f"chi <= {q['chi_max']:.3g}): E = {f.E:.5g} MPa, R^2 = {q['r2']:.5f}, RMSE = {q['rmse_n']:.3g} N, "
-                  f"max relative error {100 * q['max_rel_err']:.2f} %")
+                  f"max relative error {100 * q['max_rel_err']:.2f} %" + "".join(f"; SUSPECT: {w}" for w in f.warnings))
         with ownership.written_file(outp) as tmp:
             fileio.atomic_write_text(tmp, MARK + "\n" + f.material(name or Path(data).stem, source).to_toml())
         click.echo(f.describe())
-        click.echo(f"wrote {out}")
-        return
+        click.echo(f"wrote {out}" + (" (a suspect fit: exit status 3)" if f.warnings else ""))
+        return EXIT_SUSPECT if f.warnings else 0
     if radius is not None or thickness is not None:
         raise ParameterError("--radius/--thickness", radius if radius is not None else thickness,
                              "only with --test indentation")

@@ -354,15 +354,17 @@ def _check_stable(law: str, mat, lam, nu) -> None:
 
 def _check_loadable(law: str, mat, lam) -> None:
     """Refuse a fitted law whose small-strain moduli a material file may not hold
-    (laws.law_from_dict): written, it would be refused by every solve that reads it."""
+    (laws.law_from_dict): written, it would be refused by every solve that reads it. lam: the
+    uniaxial test's stretches (None: an indentation test)."""
     from tactileskin.materials.laws import MAX_BULK_OVER_SHEAR, MU0_RANGE
 
     lo, hi = MU0_RANGE
     if not lo <= mat.mu0 <= hi:
+        test = ("the test's stretch runs " f"{float(lam.min()):.4g}-{float(lam.max()):.4g}: check the columns and "
+                "units (stretch = 1 + strain, stress in MPa), or fit a simpler law") if lam is not None else \
+            "check the columns and units (depth in mm, force in N)"
         raise FitError(f"the fitted {law} law's small-strain shear modulus mu0 = {mat.mu0:.3g} MPa is outside "
-                       f"[{lo:g}, {hi:g}] MPa, which a material file may hold (the test's stretch runs "
-                       f"{float(lam.min()):.4g}-{float(lam.max()):.4g}): check the columns and units "
-                       "(stretch = 1 + strain, stress in MPa), or fit a simpler law")
+                       f"[{lo:g}, {hi:g}] MPa, which a material file may hold ({test})")
     if not mat.K0 / mat.mu0 <= MAX_BULK_OVER_SHEAR:
         raise FitError(f"the fitted {law} law's K0 / mu0 = {mat.K0 / mat.mu0:.4g} is above the "
                        f"{MAX_BULK_OVER_SHEAR:g} a material file may hold: give a smaller --nu")

@@ -60,13 +60,19 @@ class IndentationFit:
 
         return Material(name=name, law=self.law, prony=Prony.elastic(), source=source)
 
+    @property
+    def warnings(self) -> list[str]:
+        """What makes the fit suspect beyond its R^2 (empty: none found)."""
+        return list(self.quality.get("warnings", ()))
+
     def describe(self) -> str:
         q = self.quality
         return (f"{self.law.law}: {self.law.to_dict()} (E = 3 mu = {self.E:.5g} MPa, the incompressible "
                 f"formula's; the file's bulk modulus makes nu = {NU_INCOMPRESSIBLE:g}); R^2 = {q['r2']:.5f}, "
                 f"RMSE = {q['rmse_n']:.3g} N, max relative error {100 * q['max_rel_err']:.2f} % "
                 f"({q['n_points']} points, sphere R = {self.radius:g} mm on a bonded layer t = "
-                f"{self.thickness:g} mm, chi <= {q['chi_max']:.3g})")
+                f"{self.thickness:g} mm, chi <= {q['chi_max']:.3g})"
+                + "".join(f"\n  suspect fit: {w}" for w in self.warnings))
 
 
 def check_indentation(depth, force, radius, thickness):
@@ -135,6 +141,13 @@ def fit_indentation(law: str, depth, force, *, radius: float, thickness: float) 
                            "forces that rise with depth as a sphere on a layer gives (F ~ d^1.5)",
                            ("the force falls with depth at some rows; " if falls else "")
                            + "check the columns (depth_mm, force_n) and their units")
+    from tactileskin.materials.fit import SOFT_MU_MAX, _check_loadable
+
+    _check_loadable(law, mat, None)
+    # as the uniaxial fit's: a modulus past any skin elastomer's is most often a unit slip
+    q["warnings"] = [] if mat.mu0 <= SOFT_MU_MAX else [
+        f"shear modulus {mat.mu0:.4g} MPa: stiffer than the soft elastomers of skins (up to about "
+        f"{SOFT_MU_MAX:g} MPa); is the force column in mN? N is expected (and depth in mm)"]
     q["rmse_n"] = q.pop("rmse_mpa")
     q["chi_max"] = float(np.sqrt(R * d.max()) / t)
     q["rel_floor"] = REL_FLOOR
