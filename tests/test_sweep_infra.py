@@ -315,3 +315,23 @@ def test_a_process_that_started_solver_threads_spawns_its_workers(monkeypatch):
     monkeypatch.setattr(threads, "_parent_threads", False)
     monkeypatch.setitem(sys.modules, "numba.np.ufunc.parallel", types.SimpleNamespace(_is_initialized=True))
     assert (fresh, after_pardiso, sweep.worker_start_method()) == ("fork", "spawn", "spawn")
+
+
+def test_a_process_that_made_a_3d_mesh_spawns_its_workers(monkeypatch):
+    """A fork()ed child of a process that made a 3D mesh meshes each 3D case in a fresh Python
+    (mesh._gmsh.in_fresh_process: gmsh's OpenCASCADE pool does not survive fork()): a t = 1
+    preview dot's mesh then took 1.3 s CPU and ~4 s wall in place of 0.5 s and ~1 s, for every
+    3D case, while fork() saves each worker's imports once (~1-2 s CPU): such a process spawns."""
+    import os
+
+    from tactileskin import sweep, threads
+    from tactileskin.mesh import _gmsh
+
+    monkeypatch.setattr(threads, "_parent_threads", False)
+    monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
+    monkeypatch.setattr(_gmsh, "_meshed_3d_in", None)
+    fresh = sweep.worker_start_method()
+    monkeypatch.setattr(_gmsh, "_meshed_3d_in", os.getpid())  # this process meshed in 3D
+    here = sweep.worker_start_method()
+    monkeypatch.setattr(_gmsh, "_meshed_3d_in", os.getpid() + 1)  # its parent did, before a fork()
+    assert (fresh, here, sweep.worker_start_method()) == ("fork", "spawn", "spawn")

@@ -512,10 +512,15 @@ def worker_start_method() -> str:
     (threads.py's fork handler, mesh._gmsh.in_fresh_process) and a worker then needs no imports
     of its own; else dask's default, spawn (fork() is unsafe on macOS, absent on Windows). Also
     spawn where this process started numba's or PARDISO's threads (a notebook's solve before
-    its sweep): a child fork()ed from it solves on one thread (threads.forked_from_threads)."""
+    its sweep): a child fork()ed from it solves on one thread (threads.forked_from_threads);
+    and where this process (or one it was fork()ed from) made a 3D mesh: a child fork()ed from
+    it meshes each 3D case in a fresh Python (mesh._gmsh.in_fresh_process), dearer than the
+    imports fork() saves."""
     from tactileskin.threads import threads_started
 
-    return "fork" if sys.platform.startswith("linux") and not threads_started() else "spawn"
+    gmsh_state = sys.modules.get("tactileskin.mesh._gmsh")
+    meshed_3d = gmsh_state is not None and gmsh_state._meshed_3d_in is not None
+    return "fork" if sys.platform.startswith("linux") and not threads_started() and not meshed_3d else "spawn"
 
 
 def _restore_environ(saved: dict) -> None:
