@@ -280,11 +280,12 @@ def test_local_workers_are_forked_with_the_solver_loaded_and_one_blas_thread(mon
 
     from threadpoolctl import threadpool_limits
 
-    from tactileskin import threads
+    from tactileskin import sweep, threads
     from tactileskin.sweep import _Runner
 
     # as in a fresh process (another test here may have solved on threads: then it spawns)
     monkeypatch.setattr(threads, "threads_started", lambda: False)
+    monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
     before = signal.signal(signal.SIGTERM, lambda *a: None)
     runner = _Runner([], [], serial=False, scheduler=None, workers=2)
     try:
@@ -309,6 +310,7 @@ def test_a_process_that_started_solver_threads_spawns_its_workers(monkeypatch):
     # as a fresh process (another test here may have run numba's parallel loops)
     monkeypatch.setattr(threads, "_parent_threads", False)
     monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
+    monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
     fresh = sweep.worker_start_method()
     monkeypatch.setattr(threads, "_parent_threads", True)  # PARDISO on threads
     after_pardiso = sweep.worker_start_method()
@@ -330,8 +332,43 @@ def test_a_process_that_made_a_3d_mesh_spawns_its_workers(monkeypatch):
     monkeypatch.setattr(threads, "_parent_threads", False)
     monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
     monkeypatch.setattr(_gmsh, "_meshed_3d_in", None)
+    monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
     fresh = sweep.worker_start_method()
     monkeypatch.setattr(_gmsh, "_meshed_3d_in", os.getpid())  # this process meshed in 3D
     here = sweep.worker_start_method()
     monkeypatch.setattr(_gmsh, "_meshed_3d_in", os.getpid() + 1)  # its parent did, before a fork()
     assert (fresh, here, sweep.worker_start_method()) == ("fork", "spawn", "spawn")
+
+
+def test_a_process_with_a_thread_of_its_own_spawns_its_workers(monkeypatch):
+    """fork() copies every lock another thread holds at that moment, held for good in the child:
+    a user's thread meshing 2D sections in a loop while a 2-case sweep started hung a fork()ed
+    worker at its first case in 3 of 6 runs (functools.cached_property's lock, taken by the
+    thread in Fingertip.interface_length; spawned: 0 of 6). Such a process spawns its workers;
+    an earlier sweep's idle dask pool and the sweep command's progress bar (rich's refresh
+    thread, which the workers never call) leave it fork()ing."""
+    import threading
+
+    from rich.progress import Progress
+
+    from tactileskin import sweep, threads
+    from tactileskin.mesh import _gmsh
+
+    monkeypatch.setattr(threads, "_parent_threads", False)
+    monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
+    monkeypatch.setattr(_gmsh, "_meshed_3d_in", None)
+    ours = set(threading.enumerate())  # pytest's (xdist's) threads, here before the test
+    monkeypatch.setattr(threading, "enumerate",
+                        lambda real=threading.enumerate: [t for t in real() if t not in ours or t is threading.main_thread()])
+    stop = threading.Event()
+    with Progress(auto_refresh=True):
+        pool = threading.Thread(target=stop.wait, name="Dask-Offload_0", daemon=True)
+        pool.start()
+        ours_only = sweep.worker_start_method()
+        user = threading.Thread(target=stop.wait, daemon=True)
+        user.start()
+        with_user = sweep.worker_start_method()
+        stop.set()
+        user.join()
+        pool.join()
+    assert (ours_only, with_user, sweep.worker_start_method()) == ("fork", "spawn", "fork")

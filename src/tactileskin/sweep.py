@@ -515,12 +515,26 @@ def worker_start_method() -> str:
     its sweep): a child fork()ed from it solves on one thread (threads.forked_from_threads);
     and where this process (or one it was fork()ed from) made a 3D mesh: a child fork()ed from
     it meshes each 3D case in a fresh Python (mesh._gmsh.in_fresh_process), dearer than the
-    imports fork() saves."""
+    imports fork() saves. And where another thread of this process runs code of its own (a
+    user's thread, a notebook kernel's; _other_threads): a lock it holds as fork() copies the
+    process stays held in the child for good (a thread meshing, between two of functools.
+    cached_property's RLock calls, hung the worker at its first case)."""
     from tactileskin.threads import threads_started
 
     gmsh_state = sys.modules.get("tactileskin.mesh._gmsh")
     meshed_3d = gmsh_state is not None and gmsh_state._meshed_3d_in is not None
-    return "fork" if sys.platform.startswith("linux") and not threads_started() and not meshed_3d else "spawn"
+    return ("fork" if sys.platform.startswith("linux") and not threads_started() and not meshed_3d
+            and not _other_threads() else "spawn")
+
+
+def _other_threads() -> list:
+    """The Python threads of this process but the calling one, the idle pools of an earlier
+    sweep's dask (Dask-Offload, ...) and the sweep command's progress bar (rich's refresh)."""
+    import threading
+
+    return [t for t in threading.enumerate()
+            if t is not threading.current_thread() and not t.name.startswith("Dask-")
+            and type(t).__module__ != "rich.live"]
 
 
 def _restore_environ(saved: dict) -> None:
