@@ -372,3 +372,39 @@ def test_a_process_with_a_thread_of_its_own_spawns_its_workers(monkeypatch):
         user.join()
         pool.join()
     assert (ours_only, with_user, sweep.worker_start_method()) == ("fork", "spawn", "fork")
+
+
+def _worker_streams():
+    import sys
+
+    return [hasattr(s, "rich_proxied_file") for s in (sys.stdout, sys.stderr)]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
+def test_forked_workers_write_past_the_progress_bars_stream_proxies(monkeypatch):
+    """On a terminal the sweep command's progress bar (rich's Live) puts proxies in sys.stdout
+    and sys.stderr that print through its console and redraw the bar. A fork()ed worker kept
+    them: a worker's traceback on Ctrl-C (or any warning it printed) came out one line at a
+    time, each followed by that worker's stale copy of the bar ('solving ... 0/6 0:00:00' 11
+    times over, in a pty). The workers write to the files themselves, as spawned ones did."""
+    import io
+
+    from rich.console import Console
+    from rich.file_proxy import FileProxy
+
+    from tactileskin import sweep, threads
+    from tactileskin.sweep import _Runner
+
+    monkeypatch.setattr(threads, "threads_started", lambda: False)
+    monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
+    console = Console(file=io.StringIO())
+    monkeypatch.setattr(sys, "stdout", FileProxy(console, sys.stdout))
+    monkeypatch.setattr(sys, "stderr", FileProxy(console, sys.stderr))
+    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+    try:
+        client = runner._start(1)
+        streams = list(client.run(_worker_streams).values())
+    finally:
+        runner.close()
+    assert streams == [[False, False]], streams
+    assert _worker_streams() == [True, True]  # this process's, the bar's, stay

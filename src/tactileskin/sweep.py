@@ -464,6 +464,10 @@ class _Runner:
             # and the package: ~1 s CPU per worker idle, ~2 s loaded; preview sweep ~20 -> ~15 s CPU)
             import tactileskin.fe  # noqa: F401
             import tactileskin.mesh  # noqa: F401
+            import multiprocessing.util
+
+            # in each worker fork()ed while this runner lives (a restarted one too), first thing
+            multiprocessing.util.register_after_fork(self, _plain_streams)
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": None,
                               "distributed.worker.profile.enabled": False,
@@ -505,6 +509,18 @@ class _Runner:
         _restore_environ(self._environ)  # a worker its nanny restarted set them again
         for name, level in self._log_levels.items():
             logging.getLogger(name).setLevel(level)
+
+
+def _plain_streams(_runner) -> None:
+    """In a fork()ed worker: sys.stdout and sys.stderr the files themselves, as a spawned worker
+    has them, not the proxies of the sweep command's progress bar on a terminal (rich's Live),
+    which printed each line the worker wrote (a traceback on Ctrl-C, a warning) with its own
+    stale copy of the bar, and wait on that bar's locks, which another thread may have held
+    as fork() copied them."""
+    for name in ("stdout", "stderr"):
+        inner = getattr(getattr(sys, name), "rich_proxied_file", None)
+        if inner is not None:
+            setattr(sys, name, inner)
 
 
 def worker_start_method() -> str:
