@@ -286,6 +286,7 @@ def test_local_workers_are_forked_with_the_solver_loaded_and_one_blas_thread(mon
     # as in a fresh process (another test here may have solved on threads: then it spawns)
     monkeypatch.setattr(threads, "threads_started", lambda: False)
     monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
+    monkeypatch.setattr("tactileskin.mesh._gmsh._meshed_3d_in", None)  # another test here may have meshed 3D
     before = signal.signal(signal.SIGTERM, lambda *a: None)
     runner = _Runner([], [], serial=False, scheduler=None, workers=2)
     try:
@@ -311,6 +312,7 @@ def test_a_process_that_started_solver_threads_spawns_its_workers(monkeypatch):
     monkeypatch.setattr(threads, "_parent_threads", False)
     monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
     monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
+    monkeypatch.setattr("tactileskin.mesh._gmsh._meshed_3d_in", None)  # another test here may have meshed 3D
     fresh = sweep.worker_start_method()
     monkeypatch.setattr(threads, "_parent_threads", True)  # PARDISO on threads
     after_pardiso = sweep.worker_start_method()
@@ -333,6 +335,7 @@ def test_a_process_that_made_a_3d_mesh_spawns_its_workers(monkeypatch):
     monkeypatch.delitem(sys.modules, "numba.np.ufunc.parallel", raising=False)
     monkeypatch.setattr(_gmsh, "_meshed_3d_in", None)
     monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
+    monkeypatch.setattr("tactileskin.mesh._gmsh._meshed_3d_in", None)  # another test here may have meshed 3D
     fresh = sweep.worker_start_method()
     monkeypatch.setattr(_gmsh, "_meshed_3d_in", os.getpid())  # this process meshed in 3D
     here = sweep.worker_start_method()
@@ -397,6 +400,7 @@ def test_forked_workers_write_past_the_progress_bars_stream_proxies(monkeypatch)
 
     monkeypatch.setattr(threads, "threads_started", lambda: False)
     monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
+    monkeypatch.setattr("tactileskin.mesh._gmsh._meshed_3d_in", None)  # another test here may have meshed 3D
     console = Console(file=io.StringIO())
     monkeypatch.setattr(sys, "stdout", FileProxy(console, sys.stdout))
     monkeypatch.setattr(sys, "stderr", FileProxy(console, sys.stderr))
