@@ -233,7 +233,8 @@ BONE_SCALE_MAX = 2.3
 # (the bone balls and bone ROI keep theirs), for benchmarks/spot_scale_t5.py. The presets'
 # errors (data/presets.json "cases3d") were measured at 1, 1. At t = 5 mm, 1.6 / 8, k = 1.5-3
 # saved 2-5 % of the dofs and up to 19 % of the Newton iterations but moved the silicone dot's
-# bone map by 4.5-4.6 % (L2), as much as the default's whole map error against 0.8 / 8
+# bone map by 4.5-4.6 % (L2); against 0.8 / 8 their map errors are 2.6-4.1 % (the current plan
+# 4.5 %), but the saving (<= 19 % of the Newton iterations) does not meet T3 alone
 # (benchmarks/results/spot_scale_t5.md): not adopted.
 SPOT_FACTOR = 1.0
 STRIP_FACTOR = 1.0
