@@ -121,8 +121,8 @@ def _pad_text(cfg) -> str:
     from tactileskin.skins.pad import DEFAULT_LENGTH, DEFAULT_WIDTH
 
     h = get_standard(cfg.standard).height
-    past = [t for t in cfg.thicknesses
-            if (cfg.depth_for(t) if cfg.depth_for(t) is not None else Scene.depth_fraction * t) > h + 1e-12]
+    depths = {t: cfg.depth_for(t) for t in cfg.thicknesses}  # None: the scene's 20 % of t
+    past = [t for t, d in depths.items() if (Scene.depth_fraction * t if d is None else d) > h + 1e-12]
     if not past:
         return ""
     ts = ", ".join(f"{t:g}" for t in past)
