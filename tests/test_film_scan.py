@@ -583,3 +583,18 @@ def test_the_blur_bound_reads_the_press_s_own_edges_not_a_sharper_mark_elsewhere
         fp = analyze_scan(img, px_per_mm=16.0, rows="centre", box_px=box)
         assert fp.metrics["peak"] == pytest.approx(alone.metrics["peak"], abs=1e-3)
         assert any("a blur of up to 2 px" in x for x in fp.warnings), fp.warnings
+
+
+def test_the_resolution_warning_prints_the_width_read_under_the_width_needed():
+    """Both to the nearest 0.1 px, a press 11.27 px wide that needs 11.31 read '11.3 px wide ...
+    under the 11.3 px', and one 11.97 px wide under the 12 px threshold '12.0 px wide ... under
+    the 12 px'."""
+    import re
+
+    from tactileskin.film.scan import _narrow_text
+
+    for w50, need in ((11.27, 11.31), (11.97, 12.0), (5.0, 6.0), (9.999, 10.0)):
+        text = _narrow_text("across", w50, need, 8.0 * need / w50, 8.0, "x")
+        shown, needed = re.search(r"it is ([\d.]+) px .* under the ([\d.]+) px", text).groups()
+        assert float(shown) == pytest.approx(w50, abs=0.05) and need <= float(needed) < need + 0.1, (w50, need, text)
+        assert float(shown) < float(needed), text

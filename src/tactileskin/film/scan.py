@@ -609,9 +609,13 @@ def _narrow(across: np.ndarray, k: int, prof: np.ndarray, px_per_mm: float, axis
 
 
 def _narrow_text(where, w50, need, ppm, px_per_mm, axis, why="") -> str:
-    return (f"the scan's resolution is too coarse for this press: it is {w50:.1f} px ({w50 / px_per_mm:.3g} mm) "
+    # the width needed rounded up, and the width read to as many decimals as keep it printed under that (both
+    # to the nearest 0.1 px read "11.3 px wide ... under the 11.3 px")
+    need = math.ceil(need * 10.0 - 1e-9) / 10.0
+    digits = next((d for d in range(1, 4) if round(w50, d) < need), 4)
+    return (f"the scan's resolution is too coarse for this press: it is {w50:.{digits}f} px ({w50 / px_per_mm:.3g} mm) "
             f"wide {where} the strip ({'y' if (where == 'across') == (axis == 'x') else 'x'}) at half its "
-            f"maximum, under the {need:.3g} px a reading within the film's 10 % needs{why} (the scanner's blur "
+            f"maximum, under the {need:g} px a reading within the film's 10 % needs{why} (the scanner's blur "
             f"spreads a narrower press into the film beside it: 0.3-0.5 mm lines at 8 px/mm read 14-69 % "
             f"low), so the peak and area may read low{' and the span long' if where == 'along' else ''} (by "
             f"how much depends on the scanner's blur, which a scan does not tell); scan at {math.ceil(25.4 * ppm)} dpi or more ({ppm:.3g} px/mm: "
