@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from blank_plate import _in_square, errors
+from blank_plate import _in_square, errors, reference_maps
 
 
 def _pads(text: str) -> list[tuple[float, float]]:
@@ -28,9 +28,8 @@ def _pads(text: str) -> list[tuple[float, float]]:
 
 
 def main(argv=None) -> int:
-    from tactileskin.array.chart import _at_depth, blank_scene, bone_map_of, dot_scene, solve_cached
+    from tactileskin.array.chart import blank_scene, bone_map_of, dot_scene, solve_cached
     from tactileskin.array.config import ChartConfig
-    from tactileskin.results import BoneMap
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", default="5")
@@ -62,11 +61,7 @@ def main(argv=None) -> int:
                     recs[p] = solve_cached([sc], a.cache, workers=1)[sc]
                     secs[p] = time.perf_counter() - t0
                 ref = recs[pads[-1]]
-                rb = bone_map_of(ref)
-                s, z, _ = _in_square(rb, extent)
-                s, z = s[s >= 0], z[z >= 0]  # the modelled quarter (the maps are mirrored)
-                at = lambda rec, h: BoneMap(s, z, _at_depth(rec, s, z, t - h)[1])  # noqa: E731
-                rd = {h: at(ref, h) for h in heights}
+                rb, at, rd = reference_maps(ref, extent, t, heights)
                 for p in pads:
                     sm = recs[p].summary
                     own = bone_map_of(recs[p])

@@ -60,10 +60,26 @@ def errors(coarse, ref, extent) -> tuple[float, float, float]:
     return (float(np.abs(C - P).max() / peak), float(np.linalg.norm(C - P) / np.linalg.norm(P)), peak)
 
 
-def main(argv=None) -> int:
-    from tactileskin.array.chart import _at_depth, blank_scene, bone_map_of, dot_scene, solve_cached
-    from tactileskin.array.config import ChartConfig
+def reference_maps(ref, extent, t, heights):
+    """(bone map, at, maps at the heights) of the reference result `ref` in the read square:
+    at(rec, h) is a result's map h mm above the bone on the square's modelled quarter (the
+    maps are mirrored; a straight pad: s is s)."""
+    from tactileskin.array.chart import _at_depth, bone_map_of
     from tactileskin.results import BoneMap
+
+    rb = bone_map_of(ref)
+    s, z, _ = _in_square(rb, extent)
+    s, z = s[s >= 0], z[z >= 0]
+
+    def at(rec, h):
+        return BoneMap(s, z, _at_depth(rec, s, z, t - h)[1])
+
+    return rb, at, {h: at(ref, h) for h in heights}
+
+
+def main(argv=None) -> int:
+    from tactileskin.array.chart import blank_scene, bone_map_of, dot_scene, solve_cached
+    from tactileskin.array.config import ChartConfig
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", default="3,5")
@@ -98,11 +114,7 @@ def main(argv=None) -> int:
                 recs[m] = solve_cached([sc], a.cache, workers=1)[sc]
                 secs[m] = time.perf_counter() - t0
             ref = recs[meshes[-1]]
-            rb = bone_map_of(ref)
-            s, z, _ = _in_square(rb, extent)
-            s, z = s[s >= 0], z[z >= 0]  # the modelled quarter (the maps are mirrored)
-            at = lambda rec, h: BoneMap(s, z, _at_depth(rec, s, z, t - h)[1])  # noqa: E731 (straight pad: s is s)
-            rd = {h: at(ref, h) for h in heights}
+            rb, at, rd = reference_maps(ref, extent, t, heights)
             for m in meshes:
                 eb = errors(bone_map_of(recs[m]), rb, extent)
                 ed = [errors(at(recs[m], h), rd[h], extent) for h in heights]
