@@ -74,6 +74,39 @@ def table(rows: list[dict], ref: dict) -> str:
     return "\n".join(out) + "\n"
 
 
+def map_noise(levels: list[dict], names: list[str]) -> str:
+    """Pairwise map L2 between all solved meshes (each pair on the first level's grid, one skin
+    thickness off the free end, relative to the column's map) and each mesh's own map error
+    under the model that the meshes' errors are independent: |m_i - m_j|^2 = e_i^2 + e_j^2,
+    fitted by non-negative least squares over all pairs. The model reads the part of the
+    error that changes from mesh to mesh; an error every mesh shares is not in it."""
+    import numpy as np
+    from scipy.optimize import nnls
+
+    n = len(levels)
+    t = float(levels[0]["thickness"])
+    d = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            if i != j:
+                d[i, j] = c3.map_l2([levels[0]["map"], levels[i]["map"], levels[j]["map"]],
+                                    ref_index=2, grid_index=0, z_margin=t)[1]
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+    A = np.zeros((len(pairs), n))
+    for row, (i, j) in enumerate(pairs):
+        A[row, [i, j]] = 1.0
+    b = np.array([(d[i, j] ** 2 + d[j, i] ** 2) / 2 for i, j in pairs])
+    e2, res = nnls(A, b)
+    fit = max(abs(np.sqrt(e2[i] + e2[j]) - np.sqrt(b[row])) for row, (i, j) in enumerate(pairs))
+    out = ["| mesh | " + " | ".join(names) + " | own error (model) |",
+           "|---|" + "---|" * (n + 1)]
+    for i in range(n):
+        out.append(f"| {names[i]} | " + " | ".join("" if i == j else f"{d[i, j]:.2%}" for j in range(n))
+                   + f" | {np.sqrt(e2[i]):.2%} |")
+    out.append(f"\nLargest misfit of the model over the {len(pairs)} pairs: {fit:.2%} (model distance - measured).")
+    return "\n".join(out) + "\n"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", type=float, default=5.0)
@@ -111,6 +144,9 @@ def main(argv=None) -> int:
         key = c3.case_key(args.thickness, m, args.text)
         parts.append(f"## {key}: {h:g} / {r:g} with spot factor k, strip factor s, against "
                      f"{hr:g} / {rr:g}\n\n" + table(rows[m], refs[m]))
+        names = [f"{hr:g} / {rr:g}"] + [f"{h:g} / {r:g} k {d['k']:g} s {d['s']:g}" for d in rows[m]]
+        parts.append(f"### {key}: every mesh against every other (map L2)\n\n"
+                     + map_noise([refs[m]] + rows[m], names))
         print(parts[-1])
     from tactileskin.fileio import atomic_write_text
 
