@@ -74,12 +74,13 @@ def table(rows: list[dict], ref: dict) -> str:
     return "\n".join(out) + "\n"
 
 
-def map_noise(levels: list[dict], names: list[str]) -> str:
-    """Pairwise map L2 between all solved meshes (each pair on the first level's grid, one skin
-    thickness off the free end, relative to the column's map) and each mesh's own map error
-    under the model that the meshes' errors are independent: |m_i - m_j|^2 = e_i^2 + e_j^2,
-    fitted by non-negative least squares over all pairs. The model reads the part of the
-    error that changes from mesh to mesh; an error every mesh shares is not in it."""
+def own_map_errors(levels: list[dict]):
+    """(d, e, misfit): d[i, j] the map L2 of level i against level j (on the first level's grid,
+    one skin thickness off the free end, relative to level j's map); e[i] each level's own map
+    error under the model that the levels' errors are independent, |m_i - m_j|^2 = e_i^2 + e_j^2,
+    fitted by non-negative least squares over all pairs; misfit the largest |model - measured|
+    distance. The model reads the part of the error that changes from mesh to mesh; an error
+    every mesh shares is not in it."""
     import numpy as np
     from scipy.optimize import nnls
 
@@ -96,14 +97,22 @@ def map_noise(levels: list[dict], names: list[str]) -> str:
     for row, (i, j) in enumerate(pairs):
         A[row, [i, j]] = 1.0
     b = np.array([(d[i, j] ** 2 + d[j, i] ** 2) / 2 for i, j in pairs])
-    e2, res = nnls(A, b)
-    fit = max(abs(np.sqrt(e2[i] + e2[j]) - np.sqrt(b[row])) for row, (i, j) in enumerate(pairs))
+    e2 = nnls(A, b)[0]
+    misfit = max(abs(np.sqrt(e2[i] + e2[j]) - np.sqrt(b[row])) for row, (i, j) in enumerate(pairs))
+    return d, np.sqrt(e2), float(misfit)
+
+
+def map_noise(levels: list[dict], names: list[str]) -> str:
+    """own_map_errors as a markdown table."""
+    d, e, misfit = own_map_errors(levels)
+    n = len(levels)
     out = ["| mesh | " + " | ".join(names) + " | own error (model) |",
            "|---|" + "---|" * (n + 1)]
     for i in range(n):
         out.append(f"| {names[i]} | " + " | ".join("" if i == j else f"{d[i, j]:.2%}" for j in range(n))
-                   + f" | {np.sqrt(e2[i]):.2%} |")
-    out.append(f"\nLargest misfit of the model over the {len(pairs)} pairs: {fit:.2%} (model distance - measured).")
+                   + f" | {e[i]:.2%} |")
+    out.append(f"\nLargest misfit of the model over the {n * (n - 1) // 2} pairs: {misfit:.2%} "
+               "(model distance - measured).")
     return "\n".join(out) + "\n"
 
 

@@ -193,3 +193,33 @@ def test_a_user_geometry_that_refuses_the_studys_thickness_does_not_break_the_pr
                          env={**__import__("os").environ, "TACTILESKIN_GEOMETRY": str(geo)})
     assert run.returncode == 0, run.stderr[-500:]
     assert run.stdout.strip() == "1.0"
+
+
+def test_own_map_errors_recover_independent_errors():
+    """benchmarks/spot_scale_t5.own_map_errors: maps m* + a_i phi_i with phi_i on disjoint
+    supports (so mutually orthogonal, and orthogonal to m*'s own support) have pairwise
+    distances sqrt(a_i^2 + a_j^2) |phi| / |m_j|; the fit returns each a_i |phi| / |m*| to the
+    relative size of the bumps' share of the norms (|b_j|^2 / |m*|^2 < 1e-5 here)."""
+    spec = importlib.util.spec_from_file_location(
+        "spot_scale_t5", Path(__file__).resolve().parents[1] / "benchmarks" / "spot_scale_t5.py")
+    ss = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ss)
+    s = np.linspace(0.0, 8.0, 81)
+    z = np.linspace(0.0, 12.0, 121)  # the last 2 mm (t) are left out by map_l2's margin
+    base = np.zeros((z.size, s.size))
+    base[:, :20] = 1.0
+    amps = [0.01, 0.03, 0.02, 0.0]
+    levels = []
+    for i, a in enumerate(amps):
+        p = base.copy()
+        p[5 + 10 * i:15 + 10 * i, 40:60] += a  # disjoint interior rows: orthogonal bumps
+        levels.append({"thickness": 2.0, "map": {"s": s, "z": z, "pressure": p}})
+    d, e, misfit = ss.own_map_errors(levels)
+    W = np.outer(np.r_[0.05, np.full(99, 0.1), 0.05], np.r_[0.05, np.full(19, 0.1)])  # trapezoid, z <= 10
+    ref = math.sqrt(float(np.sum(W * 1.0)))
+    phi = math.sqrt(10 * 0.1 * 20 * 0.1)  # one bump of height a over 10 x 20 grid points
+    expected = np.array(amps) * phi / ref
+    # a zero error reads sqrt(e^2 |m_j|-share) ~ e * 1e-2 ~ 3e-5: the norms differ by the bumps
+    assert e == pytest.approx(expected, rel=1e-4, abs=5e-5)
+    assert misfit < 1e-6
+    assert d[1, 2] == pytest.approx(math.hypot(expected[1], expected[2]), rel=1e-4)
