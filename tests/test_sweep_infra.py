@@ -256,17 +256,17 @@ def test_expand_grid_refuses_a_repeated_axis_value():
 
 
 def _worker_state():
-    """(solver loaded before any case, BLAS threads, Python's SIGINT and SIGTERM handling) of a
-    sweep worker (run there by client.run)."""
+    """(solver loaded before any case, BLAS threads, SIGINT ignored and Python's SIGTERM
+    handling) of a sweep worker (run there by client.run)."""
     import signal
     import sys
 
     from threadpoolctl import threadpool_info
 
     blas = sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
-    default = (signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    signals = (signal.getsignal(signal.SIGINT) == signal.SIG_IGN
                and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
-    return "tactileskin.fe" in sys.modules, blas, default
+    return "tactileskin.fe" in sys.modules, blas, signals
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
@@ -274,8 +274,9 @@ def test_local_workers_are_forked_with_the_solver_loaded_and_one_blas_thread(mon
     """Spawned workers each imported numpy, dask, numba, scikit-fem and the package again
     (~2 s CPU each on a loaded machine, ~4 of a preview sweep's ~20 s): they are fork()ed
     from this process, which loads the solver first. As the spawned ones, they keep one BLAS
-    thread (OPENBLAS_NUM_THREADS=1 before numpy loaded), not this process's count, and
-    Python's own signal handling, not this process's handlers (the CLI's)."""
+    thread (OPENBLAS_NUM_THREADS=1 before numpy loaded), not this process's count, Python's
+    own SIGTERM handling, not this process's handler (the CLI's), and SIGINT ignored (a
+    terminal's Ctrl-C is the sweep process's to handle)."""
     import signal
 
     from threadpoolctl import threadpool_limits
@@ -297,6 +298,22 @@ def test_local_workers_are_forked_with_the_solver_loaded_and_one_blas_thread(mon
         runner.close()
         signal.signal(signal.SIGTERM, before)
     assert states == [(True, [1], True)] * 2, states
+
+
+def test_spawned_workers_ignore_sigint_too(monkeypatch):
+    """Spawned workers (a notebook's, a process that solved before its sweep, off Linux) died of
+    a terminal's Ctrl-C with a KeyboardInterrupt traceback each, as the fork()ed ones did."""
+    from tactileskin import sweep
+    from tactileskin.sweep import _Runner
+
+    monkeypatch.setattr(sweep, "worker_start_method", lambda: "spawn")
+    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+    try:
+        client = runner._start(1)
+        states = list(client.run(_worker_state).values())
+    finally:
+        runner.close()
+    assert [st[2] for st in states] == [True], states
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
@@ -412,3 +429,41 @@ def test_forked_workers_write_past_the_progress_bars_stream_proxies(monkeypatch)
         runner.close()
     assert streams == [[False, False]], streams
     assert _worker_streams() == [True, True]  # this process's, the bar's, stay
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="process groups, fork()ed workers")
+@pytest.mark.parametrize("settle", [0.0, 1.5])
+def test_ctrl_c_at_a_terminal_ends_a_sweep_with_workers_without_a_traceback(tmp_path, settle):
+    """A terminal's Ctrl-C reaches every process of the foreground group, the local workers too:
+    each printed 'Process Dask Worker process (from Nanny):' and a KeyboardInterrupt traceback
+    after 'interrupted'. The sweep's process alone handles Ctrl-C and closes its cluster."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    import psutil
+
+    env = dict(os.environ, TACTILESKIN_CACHE=str(tmp_path / "cache"), COLUMNS="100")
+    p = subprocess.Popen([sys.executable, "-m", "tactileskin", "sweep", "--quality", "preview", "--no-render",
+                          "--workers", "2", "--out", str(tmp_path / "out")],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, start_new_session=True)
+    proc = psutil.Process(p.pid)
+    deadline = time.monotonic() + 120
+    while len(proc.children()) < 2 and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert p.poll() is None, "the sweep ended before its workers started"
+    workers = proc.children(recursive=True)
+    time.sleep(settle)  # 0: the workers starting; 1.5: solving
+    os.killpg(p.pid, signal.SIGINT)  # what a terminal's Ctrl-C does
+    try:
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+    err = err.decode()
+    assert p.returncode == 130, err
+    assert "interrupted" in err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    gone, alive = psutil.wait_procs(workers, timeout=10)
+    assert alive == []

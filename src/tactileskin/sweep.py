@@ -495,10 +495,9 @@ class _Runner:
             finally:
                 _restore_environ(self._environ)
         self.client = Client(self.cluster)
-        if method == "fork":
-            from tactileskin.sweep_worker import ForkedWorker
+        from tactileskin.sweep_worker import ForkedWorker, IgnoreInterrupts
 
-            self.client.register_plugin(ForkedWorker())
+        self.client.register_plugin(ForkedWorker() if method == "fork" else IgnoreInterrupts())
         return self.client
 
     def close(self) -> None:
@@ -514,9 +513,17 @@ class _Runner:
 def _plain_streams(_runner) -> None:
     """In a fork()ed worker: sys.stdout and sys.stderr the files themselves, as a spawned worker
     has them, not the proxies of the sweep command's progress bar on a terminal (rich's Live),
-    which printed each line the worker wrote (a traceback on Ctrl-C, a warning) with its own
-    stale copy of the bar, and wait on that bar's locks, which another thread may have held
-    as fork() copied them."""
+    which printed each line the worker wrote (a warning) with its own stale copy of the bar,
+    and wait on that bar's locks, which another thread may have held as fork() copied them.
+    And from the start the signal handling sweep_worker.ForkedWorker sets later (SIGINT ignored,
+    SIGTERM Python's default): the nanny terminates a worker still starting when Ctrl-C stops
+    the sweep, which in the CLI's handler raised SystemExit inside dask's start-up."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
     for name in ("stdout", "stderr"):
         inner = getattr(getattr(sys, name), "rich_proxied_file", None)
         if inner is not None:

@@ -150,6 +150,11 @@ def main(argv: list[str] | None = None) -> int:
         err.print(f"[bold red]error:[/] {escape(where + str(e.strerror or e))}", highlight=False, soft_wrap=True)
         return 2
     finally:
+        if argv is None and _signalled:
+            # the process ends here (the console script): dask's cluster, still closing, logs
+            # the failure of its interrupted start-up (a nanny whose worker was ended) after
+            # "interrupted"; nothing is left to report
+            logging.disable(logging.CRITICAL)
         if threading.current_thread() is threading.main_thread():
             _signalled.clear()  # read above; a later run (a notebook's, another thread's) starts clean
     return rv if isinstance(rv, int) else 0
