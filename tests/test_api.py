@@ -228,7 +228,7 @@ def test_contact_csv_gives_each_contact_points_position(tmp_path):
                reaction=1.0, stats={}, scene={"thickness": 1.0, "dim": 3}, contact_points=pts)
     out = r.write(tmp_path / "o")
     rows = list(csv.DictReader(open(out / "contact.csv", encoding="utf-8")))
-    assert list(rows[0]) == ["x_mm", "y_mm", "z_mm", "contact_pressure_mpa"]
+    assert list(rows[0]) == ["x_mm", "y_mm", "z_mm", "contact_pressure_mpa", "status"]
     assert [(float(x["z_mm"]), float(x["contact_pressure_mpa"])) for x in rows] == [(0.0, 0.3), (0.5, 0.2), (0.2, 0.1)]
 
 

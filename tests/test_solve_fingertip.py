@@ -53,8 +53,8 @@ def test_result_write_is_complete(flat_1mm, tmp_path):
                      "contact.csv",
                      "profile.csv", "result.pvd", "result.vtu", "result_steps", "summary.json"]
     rows = list(csv.reader(open(out / "profile.csv")))
-    assert rows[0] == ["s_mm", "pressure_mpa"]
-    s = np.array([float(a) for a, _ in rows[1:]])
+    assert rows[0] == ["s_mm", "pressure_mpa", "status"]
+    s = np.array([float(a) for a, _, _ in rows[1:]])
     assert np.all(np.diff(s) > 0)
     summ = json.loads((out / "summary.json").read_text())
     for k in ("peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm", "dofs", "newton_iterations",

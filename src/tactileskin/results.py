@@ -6,6 +6,7 @@ two compare like for like. Pure numpy.
 
 from __future__ import annotations
 
+import csv
 import io
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -182,14 +183,17 @@ def read_bone_map(path, section_z: float = 0.0) -> BoneMap:
     """The BoneMap of a bone_map.csv (as Result.write writes it). A file that is not a complete
     (s, z) grid of finite numbers raises ParameterError naming it."""
     path = Path(path)
-    valid = "a bone_map.csv written by tactileskin solve (s_mm, z_mm, pressure_mpa on a full grid)"
+    valid = "a bone_map.csv written by tactileskin solve (s_mm, z_mm, pressure_mpa on a full grid[, status])"
     try:
         with open(path, encoding="utf-8") as fh:
             header = fh.readline().strip().split(",")
-            data = np.loadtxt(fh, delimiter=",", ndmin=2)
+            if without_status(header) != ["s_mm", "z_mm", "pressure_mpa"]:
+                raise ParameterError("bone map file", str(path), valid)
+            # the numbers only: the status (last, quoted where it holds a comma) is the summary's
+            data = np.loadtxt(fh, delimiter=",", ndmin=2, usecols=(0, 1, 2), quotechar='"')
     except (OSError, ValueError) as e:
         raise ParameterError("bone map file", str(path), valid, hint=str(e)) from None
-    if header != ["s_mm", "z_mm", "pressure_mpa"] or data.shape[1] != 3 or not np.all(np.isfinite(data)):
+    if data.shape[1] != 3 or not np.all(np.isfinite(data)):
         raise ParameterError("bone map file", str(path), valid)
     s, z = np.unique(data[:, 0]), np.unique(data[:, 1])
     if data.shape[0] != s.size * z.size:
@@ -461,25 +465,31 @@ class Result:
         return directory
 
     def _write_files(self, directory: Path) -> None:
+        summary = self.summary()
+        # every table carries the status on every row: a suspect result's rows read like an
+        # ok one's once a file is taken out of its folder (the sweep's sensors.csv does the same)
+        status = summary["status"]
+
+        def table(name: str, text: str) -> None:
+            fileio.atomic_write_text(directory / name, with_status(text, status))
+
         s, p = self._profile()
-        fileio.atomic_write_text(directory / "profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
-        fileio.atomic_write_text(directory / "contact.csv",
-                                 self._contact_csv())
+        table("profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
+        table("contact.csv", self._contact_csv())
         if self.fields is not None:
             _write_vtu(directory / "result.vtu", self.fields)
         _write_steps(directory, self.fields)
         if self.bone_map is not None:
-            fileio.atomic_write_text(directory / "bone_map.csv", self.bone_map.to_csv())
-            fileio.atomic_write_text(directory / "profile_max_z.csv",
-                                     _csv(["s_mm", "pressure_mpa", "z_mm"], *self.bone_map.max_over_z()))
+            table("bone_map.csv", self.bone_map.to_csv())
+            table("profile_max_z.csv", _csv(["s_mm", "pressure_mpa", "z_mm"], *self.bone_map.max_over_z()))
         if self.sensors is not None:
-            fileio.atomic_write_text(directory / "sensors.csv", self.sensors.to_csv())
+            table("sensors.csv", self.sensors.to_csv())
         if self.loading is not None and self.history:
             cols = ["t", "d", "reaction", "peak_mpa", "segment"]
-            fileio.atomic_write_text(directory / "history.csv", _csv(
+            table("history.csv", _csv(
                 ["t_s", "travel_mm", reaction_key(self.dim), "peak_bone_pressure_mpa", "segment"],
                 *[np.array([h.get(c, np.nan) for h in self.history], float) for c in cols]))
-        fileio.atomic_write_json(directory / "summary.json", self.summary())
+        fileio.atomic_write_json(directory / "summary.json", summary)
 
 
 def reaction_key(dim: int) -> str:
@@ -524,6 +534,25 @@ def read_vtu(path):
             return meshio.read(path)
     except SystemExit:
         raise ValueError(f"cannot read {path} as VTU (truncated or damaged?)") from None
+
+
+STATUS_COLUMN = "status"  # the last column of a solve's tables, the first after `case` in a sweep's
+
+
+def with_status(text: str, status: str) -> str:
+    """A CSV table (header line, then rows; no field holding a line break) with the column
+    STATUS_COLUMN appended: `status` (summary.json's "ok" or "suspect: reasons") on every row,
+    quoted where it holds a comma or a quote. Last, so the other columns keep their positions."""
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="").writerow([status])
+    cell = buf.getvalue()
+    lines = text.splitlines()
+    return "".join([lines[0] + "," + STATUS_COLUMN + "\n", *(line + "," + cell + "\n" for line in lines[1:])])
+
+
+def without_status(header: list[str]) -> list[str]:
+    """`header` without a trailing STATUS_COLUMN (a table written before it has none)."""
+    return header[:-1] if header[-1:] == [STATUS_COLUMN] else header
 
 
 def _csv(header: list[str], *cols) -> str:

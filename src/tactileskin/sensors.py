@@ -675,13 +675,16 @@ def read_sensors_csv(path) -> SensorReadings:
     from pathlib import Path
 
     path = Path(path)
-    valid = "a sensors.csv written by tactileskin solve (" + ", ".join(COLUMNS) + ")"
+    from tactileskin.results import without_status
+
+    valid = "a sensors.csv written by tactileskin solve (" + ", ".join(COLUMNS) + "[, status])"
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             rows = list(csv.DictReader(fh))
-        if not rows or tuple(rows[0].keys()) not in (COLUMNS, OLD_COLUMNS):
+        # the result's status (last column since it was added) is the summary's, not a reading
+        cols = tuple(without_status(list(rows[0].keys()))) if rows else ()
+        if not rows or cols not in (COLUMNS, OLD_COLUMNS):
             raise ValueError("unexpected header")
-        cols = tuple(rows[0].keys())
         f = {c: np.array([float(r[c]) for r in rows]) for c in cols[2:]}
     except (OSError, ValueError, KeyError, TypeError) as e:
         raise ParameterError("sensors file", str(path), valid, hint=str(e)) from None

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from tactileskin import quality
 from tactileskin.fileio import atomic_write_text, make_dirs
+from tactileskin.results import without_status
 from tactileskin.staging import staged_files
 
 log = logging.getLogger(__name__)
@@ -123,6 +124,8 @@ def _write_sensors(path: Path, records) -> None:
         rows = list(csv.reader(io.StringIO(f.read_text(encoding="utf-8"))))
         if not rows:
             continue
+        if without_status(rows[0]) != rows[0]:  # the solve's own status column: the sweep puts its own in front
+            rows = [r[:-1] for r in rows]
         if header is None:
             header = rows[0]
             w.writerow(["case", "status"] + header)
