@@ -146,3 +146,20 @@ def test_a_cached_suspect_case_stays_suspect_in_every_file(tmp_path):
         rows = list(rd)
     assert rd.fieldnames == ["case", "status", *COLUMNS]
     assert len(rows) == 3 and all(r["status"] == status for r in rows)
+
+
+@pytest.mark.parametrize("name", ["L\u2028a", "L\x0cb", "L\x85c", "L\x1ed"])
+def test_a_layout_name_with_a_line_separator_other_than_newline_keeps_its_rows(tmp_path, name):
+    """A layout name may hold any character but a comma, a quote, CR or LF (sensors.py); str.
+    splitlines also breaks at U+2028, form feed, NEL and the \\x1c-\\x1e separators, which cut
+    such a sensors.csv's rows in two around the status (CSV rows end at CR / LF only)."""
+    n = 2
+    r = _result(0.3)
+    r.sensors.ids[:] = [f"{name}-{i}" for i in range(n)]
+    r.sensors.layout[:] = [name] * n
+    out = r.write(tmp_path / "o")
+    assert_status_everywhere(out, "ok", ALL_FILES)
+    rd = read_sensors_csv(out / "sensors.csv")
+    assert list(rd.ids) == [f"{name}-{i}" for i in range(n)]
+    assert list(rd.layout) == [name] * n
+    np.testing.assert_allclose(rd.pressure, r.sensors.pressure)

@@ -540,13 +540,17 @@ STATUS_COLUMN = "status"  # the last column of a solve's tables, the first after
 
 
 def with_status(text: str, status: str) -> str:
-    """A CSV table (header line, then rows; no field holding a line break) with the column
-    STATUS_COLUMN appended: `status` (summary.json's "ok" or "suspect: reasons") on every row,
-    quoted where it holds a comma or a quote. Last, so the other columns keep their positions."""
+    """A CSV table (header line, then rows, each ending with a line feed; no field holding one)
+    with the column STATUS_COLUMN appended: `status` (summary.json's "ok" or "suspect: reasons")
+    on every row, quoted where it holds a comma or a quote. Last, so the other columns keep
+    their positions. Rows are split at line feeds only, as a CSV reader does: str.splitlines
+    also breaks at U+2028, NEL, form feed, ..., which a sensor layout's name may hold."""
     buf = io.StringIO()
     csv.writer(buf, lineterminator="").writerow([status])
     cell = buf.getvalue()
-    lines = text.splitlines()
+    lines = text.split("\n")
+    if lines[-1] == "":
+        lines.pop()
     return "".join([lines[0] + "," + STATUS_COLUMN + "\n", *(line + "," + cell + "\n" for line in lines[1:])])
 
 
