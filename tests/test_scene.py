@@ -145,3 +145,11 @@ def test_a_field_given_twice_in_a_scene_file_is_named_with_its_value(tmp_path):
     p.write_text("thickness = 2.0\n[scene]\nthickness = 3.0\n")
     with pytest.raises(ParameterError, match=r"^thickness=2\.0 is invalid; valid: given once .*gives it twice"):
         scenefile.read(p)
+
+
+@pytest.mark.parametrize("dim", [[3], {}, [2, 3]])
+def test_replace_refuses_an_unhashable_dim_as_the_constructor_does(dim):
+    """Scene().replace(dim=[3]) (ts.sweep({"dim": [3], ...}): dim is a Scene field there, not
+    an axis) raised TypeError: unhashable type: 'list' from the mesh-default lookup."""
+    with pytest.raises(ParameterError, match="dim"):
+        Scene().replace(dim=dim)

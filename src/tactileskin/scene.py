@@ -355,6 +355,8 @@ class Scene:
         if changes.get("depth") is not None and "depth_fraction" not in changes:
             changes["depth_fraction"] = DEPTH_FRACTION  # a depth given now replaces the fraction
         new_dim = changes.get("dim", self.dim)
+        if "dim" in changes:  # looked up below (DEFAULT_MESH): a list is refused as __post_init__ does
+            new_dim = validate.integer(new_dim, "dim", "2 or 3")
         new_skin = changes.get("skin", self.skin)
         if new_skin != self.skin:
             reads = _skins.get(new_skin).scene_params
