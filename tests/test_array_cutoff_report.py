@@ -158,3 +158,34 @@ def test_the_pad_size_sentence_s_pressure_ratio_is_the_measured_one_at_the_thick
     text = " ".join(markdown(ch).split())
     lo, hi = re.search(r"mean plate pressure is ([\d.]+)-([\d.]+)x", text).groups()
     assert (float(lo), float(hi)) == (round(min(ratios), 1), round(max(ratios), 1)), (ratios, lo, hi)
+
+
+def test_a_one_row_letters_figure_keeps_its_suspect_title_inside_the_image(tmp_path, monkeypatch):
+    """A one-thickness, one-noise letters chart (a 4.6 in wide figure) cut its title's '† indicative:
+    the letters' surrogate not shown within its tolerance (array_chart.md)' line at both sides
+    ('tive: the letters' ... (array_ch'): the figure said it was indicative only in part."""
+    from tactileskin.report import array_chart
+    from tactileskin.report.figures import _plt
+
+    ch = Chart(ChartConfig(thicknesses=(3.0,), pitches=(0.5, 1.0, 1.5, 2.0, 2.5), noise_mpa=(0.002,),
+                           sets=("letters",)))
+    ch.labels["letters"] = list(ch.config.letters)
+    for p in ch.config.pitches:
+        ch.rows.append(dict(material="silicone", thickness_mm=3.0, set="letters", pitch_mm=p, taxel_mm=0.8 * p,
+                            noise_fs=0.14, noise_mpa=0.002, full_scale_mpa=0.0147, bits=12, method="template",
+                            accuracy=1.0, chance=1 / 36, n_test=16))
+    seen = []
+
+    def measure(fig, out, stem):
+        fig.canvas.draw()
+        seen.append((fig._suptitle.get_text(), fig._suptitle.get_window_extent(fig.canvas.get_renderer()),
+                     fig.bbox.width))
+        _plt().close(fig)
+        return []
+
+    monkeypatch.setattr(array_chart, "_save", measure)
+    array_chart.write_figures(ch, tmp_path, indicative={("silicone", 3.0): "not validated"},
+                              notes=["silicone: the letters' surrogate is not shown within 5% at t = 3 mm"])
+    (text, box, width), = seen
+    assert "† indicative" in text and "SUSPECT parts of the chart" in text
+    assert box.x0 >= -1 and box.x1 <= width + 1, (box, width)

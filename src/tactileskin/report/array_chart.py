@@ -10,7 +10,7 @@ import numpy as np
 
 from tactileskin.array.chart import GOOD, PAPER_PITCH, verdicts
 from tactileskin.fileio import atomic_write_text
-from tactileskin.report.figures import _plt, _save
+from tactileskin.report.figures import _fit_width, _plt, _save
 
 SET_TITLES = {"paper": "flat / curved / Braille dot", "letters": "Braille characters {chars}",
               "shapes": "flat / curved / Braille dot / sphere R{r:g}"}
@@ -70,6 +70,7 @@ def write_figures(chart, out: Path, method: str = "template", indicative: dict |
             if notes:
                 title += f"\nSUSPECT parts of the chart: {len(notes)} note{'s' if len(notes) > 1 else ''} in array_chart.md"
             fig.suptitle(title, fontsize=10)
+            _fit_width(fig)  # a one-thickness, one-noise chart (4.6 in) cut its † and SUSPECT lines
             paths += _save(fig, out, f"array_{material}_{set_}")
     return paths
 
