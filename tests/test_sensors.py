@@ -325,6 +325,11 @@ def test_scene_default_has_no_sensors_and_sensors_enter_the_key(tmp_path):
     ({"kind": "line", "s": [0, 0.003], "pitch": 0.0005, "depth": 0.001}, 2, r"pitch=\[0.0005\].*>= 0.01 mm.*metres"),
     ({"kind": "grid", "s": [0, 2], "z": [0, 2], "pitch": [1.0, 0.001], "depth": 1.0}, 3, r">= 0.01 mm.*metres"),
     ({"kind": "line", "s": [0, 3], "pitch": 0.0, "depth": 1.0}, 2, r"pitch=\[0.0\].*>= 0.01 mm$"),
+    # a taxel in um (800 for 0.8 mm) was refused as "s +- taxel/2=-270.47", an edge the
+    # edge search reached on the surface's extension past the nail, neither the taxel nor its edge; the
+    # surface at depth 1 mm is 27.1048 mm long (its polyline through 20001 points of s in +-9.17656 mm)
+    ({"s": [0.0], "depth": 1.0, "taxel": 800.0}, 2,
+     r"'x' taxel=800.0 is invalid; valid: \(0, 27.104\d*\] mm: the surface at depth 1 mm, s in \[-9.17\d*, 9.17\d*\] mm"),
 ])
 def test_sensor_validation_names_layout_and_range(layout, dim, match):
     with pytest.raises(ParameterError, match=match) as e:

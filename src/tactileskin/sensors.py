@@ -401,6 +401,18 @@ def _check_range(where, what, v, lo, hi, unit="mm", note=""):
         raise ParameterError(f"{where} {what}", float(v[bad][0]), f"[{lo:.6g}, {hi:.6g}] {unit}{note}")
 
 
+def _check_side(where, side: float, coords, depth: float, lim: float) -> None:
+    """A taxel longer than the skin's whole surface at its depth: its edges lie past the skin
+    wherever it sits (a side in um, 800 for 0.8 mm, was named by an edge found on the surface's
+    extension past the nail, 's +- taxel/2=-270.47', neither the taxel nor an edge)."""
+    S = np.linspace(-lim, lim, 401)
+    jac = coords.frame(S, np.full(S.size, depth))[3]
+    arc = float(np.sum(0.5 * (jac[1:] + jac[:-1]) * np.diff(S)))
+    if side > arc + _TOL:
+        raise ParameterError(f"{where} taxel", float(side), f"(0, {arc:.6g}] mm: the surface at depth {depth:g} mm, "
+                             f"s in [{-lim:.6g}, {lim:.6g}] mm, is {arc:.6g} mm long", hint="sides are in mm")
+
+
 def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) -> Sites:
     """Sites of the layouts in the skin coordinates `coords`; a sensor (or a taxel's edge)
     outside the skin is a ParameterError naming the layout and the valid range."""
@@ -439,6 +451,7 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         _check_range(where, "s", s, -lim, lim,
                      note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
         if h:  # the taxel's edges: taxel/2 of arc length on the depth surface each side
+            _check_side(where, lay.taxel, coords, d, lim)
             edges = taxel_s(coords, s, d, np.array([-1.0, 1.0]), lay.taxel).ravel()
             _check_range(where, "s +- taxel/2", edges, -lim, lim,
                          note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
