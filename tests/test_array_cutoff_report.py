@@ -189,3 +189,28 @@ def test_a_one_row_letters_figure_keeps_its_suspect_title_inside_the_image(tmp_p
     (text, box, width), = seen
     assert "† indicative" in text and "SUSPECT parts of the chart" in text
     assert box.x0 >= -1 and box.x1 <= width + 1, (box, width)
+
+
+def test_an_accuracy_just_under_the_bar_does_not_read_as_the_bar(tmp_path, monkeypatch):
+    """t = 3 mm silicone letters at 1.5 mm pitch read 0.9462 (under GOOD = 0.95, so not bold) and
+    were shown '0.95' in the table (unbolded, beside '**bold** at >= 0.95'), on the figure and on the
+    terminal: a reader took the pitch as passing. Shown to the decimals that keep it under."""
+    from tactileskin.array.chart import accuracy_text
+    from tactileskin.report import array_chart
+    from tactileskin.report.figures import _plt
+
+    assert accuracy_text(0.9461805555555556) == "0.946" and accuracy_text(0.9499) == "0.9499"
+    assert accuracy_text(0.95) == "0.95" and accuracy_text(0.77) == "0.77" and accuracy_text(1.0) == "1.00"
+    ch = _one_row_chart(3.0)
+    ch.rows[0]["accuracy"] = 0.9461805555555556
+    assert "| 0.946 |" in markdown(ch) and "0.95 |" not in markdown(ch).split("### ")[-1].split("Accuracy (")[0]
+    texts = []
+
+    def grab(fig, out, stem):
+        texts.extend(t.get_text() for ax in fig.axes for t in ax.texts)
+        _plt().close(fig)
+        return []
+
+    monkeypatch.setattr(array_chart, "_save", grab)
+    array_chart.write_figures(ch, tmp_path)
+    assert texts == ["0.946"], texts

@@ -62,6 +62,16 @@ def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str |
                  refinement=ratio, depth=cfg.depth_for(thickness))
 
 
+def accuracy_text(a: float) -> str:
+    """An accuracy to 2 decimals, or to as many more as keep it on its side of GOOD: 0.9462, not
+    discriminated, read '0.95' beside a legend 'bold at >= 0.95'."""
+    for k in range(2, 7):
+        text = f"{a:.{k}f}"
+        if (float(text) >= GOOD) == (a >= GOOD):
+            return text
+    return repr(float(a))
+
+
 def section_scene(thickness, material, indenter, skin="fingertip", depth=None):
     from tactileskin.scene import Scene
 
@@ -703,7 +713,7 @@ def compute(cfg: ChartConfig, cache=None, progress: Callable[[str], None] | None
                                                    full_scale_mpa=fs, bits=cfg.bits, method=m, accuracy=acc,
                                                    chance=ev.chance, n_test=ev.n_test, ci_low=lo, ci_high=hi))
                     say(f"    pitch {pitch:g} mm: " + ", ".join(
-                        f"{chart.accuracy(material, t, set_, pitch, n):.2f}" for n in cfg.noise_levels))
+                        accuracy_text(chart.accuracy(material, t, set_, pitch, n)) for n in cfg.noise_levels))
     chart.seconds = time.perf_counter() - t0
     return chart
 
@@ -784,7 +794,7 @@ def _borderline(acc: float, row: dict | None) -> str:
     n = int(round(row["n_test"] / row["chance"]))
     lo, hi = (row["ci_low"], row["ci_high"]) if "ci_low" in row else wilson(acc, n)
     if lo < GOOD <= hi:
-        return (f" (borderline: {acc:.2f} on {n} readings at {row['n_test']} offsets, 95 % interval "
+        return (f" (borderline: {accuracy_text(acc)} on {n} readings at {row['n_test']} offsets, 95 % interval "
                 f"{lo:.2f}-{hi:.2f} spans {GOOD:g})")
     return ""
 
@@ -806,8 +816,8 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             line = _borderline(a, _row(chart, material, 1.0, "letters", PAPER_PITCH, noise, method))
             out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
                         "verdict": ("supported" if ok else "not supported") + off,
-                        "evidence": f"letters at 0.75 mm: {a:.2f}{line}; "
-                                    + ", ".join(f"{p:g} mm: {v:.2f}" for p, v in worst.items())})
+                        "evidence": f"letters at 0.75 mm: {accuracy_text(a)}{line}; "
+                                    + ", ".join(f"{p:g} mm: {accuracy_text(v)}" for p, v in worst.items())})
         else:
             out.append({"material": material, "claim": "0.75 mm pitch reads Braille at t = 1 mm",
                         "verdict": "not evaluated", "evidence": "needs t = 1, pitch 0.75 and the letters set"})
@@ -819,14 +829,14 @@ def verdicts(chart: Chart, method: str = "template") -> list[dict]:
             line = _borderline(best, _row(chart, material, 5.0, "paper", pb, noise, method))
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
                         "verdict": ("supported" if best < GOOD else "not supported") + off,
-                        "evidence": f"best accuracy at t = 5 mm over pitches: {best:.2f}" + line + off})
+                        "evidence": f"best accuracy at t = 5 mm over pitches: {accuracy_text(best)}" + line + off})
         elif 5.0 in cfg.thicknesses:  # the claim is the paper set's: a chart with t = 5 but without it
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
                         "verdict": "not evaluated (no paper set)",
                         "evidence": "needs the paper set (flat/curved/Braille dot, --set paper) at t = 5 mm"})
         else:
             thick = [t for t in cfg.thicknesses if "paper" in cfg.sets]
-            ev = ", ".join(f"t = {t:g}: {max(chart.accuracy(material, t, 'paper', p, noise, method) for p in cfg.pitches):.2f}"
+            ev = ", ".join(f"t = {t:g}: {accuracy_text(max(chart.accuracy(material, t, 'paper', p, noise, method) for p in cfg.pitches))}"
                            for t in thick)
             out.append({"material": material, "claim": "5 mm cannot discriminate flat/curved/Braille",
                         "verdict": "not evaluated (no t = 5 mm)", "evidence": f"best accuracy {ev}" if ev else ""})

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin.array.chart import GOOD, PAPER_PITCH, verdicts
+from tactileskin.array.chart import GOOD, PAPER_PITCH, accuracy_text, verdicts
 from tactileskin.fileio import atomic_write_text
 from tactileskin.report.figures import _fit_width, _plt, _save
 
@@ -47,7 +47,7 @@ def write_figures(chart, out: Path, method: str = "template", indicative: dict |
                 im = ax.imshow(A, vmin=0, vmax=1, cmap="viridis", aspect="auto", origin="lower")
                 for i in range(len(ts)):
                     for j in range(len(ps)):
-                        ax.text(j, i, f"{A[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                        ax.text(j, i, accuracy_text(A[i, j]), ha="center", va="center", fontsize=7,
                                 color="white" if A[i, j] < 0.6 else "black")
                 ax.set_xticks(range(len(ps)), [f"{p:g}" for p in ps])
                 ax.set_yticks(range(len(ts)), [f"{t:g}" + (" †" if set_ == "letters" and (material, t) in indicative
@@ -371,7 +371,7 @@ def _noise_cells(chart, material, t, set_, noise) -> str:
 
 
 def _cell(a: float) -> str:
-    return f"**{a:.2f}**" if a >= GOOD else f"{a:.2f}"
+    return f"**{accuracy_text(a)}**" if a >= GOOD else accuracy_text(a)
 
 
 # the files `array` writes into its folder (fnmatch patterns)
