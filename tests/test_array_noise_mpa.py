@@ -8,6 +8,7 @@ import pytest
 
 from tactileskin.array import chart, maps
 from tactileskin.cli import main
+from tactileskin.errors import ParameterError
 
 GRID = np.linspace(-8, 8, 161)
 WIDTH = {"flat": 3.0, "curved": 1.5, "braille": 0.4}  # three told-apart analytic stimuli
@@ -44,6 +45,15 @@ def test_the_noise_in_mpa_is_the_same_at_every_thickness_and_is_applied(monkeypa
         # looked up on the MPa axis; 5 MPa over a 1 / t MPa full scale leaves chance, 2 kPa does not
         assert ch.accuracy("silicone", t, "paper", 0.5, 0.002) == 1.0
         assert ch.accuracy("silicone", t, "paper", 0.5, 5.0) < 0.7
+    # a noise level the chart was not made for (0.02 for 0.002) read NaN, silently
+    with pytest.raises(ParameterError, match=r"noise=0\.02 is invalid; valid: one the chart was made for: 0\.002, 5"):
+        ch.accuracy("silicone", 1.0, "paper", 0.5, 0.02)
+    for args, name in ((("polyurethane", 1.0, "paper", 0.5, 0.002), "material"), (("silicone", 3.0, "paper", 0.5, 0.002), "t"),
+                       (("silicone", 1.0, "letters", 0.5, 0.002), "set_"), (("silicone", 1.0, "paper", 1.5, 0.002), "pitch")):
+        with pytest.raises(ParameterError, match=f"^{name}="):
+            ch.accuracy(*args)
+    with pytest.raises(ParameterError, match="^method="):
+        ch.accuracy("silicone", 1.0, "paper", 0.5, 0.002, method="svm")
     assert "  silicone, t = 2 mm, paper: accuracy at noise 0.002, 5 MPa" in said
     # the noise is read after the solves: the same scenes (cache keys) as a chart in x full scale
     fs_asked = []

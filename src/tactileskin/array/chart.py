@@ -476,8 +476,20 @@ class Chart:
     seconds: float = 0.0
 
     def accuracy(self, material, t, set_, pitch, noise, method="template") -> float:
+        """The accuracy of one cell of the chart; a value the chart was not made for (a noise
+        level mistyped, a pitch not charted) is a ParameterError naming it and the charted
+        values (it read NaN). NaN only for a charted cell that has no row (its solves failed)."""
+        cfg = self.config
+        methods = sorted({r["method"] for r in self.rows}) or ["template"]
+        for name, value, charted in (("material", material, cfg.materials), ("t", t, cfg.thicknesses),
+                                     ("set_", set_, cfg.sets), ("pitch", pitch, cfg.pitches),
+                                     ("noise", noise, cfg.noise_levels), ("method", method, methods)):
+            if value not in charted:
+                raise ParameterError(name, value, "one the chart was made for: "
+                                     + ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in charted),
+                                     "noise in MPa" if name == "noise" and cfg.noise_key == "noise_mpa" else "")
         for r in self.rows:
-            if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r[self.config.noise_key], r["method"]) == \
+            if (r["material"], r["thickness_mm"], r["set"], r["pitch_mm"], r[cfg.noise_key], r["method"]) == \
                     (material, t, set_, pitch, noise, method):
                 return r["accuracy"]
         return float("nan")
