@@ -146,6 +146,17 @@ def test_a_cached_suspect_case_stays_suspect_in_every_file(tmp_path):
         rows = list(rd)
     assert rd.fieldnames == ["case", "status", *COLUMNS]
     assert len(rows) == 3 and all(r["status"] == status for r in rows)
+    # the sweep's long-form profiles too (they read like an ok case's): its status on every row
+    with open(tmp_path / "o" / "profiles.csv", newline="") as fh:
+        rd = csv.DictReader(fh)
+        prof = list(rd)
+    assert rd.fieldnames == ["case", "status", "s_mm", "pressure_mpa"]
+    assert len(prof) == len(rec.s) and all(p["status"] == status for p in prof)
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(tmp_path / "o" / "profiles.parquet")
+    assert table.column_names == ["case", "status", "s_mm", "pressure_mpa"]
+    assert set(table.column("status").to_pylist()) == {status}
 
 
 @pytest.mark.parametrize("name", ["L\u2028a", "L\x0cb", "L\x85c", "L\x1ed"])

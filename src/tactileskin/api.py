@@ -150,13 +150,13 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
       `report=False` skips figures, renders and report. cache: the result cache folder (default out/cache, else default_cache_dir()).
     workers / serial / scheduler: as the command (default: a local Dask cluster, one worker
       process per core). A script needs no `if __name__ == "__main__":` guard.
-    profiles: return (metrics, profiles), profiles in long form (case, s_mm, pressure_mpa).
+    profiles: return (metrics, profiles), profiles in long form (case, status, s_mm, pressure_mpa).
     A case that failed is a row with status 'failed: ...' and its error; nothing is raised.
     """
     import pandas as pd
 
     from tactileskin.cache import ResultCache
-    from tactileskin.report.outputs import profile_rows
+    from tactileskin.report.outputs import PROFILE_COLUMNS, profile_rows
 
     for name, value in (("out", out), ("cache", cache)):
         if value is not None:
@@ -190,7 +190,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         metrics[c] = pd.to_numeric(metrics[c], errors="coerce").astype(float)
     if not profiles:
         return metrics
-    prof = pd.DataFrame(profile_rows(records), columns=["case", "s_mm", "pressure_mpa"])
+    prof = pd.DataFrame(profile_rows(records), columns=PROFILE_COLUMNS)
     return metrics, prof
 
 

@@ -64,11 +64,16 @@ def collect(outcomes, cache):
     return records, rows, failures
 
 
+PROFILE_COLUMNS = ["case", "status", "s_mm", "pressure_mpa"]
+
+
 def profile_rows(records):
-    """(case, s_mm, pressure_mpa) of every profile point, in long form."""
+    """(case, status, s_mm, pressure_mpa) of every profile point, in long form; the status is
+    results.csv's, on every row (a suspect case's profile read like an ok one's)."""
     for rec in records:
+        status = quality.status(rec.summary)
         for s, p in zip(rec.s, rec.pressure):
-            yield rec.case, float(s), float(p)
+            yield rec.case, status, float(s), float(p)
 
 
 def _write_parquet(path: Path, columns: list[str], rows) -> None:
@@ -200,11 +205,11 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
 
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")  # quoted where needed: a case id can hold a comma (braille[,a,])
-    w.writerow(["case", "s_mm", "pressure_mpa"])
+    w.writerow(PROFILE_COLUMNS)
     prof = list(profile_rows(records))
-    w.writerows((case, f"{s:.6g}", f"{p:.6g}") for case, s, p in prof)
+    w.writerows((case, status, f"{s:.6g}", f"{p:.6g}") for case, status, s, p in prof)
     atomic_write_text(out / "profiles.csv", buf.getvalue())
-    _write_parquet(out / "profiles.parquet", ["case", "s_mm", "pressure_mpa"], prof)
+    _write_parquet(out / "profiles.parquet", PROFILE_COLUMNS, prof)
 
     _write_sensors(out / "sensors.csv", records)
     figures = _figures(records, rows, out, cache) if records and figures else []
