@@ -78,7 +78,10 @@ def default_taxel_points(taxel: float) -> int:
     """Gauss points per direction of a taxel of side `taxel` (mm) when none are given."""
     import math
 
-    return int(min(MAX_TAXEL_POINTS, max(MIN_TAXEL_POINTS, math.ceil(float(taxel) / TAXEL_SPACING - 1e-9))))
+    # capped before ceil: a taxel past the skin (refused later, naming the skin's range) would
+    # overflow it (1e308 / 0.25 is inf)
+    per_side = min(float(MAX_TAXEL_POINTS), float(taxel) / TAXEL_SPACING)
+    return int(max(MIN_TAXEL_POINTS, math.ceil(per_side - 1e-9)))
 _KEYS = ("name", "kind", "s", "z", "depth", "height", "pitch", "taxel", "taxel_points")
 _TOL = 1e-9                  # mm: positions on a range's end are inside
 
