@@ -71,6 +71,7 @@ def test_a_box_in_mm_too_small_for_its_pixels_says_how_small_it_may_be(tmp_path,
     (["--box-mm", "nan", "0", "10", "5"], "box_mm"),
     (["--box-mm", "0", "0", "inf", "5"], "box_mm"),
     (["--box-mm", "0", "0", "1e300", "5"], "box_mm"),
+    (["--box-mm", "0", "0", "1e308", "1e308"], "box_mm"),  # x px/mm overflows: was an OverflowError
     (["--box-px", "50", "0", "40", "10"], "x1 <= x0"),
     (["--box-px", "0", "0", "500", "10"], "outside"),
     (["--box-px", "-1", "0", "10", "10"], "box_px"),

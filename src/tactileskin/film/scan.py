@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +63,10 @@ def _box_numbers(name: str, box, px_per_mm: float | None) -> tuple[int, int, int
     for v in vals:
         f = finite(name, v)
         if px_per_mm is not None:
-            f = round(f * px_per_mm)
+            px = f * px_per_mm
+            # past the float range (1e308 mm at 8 px/mm) the exact product: round(inf) overflows,
+            # and the box stays ordered, so the range check names it as outside the image
+            f = round(px) if math.isfinite(px) else round(Fraction(f) * Fraction(px_per_mm))
         elif f != int(f):
             raise ParameterError(name, tuple(vals), "whole pixel numbers x0, y0, x1, y1")
         out.append(int(f))
