@@ -148,6 +148,10 @@ ROWS = "30,100,40\n20,100,100\n10,100,160\n2,100,220\n"
     (HEADER + ROWS + "inf,100,120\n", "force_n (cal.csv line 6)"),
     (HEADER + ROWS + "5,,120\n", "area_mm2 (cal.csv line 6)"),
     (HEADER + ROWS + "5,100,300\n", "[0, 255]"),
+    # F / A past any film: an OverflowError in the fit, or a fit of 4e-307 MPa written as ok
+    (HEADER + ROWS + "1e308,100,120\n", "force_n/area_mm2 (cal.csv line 6)"),
+    (HEADER + ROWS + "5,1e308,120\n", "force_n/area_mm2 (cal.csv line 6)"),
+    (HEADER + ROWS + "1e5,0.001,120\n", "[1e-06, 10000] MPa"),
     (HEADER + ROWS + "5,100,abc\n", "gray (cal.csv line 6)"),
     ("force_n,area_mm2,image,x0,y0,x1,y1\n30,100,p.png,0,0,zz,4\n", "crop"),
     (HEADER + "5,100,10\n5,100,100\n5,100,200\n", "same force per area"),

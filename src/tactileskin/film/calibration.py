@@ -58,6 +58,9 @@ AICC_TIE = 2.0
 MIN_POINTS = 3
 _MONO_GRID = 1001
 MAX_PRESSES = 10_000    # a calibration is tens of presses; more is a wrong file
+# P = F/A of a press (MPa): pressure films read 0.005-300 MPa; past these a unit is wrong (a force
+# of 1e308 N overflowed the fit, an area of 1e308 mm^2 fitted 4e-307 MPa and was written)
+PRESS_P_RANGE = (1e-6, 1e4)
 
 
 @dataclass(frozen=True)
@@ -483,6 +486,10 @@ def read_calibration_csv(path) -> dict[str, np.ndarray]:
             raise ParameterError(f"force_n ({where})", f_n, "> 0 N")
         if not a > 0:
             raise ParameterError(f"area_mm2 ({where})", a, "> 0 mm^2")
+        lo, hi = PRESS_P_RANGE
+        if not lo <= f_n / a <= hi:
+            raise ParameterError(f"force_n/area_mm2 ({where})", f"{f_n:g} N / {a:g} mm^2 = {f_n / a:g} MPa",
+                                 f"[{lo:g}, {hi:g}] MPa (a press on film; check the units: N and mm^2)")
         if r.get("gray") and r.get("image"):  # the gray value won and the image was never read
             raise ParameterError(f"calibration CSV ({where})", f"gray {r['gray']} and image {r['image']}",
                                  "a gray value or an image path, not both",
