@@ -174,3 +174,27 @@ def test_quadratic_step_factors_match_quadrature(dt, dt_prev):
         got = gain[i] * (S1 - S0) - back[i] * (S0 - Sm)
         assert got == pytest.approx(ref, rel=1e-9, abs=1e-15)
     assert np.allclose(decay, np.exp(-dt / np.asarray(pr.tau)))
+
+
+@pytest.mark.parametrize("tau", [1e200, 1e13, 1e-320, 1e-10])
+def test_a_relaxation_time_past_the_solvable_range_is_refused_naming_it(tmp_path, capsys, tau):
+    """tau = 1e200 s (or 1e-320 s) was accepted and every solve failed with 'no convergence ...
+    non-finite residual' (tau**2 overflows in the quadratic update), naming neither tau nor a range."""
+    from tactileskin.cli import main
+
+    mat = tmp_path / "gel.toml"
+    mat.write_text(f"[hyperfoam]\nmu = [0.08, 0.01]\nalpha = [0.001, 15.5]\nnu = 0.49\n"
+                   f"[prony]\ng = [0.015, 0.044]\ntau = [{tau!r}, 0.15]\n")
+    assert main(["solve", "--quality", "preview", "-t", "1", "-m", str(mat), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "tau[0]" in err and "[1e-09, 1e+12] s" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("tau", [1e-9, 1e12])
+def test_the_update_stays_finite_at_the_ends_of_the_relaxation_time_range(tau):
+    p = Prony((0.3,), (tau,))
+    for dt in (1e-12, 1e-6, 1.0, 3e7):
+        for dt_prev in (1e-12, 1.0, 3e7):
+            assert all(np.all(np.isfinite(f)) for f in p.step_factors_quadratic(dt, dt_prev))
+        assert np.all(np.isfinite(p.step_factors(dt)))

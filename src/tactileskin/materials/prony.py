@@ -33,6 +33,10 @@ __all__ = ["Prony", "QLVHistory"]
 # indentation. Each term keeps a stress history at every quadrature point (memory and one
 # update per increment), so the count is bounded.
 MAX_TERMS = 12
+# relaxation times (s) a series may hold: 1 ns to 30,000 years, beyond any skin's test. Past
+# about 1e154 s tau**2 overflows in the quadratic update and every solve failed as 'no
+# convergence'; down at 1e-320 s dt/tau does; the range names the mistake (a unit) instead.
+TAU_RANGE = (1e-9, 1e12)
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,8 @@ class Prony:
                 raise ParameterError(f"g[{i}]", gi, ">= 0")
             if not (math.isfinite(ti) and ti > 0.0):
                 raise ParameterError(f"tau[{i}]", ti, "> 0 s")
+            if not TAU_RANGE[0] <= ti <= TAU_RANGE[1]:
+                raise ParameterError(f"tau[{i}]", ti, f"[{TAU_RANGE[0]:g}, {TAU_RANGE[1]:g}] s")
         if not sum(g) < 1.0:
             raise ParameterError("g", g, "sum(g_i) < 1 (long-term modulus g_inf > 0)")
         object.__setattr__(self, "g", g)
