@@ -723,3 +723,32 @@ def test_result_write_refuses_a_folder_another_run_is_writing_into(tmp_path):
         os.close(fd)
     assert {p.name: p.read_bytes() for p in d.iterdir() if p.is_file()} == before
     fake_result().write(d)
+
+
+@pytest.mark.parametrize("lock", [outdir.RUN_LOCK, ownership.RECORD_LOCK])
+def test_a_lock_file_that_is_a_symlink_is_not_followed(tmp_path, capsys, fake_solve, lock):
+    """A dangling symlink named like a lock file made the run create its target outside --out
+    (open(O_CREAT) follows it); a link to a user's file was opened and locked."""
+    d = tmp_path / "d"
+    assert main(["solve", *CHEAP, "--out", str(d)]) == 0
+    before = {p.name: p.read_bytes() for p in d.iterdir() if p.name != lock}
+    (d / lock).unlink()
+    (d / lock).symlink_to(tmp_path / "elsewhere")
+    assert main(["solve", *CHEAP, "-t", "2", "--out", str(d)]) == 2
+    err = _err(capsys)
+    assert len(err.strip().splitlines()) == 1 and "symbolic link" in err and str(d) in err
+    assert not (tmp_path / "elsewhere").exists()
+    assert {p.name: p.read_bytes() for p in d.iterdir() if p.name != lock} == before
+    if lock == outdir.RUN_LOCK:  # refused before the solve (the record's lock is taken to write)
+        assert len(fake_solve) == 1
+
+
+def test_a_case_lock_that_is_a_symlink_is_not_followed(tmp_path):
+    from tactileskin.cache import ResultCache
+
+    cache = ResultCache(tmp_path / "cache")
+    cache.root.mkdir()
+    (cache.root / "abc.lock").symlink_to(tmp_path / "elsewhere")
+    with pytest.raises(fileio.OutputError, match="symbolic link"):
+        cache.lock("abc", blocking=False)
+    assert not (tmp_path / "elsewhere").exists()

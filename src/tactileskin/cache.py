@@ -61,6 +61,7 @@ import numpy as np
 
 from tactileskin import __version__, fileio, params, staging
 from tactileskin.errors import TactileSkinError
+from tactileskin.ownership import open_lock_file
 from tactileskin.scene import SCHEMA_VERSION, Scene
 
 try:
@@ -483,7 +484,7 @@ class ResultCache:
         while True:
             fileio.make_dirs(self.root)
             with fileio.os_errors(path):
-                fd = os.open(path, os.O_RDWR | os.O_CREAT, fileio.file_mode())
+                fd = open_lock_file(path, os.O_RDWR)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
                 if fileio.is_open_file(fd, path):

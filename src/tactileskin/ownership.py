@@ -163,6 +163,21 @@ def record_lock(folder: Path) -> Iterator[None]:
         yield
 
 
+NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)  # not on every OS
+
+
+def open_lock_file(path: Path, mode: int) -> int:
+    """os.open of a lock file (created, 0o666 less the umask) that does not follow a symlink of
+    its name: O_CREAT would make the link's target, outside the folder. A link is refused
+    naming it."""
+    try:
+        return os.open(path, mode | os.O_CREAT | NOFOLLOW, 0o666)
+    except OSError as e:
+        if e.errno == errno.ELOOP:
+            raise OutputError(path, "it is a symbolic link, which tactileskin does not follow: remove it") from None
+        raise
+
+
 @contextlib.contextmanager
 def folder_lock(folder: Path, name: str, about: Path, blocking: bool = True) -> Iterator[None]:
     """Hold an exclusive flock on `folder / name` (created, left in place) for the body; errors
@@ -178,9 +193,9 @@ def folder_lock(folder: Path, name: str, about: Path, blocking: bool = True) -> 
         # a group-shared folder's lock file (0644 under umask 022) must open for the other users too
         with os_errors(about, own_name=False):
             try:
-                fd = os.open(folder / name, os.O_RDWR | os.O_CREAT, 0o666)  # open applies the umask
+                fd = open_lock_file(folder / name, os.O_RDWR)
             except PermissionError:
-                fd = os.open(folder / name, os.O_RDONLY | os.O_CREAT, 0o666)
+                fd = open_lock_file(folder / name, os.O_RDONLY)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | (0 if blocking else fcntl.LOCK_NB))
         except BlockingIOError:
