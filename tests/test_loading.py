@@ -48,6 +48,10 @@ def test_default_scene_keys_unchanged_and_loading_enters_them():
     (dict(loading=[{"depth": 0.1, "force": 1.0}]), "exactly one"),
     (dict(loading=[{"squeeze": 1.0}]), "squeeze"),
     (dict(depth=0.4, loading=[{"depth": 0.4}]), "other than the previous"),
+    # a ramp of 1e-20 s ends where it starts in float time (t0 + 1e-20 == t0): the solve
+    # stopped with a ZeroDivisionError traceback
+    (dict(loading=[{"depth": 0.1, "time": 1e-20}]), r"loading\[0\].time.*\[1e-06, 1e\+06\] s"),
+    (dict(loading=[{"force": 0.05, "time": 1e-9}]), r"loading\[0\].time.*\[1e-06, 1e\+06\] s"),
 ])
 def test_bad_histories_name_the_parameter(fields, needle):
     with pytest.raises(ParameterError, match=needle):
@@ -477,3 +481,13 @@ def test_a_segment_force_is_shown_in_the_scenes_unit(mesh, caplog):
     assert seg.describe(3) == "force to 0.5 N at 2 N/s"
     assert seg.describe(2) == "force to 0.5 N/mm at 2 N/mm/s"
     assert Segment("depth", 0.4, time=1.0).describe(2) == "depth to 0.4 mm in 1 s"
+
+
+def test_a_ramp_time_at_its_lower_end_solves(tmp_path, capsys):
+    """The shortest ramp allowed after a force ramp (whose end depth the check cannot know) runs."""
+    from tactileskin.cli import main
+
+    (tmp_path / "s.toml").write_text("thickness = 1\nforce = 0.05\nforce_rate = 0.05\n"
+                                     "[[loading]]\ndepth = 0.1\ntime = 1e-6\n")
+    assert main(["solve", "--scene", str(tmp_path / "s.toml"), "--quality", "preview", "--elastic",
+                 "-o", str(tmp_path / "o")]) == 0, capsys.readouterr().err

@@ -28,6 +28,10 @@ from tactileskin.errors import ParameterError, check_range
 KINDS = ("depth", "force", "hold")
 MAX_SEGMENTS = 20
 MAX_TIME = 1e6       # s: a segment longer than ~11 days is a units mistake
+# s: the shortest depth or force ramp given by `time`; a shorter one can end where it starts in
+# float time (t0 + 1e-20 == t0 after a 0.2 s ramp: the solve divided by zero). Far above the
+# spacing of floats at the longest history (20 x MAX_TIME: 4e-9 s)
+MIN_RAMP_TIME = 1e-6
 MAX_FORCE = 1e4      # N (N/mm): far beyond any soft skin under a fingertip-sized indenter
 # N (N/mm): below it the ramp's first targets are within the reaction's own resolution (1 mm
 # silicone under the flat plate in 2D: 1e-7 N/mm stalled in its first increment, its reaction
@@ -97,8 +101,8 @@ def segment_from(value, where: str, *, max_depth: float, default_rate: float) ->
         if "rate" not in d and "time" not in d:
             raise ParameterError(f"{where}.rate", None, f"rate = {unit} or time = s for a force segment")
     if "time" in d:
-        return Segment(kind, target, time=check_range(f"{where}.time", d["time"], 0.0, MAX_TIME,
-                                                      lo_open=True, unit="s"))
+        return Segment(kind, target, time=check_range(f"{where}.time", d["time"], MIN_RAMP_TIME, MAX_TIME,
+                                                      unit="s"))
     rate = d.get("rate", default_rate)
     return Segment(kind, target, rate=check_range(f"{where}.rate", rate, 1e-6, 1e6, unit=unit))
 
