@@ -79,12 +79,14 @@ def test_cli_noise_mpa_reaches_the_report_and_the_csv(tmp_path, monkeypatch, clo
 
 
 @pytest.mark.parametrize("flags, config, words", [
-    (["--noise-mpa", "0"], None, ["noise_mpa (--noise-mpa)=0.0", "> 0 MPa"]),
-    (["--noise-mpa", "-0.1"], None, ["noise_mpa (--noise-mpa)=-0.1", "> 0 MPa"]),
+    (["--noise-mpa", "0"], None, ["noise_mpa (--noise-mpa)=0.0", "(0, 10000] MPa"]),
+    (["--noise-mpa", "-0.1"], None, ["noise_mpa (--noise-mpa)=-0.1", "(0, 10000] MPa"]),
     (["--noise-mpa", "inf"], None, ["noise_mpa (--noise-mpa)='inf'", "finite numbers"]),
+    # was charted (accuracy at chance, status ok) with noise_fs = inf in accuracies.csv
+    (["--noise-mpa", "1e308"], None, ["noise_mpa (--noise-mpa)=1e+308", "(0, 10000] MPa"]),
     (["--noise", "0.01", "--noise-mpa", "0.001"], None, ["noise_mpa (--noise-mpa)", "not with --noise"]),
     ([], "[array]\nnoise_fs = [0.01]\nnoise_mpa = [0.001]\n", ["noise_mpa (--noise-mpa)", "not with noise_fs"]),
-    ([], "[array]\nnoise_mpa = \"x\"\n", ["noise_mpa (--noise-mpa)='x'", "> 0 MPa"]),
+    ([], "[array]\nnoise_mpa = \"x\"\n", ["noise_mpa (--noise-mpa)='x'", "(0, 10000] MPa"]),
 ])
 def test_bad_noise_mpa_is_one_line_before_any_solve(tmp_path, capsys, monkeypatch, flags, config, words):
     def refuse(*a, **k):

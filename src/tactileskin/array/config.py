@@ -32,6 +32,10 @@ LETTERS_MODELS = ("interaction", "sum", "full")
 CHART_MESH = (1.2, 8.0)
 
 
+# MPa: a noise std past any skin's pressure (a unit slip; 1e308 was charted with noise_fs = inf)
+NOISE_MPA_MAX = 1e4
+
+
 def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:
     """A non-empty list of distinct numbers within [lo, hi] as a tuple (a repeated value wrote
     every row of accuracies.csv twice; [1, 3, 1] is likely a typo for [1, 3, 5], refused as a
@@ -138,7 +142,7 @@ class ChartConfig:
             if self.noise_fs is not None:
                 raise ParameterError("noise_mpa (--noise-mpa)", self.noise_mpa,
                                      "not with noise_fs (--noise): the noise is either in MPa or x full scale")
-            set_("noise_mpa", _numbers(self.noise_mpa, "noise_mpa (--noise-mpa)", 0.0, None, "MPa", True))
+            set_("noise_mpa", _numbers(self.noise_mpa, "noise_mpa (--noise-mpa)", 0.0, NOISE_MPA_MAX, "MPa", True))
         elif self.noise_fs is None:
             set_("noise_fs", NOISE_FS)
         for name, flag, lo, hi, lo_open, unit in (("thicknesses", "-t", 0.0, None, True, "mm"),  # the skin: its range
