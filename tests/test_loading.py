@@ -52,6 +52,12 @@ def test_default_scene_keys_unchanged_and_loading_enters_them():
     # stopped with a ZeroDivisionError traceback
     (dict(loading=[{"depth": 0.1, "time": 1e-20}]), r"loading\[0\].time.*\[1e-06, 1e\+06\] s"),
     (dict(loading=[{"force": 0.05, "time": 1e-9}]), r"loading\[0\].time.*\[1e-06, 1e\+06\] s"),
+    # the same by a rate: 2e-10 mm at 1e6 mm/s after a 100 s ramp ends where it starts in float
+    # time (ZeroDivisionError traceback); so does a force step of 1e-10 N at 1e6 N/s
+    (dict(loading=[{"depth": 0.1, "rate": 0.001}, {"depth": 0.1000000002, "rate": 1e6}]),
+     r"loading\[1\].rate=1000000.0 is invalid; valid: <= 0.0002 mm/s.*2e-16 s.*1e-06 s"),
+    (dict(force=0.05, force_rate=0.05, loading=[{"force": 0.0500000001, "rate": 1e6}]),
+     r"loading\[0\].rate=1000000.0 is invalid; valid: <= 0.0001 N/s.*1e-06 s"),
 ])
 def test_bad_histories_name_the_parameter(fields, needle):
     with pytest.raises(ParameterError, match=needle):
@@ -491,3 +497,15 @@ def test_a_ramp_time_at_its_lower_end_solves(tmp_path, capsys):
                                      "[[loading]]\ndepth = 0.1\ntime = 1e-6\n")
     assert main(["solve", "--scene", str(tmp_path / "s.toml"), "--quality", "preview", "--elastic",
                  "-o", str(tmp_path / "o")]) == 0, capsys.readouterr().err
+
+
+def test_a_ramp_that_ends_where_it_starts_in_float_time_is_refused_at_run_time():
+    """A rate ramp from where a force ramp left the travel (unknown to the scene's check) to
+    within 2e-16 s of it at t = 100 s: t0 + duration == t0, and the travel path divided by zero."""
+    from types import SimpleNamespace
+
+    from tactileskin.fe.loading import run_program
+
+    model = SimpleNamespace(t=100.0, d=0.1, history=None, m=2)
+    with pytest.raises(ParameterError, match=r"loading segment 0 .*depth to 0.1 mm at 1e\+06 mm/s.*1e-06 s"):
+        run_program(model, [Segment("depth", 0.1000000002, rate=1e6)], d_max=1.0, d_guess=0.1)

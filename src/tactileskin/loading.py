@@ -130,4 +130,10 @@ def check_program(program: list[Segment]) -> None:
         if start is not None and seg.rate is not None and math.isclose(seg.target, start, abs_tol=1e-12):
             raise ParameterError(f"{where}.{seg.kind}", seg.target, f"a value other than the previous {start:g}",
                                  "use hold = seconds to stay")
+        if start is not None and seg.rate is not None and seg.duration(start) < MIN_RAMP_TIME:
+            # as a time below MIN_RAMP_TIME: the ramp can end where it starts in float time
+            unit = "mm/s" if seg.kind == "depth" else "N/s (N/mm/s in 2D)"
+            raise ParameterError(f"{where}.rate", seg.rate, f"<= {abs(seg.target - start) / MIN_RAMP_TIME:.3g} {unit}: "
+                                 f"the ramp from {start:.12g} to {seg.target:.12g} takes {seg.duration(start):.3g} s, "
+                                 f"under the shortest ramp, {MIN_RAMP_TIME:g} s")
         control, value = seg.kind, seg.target

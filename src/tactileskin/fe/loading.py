@@ -28,8 +28,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from tactileskin.errors import ConvergenceError
+from tactileskin.errors import ConvergenceError, ParameterError
 from tactileskin.fe.solver import SolverOptions, Stats, _Failure, _solve_increment, run
+from tactileskin.loading import MIN_RAMP_TIME
 
 log = logging.getLogger(__name__)
 
@@ -306,6 +307,13 @@ def run_program(model, program, opts=None, *, d_max: float, d_guess, record=None
             return r
 
         increment, stops = None, None
+        if seg.kind != "hold" and not t0 + seg.duration(model.d if seg.kind == "depth" else f_now) > t0:
+            # a rate ramp from where another control left it (a force ramp's end depth, which the
+            # scene's check cannot know) to within the float spacing of t0: the path divides by T - t0
+            raise ParameterError(f"loading segment {i} ({seg.describe(getattr(model, 'm', 3))})",
+                                 seg.duration(model.d if seg.kind == "depth" else f_now),
+                                 f"a ramp of at least {MIN_RAMP_TIME:g} s (from {model.d if seg.kind == 'depth' else f_now:g}"
+                                 f" at t = {t0:g} s it ends where it starts)", "a smaller rate, or time = s")
         if seg.kind == "depth":
             d0, d1 = model.d, seg.target
             T = t0 + seg.duration(d0)
