@@ -105,3 +105,16 @@ def test_chart_rows_and_csv_carry_the_interval():
         assert a.shape == (16,) and np.mean(a) == pytest.approx(acc)
         lo, hi = ch_mod.accuracy_interval(acc, 32, a)
         assert lo <= acc <= hi
+
+
+def test_a_borderline_interval_just_under_the_bar_is_not_shown_on_it():
+    """accuracy_text kept an accuracy just under 0.95 off the bar, but the borderline note's
+    interval still rounded its lower end onto it: 0.9496 read '95 % interval 0.95-0.98 spans
+    0.95', an interval that seems to start at the bar it is said to span."""
+    ch = _chart(None)
+    for r in ch.rows:
+        r.update(n_test=16, chance=1 / 3)
+        if r["set"] == "paper" and r["thickness_mm"] == 5.0:
+            r.update(accuracy=0.96, ci_low=0.9496, ci_high=0.98)
+    five = {x["claim"][:4]: x for x in verdicts(ch)}["5 mm"]
+    assert "95 % interval 0.9496-0.98 spans 0.95)" in five["evidence"]

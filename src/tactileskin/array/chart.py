@@ -807,7 +807,7 @@ def _borderline(acc: float, row: dict | None) -> str:
     lo, hi = (row["ci_low"], row["ci_high"]) if "ci_low" in row else wilson(acc, n)
     if lo < GOOD <= hi:
         return (f" (borderline: {accuracy_text(acc)} on {n} readings at {row['n_test']} offsets, 95 % interval "
-                f"{lo:.2f}-{hi:.2f} spans {GOOD:g})")
+                f"{accuracy_text(lo)}-{accuracy_text(hi)} spans {GOOD:g})")
     return ""
 
 
