@@ -70,3 +70,35 @@ def test_sweep_outputs_include_the_fig9_render_of_the_flat_case(tmp_path, caplog
     assert [p.name for p in paths["renders"]] == ["fig9_t1-polyurethane-flat-2d.png"]
     assert paths["renders"][0].stat().st_size > 1000
     assert not [r for r in caplog.records if "render" in r.getMessage()]
+
+
+def test_report_says_which_cases_this_run_solved_and_which_it_read_from_the_cache(tmp_path):
+    """A rerun after a scene change solved only the new cases and read the rest from the cache,
+    but report.md read as a fresh run: no word of which numbers were solved now, with each
+    cached case's 'wall (s)' that of a solve in an earlier run ('wall time 6.2 s' over six
+    cases of which four were cached). The header counts them and the Cases table marks each.
+    That mark does not enter the figures' key: a cached rerun still copies its figures."""
+    import re
+
+    from tactileskin.report import figures
+    from tactileskin.report.outputs import collect, write_outputs
+
+    cache = ResultCache(tmp_path / "cache")
+    one = expand_grid(thicknesses=[1.0], materials=["polyurethane"], indenters=["flat"], base=Scene(**COARSE))
+    first = run_sweep(one, cache, serial=True)
+    write_outputs(tmp_path / "a", first, cache, 1.0, render=False)
+    assert "1 solved in this run, 0 read from the cache" in (tmp_path / "a" / "report.md").read_text()
+    two = expand_grid(thicknesses=[1.0], materials=["polyurethane"], indenters=["flat", "curved"],
+                      base=Scene(**COARSE))
+    outcomes = run_sweep(two, cache, serial=True)
+    assert [o.status for o in outcomes] == ["cached", "done"]
+    write_outputs(tmp_path / "b", outcomes, cache, 1.0, render=False)
+    md = (tmp_path / "b" / "report.md").read_text()
+    assert "1 solved in this run, 1 read from the cache" in md
+    rows = {m.group(1): m.group(2) for m in re.finditer(r"^\| (t1-polyurethane-\w+-2d) \|.*\| (\w+) \|$", md, re.M)}
+    assert rows == {"t1-polyurethane-flat-2d": "cached", "t1-polyurethane-curved-2d": "solved"}
+    # the first run's case, read from the cache now: the same figures' key as when it was solved
+    recs_a, rows_a, _ = collect(first, cache)
+    recs_b, rows_b, _ = collect(run_sweep(one, cache, serial=True), cache)
+    assert rows_b[0]["source"] == "cached" and rows_a[0]["source"] == "solved"
+    assert figures.figures_key(recs_a, rows_a) == figures.figures_key(recs_b, rows_b)

@@ -269,9 +269,10 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
 
 FIGURES_SCHEMA = 2  # the layout of figures_key's payload
 
-# row and summary fields no figure draws that change between two solves of the same case (the
-# solve's wall time): in the key, a case solved again with the same numbers redrew every figure
-UNDRAWN_FIELDS = frozenset({"wall_s"})
+# row and summary fields no figure draws that change between two runs of the same case (the
+# solve's wall time, whether this run solved it or read it from the cache): in the key, a case
+# solved again with the same numbers, or cached on a rerun, redrew every figure
+UNDRAWN_FIELDS = frozenset({"wall_s", "source"})
 
 
 def _drawn_fields(d: dict) -> dict:

@@ -571,9 +571,13 @@ def _visco(sc) -> str:
 def build_report(rows, records, failures, figures, renders, wall_s: float, scenes=None) -> str:
     kinds = [quality.kind(r.get("status", "")) for r in rows]
     nok, nsus = kinds.count("ok"), kinds.count("suspect")
+    sources = [r.get("source") for r in rows]
+    ran = (f"{sources.count('solved')} solved in this run, {sources.count('cached')} read from the cache "
+           "(the Cases table's 'run' column; a cached case's wall time is that of its earlier solve); "
+           if any(sources) else "")
     out = ["# tactileskin sweep report", "",
            f"{nok} of {len(rows)} cases ok ({nsus} suspect, {kinds.count('failed')} failed); "
-           f"wall time {wall_s:.1f} s.",
+           f"{ran}wall time {wall_s:.1f} s.",
            "Units: mm, s, N, MPa. Pressure is the mean pressure P = −(σx+σy+σz)/3 along the bone "
            "interface, positive in compression (Abaqus PRESS); plane-strain values are per mm of depth."]
     bad = [r for r in _status_order(rows) if quality.kind(r.get("status", "")) != "ok"]
@@ -591,17 +595,20 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                 p.name == "metrics_vs_thickness.png" for p in figures) else []
     out += [""] + run_settings(scenes if scenes is not None else [r.scene for r in records])
     out += ["## Cases", "",
-            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm of the half section in 2D, N on the whole indenter in 3D) | increments | Newton its | wall (s) | status |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+            "| case | t (mm) | material | indenter | depth (mm) | peak P (MPa) | span (mm) | AUC (MPa·mm) | reaction (N/mm of the half section in 2D, N on the whole indenter in 3D) | increments | Newton its | wall (s) | status |"
+            + (" run |" if any(sources) else ""),
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if any(sources) else "")]
+    run = lambda r: f" {r.get('source') or '–'} |" if any(sources) else ""  # noqa: E731
     for r in _status_order(rows):
         k = quality.kind(r.get("status", ""))
         if k == "failed":
-            out.append(f"| {r['case']} | {r['thickness_mm']:g} | {r['material']} | {r['indenter']} | – | failed | | | | | | | failed |")
+            out.append(f"| {r['case']} | {r['thickness_mm']:g} | {r['material']} | {r['indenter']} | – | failed | | | | | | | failed |"
+                       + run(r))
             continue
         out.append(f"| {r['case']} | {r['thickness_mm']:g} | {r['material']} | {r['indenter']} | {r['depth_mm']:.3g} | "
                    f"{_fmt(r['peak_mpa'])} | {_fmt(r['span_mm'])} | {_fmt(r['auc_mpa_mm'])} | {_reaction(r)} | "
                    f"{r.get('increments', '')} | {r.get('newton_iterations', '')} | {_fmt(r.get('wall_s'), 2)} | "
-                   f"{'**suspect**' if k == 'suspect' else 'ok'} |")
+                   f"{'**suspect**' if k == 'suspect' else 'ok'} |" + run(r))
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
     with_sensors = [r.case for r in records if r.scene.sensors]
     if with_sensors:

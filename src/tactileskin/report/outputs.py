@@ -45,6 +45,8 @@ def collect(outcomes, cache):
                    rate_mm_s=sc.rate, dim=sc.dim)
         if sc.force is not None:  # force control: the force asked for (the reaction columns hold what it reached)
             row["target_force_n" if sc.dim == 3 else "target_force_n_per_mm"] = sc.force
+        # solved by this run, or read from the cache (a rerun's report told them apart nowhere)
+        row["source"] = {"cached": "cached", "done": "solved"}.get(oc.status, "failed")
         if oc.status == "failed":
             row.update(status=quality.failed_status(oc.error), error=oc.error)
             failures.append(oc)
