@@ -315,3 +315,31 @@ def test_a_3d_verdict_missing_one_of_its_braille_texts_is_not_a_change():
     g = {m["group"]: m for m in markdown.discrimination_by_model(recs)}[("silicone", 1.0, "")]
     assert g["verdict"][2] == "not distinguishable"
     assert g["verdict"][3].startswith("n/a") and not g["changed"]
+
+
+def test_ridge_section_states_this_sweeps_ratios_and_those_outside_the_measured_range():
+    """The default paper sweep's ridge-vs-dots section said 'The project measured the ridge at
+    1.9-3.1x the peak of a dot ... with spans within 7 %' above a table whose t = 3 mm silicone
+    row read span 2D/3D 0.90 (1.957 / 2.165 mm: 9.6 % short), without a word: the measurement
+    is against a converged 3D mesh, the sweep's dots are on their preset's. The section now
+    states this sweep's own range and names the pairs outside the measured one (at the digits
+    the measured range is given to)."""
+    import re
+
+    from tactileskin.planner import MEASURED_RIDGE_VS_DOTS
+
+    w = 1.0 / np.sqrt(np.log(10))  # span 1 mm
+    recs, rows = _sweep([_case(1.0, "braille", 0.25, 0.98 * w), _case(1.0, "braille", 0.1, w, dim=3),
+                         _case(3.0, "braille", 0.0719, 1.9572 * w),
+                         _case(3.0, "braille", 0.0236, 2.1646 * w, dim=3)])
+    text = " ".join(markdown.braille_comparison(recs, rows))
+    peaks = [1 + m["peak"] for m in MEASURED_RIDGE_VS_DOTS.values()]
+    spans = [100 * m["span"] for m in MEASURED_RIDGE_VS_DOTS.values()]
+    assert f"at {min(peaks):.1f}-{max(peaks):.1f}x the peak of a dot" in text
+    assert f"spans {min(spans):.0f} to +{max(spans):.0f} % off the dots'" in text
+    said = re.search(r"In this sweep the ridge reads 2\.50-3\.05x the dots' peak, its span -9\.6 to (\S+) % off theirs\.",
+                     text)
+    assert said and float(said.group(1)) == pytest.approx(-2.0, abs=0.15)  # the sampled Gaussian's span
+    assert ("Outside the measured range: t3-silicone-braille-2d / t3-silicone-braille-3d (span -9.6 %)"
+            in text)
+    assert "t1-silicone-braille-2d / t1-silicone-braille-3d (" not in text
