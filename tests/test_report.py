@@ -239,3 +239,17 @@ def test_the_suspect_section_names_the_kinds_of_suspect_result_a_sweep_reports()
     intro = md.split("## Failed and suspect cases")[1].split("\n- ")[0]
     for kind in ("no contact", "outside its range", "locking", "mesh coarser", "edge"):
         assert kind in intro, kind
+
+
+def test_cases_table_gives_long_wall_times_in_seconds_not_in_exponent_form():
+    """The default paper sweep's Cases table read the 3D dots' wall times as '1.2e+02',
+    '1.5e+02' and '2e+02' (119.0, 153.2 and 200.5 s: the last one's three digits lost to '2e+02')."""
+    from tactileskin.report.markdown import build_report
+
+    recs, rows = _records({("polyurethane", 2.0, "flat"): (0.4, 3.0), ("polyurethane", 4.0, "flat"): (0.3, 2.0)})
+    for r, rec, wall in zip(rows, recs, (153.2, 0.63)):
+        r.update(case=f"t{r['thickness_mm']:g}", depth_mm=rec.scene.indentation, reaction_n_per_mm=0.1, wall_s=wall)
+    md = build_report(rows, recs, [], [], [], 1.0, scenes=[r.scene for r in recs])
+    walls = [ln.split("|")[12].strip() for ln in md.splitlines() if ln.startswith("| t")]
+    assert walls == ["153", "0.63"]
+    assert "e+0" not in md

@@ -22,7 +22,12 @@ SPAN_TOL_MM = 0.3  # a span "agrees" within 0.3 mm of the paper's range (its fig
 
 
 def _fmt(v, nd=3):
-    return "n/a" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{nd}g}"
+    """v to nd significant digits; one of nd digits or more before the point whole, not in
+    exponent form (a 200.5 s wall time read '2e+02' at nd = 2)."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "n/a"
+    text = f"{v:.{nd}g}"
+    return f"{v:.0f}" if "e+" in text else text  # 99.96 at nd = 2 too: '1e+02' -> '100'
 
 
 def _reaction(row) -> str:
