@@ -453,3 +453,22 @@ def test_a_resolved_case_with_the_same_results_keeps_its_figures(tmp_path):
     summ = [CaseRecord(r.scene, r.s, r.pressure, {**r.summary, "peak_mpa": 0.1}, r.path) if k == 0 else r
             for k, r in enumerate(a[0])]
     assert figures.figures_key(summ, a[1]) != figures.figures_key(*a)
+
+
+def test_run_settings_give_the_numbers_of_each_material(tmp_path):
+    """A material file edited between two sweeps (mu 0.010 -> 0.012 MPa in a copy of silicone)
+    re-solved every case and moved every number (t = 1 mm flat peak 0.315 -> 0.340 MPa), but the
+    two report.md's Run settings, which state what produced the numbers, read alike: the material
+    was its path only. They now give each material's law and numbers, as the cache keys them."""
+    toml = ("[hyperfoam]\nmu = [0.080, {mu}]\nalpha = [0.001, 15.5]\nnu = 0.49\n"
+            "[prony]\ng = [0.015, 0.044, 0.029]\ntau = [0.025, 0.150, 0.300]\n")
+    mat = tmp_path / "mysil.toml"
+    mat.write_text(toml.format(mu="0.010"))
+    scenes = [Scene(thickness=1.0, material=str(mat)), Scene(thickness=1.0, material="polyurethane")]
+    before = "\n".join(run_settings(scenes))
+    assert f"`{mat}`: hyperfoam alpha = [0.001, 15.5], mu = [0.08, 0.01], nu = 0.49; " \
+           "Prony g = [0.015, 0.044, 0.029], tau = [0.025, 0.15, 0.3] s" in before
+    assert "`polyurethane`: hyperfoam alpha = [5.5, 8.25], mu = [0.1, 0.063], nu = 0.47; " in before
+    mat.write_text(toml.format(mu="0.012"))
+    after = "\n".join(run_settings(scenes))
+    assert after != before and "mu = [0.08, 0.012]" in after

@@ -597,6 +597,7 @@ def run_settings(scenes) -> list[str]:
             sizes = "– | – | –" if h is None else f"{h:g} | {ref:g} | {h / ref:.3g}"
             out.append(f"| {dim}D | {ind} | {q} | {sizes} | P{order} | {form} | {visco} | {rate:g} | {n} |")
         out.append("")
+        out += _material_lines(scenes)
     note = geometry_note()
     if note:
         out += [note, ""]
@@ -604,6 +605,29 @@ def run_settings(scenes) -> list[str]:
     out += [f"Solver settings (fe.solver.SolverOptions): {opts}; where None, by model dimension: "
             f"easy_iterations {EASY_ITERATIONS}, short_step {SHORT_STEP}.", ""]
     return out
+
+
+def _material_lines(scenes) -> list[str]:
+    """Each material's law and numbers as the cache keys them (cache.material_content): a
+    material file edited between two sweeps changes every number, and the Run settings, which
+    state what produced them, read alike when the material was its name or path only."""
+    from tactileskin.cache import material_content
+
+    def fmt(d: dict) -> str:
+        return ", ".join(f"{k} = {v!r}" for k, v in d.items())
+
+    out = ["Materials (the numbers the cases are keyed and solved with; moduli in MPa, times in s):", ""]
+    for name in sorted({sc.material for sc in scenes}, key=str):
+        try:
+            c = material_content(name)
+        except TactileSkinError as e:  # a file removed since the solve: its numbers are not known here
+            out.append(f"- `{name}`: not readable now ({e})")
+            continue
+        prony = c.pop("prony", {})
+        law = "; ".join(f"{k} {fmt(v)}" for k, v in c.items())
+        visco = f"Prony {fmt(prony)} s" if prony.get("g") else "no Prony terms"
+        out.append(f"- `{name}`: {law}; {visco}")
+    return out + [""]
 
 
 def _visco(sc) -> str:
