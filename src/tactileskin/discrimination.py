@@ -8,7 +8,7 @@ compared pairwise on a common s grid by the relative L2 distance
 which weighs both shape and magnitude (the paper discriminates by both: Figs. 10-13).
 Two profiles count as distinguishable when d >= THRESHOLD = 0.2. Why 0.2: a measured
 profile carries about +-10 % error (pressure-film accuracy; the paper's 1 mm
-simulation-experiment peak differences are 1-9 %), so two profiles can only be told
+simulation-experiment peak differences are 1.3-9 %, but 33 % for polyurethane's Braille), so two profiles can only be told
 apart reliably when they differ by more than twice that. A set of indenters is
 distinguishable when every pair is.
 """

@@ -17,7 +17,7 @@ from tactileskin.errors import TactileSkinError
 PAPER_PEAK_1MM_FLAT = {"silicone": 0.5, "polyurethane": 0.8}   # MPa/mm, Fig. 11 / Sec. V-B
 PAPER_MATERIALS = tuple(PAPER_PEAK_1MM_FLAT)                    # Table I's presets: the claims' skins
 PAPER_SPAN_5MM = (2.3, 2.5)                                      # mm, simulations, Sec. V-C
-AGREE_REL = 0.25   # a magnitude "agrees" within 25 %: the paper's own sim-vs-film gaps reach 19-40 % at 3 mm
+AGREE_REL = 0.25   # a magnitude "agrees" within 25 %: the paper's own sim-vs-film gaps at 3 mm are 0-40 % (19 % flat silicone)
 SPAN_TOL_MM = 0.3  # a span "agrees" within 0.3 mm of the paper's range (its figures read to ~0.25 mm)
 
 
