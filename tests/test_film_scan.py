@@ -598,3 +598,36 @@ def test_the_resolution_warning_prints_the_width_read_under_the_width_needed():
         shown, needed = re.search(r"it is ([\d.]+) px .* under the ([\d.]+) px", text).groups()
         assert float(shown) == pytest.approx(w50, abs=0.05) and need <= float(needed) < need + 0.1, (w50, need, text)
         assert float(shown) < float(needed), text
+
+
+def test_pixels_held_at_the_calibration_s_top_are_left_out_of_the_noise_check():
+    """A calibration whose darkest press reads below the film's range (here 0.3 MPa/mm of Eq. 8's 0.978) holds
+    every darker pixel at that press's pressure: flat, clipped, as at the activation range's top. The noise check
+    left out only the activation range's clipped pixels, so on a noise-free Hertzian spot (a = 1 mm, 0.9 MPa/mm,
+    8 px/mm, --rows centre) whose top is held, the step from the held row to its neighbours at the flat top's
+    edge was read as 'pixel noise', 6 % of the peak. A pixel at either clip is now left out, and a peak at a clip
+    (the film's saturation or the calibration's top) is not judged for noise."""
+    from tactileskin.film.calibration import Calibration
+
+    eq8 = paper_eq8()
+
+    def upto(top):  # Eq. 8 calibrated up to `top` MPa/mm
+        return Calibration(name="low", model="linear", params=eq8.params, gs_range=(float(eq8.grayscale(top)), 255.0),
+                           p_range=eq8.p_range, unit=eq8.unit)
+
+    low = upto(0.3)
+    # held, the top's own columns left out leave its edge's few, whose step is the spot's shape: a held peak reads
+    # the calibration's top, which noise cannot lift, and is not judged for noise
+    for top, peak in ((0.3, 0.9), (0.3, 0.5), (0.5, 0.9)):
+        img = _spot(peak, 1.0, "hertz", blur=0.0, seed=0, noise=0.0, dx=0.07, dy=0.05)
+        fp = analyze_scan(img, upto(top), rows="centre")
+        assert fp.coverage["held_fraction"] > 0 and fp.metrics["peak"] == pytest.approx(top, rel=1e-9)  # the premise
+        assert not any("pixel noise" in w for w in fp.warnings), (top, peak, fp.warnings)
+    # under the calibration's top, noise is still told: the same spot at 0.2 MPa/mm under 3 GS reads +13-15 %
+    clean = analyze_scan(_spot(0.2, 1.0, "hertz", blur=0.0, seed=0, noise=0.0, dx=0.07, dy=0.05), low, rows="centre")
+    for seed in (0, 1):
+        noisy = _spot(0.2, 1.0, "hertz", blur=0.0, seed=seed, noise=3.0, dx=0.07, dy=0.05)
+        fp = analyze_scan(noisy, low, rows="centre")
+        assert fp.metrics["peak"] > 1.1 * clean.metrics["peak"]
+        assert any("pixel noise" in w for w in fp.warnings), (seed, fp.warnings)
+

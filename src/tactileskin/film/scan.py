@@ -634,6 +634,14 @@ def _row_reach(n: int) -> float:
     return max(2.0, float(ndtri(0.9 ** (1.0 / max(n, 1)))))
 
 
+def _flat_ends(cal: Calibration) -> tuple[float, float]:
+    """The readings a clipped pixel holds: the activation range's bottom and the lower of its top and the
+    calibration's darkest press (darker pixels are held there: calibration.Calibration.reading), for _row_noise."""
+    lo, hi = cal.p_range
+    # a hair under it: a transcendental model may round a 0-d and an array evaluation an ulp apart
+    return lo, min(hi, float(cal.pressure(cal._ends()[0])) * (1.0 - 1e-12))
+
+
 SHAPE_COLUMNS = 10  # _row_noise(shape=True): the fewest columns to fit a press's edge step over
 
 
@@ -641,7 +649,7 @@ def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> floa
     """The pixel noise (sd) of row k: the spread of the row less its neighbours' mean over the columns at
     >= SPAN_LEVEL of its largest (the curvature across, nearly constant along them, drops out of the
     spread), / sqrt(1 + 1/n) for the neighbours' own noise; None without a neighbour or 3 such columns.
-    clip: the film's (lowest, highest) reading: a column where the row or both neighbours read one is left out
+    clip: the (lowest, highest) reading (_flat_ends): a column where the row or both neighbours read one is left out
     (a dot's edge whose neighbours read 0: the difference there is the row itself, not noise).
     shape: less first the part of that difference proportional to the neighbours' mean (a press a few
     pixels wide: its neighbours are its blurred edges, whose step below it scales with the profile along
@@ -751,7 +759,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         c_lo, c_hi = (x0, x1) if axis == "x" else (y0, y1)
         # the rows beside it on the image (the region found may be a row or two), for its noise
         beside = cal.pressure(oriented[max(r - 1, 0):r + 2, c_lo:c_hi]), r - max(r - 1, 0)
-        row_noise = _row_noise(*beside, clip=cal.p_range)
+        row_noise = _row_noise(*beside, clip=_flat_ends(cal))
         near = max(r - 2, 0), min(r + 3, oriented.shape[0])  # 5 rows about it: their mean's noise / sqrt(5)
     if rows == "centre":
         region, pmap = region[k:k + 1], pmap[k:k + 1]
@@ -834,9 +842,11 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         if row_noise is not None and " wide across " in narrow:
             # the rows beside a press this narrow are its blurred edges: their step, not noise (the
             # resolution warning says why it reads wrong); the noise left once that step is fitted out
-            shaped = _row_noise(*beside, shape=True, clip=cal.p_range)
+            shaped = _row_noise(*beside, shape=True, clip=_flat_ends(cal))
             row_noise = None if shaped is None else shaped / math.sqrt(pmap.shape[0])  # one row or their mean
     top = float(np.max(prof))
+    if top >= _flat_ends(cal)[1]:  # a peak at a clip (saturated, or held at the darkest press) reads it, not noise
+        row_noise = None
     n_top = int(np.sum(prof >= top - 3.0 * row_noise)) if row_noise is not None else 0
     if n_top and row_noise * _row_reach(n_top) > 2.0 * ROW_NOISE * top:
         fix = (x0, near[0], x1, near[1]) if axis == "x" else (near[0], y0, near[1], y1)
