@@ -645,6 +645,16 @@ def _flat_ends(cal: Calibration) -> tuple[float, float]:
 SHAPE_COLUMNS = 10  # _row_noise(shape=True): the fewest columns to fit a press's edge step over
 
 
+def _roughness(row: np.ndarray, keep: np.ndarray) -> float | None:
+    """The pixel noise (sd) of a row from its second differences along it over runs of kept columns (a smooth
+    profile's nearly vanish; independent noise's have variance 6 sd^2), their mean (the curvature) taken out;
+    None under 3 of them."""
+    j = np.flatnonzero(keep[:-2] & keep[1:-1] & keep[2:])
+    if j.size < 3:
+        return None
+    return float(np.std(row[j] - 2.0 * row[j + 1] + row[j + 2]) / math.sqrt(6.0))
+
+
 def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> float | None:
     """The pixel noise (sd) of row k: the spread of the row less its neighbours' mean over the columns at
     >= SPAN_LEVEL of its largest (the curvature across, nearly constant along them, drops out of the
@@ -653,10 +663,18 @@ def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> floa
     (a dot's edge whose neighbours read 0: the difference there is the row itself, not noise).
     shape: less first the part of that difference proportional to the neighbours' mean (a press a few
     pixels wide: its neighbours are its blurred edges, whose step below it scales with the profile along
-    it, and was read as noise: a noise-free 0.3 mm line at 8 px/mm, 5 % of its peak)."""
+    it, and was read as noise: a noise-free 0.3 mm line at 8 px/mm, 5 % of its peak); a row whose neighbours read
+    under STRIP_ROWS of it is the press alone across, judged on its roughness along it (_roughness)."""
     nb = [j for j in (k - 1, k + 1) if 0 <= j < pmap.shape[0]]
     row = pmap[k]
     keep = row >= SPAN_LEVEL * row.max()
+    if shape and nb and pmap[nb][:, keep].mean(axis=0).sum() < STRIP_ROWS * row[keep].sum():
+        # the row stands alone (a line a pixel wide): the rows beside are white film and its blur, the row less
+        # them its own height along its profile (a noise-free 0.2 mm line at 4 px/mm: 6 % of its peak), not noise
+        unclipped = keep if clip is None else keep & (row > clip[0]) & (row < clip[1])
+        rough = _roughness(row, unclipped)
+        if rough is not None:
+            return rough
     if clip is not None and nb:  # (one neighbour clipped still holds the other's reading and the row's noise)
         inside = (pmap[[k] + nb] > clip[0]) & (pmap[[k] + nb] < clip[1])
         keep &= inside[0] & inside[1:].any(axis=0)
