@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import meshio
 
 from tactileskin.cli import main
@@ -71,3 +73,65 @@ def test_mesh_command_bone_interface_length_agrees_with_cad_for_every_skin(capsy
         assert rc == 0
         err = float(re.search(r"bone interface length \(mm\).*rel\. err ([0-9.e+-]+)\)", text).group(1))
         assert err < 1e-3, (args, text)
+
+
+def _no_mesh(monkeypatch):
+    import tactileskin.mesh
+
+    calls = []
+
+    def build_mesh(*a, **kw):  # the checks must refuse before this
+        calls.append(a)
+        raise AssertionError("meshed before the output was checked")
+
+    monkeypatch.setattr(tactileskin.mesh, "build_mesh", build_mesh)
+    return calls
+
+
+def test_mesh_command_refuses_an_unwritable_out_before_meshing(tmp_path, capsys, monkeypatch):
+    """`mesh -o afile/m.msh` (a file where its folder should be) printed the whole table, then
+    'cannot write afile'; the folder is now checked before the mesh is made, nothing printed."""
+    calls = _no_mesh(monkeypatch)
+    (tmp_path / "afile").write_text("mine\n")
+    assert main(["mesh", "--quality", "preview", "-o", str(tmp_path / "afile" / "m.msh")]) == 2
+    cap = capsys.readouterr()
+    assert calls == [] and cap.out == "" and "afile" in cap.err and "Traceback" not in cap.err
+    assert (tmp_path / "afile").read_text() == "mine\n"
+
+
+def test_mesh_command_refuses_a_linked_record_lock_before_meshing(tmp_path, capsys, monkeypatch):
+    """A symlink named .tactileskin-files.lock in the folder of --out was refused only when the
+    mesh was written, after its table; now before the mesh is made, naming the link."""
+    from tactileskin import ownership
+
+    calls = _no_mesh(monkeypatch)
+    d = tmp_path / "d"
+    d.mkdir()
+    (d / ownership.RECORD_LOCK).symlink_to(tmp_path / "elsewhere")
+    assert main(["mesh", "--quality", "preview", "-o", str(d / "m.msh")]) == 2
+    cap = capsys.readouterr()
+    assert calls == [] and cap.out == "" and "symbolic link" in cap.err and ownership.RECORD_LOCK in cap.err
+    assert not (tmp_path / "elsewhere").exists() and [p.name for p in d.iterdir()] == [ownership.RECORD_LOCK]
+
+
+def test_mesh_command_refuses_a_read_only_folder_before_meshing(tmp_path, capsys, monkeypatch):
+    """A folder where no file can be made (root ignores folder modes: mkstemp refused there
+    stands for read-only) is refused before the mesh is made."""
+    import errno
+    import tempfile
+
+    calls = _no_mesh(monkeypatch)
+    d = tmp_path / "ro"
+    d.mkdir()
+    real = tempfile.mkstemp
+
+    def mkstemp(*a, dir=None, **kw):
+        if dir is not None and Path(dir) == d:
+            raise PermissionError(errno.EACCES, "Permission denied", str(dir))
+        return real(*a, dir=dir, **kw)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    assert main(["mesh", "--quality", "preview", "-o", str(d / "m.msh")]) == 2
+    cap = capsys.readouterr()
+    assert calls == [] and cap.out == "" and "permission denied" in cap.err and str(d) in cap.err
+    assert list(d.iterdir()) == []

@@ -63,7 +63,41 @@ def claim_file(path, what: str = "--out") -> Path:
         if not ours:
             raise OutputError(path, "the file exists and tactileskin did not write it (or it was changed since); "
                                     f"refusing to overwrite it: give {what} a new file name")
+    check_writable(path)
     return path
+
+
+def check_writable(path: Path) -> None:
+    """OutputError now if the file `path` could not be written where it is named (a file in
+    the way of its folder, a folder where no file can be made, a linked record lock): before
+    the work, not after it (a mesh, a fit). Nothing is left behind."""
+    import tempfile
+
+    from tactileskin.fileio import tmp_prefix
+
+    folder = path.parent
+    # the folder, or the deepest one of its path that exists (written_file makes the rest)
+    there = next((d for d in [folder, *folder.parents] if d.exists() or d.is_symlink()), Path("."))
+    if there.is_symlink() and not there.exists():
+        raise OutputError(there, "it is a broken symbolic link")
+    if not there.is_dir():
+        raise OutputError(there, "a part of the path is a file, not a folder")
+    if there == folder:
+        check_lock_name(folder, RECORD_LOCK)
+    with os_errors(there, own_name=False):
+        fd, probe = tempfile.mkstemp(prefix=tmp_prefix(path), dir=there)
+        os.close(fd)
+        os.unlink(probe)
+
+
+def check_lock_name(folder: Path, name: str) -> None:
+    """OutputError now if `folder / name`, a lock file the run will take, is a symbolic link
+    (open_lock_file refuses it when taking the lock: after the work) or not a file."""
+    lock = folder / name
+    if lock.is_symlink():
+        raise OutputError(lock, LINKED_LOCK)
+    if lock.exists() and not lock.is_file():
+        raise OutputError(lock, "it is not a file (tactileskin's lock file of that folder): remove it")
 
 
 def record_file(path) -> None:
@@ -164,6 +198,7 @@ def record_lock(folder: Path) -> Iterator[None]:
 
 
 NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)  # not on every OS
+LINKED_LOCK = "it is a symbolic link, which tactileskin does not follow: remove it"
 
 
 def open_lock_file(path: Path, mode: int) -> int:
@@ -174,7 +209,7 @@ def open_lock_file(path: Path, mode: int) -> int:
         return os.open(path, mode | os.O_CREAT | NOFOLLOW, 0o666)
     except OSError as e:
         if e.errno == errno.ELOOP:
-            raise OutputError(path, "it is a symbolic link, which tactileskin does not follow: remove it") from None
+            raise OutputError(path, LINKED_LOCK) from None
         raise
 
 
