@@ -19,7 +19,7 @@ from typing import Iterable, Iterator
 
 from tactileskin.fileio import (STAGING, OutputError, atomic_write_json, clean_stale, is_temporary, make_dirs,
                                 os_errors, tmp_prefix)
-from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, folder_lock, record_file
+from tactileskin.ownership import OWNED_FILES, RECORD_LOCK, check_lock_name, folder_lock, record_file
 
 MARKER = ".tactileskin"
 # held (flock) by the run writing into the folder: a second run into it is refused, as its
@@ -85,6 +85,9 @@ def claim_dir(folder, kind: str, *, what: str = "out") -> Path:
             shown = ", ".join(sorted(p.name for p in entries)[:3]) + (", ..." if len(entries) > 3 else "")
             raise OutputError(folder, f"the folder holds files tactileskin did not write ({shown}); "
                                       f"refusing to write into it: give {what} a new or empty folder")
+    if folder.is_dir():  # refused now, not when the result's files are recorded (after a solve)
+        for name in (RECORD_LOCK, RUN_LOCK):
+            check_lock_name(folder, name)
     make_dirs(folder)
     clean_stale(folder)
     if not (folder / MARKER).is_file():
