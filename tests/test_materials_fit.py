@@ -337,3 +337,38 @@ def test_a_headerless_strain_column_or_swapped_columns_are_named_as_such(tmp_pat
     # a tension test with negative stress keeps the sign question alone
     with pytest.raises(FitDataError, match=r"with its sign\?\)$"):
         fit("neo_hookean", lam, -P)
+
+
+@pytest.mark.parametrize("column, value, line, valid", [
+    ("nominal_stress_mpa", "1e308", 6, "[-10000, 10000] MPa"),
+    ("nominal_stress_mpa", "-1e300", 4, "[-10000, 10000] MPa"),
+    ("nominal_stress_mpa", "inf", 6, "[-10000, 10000] MPa"),
+    ("nominal_stress_mpa", "nan", 4, "[-10000, 10000] MPa"),
+    ("stretch", "1e-300", 4, "[0.001, 50]"),
+    ("stretch", "1e308", 12, "[0.001, 50]"),
+])
+def test_an_absurd_value_in_the_test_csv_is_refused_naming_its_column_and_line(tmp_path, capsys, column, value,
+                                                                            line, valid):
+    """A stress of 1e308 MPa was fitted and reported as 'did not converge (gtol ...)', a stretch
+    of 1e-300 stopped with a ValueError traceback; such a value is refused up front naming the
+    column, the CSV line and the valid range (exit 2, nothing written)."""
+    lam = np.linspace(0.8, 1.6, 9)
+    rows = [[f"{float(a)!r}", f"{float(0.04 * (a - a ** -2))!r}"] for a in lam]
+    rows[line - 4][0 if column == "stretch" else 1] = value
+    csv = tmp_path / "t.csv"  # a comment line and a blank line before the data: lines, not rows
+    csv.write_text("# a tensile test\n\nstretch,nominal_stress_mpa\n" + "".join(",".join(r) + "\n" for r in rows))
+    out = tmp_path / "m.toml"
+    assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert column in err and f"line {line}" in err and valid in err and value in err, err
+    assert "Traceback" not in err and not out.exists()
+
+
+def test_an_absurd_strain_is_refused_in_strain_units(tmp_path, capsys):
+    csv = tmp_path / "t.csv"
+    lam = np.linspace(0.8, 1.6, 9)
+    csv.write_text("strain,stress\n" + "".join(f"{a - 1:.6g},{0.04 * (a - a ** -2):.6g}\n" for a in lam[:-1])
+                   + "1e308,0.1\n")
+    assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(tmp_path / "m.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "strain" in err and "line 10" in err and "[-0.999, 49]" in err and "Traceback" not in err, err

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tactileskin.errors import ParameterError, TactileSkinError
+from tactileskin.errors import ParameterError, TactileSkinError, range_text
 from tactileskin.materials.laws import get_law
 
 log = logging.getLogger(__name__)
@@ -137,6 +137,12 @@ def _quality(stress, pred, n_params) -> dict:
 # Stretches of a uniaxial test: soft elastomers break at about 10 (900 % elongation, the
 # softest silicones); beyond 50 the strain column is surely in percent.
 PLAUSIBLE_STRETCH, MAX_STRETCH = 10.0, 50.0
+# What no uniaxial test of an elastomer leaves, so that a value outside is a slip (a typo, a
+# unit), refused naming it; the fit's powers of the stretch overflow on one (1e-300, 1e308).
+# Stretch from 0.001 (99.9 % compression: foams densify by 0.05-0.1); nominal stress within
+# +-1e4 MPa, 100x the breaking stress of the strongest elastomers (~100 MPa).
+MIN_STRETCH = 1e-3
+MAX_STRESS_MPA = 1e4
 
 
 def check_data(stretch, stress, n_params: int):
@@ -158,6 +164,13 @@ def check_data(stretch, stress, n_params: int):
             raise FitDataError(name, f"non-finite value at row {bad[0] + 1}", "finite numbers")
     if np.any(lam <= 0.0):
         raise FitDataError("stretch", float(lam[lam <= 0.0][0]), "> 0 (stretch = 1 + engineering strain)")
+    if np.any(lam < MIN_STRETCH):
+        i = int(np.flatnonzero(lam < MIN_STRETCH)[0])
+        raise FitDataError("stretch", f"{lam[i]:g} at row {i + 1}", range_text(MIN_STRETCH, MAX_STRETCH))
+    if np.any(np.abs(P) > MAX_STRESS_MPA):
+        i = int(np.flatnonzero(np.abs(P) > MAX_STRESS_MPA)[0])
+        raise FitDataError("stress", f"{P[i]:g} at row {i + 1}", range_text(-MAX_STRESS_MPA, MAX_STRESS_MPA, unit="MPa"),
+                           "a stress in kPa or Pa? give MPa")
     d = np.diff(lam)
     if not (np.all(d > 0) or np.all(d < 0)):
         i = int(np.flatnonzero(np.sign(d) != np.sign(d[0]))[0]) if np.any(d) else 0
@@ -392,7 +405,8 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
     column (nominal_stress_mpa | stress_mpa | nominal_stress | stress; MPa), or from two
     unnamed numeric columns (stretch, stress)."""
     path = Path(path)
-    rows = _csv_rows(path, "stretch and stress")
+    lines, rows = zip(*_csv_numbered_rows(path, "stretch and stress"))
+    rows = list(rows)
     head = [c.strip().lower() for c in rows[0]]
 
     def col(names):
@@ -410,12 +424,25 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
                                "a stretch (or strain) column and a stress column (nominal_stress_mpa)")
         body = rows[1:]
     lam, P = [], []
-    for n, r in enumerate(body, start=2 if body is not rows else 1):
+    named = body is not rows
+    # the stretch bounds in the column's own units (a strain column: stretch - 1)
+    shift = 1.0 if strain else 0.0
+    cols = ((i_s, head[i_s] if named else "stretch", MIN_STRETCH - shift, MAX_STRETCH - shift, ""),
+            (i_p, head[i_p] if named else "stress", -MAX_STRESS_MPA, MAX_STRESS_MPA, "MPa"))
+    for n, (r, line) in enumerate(zip(body, lines[1:] if named else lines), start=2 if named else 1):
         try:
             lam.append(float(r[i_s]))
             P.append(float(r[i_p]))
         except (ValueError, IndexError):
             raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", "two numbers (stretch, stress)") from None
+        for i, name, lo, hi, unit in cols:
+            x = float(r[i])
+            if not lo <= x <= hi:  # NaN too
+                hint = ("" if not math.isfinite(x) else "a stress in kPa or Pa? give MPa" if unit
+                        else "a strain in percent? give it as a fraction (0.5 for 50 %)" if x > hi
+                        else "" if named else "are the columns swapped (stretch first)?")
+                raise FitDataError(name, f"{r[i].strip()} on line {line} of {path.name}",
+                                   range_text(lo, hi, unit=unit), hint)
     lam, P = np.array(lam), np.array(P)
     if strain and lam.size and np.all(np.isfinite(lam)) and np.all(np.isfinite(P)):
         # the unloaded state of a strain column is strain 0; at strain 1 it is a stretch column
@@ -429,6 +456,11 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
 
 def _csv_rows(path: Path, what: str) -> list[list[str]]:
     """The non-empty, non-comment rows of a UTF-8 CSV of at most MAX_CSV_BYTES."""
+    return [r for _, r in _csv_numbered_rows(path, what)]
+
+
+def _csv_numbered_rows(path: Path, what: str) -> list[tuple[int, list[str]]]:
+    """_csv_rows, each with its line number in the file (where it ends), for messages."""
     try:
         with open(path, "rb") as fh:
             raw = fh.read(MAX_CSV_BYTES + 1)
@@ -442,8 +474,9 @@ def _csv_rows(path: Path, what: str) -> list[list[str]]:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise FitDataError("data", str(path), "a UTF-8 text CSV") from None
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
-    rows = [r for r in rows if not r[0].lstrip().startswith("#")]
+    reader = csv.reader(io.StringIO(text))
+    rows = [(reader.line_num, r) for r in reader if r and any(c.strip() for c in r)]
+    rows = [(n, r) for n, r in rows if not r[0].lstrip().startswith("#")]
     if not rows:
         raise FitDataError("data", str(path), f"a CSV with rows of {what}")
     return rows
