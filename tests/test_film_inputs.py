@@ -204,3 +204,25 @@ def test_inverted_activation_range_is_refused(tmp_path, capsys):
                     p_range=(0.0, 0.9))
     with pytest.raises(ParameterError, match="calibration pressure"):
         fit_calibration([40, 100, 160], [0.2, 0.2, 0.2])
+
+
+@pytest.mark.parametrize("value", [0.95, 0.5, 90, "high", None, True])
+def test_a_calibration_confidence_other_than_the_bands_level_is_refused(tmp_path, value):
+    """`confidence` (0.9, written by film calibrate) is the level of the bands computed from the
+    file's cov and dof, always models.CONFIDENCE; any other value was accepted and never read,
+    so a file claiming 95 % bands got 90 % ones silently. It is now refused naming the field."""
+    from tactileskin.film import models
+
+    p = tmp_path / "cal.json"
+    p.write_text(json.dumps({**GOOD, "confidence": value}))
+    with pytest.raises(ParameterError, match=r"calibration confidence=.* valid: 0\.9 or absent") as ei:
+        load_calibration(p)
+    assert str(p) in str(ei.value) and models.CONFIDENCE == 0.9
+
+
+def test_a_calibration_without_confidence_or_with_its_level_loads(tmp_path):
+    p = tmp_path / "cal.json"
+    assert GOOD["confidence"] == 0.9
+    for doc in (GOOD, {k: v for k, v in GOOD.items() if k != "confidence"}):
+        p.write_text(json.dumps(doc))
+        assert load_calibration(p).params == (-0.004, 0.95)

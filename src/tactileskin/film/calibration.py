@@ -215,6 +215,13 @@ class Calibration:
                                  hint="required: name, model, params, gs_range, p_range")
         if d["model"] not in models.MODELS:
             raise ParameterError("calibration model", d["model"], ", ".join(models.MODELS))
+        # the level of the bands, which are computed from cov and dof at models.CONFIDENCE
+        # whatever the file says: a file claiming another level would be read wrongly
+        if "confidence" in d and not (type(d["confidence"]) in (int, float)
+                                      and d["confidence"] == models.CONFIDENCE):
+            raise ParameterError("calibration confidence", d["confidence"], f"{models.CONFIDENCE:g} or absent",
+                                 hint="the confidence level of the bands tactileskin computes from cov and dof; "
+                                      "not a setting")
         return cls(name=d["name"], model=d["model"], params=d["params"],
                    gs_range=d["gs_range"], p_range=d["p_range"], unit=d.get("unit", "MPa"),
                    cov=d.get("cov"), dof=d.get("dof"), report=d.get("report", {}))
