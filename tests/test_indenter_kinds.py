@@ -352,3 +352,32 @@ def test_a_contact_past_the_printed_face_is_flagged():
     assert "contact_mm" not in mid["indenter_cap"] and mid["indenter_cap"]["cap_mm"] < 0.4
     assert solve(Scene(thickness=1, indenter="cylinder", indenter_radius=0.5, depth=0.25, **kw)).status == "ok"
     assert solve(Scene(skin="pad", pad_width=40, thickness=2, indenter="flat", depth=0.1, **kw)).status == "ok"
+
+
+@pytest.mark.parametrize("name", ["tips.stl", "tips"])
+def test_an_indenter_file_that_is_a_folder_is_named_a_folder(tmp_path, capsys, name):
+    """A folder given as --indenter-file was 'no such file' (named like a file) or 'unsupported
+    suffix' (any other name): it exists, it is a folder; the message says so and what to give."""
+    from tactileskin.cli import main
+
+    d = tmp_path / name
+    d.mkdir()
+    with pytest.raises(ParameterError, match=r"indenter_file=.*it is a folder: give the indenter's STL, OBJ, "
+                                             r"PLY, OFF or STEP file itself"):
+        Scene(dim=3, indenter="file", indenter_file=str(d))
+    capsys.readouterr()
+    assert main(["solve", "--dim", "3", "--indenter", "file", "--indenter-file", str(d), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "is a folder" in err and "no such file" not in err and "suffix" not in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("name", ["skin.step", "skin"])
+def test_a_skin_file_that_is_a_folder_is_named_a_folder(tmp_path, capsys, name):
+    from tactileskin.cli import main
+
+    d = tmp_path / name
+    d.mkdir()
+    assert main(["mesh", "--skin", "file", "--skin-file", str(d)]) == 2
+    err = capsys.readouterr().err
+    assert "skin_file" in err and "it is a folder: give the skin's .msh or STEP file itself" in err, err

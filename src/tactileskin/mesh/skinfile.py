@@ -78,8 +78,14 @@ RULE_FORMS = "'normal:-y' (optionally ':TOL_DEG'), 'normal:+x', ... or 'plane:y=
 _VALID_FILE = "a gmsh .msh with named physical groups or a STEP (.step/.stp) of the skin solid, in mm"
 
 
+# a folder given for the file (the folder of a CAD export): named as such
+_FOLDER = "it is a folder: give the skin's .msh or STEP file itself"
+
+
 def file_digest(path) -> str:
     """SHA-256 of the file's bytes (ParameterError naming `skin_file` if it cannot be read)."""
+    if Path(path).is_dir():
+        raise ParameterError("skin_file", str(path), _VALID_FILE, _FOLDER)
     try:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError as e:
@@ -87,6 +93,8 @@ def file_digest(path) -> str:
 
 
 def file_kind(path) -> str:
+    if Path(str(path)).is_dir():
+        raise ParameterError("skin_file", str(path), _VALID_FILE, _FOLDER)
     suffix = Path(str(path)).suffix.lower()
     if suffix in MSH_SUFFIXES:
         return "msh"

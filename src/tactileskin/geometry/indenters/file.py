@@ -47,7 +47,13 @@ _PAIR_CHUNK = 200_000       # (point, triangle) pairs per closest-point batch (m
 _VALID = "a closed triangle surface in mm (" + ", ".join(MESH_SUFFIXES + STEP_SUFFIXES) + ")"
 
 
+# a folder given for the file (the folder of a CAD export): named as such, not 'no such file'
+_FOLDER = "it is a folder: give the indenter's STL, OBJ, PLY, OFF or STEP file itself"
+
+
 def file_digest(path) -> str:
+    if Path(path).is_dir():
+        raise ParameterError("indenter_file", str(path), _VALID, _FOLDER)
     try:
         return hashlib.sha256(Path(path).read_bytes()).hexdigest()
     except OSError as e:
@@ -98,6 +104,8 @@ def _load(path: str, digest: str):
 
 def load_surface(path) -> tuple[np.ndarray, np.ndarray]:
     p = Path(path)
+    if p.is_dir():
+        raise ParameterError("indenter_file", str(path), _VALID, _FOLDER)
     if p.suffix.lower() not in MESH_SUFFIXES + STEP_SUFFIXES:
         raise ParameterError("indenter_file", str(path), _VALID, f"unsupported suffix {p.suffix!r}")
     if not p.is_file():
