@@ -297,3 +297,23 @@ def test_export_refuses_a_law_the_deck_cannot_write_before_meshing(tmp_path, cap
     err = " ".join(capsys.readouterr().err.split())
     assert "neo_hookean" in err and "hyperfoam for a deck" in err and "Material.law" not in err, err
     assert "Traceback" not in err and not out.exists()
+
+
+@pytest.mark.parametrize("argv", [
+    ["--depth", "5e-324"],                                      # the flat plate: contact at 0 travel
+    ["--depth", "1e-308"],
+    ["-t", "1", "-i", "braille", "--braille-text", "ab"],       # dots at |x| = 3.1 mm: the plate alone
+    ["-t", "1", "-i", "braille", "--braille-text", "ab", "--dim", "3", "--quality", "preview"],
+])
+def test_export_refuses_a_scene_without_contact_as_solve_does(tmp_path, capsys, argv):
+    """`export --depth 5e-324` wrote an Abaqus deck moving the plate by 5e-324 mm over a
+    5e-324 s *VISCO step (exit 0), and a Braille text whose dots touch nothing within the
+    depth a deck of the base plate alone; `solve` refuses both ('no contact', require_contact).
+    The deck now refuses them the same way, before meshing, and writes nothing."""
+    from tactileskin.cli import main
+
+    out = tmp_path / "d.inp"
+    assert main(["export", *argv, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "no contact" in err and "depth=" in err and "Traceback" not in err, err
+    assert not out.exists()

@@ -315,7 +315,9 @@ def _check_dim(dim: int, dialect: str) -> None:
 
 def _check_scene(scene, dialect: str) -> None:
     """What a deck cannot hold, checked before meshing: the dimension's dialect, a loading
-    other than one depth ramp, a material law other than hyperfoam."""
+    other than one depth ramp, a material law other than hyperfoam, and (as solve) an
+    indenter that does not reach the skin within the depth: a deck of no contact."""
+    from tactileskin.geometry.indenters import require_contact
     from tactileskin.materials import get_material
 
     _check_dim(scene.dim, dialect)
@@ -331,6 +333,7 @@ def _check_scene(scene, dialect: str) -> None:
         raise ParameterError(f"material {mat.name!r} law", mat.law_name,
                              "hyperfoam for a deck (it writes *HYPERFOAM)",
                              f"a {mat.law_name} material is not written to decks yet")
+    require_contact(scene)
 
 
 def deck_text(scene, skinmesh, dialect: str = "abaqus", *, viscoelastic: bool | None = None,
