@@ -135,3 +135,27 @@ def test_mesh_command_refuses_a_read_only_folder_before_meshing(tmp_path, capsys
     cap = capsys.readouterr()
     assert calls == [] and cap.out == "" and "permission denied" in cap.err and str(d) in cap.err
     assert list(d.iterdir()) == []
+
+
+def test_the_writability_probe_is_removed_when_interrupted(tmp_path, monkeypatch):
+    """check_writable makes a temporary in the user's folder to see a file can be made there; a
+    Ctrl-C between making it and removing it (here at its os.close) left it behind in their folder."""
+    import os
+
+    import pytest
+
+    from tactileskin import ownership
+
+    d = tmp_path / "d"
+    d.mkdir()
+    real = os.close
+
+    def close(fd):
+        real(fd)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "close", close)
+    with pytest.raises(KeyboardInterrupt):
+        ownership.check_writable(d / "m.msh")
+    monkeypatch.setattr(os, "close", real)
+    assert list(d.iterdir()) == []

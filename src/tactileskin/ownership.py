@@ -86,8 +86,10 @@ def check_writable(path: Path) -> None:
         check_lock_name(folder, RECORD_LOCK)
     with os_errors(there, own_name=False):
         fd, probe = tempfile.mkstemp(prefix=tmp_prefix(path), dir=there)
-        os.close(fd)
-        os.unlink(probe)
+        try:
+            os.close(fd)
+        finally:  # removed even on a Ctrl-C here: the user's folder keeps no trace
+            os.unlink(probe)
 
 
 def check_lock_name(folder: Path, name: str) -> None:
