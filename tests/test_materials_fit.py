@@ -372,3 +372,15 @@ def test_an_absurd_strain_is_refused_in_strain_units(tmp_path, capsys):
     assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(tmp_path / "m.toml")]) == 2
     err = capsys.readouterr().err
     assert "strain" in err and "line 10" in err and "[-0.999, 49]" in err and "Traceback" not in err, err
+
+
+def test_a_headerless_strain_column_from_zero_is_named_as_such(tmp_path):
+    """Two unnamed columns whose first row is 0,0 (a strain column from the unloaded state without its
+    header) were refused at stretch 0 with 'are the columns swapped (stretch first)?' alone; the likelier
+    slip, a strain without its header, is named first (as the fit's own check names it)."""
+    lam = np.linspace(1.0, 2.0, 11)
+    P, _ = uniaxial_nominal(NeoHookean(0.03, 1.5), lam, None)
+    f = tmp_path / "t.csv"
+    f.write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(lam - 1.0, P)))
+    with pytest.raises(FitDataError, match=r"line 1 .*strain.*'strain' header.*swapped"):
+        read_uniaxial_csv(f)

@@ -440,7 +440,8 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
             if not lo <= x <= hi:  # NaN too
                 hint = ("" if not math.isfinite(x) else "a stress in kPa or Pa? give MPa" if unit
                         else "a strain in percent? give it as a fraction (0.5 for 50 %)" if x > hi
-                        else "" if named else "are the columns swapped (stretch first)?")
+                        else "" if named else "a strain without its 'strain' header (stretch = 1 + strain), "
+                                              "or are the columns swapped (stretch first)?")
                 raise FitDataError(name, f"{r[i].strip()} on line {line} of {path.name}",
                                    range_text(lo, hi, unit=unit), hint)
     lam, P = np.array(lam), np.array(P)
