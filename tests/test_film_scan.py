@@ -651,3 +651,26 @@ def test_a_noise_free_line_one_pixel_wide_is_not_told_pixel_noise():
                     for g in (3.0, 0.0))
     assert noisy.pressure_map.shape[0] == 1 and noisy.metrics["peak"] > 1.05 * clean.metrics["peak"]
     assert any("pixel noise" in x for x in noisy.warnings) and not any("pixel noise" in x for x in clean.warnings)
+
+
+def test_noise_that_lifts_a_pixel_to_the_calibration_s_top_is_still_told():
+    """A peak at the calibration's top was not judged for noise at all ('noise cannot lift it'), but noise
+    lifts a pixel under the top to it: a 0.26 MPa/mm Gaussian strip under Eq. 8 calibrated up to 0.3, 5 GS,
+    --rows centre, read 0.300 (+15 % on its noise-free 0.260) with no pixel-noise warning, while the same scan
+    under a calibration reaching 0.6 was told. A peak at the top is judged on the profile's roughness along
+    it over its unclipped columns; noise-free held spots are still not told."""
+    from tactileskin.film.calibration import Calibration
+
+    eq8 = paper_eq8()
+    low = Calibration(name="low", model="linear", params=eq8.params, gs_range=(float(eq8.grayscale(0.3)), 255.0),
+                      p_range=eq8.p_range, unit=eq8.unit)
+    kw = dict(width_mm=5.0, px_per_mm=8.0, background_gs=245.0)
+    clean = analyze_scan(render_scan(gaussian_profile(0.26, 1.0), **kw), low, rows="centre")
+    fp = analyze_scan(render_scan(gaussian_profile(0.26, 1.0), noise_gs=5.0, seed=1, **kw), low, rows="centre")
+    assert fp.coverage["held_fraction"] > 0 and fp.metrics["peak"] == pytest.approx(0.3, rel=1e-9)  # the premise
+    assert fp.metrics["peak"] > 1.1 * clean.metrics["peak"]
+    told = [w for w in fp.warnings if "pixel noise" in w]
+    assert told and "roughness along it" in told[0], fp.warnings
+    for peak, size in ((0.9, 1.0), (0.5, 1.0), (0.9, 2.0)):  # noise-free, held: not told
+        img = _spot(peak, size, "hertz", blur=0.5, seed=0, noise=0.0, dx=0.07, dy=0.05)
+        assert not any("pixel noise" in w for w in analyze_scan(img, low, rows="centre").warnings)
