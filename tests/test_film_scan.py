@@ -674,3 +674,13 @@ def test_noise_that_lifts_a_pixel_to_the_calibration_s_top_is_still_told():
     for peak, size in ((0.9, 1.0), (0.5, 1.0), (0.9, 2.0)):  # noise-free, held: not told
         img = _spot(peak, size, "hertz", blur=0.5, seed=0, noise=0.0, dx=0.07, dy=0.05)
         assert not any("pixel noise" in w for w in analyze_scan(img, low, rows="centre").warnings)
+
+
+def test_a_one_pixel_line_s_noise_warning_says_how_it_was_read():
+    """A row standing alone (a line a pixel wide) is judged on its roughness along it, but its warning said
+    '(against the rows beside it)', the estimate it was not read from."""
+    noisy = analyze_scan(render_scan(gaussian_profile(0.5, 1.0), paper_eq8(), width_mm=0.25, px_per_mm=4.0,
+                                     blur_px=1.0, noise_gs=3.0, background_gs=245.0, seed=1), px_per_mm=4.0)
+    told = [w for w in noisy.warnings if "pixel noise" in w]
+    assert noisy.pressure_map.shape[0] == 1 and told, noisy.warnings  # the premise
+    assert "from its roughness along it" in told[0] and "against the rows beside it" not in told[0], told

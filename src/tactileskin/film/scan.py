@@ -655,7 +655,7 @@ def _roughness(row: np.ndarray, keep: np.ndarray) -> float | None:
     return float(np.std(row[j] - 2.0 * row[j + 1] + row[j + 2]) / math.sqrt(6.0))
 
 
-def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> float | None:
+def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None, how: list | None = None) -> float | None:
     """The pixel noise (sd) of row k: the spread of the row less its neighbours' mean over the columns at
     >= SPAN_LEVEL of its largest (the curvature across, nearly constant along them, drops out of the
     spread), / sqrt(1 + 1/n) for the neighbours' own noise; None without a neighbour or 3 such columns.
@@ -664,7 +664,8 @@ def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> floa
     shape: less first the part of that difference proportional to the neighbours' mean (a press a few
     pixels wide: its neighbours are its blurred edges, whose step below it scales with the profile along
     it, and was read as noise: a noise-free 0.3 mm line at 8 px/mm, 5 % of its peak); a row whose neighbours read
-    under STRIP_ROWS of it is the press alone across, judged on its roughness along it (_roughness)."""
+    under STRIP_ROWS of it is the press alone across, judged on its roughness along it (_roughness; "rough" is then
+    appended to `how`, for the warning's words)."""
     nb = [j for j in (k - 1, k + 1) if 0 <= j < pmap.shape[0]]
     row = pmap[k]
     keep = row >= SPAN_LEVEL * row.max()
@@ -674,6 +675,8 @@ def _row_noise(pmap: np.ndarray, k: int, shape: bool = False, clip=None) -> floa
         unclipped = keep if clip is None else keep & (row > clip[0]) & (row < clip[1])
         rough = _roughness(row, unclipped)
         if rough is not None:
+            if how is not None:
+                how.append("rough")
             return rough
     if clip is not None and nb:  # (one neighbour clipped still holds the other's reading and the row's noise)
         inside = (pmap[[k] + nb] > clip[0]) & (pmap[[k] + nb] < clip[1])
@@ -767,6 +770,7 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
     pmap = cal.pressure(region)
     full = pmap  # the strip's orientation and an inverted scan are judged on all its rows
     row_noise = None  # the pixel noise of a profile read from a row or a few (FEW_ROWS), else not judged
+    alone = []  # "rough": its row stands alone across (a line a pixel wide), its noise read along it
     if rows == "centre" or (pmap.shape[0] <= FEW_ROWS and region_info["method"] == "auto"):
         # a round press read across its rows averages its fall-off (a Hertzian spot's mean 9 % below its
         # centre line): the row through the peak of the row means, found as the peak along the strip is
@@ -860,11 +864,13 @@ def analyze_scan(scan, calibration: Calibration | None = None, *, px_per_mm: flo
         if row_noise is not None and " wide across " in narrow:
             # the rows beside a press this narrow are its blurred edges: their step, not noise (the
             # resolution warning says why it reads wrong); the noise left once that step is fitted out
-            shaped = _row_noise(*beside, shape=True, clip=_flat_ends(cal))
+            shaped = _row_noise(*beside, shape=True, clip=_flat_ends(cal), how=alone)
             row_noise = None if shaped is None else shaped / math.sqrt(pmap.shape[0])  # one row or their mean
     top = float(np.max(prof))
     noise_how = "against the rows beside it" + (f", / sqrt({pmap.shape[0]}) for the mean"
                                                if rows != "centre" and pmap.shape[0] > 1 else "")
+    if row_noise is not None and alone:
+        noise_how = "from its roughness along it (the rows beside it are white film)"
     flat = _flat_ends(cal)
     if row_noise is not None and top >= flat[1]:
         # a peak at the top clip (saturated, or held at the darkest press): the rows beside a held top step
