@@ -317,3 +317,24 @@ def test_export_refuses_a_scene_without_contact_as_solve_does(tmp_path, capsys, 
     err = capsys.readouterr().err
     assert "no contact" in err and "depth=" in err and "Traceback" not in err, err
     assert not out.exists()
+
+
+def test_a_depth_at_the_first_touch_is_refused_with_a_range_it_is_outside(tmp_path, capsys, monkeypatch):
+    """`--depth 5e-324` on the flat plate (first touch at 0 travel) was refused as 'depth=5e-324 is
+    invalid; valid: > 0 mm': a value the message itself calls valid (contact needs depth > travel + 1e-9);
+    likewise a first touch at 0.4764 mm refused depth 0.4762 under 'valid: > 0.476'. The bound shown is
+    the one applied, rounded up."""
+    import re
+
+    import tactileskin.geometry.indenters as ind
+    from tactileskin.cli import main
+    from tactileskin.errors import ParameterError
+    from tactileskin.scene import Scene
+
+    assert main(["export", "--depth", "5e-324", "-o", str(tmp_path / "d.inp")]) == 2
+    err = capsys.readouterr().err
+    assert not 5e-324 > float(re.search(r"valid: > ([0-9.e+-]+) mm", err).group(1)), err
+    monkeypatch.setattr(ind, "first_contact_travel", lambda scene: 0.4764)
+    with pytest.raises(ParameterError) as e:
+        ind.require_contact(Scene(thickness=1.0, depth=0.4762))
+    assert not 0.4762 > float(re.search(r"valid: > ([0-9.e+-]+) mm", str(e.value)).group(1)), str(e.value)

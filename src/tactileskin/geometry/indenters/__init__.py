@@ -10,6 +10,7 @@ the CAD solids are built from. See docs/architecture.md, "geometry.indenters".
 from __future__ import annotations
 
 import logging
+import math
 
 import numpy as np
 
@@ -153,6 +154,12 @@ def _require_every_dot(scene) -> None:
                              f"{touch[far].min():.3g} mm and would press nothing; use a larger depth or fewer cells")
 
 
+def _up3(x: float) -> float:
+    """x rounded up at 3 significant digits: a bound shown that no refused value exceeds."""
+    e = math.floor(math.log10(x)) - 2
+    return math.ceil(x / 10.0 ** e) * 10.0 ** e
+
+
 def require_contact(scene) -> None:
     """Raise ParameterError if the scene's indenter cannot touch the skin within its depth
     (a solve would return zero pressure everywhere: no contact)."""
@@ -179,7 +186,7 @@ def require_contact(scene) -> None:
     dmax = 0.6 * scene.thickness
     if travel < dmax:
         hint = " or a text with a dot on the centre line" if isinstance(ind, BrailleIndenter) else ""
-        raise ParameterError("depth", depth, f"> {travel:.3g} mm for this indenter, at most {dmax:g} mm",
+        raise ParameterError("depth", depth, f"> {_up3(travel + 1e-9):.3g} mm for this indenter, at most {dmax:g} mm",
                              f"no contact: {why}; use a larger depth{hint}")
     # the kind's own parameters place it: name the first (the text, the file), else the kind
     field_ = next(iter(get_kind(scene.indenter).scene_params), "indenter")
