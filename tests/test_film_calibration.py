@@ -85,6 +85,19 @@ def test_fewer_than_three_points_is_an_error():
         fit_calibration([50, 150], [0.7, 0.3])
 
 
+@pytest.mark.parametrize("scale", [1e300, 1e200, 1e160])
+def test_pressures_past_what_the_fit_can_square_are_a_parameter_error(scale):
+    """From Python (any unit: the CSV path checks MPa), pressures of 1e200-1e300 stopped the fit
+    with an OverflowError, and 1e160 gave a band of zero width (J^T J overflowed to inf)."""
+    with pytest.raises(ParameterError, match=r"calibration pressure=.*\|P\| <= 1e\+100"):
+        fit_calibration([200, 150, 100, 50], [1 * scale, 2.1 * scale, 2.9 * scale, 4 * scale])
+    # at the bound the band is the scaled one of unit pressures
+    c = fit_calibration([200, 150, 100, 50], [0.25e100, 0.525e100, 0.725e100, 1e100])
+    ref = fit_calibration([200, 150, 100, 50], [0.25, 0.525, 0.725, 1.0])
+    lo, hi = c.band(np.array([125.0]))
+    assert np.allclose([lo[0] / 1e100, hi[0] / 1e100], [b[0] for b in ref.band(np.array([125.0]))], rtol=1e-9)
+
+
 def test_presses_a_scan_cannot_tell_apart_are_rejected():
     # 1e-4 gray levels apart: fitted a slope of 1e4 MPa per level (overflow warnings), and
     # read 82 % of a normal scan as saturated

@@ -61,6 +61,7 @@ MAX_PRESSES = 10_000    # a calibration is tens of presses; more is a wrong file
 # P = F/A of a press (MPa): pressure films read 0.005-300 MPa; past these a unit is wrong (a force
 # of 1e308 N overflowed the fit, an area of 1e308 mm^2 fitted 4e-307 MPa and was written)
 PRESS_P_RANGE = (1e-6, 1e4)
+MAX_ABS_PRESSURE = 1e100  # fit_calibration, any unit: J^T J of the fit stays finite (1e160 overflowed)
 
 
 @dataclass(frozen=True)
@@ -336,6 +337,11 @@ def fit_calibration(gray, pressure, *, model: str = "auto", name: str = "fitted"
         raise ParameterError("calibration points", "non-finite values", "finite GS and P")
     if np.any((x < 0) | (x > 255)):
         raise ParameterError("calibration gray", f"[{x.min():g}, {x.max():g}]", "[0, 255]")
+    if np.max(np.abs(y)) > MAX_ABS_PRESSURE:  # any unit here (the CSV path checks MPa)
+        raise ParameterError("calibration pressure", f"{np.max(np.abs(y)):g} {unit}",
+                             f"|P| <= {MAX_ABS_PRESSURE:g} in any unit",
+                             hint="the fit's normal equations square the pressures: 1e200 overflowed, "
+                                  "1e160 gave a band of zero width")
     if np.ptp(x) == 0:
         raise ParameterError("calibration gray", f"all {x[0]:g}", "at least two distinct values",
                              hint="every press has the same grayscale")
