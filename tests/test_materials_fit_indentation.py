@@ -144,3 +144,47 @@ def test_a_force_column_off_by_a_unit_is_flagged_or_refused_as_the_uniaxial_fits
     assert main(["material", "fit", str(csv), "--test", "indentation", "--radius", str(R), "--thickness", str(T),
                  "--law", "neo_hookean", "-o", str(tmp_path / "uN.toml")]) == 2
     assert not (tmp_path / "uN.toml").exists()
+
+
+@pytest.mark.parametrize("col, value, words", [
+    ("depth", "1e308", ["depth_mm", "1e308", "line 4", "[0, 1000] mm", "um"]),
+    ("depth", "inf", ["depth_mm", "inf", "line 4", "[0, 1000] mm"]),
+    ("depth", "nan", ["depth_mm", "nan", "line 4", "[0, 1000] mm"]),
+    ("depth", "-0.05", ["depth_mm", "-0.05", "line 4", "[0, 1000] mm"]),
+    ("force", "1e308", ["Force_N", "1e308", "line 4", "[0, 10000] N", "mN"]),
+    ("force", "-inf", ["Force_N", "-inf", "line 4", "[0, 10000] N"]),
+    ("force", "NaN", ["Force_N", "NaN", "line 4", "[0, 10000] N"]),
+    ("force", "-0.2", ["Force_N", "-0.2", "line 4", "[0, 10000] N"]),
+])
+def test_a_value_no_indentation_test_gives_is_refused_as_the_csv_is_read(tmp_path, capsys, col, value, words):
+    """The uniaxial reader refuses a stretch or stress no test gives, naming the column, value,
+    line and range; the indentation reader read any number (1e308, inf, a negative depth) and
+    left it to the fit (a row number, not the line, or no message naming the column)."""
+    from tactileskin.materials.indentation import read_indentation_csv
+
+    d = np.linspace(0.02, 0.2, 6)
+    rows = [[f"{float(a)!r}", f"{float(b)!r}"] for a, b in zip(d, bonded_sphere_force(0.18, d, R, T))]
+    rows[1][0 if col == "depth" else 1] = value   # the 2nd data row: line 4 (a comment line first)
+    csv = tmp_path / "ind.csv"
+    csv.write_text("# sphere on a pad\ndepth_mm,Force_N\n" + "".join(",".join(r) + "\n" for r in rows))
+    with pytest.raises(FitDataError) as e:
+        read_indentation_csv(csv)
+    msg = str(e.value)
+    assert all(w in msg for w in words), msg
+    out = tmp_path / "m.toml"
+    assert main(["material", "fit", str(csv), "--test", "indentation", "--radius", str(R), "--thickness", str(T),
+                 "--law", "neo_hookean", "-o", str(out)]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "line 4" in err and "Traceback" not in err and not out.exists()
+
+
+def test_unnamed_indentation_columns_are_range_checked_by_their_role(tmp_path):
+    from tactileskin.materials.indentation import read_indentation_csv
+
+    csv = tmp_path / "ind.csv"
+    csv.write_text("0,0\n0.05,0.01\n0.1,20000\n")
+    with pytest.raises(FitDataError, match=r"force.*20000 on line 3.*\[0, 10000\] N"):
+        read_indentation_csv(csv)
+    csv.write_text("0,0\n0.05,0.01\n0.1,0.03\n")
+    d, F = read_indentation_csv(csv)
+    assert d.tolist() == [0.0, 0.05, 0.1] and F.tolist() == [0.0, 0.01, 0.03]

@@ -455,13 +455,9 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
     return (1.0 + lam if strain else lam), P
 
 
-def _csv_rows(path: Path, what: str) -> list[list[str]]:
-    """The non-empty, non-comment rows of a UTF-8 CSV of at most MAX_CSV_BYTES."""
-    return [r for _, r in _csv_numbered_rows(path, what)]
-
-
 def _csv_numbered_rows(path: Path, what: str) -> list[tuple[int, list[str]]]:
-    """_csv_rows, each with its line number in the file (where it ends), for messages."""
+    """The non-empty, non-comment rows of a UTF-8 CSV of at most MAX_CSV_BYTES, each with its
+    line number in the file (where it ends), for messages."""
     try:
         with open(path, "rb") as fh:
             raw = fh.read(MAX_CSV_BYTES + 1)
@@ -481,31 +477,6 @@ def _csv_numbered_rows(path: Path, what: str) -> list[tuple[int, list[str]]]:
     if not rows:
         raise FitDataError("data", str(path), f"a CSV with rows of {what}")
     return rows
-
-
-def read_columns(path, xnames, ynames, xlabel: str, ylabel: str) -> tuple[np.ndarray, np.ndarray]:
-    """Two numeric columns from a CSV: named by a header (the first of `xnames` / `ynames`
-    found) or the first two unnamed columns."""
-    path = Path(path)
-    rows = _csv_rows(path, f"{xlabel} and {ylabel}")
-    head = [c.strip().lower() for c in rows[0]]
-    if _is_number(rows[0][0]):
-        ix, iy, body, first = 0, 1, rows, 1
-    else:
-        ix = next((head.index(n) for n in xnames if n in head), None)
-        iy = next((head.index(n) for n in ynames if n in head), None)
-        if ix is None or iy is None:
-            raise FitDataError("data header", ",".join(head), f"a {xlabel} column ({' | '.join(xnames)}) and a "
-                                                             f"{ylabel} column ({' | '.join(ynames)})")
-        body, first = rows[1:], 2
-    x, y = [], []
-    for n, r in enumerate(body, start=first):
-        try:
-            x.append(float(r[ix]))
-            y.append(float(r[iy]))
-        except (ValueError, IndexError):
-            raise FitDataError("data", f"{path.name} row {n}: {','.join(r)}", f"two numbers ({xlabel}, {ylabel})") from None
-    return np.array(x), np.array(y)
 
 
 def _is_number(s) -> bool:

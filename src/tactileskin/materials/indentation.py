@@ -158,10 +158,55 @@ _DEPTH = ("depth_mm", "depth", "indentation_mm", "indentation")
 _FORCE = ("force_n", "force")
 
 
+# What no indentation test of a skin layer gives, so that a value outside is a slip (a typo, a
+# unit), refused naming it as the CSV is read (as fit.read_uniaxial_csv does). Depth in
+# [0, 1000] mm: the fit takes d/R <= 0.1 at R <= 1e4 mm, so a deeper point cannot be fitted,
+# and 1 m is past any instrument's travel on a layer (0: the contact row). Force in [0, 1e4] N:
+# the sphere pushes the layer (compression positive), and 10 kN is past the load cells of
+# tabletop testing machines (loading.MAX_FORCE, the solver's target, is the same bound).
+MAX_DEPTH_MM = 1e3
+MAX_FORCE_N = 1e4
+
+
 def read_indentation_csv(path) -> tuple[np.ndarray, np.ndarray]:
     """(depth mm, force N) from a CSV with a header naming a depth column (depth_mm | depth |
     indentation_mm | indentation) and a force column (force_n | force), or two unnamed
-    numeric columns (depth, force)."""
-    from tactileskin.materials.fit import read_columns
+    numeric columns (depth, force). A value outside [0, MAX_DEPTH_MM] mm or [0, MAX_FORCE_N]
+    N (NaN, inf too) raises FitDataError naming the column, the value and its line."""
+    import math
+    from pathlib import Path
 
-    return read_columns(path, _DEPTH, _FORCE, "depth", "force")
+    from tactileskin.errors import range_text
+    from tactileskin.materials.fit import _csv_numbered_rows, _is_number
+
+    path = Path(path)
+    lines, rows = zip(*_csv_numbered_rows(path, "depth and force"))
+    head = [c.strip().lower() for c in rows[0]]
+    named = not _is_number(rows[0][0])
+    if named:
+        i_d = next((head.index(n) for n in _DEPTH if n in head), None)
+        i_f = next((head.index(n) for n in _FORCE if n in head), None)
+        if i_d is None or i_f is None:
+            raise FitDataError("data header", ",".join(head), f"a depth column ({' | '.join(_DEPTH)}) and a "
+                                                             f"force column ({' | '.join(_FORCE)})")
+        body, where = rows[1:], lines[1:]
+    else:
+        i_d, i_f, body, where = 0, 1, rows, lines
+    # the column as the header spells it
+    cols = ((i_d, rows[0][i_d].strip() if named else "depth", MAX_DEPTH_MM, "mm", "a depth in um? give mm"),
+            (i_f, rows[0][i_f].strip() if named else "force", MAX_FORCE_N, "N", "a force in mN? give N"))
+    out = ([], [])
+    for r, line in zip(body, where):
+        for k, (i, name, hi, unit, hint) in enumerate(cols):
+            try:
+                x = float(r[i])
+            except (ValueError, IndexError):
+                raise FitDataError("data", f"line {line} of {path.name}: {','.join(r)}",
+                                   "two numbers (depth mm, force N)") from None
+            if not 0.0 <= x <= hi:  # NaN too
+                raise FitDataError(name, f"{r[i].strip()} on line {line} of {path.name}", range_text(0.0, hi, unit=unit),
+                                   hint if math.isfinite(x) and x > hi else
+                                   "" if not math.isfinite(x) else f"a {('depth' if k == 0 else 'force')} is "
+                                   + ("measured from first contact" if k == 0 else "positive in compression"))
+            out[k].append(x)
+    return np.array(out[0]), np.array(out[1])
