@@ -93,7 +93,7 @@ def no_solves(monkeypatch):
 @pytest.mark.parametrize("text, words", [
     ("[array]\nthicknesses = \"x\"\n", ["thicknesses", "a list of numbers > 0 mm"]),   # was a ValueError traceback
     ("[array]\nseed = \"x\"\n", ["seed='x'", "an integer >= 0"]),                       # ditto
-    ("[array]\npitches = \"abc\"\n", ["pitches", "[0.05, 20] mm"]),                   # was "ufunc 'isfinite'..."
+    ("[array]\npitches = \"abc\"\n", ["pitches", "[0.0809, 20] mm"]),   # was "ufunc 'isfinite'..."; the memory's bound
     ("[array]\nnoise_fs = \"abc\"\n", ["noise_fs", "[0, 10]"]),
     ("[array]\nmax_depth = \"abc\"\n", ["max_depth='abc'", "> 0 mm"]),
     ("[array]\nthicknesses = [1, \"x\"]\n", ["thicknesses", "'x'", "> 0 mm"]),
@@ -168,7 +168,7 @@ def test_a_value_listed_twice_is_refused(tmp_path, capsys):
 
 @pytest.mark.parametrize("flags, words", [
     # LDA's covariance of 161 x 161 taxels is 5 GB a copy: a MemoryError traceback after the solves
-    (["--pitch", "0.05,1"], ["pitches (--pitch)=0.05", ">= 0.08", "8 mm window", "covariance"]),
+    (["--pitch", "0.05,1"], ["pitches (--pitch)=0.05", "[0.08", "8 mm window", "memory"]),
     # the readings of 1e8 offsets filled the memory after the solves
     (["--offsets", "100000000"], ["n_train (--offsets)=100000000", "an integer in [2, "]),
 ])
@@ -191,7 +191,7 @@ def test_the_memory_rule_keeps_the_default_chart_and_its_finest_allowed_pitch():
         ChartConfig(pitches=(0.05,), sets=("letters",))
     except ParameterError as e:
         msg = str(e)
-    p = float(msg.split(">= ")[1].split(" mm")[0])
+    p = float(msg.split("[")[1].split(",")[0])
     cfg = ChartConfig(pitches=(p,), sets=("letters",))  # the pitch the message quotes is accepted
     assert classify.memory_bytes(36, cfg.spec(p).n ** 2, 16, 16, 4) <= classify.MAX_BYTES
     with pytest.raises(ParameterError, match="template_grid"):
@@ -266,3 +266,26 @@ def test_the_readme_names_every_column_of_accuracies_csv():
     cell = re.search(r"- `accuracies\.csv`: (.*?) - `array_chart\.md`", doc).group(1)
     assert "n_test" in header and [c for c in header if f"`{c}`" not in cell] == []
     assert "test readings per stimulus" in cell
+
+
+def test_the_pitch_range_states_the_bound_the_memory_rule_keeps(tmp_path, capsys, no_solves):
+    """--pitch 0.04 was refused with "valid: [0.05, 20] mm", then --pitch 0.05 by the memory rule
+    (">= 0.0809 mm over the 8 mm window"): the range must state the finest pitch this chart's
+    window, sets and offsets allow, and that pitch must be accepted."""
+    from tactileskin.array.chart import ChartConfig
+    from tactileskin.errors import ParameterError
+
+    out = tmp_path / "o"
+    assert main(["array", "--set", "paper", "-t", "1", "-o", str(out), "--pitch", "0.04"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    lo = float(err.split("[")[1].split(",")[0])
+    assert lo > 0.05 and "8 mm window" in err, err
+    ChartConfig(pitches=(lo,), sets=("paper",))  # the bound it states is accepted
+    with pytest.raises(ParameterError, match="memory"):
+        ChartConfig(pitches=(0.95 * lo,), sets=("paper",))
+    # a small window keeps the sampler's own 0.05 mm
+    with pytest.raises(ParameterError, match=r"\[0\.05, 20\] mm"):
+        ChartConfig(pitches=(0.04,), window=2.0)
+    ChartConfig(pitches=(0.05,), window=2.0)
+    assert not out.exists()

@@ -36,6 +36,9 @@ CHART_MESH = (1.2, 8.0)
 NOISE_MPA_MAX = 1e4
 
 
+PITCH = (0.05, 20.0)  # mm: the taxel pitch (a finer one where the window and memory allow none finer)
+
+
 def _numbers(v, name: str, lo: float, hi: float | None, unit: str, lo_open: bool = False) -> tuple:
     """A non-empty list of distinct numbers within [lo, hi] as a tuple (a repeated value wrote
     every row of accuracies.csv twice; [1, 3, 1] is likely a typo for [1, 3, 5], refused as a
@@ -145,8 +148,10 @@ class ChartConfig:
             set_("noise_mpa", _numbers(self.noise_mpa, "noise_mpa (--noise-mpa)", 0.0, NOISE_MPA_MAX, "MPa", True))
         elif self.noise_fs is None:
             set_("noise_fs", NOISE_FS)
+        # the finest pitch the checks below keep (window, memory), so the range states no pitch they refuse
+        plo, punit = self._pitch_floor()
         for name, flag, lo, hi, lo_open, unit in (("thicknesses", "-t", 0.0, None, True, "mm"),  # the skin: its range
-                                                  ("pitches", "--pitch", 0.05, 20.0, False, "mm"),
+                                                  ("pitches", "--pitch", plo, PITCH[1], False, punit),
                                                   ("noise_fs", "--noise", 0.0, 10.0, False, "x full scale")):
             if getattr(self, name) is not None:  # noise_fs: None with noise_mpa
                 set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
@@ -221,6 +226,39 @@ class ChartConfig:
             raise ParameterError("letters", self.letters, "at least two distinct characters a-z, 0-9",
                                  hint=f"not characters of the set: {''.join(dict.fromkeys(bad))}" if bad else "")
         self._check_memory()
+
+    def _pitch_floor(self) -> tuple[float, str]:
+        """(finest pitch, unit text) this chart allows: PITCH[0], or coarser where the sampler's
+        MAX_TAXELS a side or _check_memory would refuse a finer one over the window (for the
+        pitch's range message; read before the other fields are checked: PITCH[0] if they are not
+        numbers of the right kind, their own checks then name them)."""
+        import math
+
+        from tactileskin.array import classify
+
+        try:
+            window = float(self.window)
+            letters = {c for c in self.letters if c not in ", "}
+            ncls = max({"paper": 3, "shapes": 4, "letters": len(letters)}[s] for s in _names(self.sets, "sets", SETS))
+            tr, te, g = (int(v) for v in (self.n_train, self.n_test, self.template_grid))
+            if not (window > 0.0 and math.isfinite(window) and tr >= 2 and te >= 1 and g >= 1):
+                return PITCH[0], "mm"
+        except (TypeError, ValueError, ParameterError):
+            return PITCH[0], "mm"
+        need = lambda k, a, b, c: classify.memory_bytes(ncls, k * k, a, b, c)  # noqa: E731
+        # taxels a side that fit (as _check_memory: the offsets' and templates' if any, else LDA's alone)
+        kmax = 2
+        fits = (lambda k: need(k, tr, te, g) <= classify.MAX_BYTES) if need(2, tr, te, g) <= classify.MAX_BYTES \
+            else (lambda k: need(k, 2, 1, 1) <= classify.MAX_BYTES)
+        while kmax < MAX_TAXELS and fits(kmax + 1):
+            kmax += 1
+        pmin = window / (kmax - 1)
+        e = 10.0 ** (math.floor(math.log10(pmin)) - 2)
+        pmin = math.ceil(pmin / e) * e
+        if pmin <= PITCH[0] or pmin > PITCH[1]:  # above PITCH[1]: the window's own check names it
+            return PITCH[0], "mm"
+        why = "the sampler's" if kmax == MAX_TAXELS else "the memory of one pitch's classification"
+        return float(f"{pmin:.3g}"), f"mm over the {window:g} mm window ({kmax} x {kmax} taxels at most: {why})"
 
     def _check_memory(self) -> None:
         """Refuse, before any solve, a chart whose classification of one (set, pitch) would
