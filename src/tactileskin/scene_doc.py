@@ -38,7 +38,7 @@ FIELDS: dict[str, tuple[str, str, str]] = {
                 "inward normal there, height along that line from the bonded surface; dome: as file, s = x, "
                 "z in [-dome_length, dome_tip]",
                 "where stresses are read (sensors.csv); () = none"),
-    "indenter_radius": ("mm", "(0.1, 1000]; sphere and cylinder only", "indenter radius"),
+    "indenter_radius": ("mm", "(0.1, 1000] (sphere: (0.1, 100], its printed part); sphere and cylinder only", "indenter radius"),
     "indenter_axis": ("-", "'z' (along the finger, 2D-exact) or 'x' (3D); cylinder only", "cylinder axis"),
     "indenter_file": ("mm", "a closed STL/OBJ/PLY/OFF or STEP surface in mm; 'file' indenter only",
                       "the user's indenter surface"),

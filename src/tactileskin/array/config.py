@@ -187,7 +187,10 @@ class ChartConfig:
         for name, choices in (("letters_model", LETTERS_MODELS), ("sphere_quality", QUALITIES), ("skin", SKINS)):
             if not isinstance(getattr(self, name), str) or getattr(self, name) not in choices:
                 raise ParameterError(name, getattr(self, name), " or ".join(choices))
-        check_range("sphere_radius", self.sphere_radius, 0.1, 1000.0, lo_open=True, unit="mm")  # the sphere kind's range
+        from tactileskin.geometry.indenters.base import RADIUS
+        from tactileskin.geometry.indenters.sphere import MAX_RADIUS
+
+        check_range("sphere_radius", self.sphere_radius, RADIUS[0], MAX_RADIUS, lo_open=True, unit="mm")  # the sphere kind's range
         if self.max_depth is not None:
             set_("max_depth", check_range("max_depth", self.max_depth, 0.0, lo_open=True,
                                           unit="mm (or none: 20 % of t)"))

@@ -216,11 +216,16 @@ class Indenter:
 RADIUS = (0.1, 1000.0)  # mm: indenter_radius of a sphere or cylinder, (lo, hi]
 
 
-def check_radius(value, kind: str, lo: float = RADIUS[0], hi: float = RADIUS[1]) -> float:
+def check_radius(value, kind: str, lo: float = RADIUS[0], hi: float = RADIUS[1], hint: str = "") -> float:
     if value is None:
         raise ParameterError("indenter_radius", None, f"({lo:g}, {hi:g}] mm for the {kind} indenter",
                              "the radius is required (no default)")
-    return check_range("indenter_radius", value, lo, hi, lo_open=True, unit="mm")
+    try:
+        return check_range("indenter_radius", value, lo, hi, lo_open=True, unit="mm")
+    except ParameterError as e:
+        if not hint:
+            raise
+        raise ParameterError("indenter_radius", value, f"{e.valid} for the {kind} indenter", hint) from None
 
 
 def stem_params() -> dict:

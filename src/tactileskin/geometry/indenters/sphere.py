@@ -18,6 +18,15 @@ from tactileskin.geometry.indenters.registry import register
 # the printed ball's working face: a cap this fraction of R high (solids.sphere_indenter fuses
 # it into a plate there); deeper presses are refused
 CAP = 0.95
+# The largest ball (mm): its printed part (solids.sphere_indenter, a 2.4 R plate under the
+# ball) is then 240 mm across, a desktop printer's bed. The ball cannot be cut to the part
+# that touches the skin as the cylinder's strip is: its contact grows as sqrt(2 R d) along the
+# finger as well as across it, so a cut face would end inside the contact the model has. Past
+# it the build grows with R (R 100: 8 s, a 5 MB STL; R 1000: 176 s, 46 MB, for a part
+# 2.4 m across); a larger ball on a fingertip-sized skin approaches the flat plate.
+MAX_RADIUS = 100.0
+RADIUS_HINT = (f"the printed ball is 2.4 R across (a desktop printer's bed at R {MAX_RADIUS:g}); "
+               "a larger one on a fingertip-sized skin approaches the flat indenter")
 
 
 @register
@@ -33,7 +42,7 @@ class SphereIndenter(Indenter):
 
     @classmethod
     def check_scene(cls, scene) -> dict:
-        radius = check_radius(scene.indenter_radius, cls.name)
+        radius = check_radius(scene.indenter_radius, cls.name, hi=MAX_RADIUS, hint=RADIUS_HINT)
         if scene.dim == 2:
             raise ParameterError("dim", 2, "3 for the sphere indenter",
                                  "a sphere is not uniform along the finger; its plane-strain section "
@@ -56,7 +65,7 @@ class SphereIndenter(Indenter):
 
     @classmethod
     def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None, **_):
-        R = check_radius(indenter_radius, cls.name)
+        R = check_radius(indenter_radius, cls.name, hi=MAX_RADIUS, hint=RADIUS_HINT)
         # the standard stem: a ball narrower than it gets a mount block (solids._add_stem)
         return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem_params())
 
