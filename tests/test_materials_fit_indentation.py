@@ -151,10 +151,10 @@ def test_a_force_column_off_by_a_unit_is_flagged_or_refused_as_the_uniaxial_fits
     ("depth", "inf", ["depth_mm", "inf", "line 4", "[0, 1000] mm"]),
     ("depth", "nan", ["depth_mm", "nan", "line 4", "[0, 1000] mm"]),
     ("depth", "-0.05", ["depth_mm", "-0.05", "line 4", "[0, 1000] mm"]),
-    ("force", "1e308", ["Force_N", "1e308", "line 4", "[0, 10000] N", "mN"]),
-    ("force", "-inf", ["Force_N", "-inf", "line 4", "[0, 10000] N"]),
-    ("force", "NaN", ["Force_N", "NaN", "line 4", "[0, 10000] N"]),
-    ("force", "-0.2", ["Force_N", "-0.2", "line 4", "[0, 10000] N"]),
+    ("force", "1e308", ["Force_N", "1e308", "line 4", "[-10000, 10000] N", "mN"]),
+    ("force", "-inf", ["Force_N", "-inf", "line 4", "[-10000, 10000] N"]),
+    ("force", "NaN", ["Force_N", "NaN", "line 4", "[-10000, 10000] N"]),
+    ("force", "-2e4", ["Force_N", "-2e4", "line 4", "[-10000, 10000] N", "mN"]),
 ])
 def test_a_value_no_indentation_test_gives_is_refused_as_the_csv_is_read(tmp_path, capsys, col, value, words):
     """The uniaxial reader refuses a stretch or stress no test gives, naming the column, value,
@@ -183,8 +183,11 @@ def test_unnamed_indentation_columns_are_range_checked_by_their_role(tmp_path):
 
     csv = tmp_path / "ind.csv"
     csv.write_text("0,0\n0.05,0.01\n0.1,20000\n")
-    with pytest.raises(FitDataError, match=r"force.*20000 on line 3.*\[0, 10000\] N"):
+    with pytest.raises(FitDataError, match=r"force.*20000 on line 3.*\[-10000, 10000\] N"):
         read_indentation_csv(csv)
     csv.write_text("0,0\n0.05,0.01\n0.1,0.03\n")
     d, F = read_indentation_csv(csv)
     assert d.tolist() == [0.0, 0.05, 0.1] and F.tolist() == [0.0, 0.01, 0.03]
+    # a load cell's noise near contact (a small negative reading) is read, as before, for the fit
+    csv.write_text("0,0\n0.01,-0.0004\n0.05,0.01\n0.1,0.03\n")
+    assert read_indentation_csv(csv)[1].tolist() == [0.0, -0.0004, 0.01, 0.03]

@@ -161,9 +161,10 @@ _FORCE = ("force_n", "force")
 # What no indentation test of a skin layer gives, so that a value outside is a slip (a typo, a
 # unit), refused naming it as the CSV is read (as fit.read_uniaxial_csv does). Depth in
 # [0, 1000] mm: the fit takes d/R <= 0.1 at R <= 1e4 mm, so a deeper point cannot be fitted,
-# and 1 m is past any instrument's travel on a layer (0: the contact row). Force in [0, 1e4] N:
-# the sphere pushes the layer (compression positive), and 10 kN is past the load cells of
-# tabletop testing machines (loading.MAX_FORCE, the solver's target, is the same bound).
+# and 1 m is past any instrument's travel on a layer (0: the contact row). Force within +-1e4 N:
+# 10 kN is past the load cells of tabletop testing machines (loading.MAX_FORCE, the solver's
+# target, is the same bound); a small negative reading is a load cell's noise near contact
+# (compression positive), left to the fit as before.
 MAX_DEPTH_MM = 1e3
 MAX_FORCE_N = 1e4
 
@@ -193,20 +194,19 @@ def read_indentation_csv(path) -> tuple[np.ndarray, np.ndarray]:
     else:
         i_d, i_f, body, where = 0, 1, rows, lines
     # the column as the header spells it
-    cols = ((i_d, rows[0][i_d].strip() if named else "depth", MAX_DEPTH_MM, "mm", "a depth in um? give mm"),
-            (i_f, rows[0][i_f].strip() if named else "force", MAX_FORCE_N, "N", "a force in mN? give N"))
+    cols = ((i_d, rows[0][i_d].strip() if named else "depth", 0.0, MAX_DEPTH_MM, "mm", "a depth in um? give mm"),
+            (i_f, rows[0][i_f].strip() if named else "force", -MAX_FORCE_N, MAX_FORCE_N, "N", "a force in mN? give N"))
     out = ([], [])
     for r, line in zip(body, where):
-        for k, (i, name, hi, unit, hint) in enumerate(cols):
+        for k, (i, name, lo, hi, unit, hint) in enumerate(cols):
             try:
                 x = float(r[i])
             except (ValueError, IndexError):
                 raise FitDataError("data", f"line {line} of {path.name}: {','.join(r)}",
                                    "two numbers (depth mm, force N)") from None
-            if not 0.0 <= x <= hi:  # NaN too
-                raise FitDataError(name, f"{r[i].strip()} on line {line} of {path.name}", range_text(0.0, hi, unit=unit),
-                                   hint if math.isfinite(x) and x > hi else
-                                   "" if not math.isfinite(x) else f"a {('depth' if k == 0 else 'force')} is "
-                                   + ("measured from first contact" if k == 0 else "positive in compression"))
+            if not lo <= x <= hi:  # NaN too
+                raise FitDataError(name, f"{r[i].strip()} on line {line} of {path.name}", range_text(lo, hi, unit=unit),
+                                   hint if math.isfinite(x) and abs(x) > hi else
+                                   "" if not math.isfinite(x) else "a depth is measured from first contact")
             out[k].append(x)
     return np.array(out[0]), np.array(out[1])
