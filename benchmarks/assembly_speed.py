@@ -44,6 +44,24 @@ def timed(fns: dict, repeat: int) -> dict:
     return {k: (1e3 * float(np.median(cpu[k])), 1e3 * float(np.median(wall[k]))) for k in fns}
 
 
+def dot_state(doc: str, argv=None):
+    """(args, model, evaluation) of the benchmarks on the `default` single dot: --thickness
+    (mm, default 5) and --repeat parsed, the model made, and evaluated (no tangent) at 0.1 x
+    kernels.trial_state, a state with every element deformed."""
+    from kernels import trial_state  # benchmarks/kernels.py
+
+    from tactileskin.fe import model_for_scene
+    from tactileskin.scene import Scene
+
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--thickness", type=float, default=5.0)
+    ap.add_argument("--repeat", type=int, default=9)
+    a = ap.parse_args(argv)
+    sc = Scene(dim=3, indenter="braille", thickness=a.thickness, material="silicone", braille_text="")
+    model, _ = model_for_scene(sc)
+    return a, model, model.evaluate(0.1 * trial_state(model), 0.0, 1.0, tangent=False)
+
+
 def row(name, old, new, diff=""):
     print(f"{name:34s} {old[0]:9.2f} {old[1]:9.2f} {new[0]:9.2f} {new[1]:9.2f} {old[1] / new[1]:7.2f}x  {diff}")
 
@@ -68,23 +86,12 @@ def _csr_matvec(indptr, indices, data, x, y, bounds):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--thickness", type=float, default=5.0)
-    ap.add_argument("--repeat", type=int, default=9)
-    a = ap.parse_args(argv)
-
-    from kernels import trial_state  # benchmarks/kernels.py
-
-    from tactileskin.fe import kernels, model_for_scene
+    from tactileskin.fe import kernels
     from tactileskin.fe.assembly import Pattern
-    from tactileskin.scene import Scene
     from tactileskin.threads import numba_threads
 
-    sc = Scene(dim=3, indenter="braille", thickness=a.thickness, material="silicone", braille_text="")
-    model, _ = model_for_scene(sc)
+    a, model, ev = dot_state(__doc__, argv)
     p, m = model.pattern, model.m
-    u = 0.1 * trial_state(model)
-    ev = model.evaluate(u, 0.0, 1.0, tangent=False)
     with numba_threads(2):
         D = model._law(ev.kin.C, True)[1]
         Ke = kernels.tangent(ev.kin, ev.S[..., :m, :m], np.ascontiguousarray(D[..., :m, :m, :m, :m]))

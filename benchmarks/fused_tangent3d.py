@@ -18,7 +18,6 @@ not adopted: benchmarks/results/braille3d_default.md, twenty-second session.
 
 from __future__ import annotations
 
-import argparse
 import os
 
 import numba as nb
@@ -53,22 +52,13 @@ def fused_3_10(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, sd, off, indpt
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--thickness", type=float, default=5.0)
-    ap.add_argument("--repeat", type=int, default=9)
-    a = ap.parse_args(argv)
+    from assembly_speed import dot_state, timed  # benchmarks/assembly_speed.py
 
-    from assembly_speed import timed  # benchmarks/assembly_speed.py
-    from kernels import trial_state  # benchmarks/kernels.py
-
-    from tactileskin.fe import _sparse_nb, kernels, model_for_scene
-    from tactileskin.scene import Scene
+    from tactileskin.fe import _sparse_nb, kernels
     from tactileskin.threads import numba_threads
 
-    sc = Scene(dim=3, indenter="braille", thickness=a.thickness, material="silicone", braille_text="")
-    model, _ = model_for_scene(sc)
+    a, model, ev = dot_state(__doc__, argv)
     p, m = model.pattern, model.m
-    ev = model.evaluate(0.1 * trial_state(model), 0.0, 1.0, tangent=False)
     kin = ev.kin
     S = np.ascontiguousarray(ev.S[..., :m, :m])
     with numba_threads(1):
