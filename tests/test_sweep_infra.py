@@ -255,6 +255,17 @@ def test_expand_grid_refuses_a_repeated_axis_value():
     assert len(expand_grid(thicknesses=[1.0, 3.0], materials=["silicone"], indenters=["flat"])) == 2
 
 
+def _on_one_worker(fn) -> list:
+    """fn's results on the one local worker of a sweep's cluster (client.run), cluster closed."""
+    from tactileskin.sweep import _Runner
+
+    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+    try:
+        return list(runner._start(1).run(fn).values())
+    finally:
+        runner.close()
+
+
 def _worker_state():
     """(solver loaded before any case, BLAS threads, SIGINT ignored and Python's SIGTERM
     handling) of a sweep worker (run there by client.run)."""
@@ -304,15 +315,9 @@ def test_spawned_workers_ignore_sigint_too(monkeypatch):
     """Spawned workers (a notebook's, a process that solved before its sweep, off Linux) died of
     a terminal's Ctrl-C with a KeyboardInterrupt traceback each, as the fork()ed ones did."""
     from tactileskin import sweep
-    from tactileskin.sweep import _Runner
 
     monkeypatch.setattr(sweep, "worker_start_method", lambda: "spawn")
-    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
-    try:
-        client = runner._start(1)
-        states = list(client.run(_worker_state).values())
-    finally:
-        runner.close()
+    states = _on_one_worker(_worker_state)
     assert [st[2] for st in states] == [True], states
 
 
@@ -413,7 +418,6 @@ def test_forked_workers_write_past_the_progress_bars_stream_proxies(monkeypatch)
     from rich.file_proxy import FileProxy
 
     from tactileskin import sweep, threads
-    from tactileskin.sweep import _Runner
 
     monkeypatch.setattr(threads, "threads_started", lambda: False)
     monkeypatch.setattr(sweep, "_other_threads", list)  # pytest-xdist's own threads
@@ -421,12 +425,7 @@ def test_forked_workers_write_past_the_progress_bars_stream_proxies(monkeypatch)
     console = Console(file=io.StringIO())
     monkeypatch.setattr(sys, "stdout", FileProxy(console, sys.stdout))
     monkeypatch.setattr(sys, "stderr", FileProxy(console, sys.stderr))
-    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
-    try:
-        client = runner._start(1)
-        streams = list(client.run(_worker_streams).values())
-    finally:
-        runner.close()
+    streams = _on_one_worker(_worker_streams)
     assert streams == [[False, False]], streams
     assert _worker_streams() == [True, True]  # this process's, the bar's, stay
 
