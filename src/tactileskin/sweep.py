@@ -518,12 +518,9 @@ def _plain_streams(_runner) -> None:
     And from the start the signal handling sweep_worker.ForkedWorker sets later (SIGINT ignored,
     SIGTERM Python's default): the nanny terminates a worker still starting when Ctrl-C stops
     the sweep, which in the CLI's handler raised SystemExit inside dask's start-up."""
-    import signal
-    import threading
+    from tactileskin.sweep_worker import worker_signals
 
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    worker_signals(default_sigterm=True)
     for name in ("stdout", "stderr"):
         inner = getattr(getattr(sys, name), "rich_proxied_file", None)
         if inner is not None:
