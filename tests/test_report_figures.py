@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -358,10 +360,10 @@ def _small_grid():
 
 
 def _drawn(monkeypatch):
-    """Count all_figures' calls (the drawing) while it still draws."""
+    """Count figure_jobs' calls (the drawing) while it still draws."""
     calls = []
-    real = figures.all_figures
-    monkeypatch.setattr(figures, "all_figures", lambda *a: (calls.append(1), real(*a))[1])
+    real = figures.figure_jobs
+    monkeypatch.setattr(figures, "figure_jobs", lambda *a: (calls.append(1), real(*a))[1])
     return calls
 
 
@@ -388,14 +390,19 @@ def test_a_changed_input_or_a_damaged_kept_figure_is_drawn_again(tmp_path, monke
 
     calls = []
 
-    def drawn(records, rows, out):  # a stand-in for the drawing: files that follow the inputs
+    def drawn(records, rows):  # a stand-in for the drawing: files that follow the inputs
         calls.append(1)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "fig11_peak.png").write_text(repr([r["peak_mpa"] for r in rows]))
-        (out / "fig10_profiles.png").write_text(repr([r.pressure.tolist() for r in records]))
-        return [out / "fig11_peak.png", out / "fig10_profiles.png"]
 
-    monkeypatch.setattr(figures, "all_figures", drawn)
+        def peak(out):
+            (out / "fig11_peak.png").write_text(repr([r["peak_mpa"] for r in rows]))
+            return [out / "fig11_peak.png"]
+
+        def profiles(out):
+            (out / "fig10_profiles.png").write_text(repr([r.pressure.tolist() for r in records]))
+            return [out / "fig10_profiles.png"]
+        return [peak, profiles]
+
+    monkeypatch.setattr(figures, "figure_jobs", drawn)
     recs, rows = _small_grid()
     cache = ResultCache(tmp_path / "cache")
     first = {p.name: p.read_bytes() for p in outputs._figures(recs, rows, tmp_path / "a", cache)}
@@ -416,6 +423,45 @@ def test_a_changed_input_or_a_damaged_kept_figure_is_drawn_again(tmp_path, monke
     kept.write_bytes(kept.read_bytes()[:-1] + b"!")
     again = {p.name: p.read_bytes() for p in outputs._figures(recs, rows, tmp_path / "d", cache)}
     assert len(calls) == 4 and again == first
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork() is Linux-only here")
+def test_the_first_figures_are_drawn_in_a_second_process_to_the_same_bytes(tmp_path, monkeypatch):
+    """The sweep's figures took ~3 s after its last solve on 2 cores; the first
+    BACKGROUND_JOBS figures are drawn in a fork()ed child meanwhile. The files, their order
+    and their bytes are all_figures' own."""
+    from tactileskin import threads
+    from tactileskin.cache import ResultCache
+    from tactileskin.report import outputs
+
+    monkeypatch.setattr(threads, "other_threads", list)  # pytest-xdist's own threads
+    recs, rows = _small_grid()
+    serial = figures.all_figures(recs, rows, tmp_path / "serial")
+    pids = {}
+    real = figures.figure_jobs
+
+    def jobs(records, rows):  # each job notes the process that ran it beside its files
+        def noted(job, k):
+            def run(out):
+                (out / f"pid{k}").write_text(str(os.getpid()))
+                return job(out) + [out / f"pid{k}"]
+            return run
+        return [noted(job, k) for k, job in enumerate(real(records, rows))]
+
+    monkeypatch.setattr(figures, "figure_jobs", jobs)
+    rendered = []
+    split = outputs._figures(recs, rows, tmp_path / "split", ResultCache(tmp_path / "cache"),
+                             meanwhile=lambda: rendered.append(os.getpid()))
+    for p in split:
+        if p.name.startswith("pid"):
+            pids[int(p.name[3:])] = int(p.read_text())
+    drawn = [p for p in split if not p.name.startswith("pid")]
+    assert [p.name for p in drawn] == [p.name for p in serial]
+    assert [p.read_bytes() for p in drawn] == [p.read_bytes() for p in serial]
+    here = os.getpid()
+    assert rendered == [here]
+    assert [pids[k] != here for k in sorted(pids)] == [True] * outputs.BACKGROUND_JOBS + [False] * (
+        len(pids) - outputs.BACKGROUND_JOBS)
 
 
 def test_the_figures_key_does_not_import_pyplot():

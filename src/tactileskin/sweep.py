@@ -36,6 +36,7 @@ from tactileskin.cache import changed_code_message, code_changes
 from tactileskin.errors import ParameterError, TactileSkinError
 from tactileskin.geometry.indenters.registry import get as get_kind
 from tactileskin.scene import Scene
+from tactileskin.threads import other_threads as _other_threads  # tests replace it here
 
 log = logging.getLogger(__name__)
 
@@ -545,16 +546,6 @@ def worker_start_method() -> str:
     meshed_3d = gmsh_state is not None and gmsh_state._meshed_3d_in is not None
     return ("fork" if sys.platform.startswith("linux") and not threads_started() and not meshed_3d
             and not _other_threads() else "spawn")
-
-
-def _other_threads() -> list:
-    """The Python threads of this process but the calling one, the idle pools of an earlier
-    sweep's dask (Dask-Offload, ...) and the sweep command's progress bar (rich's refresh)."""
-    import threading
-
-    return [t for t in threading.enumerate()
-            if t is not threading.current_thread() and not t.name.startswith("Dask-")
-            and type(t).__module__ != "rich.live"]
 
 
 def _restore_environ(saved: dict) -> None:

@@ -56,6 +56,17 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
+def other_threads() -> list:
+    """The Python threads of this process but the calling one, the idle pools of an earlier
+    sweep's dask (Dask-Offload, ...) and the sweep command's progress bar (rich's refresh):
+    threads that may hold a lock when fork() copies the process (sweep, report.background)."""
+    import threading
+
+    return [t for t in threading.enumerate()
+            if t is not threading.current_thread() and not t.name.startswith("Dask-")
+            and type(t).__module__ != "rich.live"]
+
+
 def started_threads() -> None:
     """Note that this process started OpenMP threads (PARDISO on several threads)."""
     global _parent_threads

@@ -11,6 +11,7 @@ style and marker too. matplotlib runs on the Agg backend (no display).
 from __future__ import annotations
 
 import io
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -327,18 +328,25 @@ def figures_key(records, rows) -> str:
     return h.hexdigest()[:24]
 
 
-def all_figures(records, rows, out: Path) -> list[Path]:
-    """Every sweep figure; like the bar and thickness figures (rows of status ok), Fig. 10
+def figure_jobs(records, rows) -> list:
+    """Every sweep figure as a function of the folder it is written to (returning its files),
+    in all_figures' order. Like the bar and thickness figures (rows of status ok), Fig. 10
     draws the ok results only: a suspect profile is not a result to compare with (it is in
     the tables, marked)."""
-    make_dirs(out)
     if not any(r.get("status", "ok") == "ok" for r in rows):
         return []  # no ok case: every figure would be empty axes under a legend
-    paths = thickness_figure(rows, out)
+    jobs = [partial(thickness_figure, rows)]
     ok = [r for r in records if quality.status(r.summary) == "ok"]
     if ok:
-        paths += profiles_figure(ok, out)
-    paths += metric_figure(rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)", out)
-    paths += metric_figure(rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)", out)
-    paths += metric_figure(rows, "auc_mpa_mm", "area under P(s) (MPa mm)", "fig13_auc", "Area under the curve (cf. Fig. 13)", out)
-    return paths
+        jobs.append(partial(profiles_figure, ok))
+    jobs += [partial(metric_figure, rows, "peak_mpa", "peak P (MPa)", "fig11_peak", "Peak pressure (cf. Fig. 11)"),
+             partial(metric_figure, rows, "span_mm", "span (mm)", "fig12_span", "Span of the pressure profile (cf. Fig. 12)"),
+             partial(metric_figure, rows, "auc_mpa_mm", "area under P(s) (MPa mm)", "fig13_auc",
+                     "Area under the curve (cf. Fig. 13)")]
+    return jobs
+
+
+def all_figures(records, rows, out: Path) -> list[Path]:
+    """Every sweep figure (figure_jobs) written into `out`."""
+    make_dirs(out)
+    return [p for job in figure_jobs(records, rows) for p in job(out)]

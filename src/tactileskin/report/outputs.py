@@ -146,19 +146,39 @@ def _write_sensors(path: Path, records) -> None:
         atomic_write_text(path, out.getvalue())
 
 
-def _figures(records, rows, out: Path, cache) -> list[Path]:
-    """all_figures into `out`; their files are kept in the cache under their inputs' digest
-    (figures.figures_key), and a sweep whose figures are there already (a cached rerun) writes
-    those bytes instead of drawing them again. An entry whose bytes changed is not used."""
+# figure_jobs drawn in a second process: the first two (the designer's figure in three
+# formats and Fig. 10, about half the drawing time of a paper sweep) while this one draws the
+# rest and the renders
+BACKGROUND_JOBS = 2
+
+
+def _figures(records, rows, out: Path, cache, meanwhile=lambda: None) -> list[Path]:
+    """figure_jobs into `out`, and meanwhile() (the renders) while they are drawn; their files
+    are kept in the cache under their inputs' digest (figures.figures_key), and a sweep whose
+    figures are there already (a cached rerun) writes those bytes instead of drawing them
+    again. An entry whose bytes changed is not used."""
     from tactileskin.errors import TactileSkinError
     from tactileskin.fileio import atomic_write_bytes
-    from tactileskin.report.figures import all_figures, figures_key
+    from tactileskin.report.background import Background
+    from tactileskin.report.figures import _plt, figure_jobs, figures_key
 
     name = f"figures-{figures_key(records, rows)}"
     kept = cache.load_files(name)
     if kept is not None:
-        return [atomic_write_bytes(out / fname, data) for fname, data in kept]
-    paths = all_figures(records, rows, out)
+        paths = [atomic_write_bytes(out / fname, data) for fname, data in kept]
+        meanwhile()
+        return paths
+    jobs = figure_jobs(records, rows)
+    if not jobs:
+        meanwhile()
+        return []
+    there, here = jobs[:BACKGROUND_JOBS], jobs[BACKGROUND_JOBS:]
+    make_dirs(out)
+    _plt()  # imported before the fork: the child needs no import of its own
+    with Background(lambda folder: [p for job in there for p in job(folder)]) as bg:
+        mine = [p for job in here for p in job(out)]
+        meanwhile()
+        paths = [atomic_write_bytes(out / fname, data) for fname, data in bg.files()] + mine
     if paths:
         try:
             cache.store_files(name, paths)
@@ -193,6 +213,31 @@ def _render(render_case, vtu: Path, png: Path, rec, cache) -> Path:
     return path
 
 
+def _renders(records, out: Path, cache) -> list[Path]:
+    """One Fig. 9A-style render per material at the thinnest skin, flat plate; a suspect case
+    (no contact, the law out of its range) is not shown as a result."""
+    from tactileskin.report.render import render_case
+
+    shown = [r for r in records if quality.status(r.summary) == "ok"]
+    renders, thinnest, used = [], {}, set()
+    for r in shown:
+        m = r.scene.material
+        thinnest[m] = min(thinnest.get(m, r.scene.thickness), r.scene.thickness)
+    for rec in shown:
+        sc = rec.scene
+        vtu = rec.path / "result.vtu"
+        if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
+            try:
+                name = re.sub(r"[^A-Za-z0-9._=,\[\]-]", "_", rec.case)
+                if name in used:  # two case ids made alike by the substitution ('gel-ä', 'gel-ö')
+                    name += "-" + hashlib.sha256(rec.case.encode()).hexdigest()[:8]
+                used.add(name)
+                renders.append(_render(render_case, vtu, out / f"fig9_{name}.png", rec, cache))
+            except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
+                log.warning("render of %s failed: %s", rec.case, e)
+    return renders
+
+
 def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
     from tactileskin.report.markdown import build_report
 
@@ -214,31 +259,17 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     _write_parquet(out / "profiles.parquet", PROFILE_COLUMNS, prof)
 
     _write_sensors(out / "sensors.csv", records)
-    figures = _figures(records, rows, out, cache) if records and figures else []
-    renders = []
-    if render and records:
-        from tactileskin.report.render import render_case
+    renders: list[Path] = []
 
-        # a suspect case (no contact, the law out of its range) is not shown as a result
-        shown = [r for r in records if quality.status(r.summary) == "ok"]
-        thinnest, used = {}, set()
-        for r in shown:
-            m = r.scene.material
-            thinnest[m] = min(thinnest.get(m, r.scene.thickness), r.scene.thickness)
-        for rec in shown:  # one Fig. 9A-style render per material at the thinnest skin, flat plate
-            sc = rec.scene
-            vtu = rec.path / "result.vtu"
-            if sc.indenter.value == "flat" and sc.thickness == thinnest[sc.material] and vtu.is_file():
-                try:
-                    name = re.sub(r"[^A-Za-z0-9._=,\[\]-]", "_", rec.case)
-                    if name in used:  # two case ids made alike by the substitution ('gel-ä', 'gel-ö')
-                        name += "-" + hashlib.sha256(rec.case.encode()).hexdigest()[:8]
-                    used.add(name)
-                    renders.append(_render(render_case, vtu, out / f"fig9_{name}.png", rec, cache))
-                except Exception as e:  # noqa: BLE001 - a render failure must not lose the report
-                    log.warning("render of %s failed: %s", rec.case, e)
-    report = build_report(rows, records, failures, figures, renders, wall_s,
+    def draw_renders() -> None:
+        if render and records:
+            renders.extend(_renders(records, out, cache))
+
+    drawn = _figures(records, rows, out, cache, meanwhile=draw_renders) if records and figures else []
+    if not (records and figures):
+        draw_renders()
+    report = build_report(rows, records, failures, drawn, renders, wall_s,
                           scenes=[oc.scene for oc in outcomes])
     atomic_write_text(out / "report.md", report)
     return dict(results=out / "results.csv", profiles=out / "profiles.csv", report=out / "report.md",
-                figures=figures, renders=renders, failures=failures, rows=rows, records=records)
+                figures=drawn, renders=renders, failures=failures, rows=rows, records=records)

@@ -1,0 +1,155 @@
+"""A second pair of hands for drawing: `Background(fn)` runs fn(folder) in a fork()ed child
+while this process goes on, and `files()` returns the (name, bytes) of the files fn wrote
+into its private folder (fn returns their paths). The sweep draws half its figures there, half here (2 cores: the
+figures of an 18-case preview took about 3 s after the last solve; benchmarks/figure_split.py).
+
+The child writes nothing the user sees: only a private temporary folder, which this process
+removes. Whatever goes wrong there (no fork() here, the child crashed, was killed or hung,
+its bytes did not arrive) fn runs here instead, so results and errors are those of drawing
+here. Log records the child made are handed to this process's loggers (a child writing to
+the terminal could meet a lock held by the progress bar's thread at the fork)."""
+
+from __future__ import annotations
+
+import logging
+import os
+import pickle
+import select
+import shutil
+import signal
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+# how long to wait for the child beyond the time this process spent on its own share; a
+# child past it is killed and its share drawn here (a hang costs that much, never the result)
+GRACE_S = 60.0
+
+
+def can_fork() -> bool:
+    """fork() is safe here: Linux, and no thread of this process runs code of its own
+    (threads.other_threads: a lock it holds as fork() copies the process stays held)."""
+    from tactileskin.threads import other_threads
+
+    return sys.platform.startswith("linux") and not other_threads()
+
+
+def _read_files(paths) -> list[tuple[str, bytes]]:
+    return [(Path(p).name, Path(p).read_bytes()) for p in paths]
+
+
+class _Keep(logging.Handler):
+    """Keeps the child's log records, made picklable (message formatted, no traceback object)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        record.msg, record.args = record.getMessage(), None
+        record.exc_info, record.exc_text, record.stack_info = None, None, None
+        self.records.append(record)
+
+
+def _in_child(fn, folder: Path, fd: int) -> None:
+    """Run fn(folder), send ("ok", files, records) or ("error", text, records), and end the
+    process without its parent's exit handlers (os._exit: they close the parent's cluster,
+    release its locks)."""
+    code = 1
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        keep = _Keep()
+        root = logging.getLogger()
+        root.handlers = [keep]
+        for lg in list(logging.Logger.manager.loggerDict.values()):
+            if isinstance(lg, logging.Logger):
+                lg.handlers = []
+        try:
+            payload = ("ok", _read_files(fn(folder)), keep.records)
+        except BaseException as e:  # noqa: BLE001 - reported to the parent, which draws again
+            payload = ("error", f"{type(e).__name__}: {e}", keep.records)
+        data = pickle.dumps(payload, protocol=pickle.HIGHEST_PROTOCOL)
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+        code = 0
+    finally:
+        os._exit(code)
+
+
+class Background:
+    """`with Background(fn) as bg: ...; files = bg.files()`: fn(folder) drawn in a child, or
+    here when files() finds the child's work missing. Leaving the block kills a child not
+    collected (an error or Ctrl-C here) and removes its folder."""
+
+    def __init__(self, fn) -> None:
+        self.fn = fn
+        self.pid: int | None = None
+        self.fd: int | None = None
+        self.folder: Path | None = None
+        self.started = time.perf_counter()
+
+    def __enter__(self) -> "Background":
+        if can_fork():
+            self.folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
+            r, w = os.pipe()
+            pid = os.fork()
+            if pid == 0:
+                os.close(r)
+                _in_child(self.fn, self.folder, w)
+            os.close(w)
+            self.pid, self.fd = pid, r
+        self.started = time.perf_counter()
+        return self
+
+    def _receive(self, deadline: float) -> bytes | None:
+        chunks = []
+        while True:
+            left = deadline - time.perf_counter()
+            if left <= 0 or not select.select([self.fd], [], [], left)[0]:
+                return None
+            chunk = os.read(self.fd, 1 << 20)
+            if not chunk:
+                return b"".join(chunks)
+            chunks.append(chunk)
+
+    def files(self) -> list[tuple[str, bytes]]:
+        """The (name, bytes) of the files fn returned, in its order: the child's, or fn's run here."""
+        if self.pid is not None:
+            data = self._receive(time.perf_counter() + GRACE_S + (time.perf_counter() - self.started))
+            self._end_child()
+            try:
+                status, value, records = pickle.loads(data) if data else ("error", "no answer", [])
+            except Exception as e:  # noqa: BLE001 - a cut message: draw here
+                status, value, records = "error", f"unreadable answer ({e})", []
+            for rec in records:
+                logging.getLogger(rec.name).handle(rec)
+            if status == "ok":
+                return value
+            log.debug("drawing in a second process failed (%s); drawing here", value)
+        folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
+        try:
+            return _read_files(self.fn(folder))
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+
+    def _end_child(self) -> None:
+        if self.pid is None:
+            return
+        try:
+            os.kill(self.pid, signal.SIGKILL)  # done already (os._exit) or to be given up
+        except ProcessLookupError:
+            pass
+        os.waitpid(self.pid, 0)
+        os.close(self.fd)
+        self.pid = self.fd = None
+        if self.folder is not None:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            self.folder = None
+
+    def __exit__(self, *exc) -> None:
+        self._end_child()

@@ -1,0 +1,122 @@
+"""report.background: drawing in a fork()ed child, and drawing here whenever the child fails."""
+
+import logging
+import os
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tactileskin import threads
+from tactileskin.report import background
+from tactileskin.report.background import Background
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork() is Linux-only here")
+
+
+@pytest.fixture(autouse=True)
+def no_other_threads(monkeypatch):
+    monkeypatch.setattr(threads, "other_threads", list)  # pytest-xdist's own threads
+
+
+def write_pids(folder):
+    """Two files, the second first in name order: the order fn returns must be kept."""
+    b = Path(folder) / "b.txt"
+    a = Path(folder) / "a.txt"
+    b.write_text(str(os.getpid()))
+    a.write_text("a")
+    return [b, a]
+
+
+def test_runs_in_a_child_and_keeps_the_order():
+    with Background(write_pids) as bg:
+        assert bg.pid is not None
+        folder = bg.folder
+        files = bg.files()
+    assert [n for n, _ in files] == ["b.txt", "a.txt"]
+    assert not folder.exists()  # the child's private folder is removed
+    assert int(files[0][1]) != os.getpid()
+
+
+def test_without_fork_it_draws_here(monkeypatch):
+    monkeypatch.setattr(threads, "other_threads", lambda: ["a user's thread"])
+    with Background(write_pids) as bg:
+        assert bg.pid is None
+        files = bg.files()
+    assert int(files[0][1]) == os.getpid()
+
+
+def test_a_failing_child_is_redone_here():
+    parent = os.getpid()
+
+    def fails_in_child(folder):
+        if os.getpid() != parent:
+            raise RuntimeError("child broke")
+        return write_pids(folder)
+
+    with Background(fails_in_child) as bg:
+        files = bg.files()
+    assert int(files[0][1]) == parent
+
+
+def test_a_child_that_dies_is_redone_here():
+    parent = os.getpid()
+
+    def dies(folder):
+        if os.getpid() != parent:
+            os._exit(3)
+        return write_pids(folder)
+
+    with Background(dies) as bg:
+        files = bg.files()
+    assert int(files[0][1]) == parent
+
+
+def test_a_hung_child_is_killed_and_redone_here(monkeypatch):
+    monkeypatch.setattr(background, "GRACE_S", 0.5)
+    parent = os.getpid()
+
+    def hangs(folder):
+        if os.getpid() != parent:
+            time.sleep(60)
+        return write_pids(folder)
+
+    t0 = time.perf_counter()
+    with Background(hangs) as bg:
+        pid = bg.pid
+        files = bg.files()
+    assert time.perf_counter() - t0 < 30
+    assert int(files[0][1]) == parent
+    with pytest.raises(ChildProcessError):  # reaped: no zombie left
+        os.waitpid(pid, os.WNOHANG)
+
+
+def test_leaving_the_block_early_kills_the_child():
+    parent = os.getpid()
+
+    def slow(folder):
+        if os.getpid() != parent:
+            time.sleep(60)
+        return []
+
+    with pytest.raises(KeyboardInterrupt):
+        with Background(slow) as bg:
+            pid, folder = bg.pid, bg.folder
+            raise KeyboardInterrupt
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)
+    assert not folder.exists()
+
+
+def test_the_childs_log_records_reach_this_process(caplog):
+    def logs(folder):
+        logging.getLogger("tactileskin.report.figures").warning("drawn in %d", os.getpid())
+        return write_pids(folder)
+
+    with caplog.at_level(logging.WARNING):
+        with Background(logs) as bg:
+            files = bg.files()
+    msgs = [r.getMessage() for r in caplog.records if r.name == "tactileskin.report.figures"]
+    assert msgs == [f"drawn in {int(files[0][1])}"]
+    assert int(files[0][1]) != os.getpid()
