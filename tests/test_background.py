@@ -120,3 +120,17 @@ def test_the_childs_log_records_reach_this_process(caplog):
     msgs = [r.getMessage() for r in caplog.records if r.name == "tactileskin.report.figures"]
     assert msgs == [f"drawn in {int(files[0][1])}"]
     assert int(files[0][1]) != os.getpid()
+
+
+def test_the_childs_warnings_reach_this_process_as_records(caplog):
+    import warnings
+
+    def warns(folder):
+        warnings.warn(f"odd axis in {os.getpid()}", UserWarning)
+        return write_pids(folder)
+
+    with caplog.at_level(logging.WARNING):
+        with Background(warns) as bg:
+            files = bg.files()
+    assert int(files[0][1]) != os.getpid()
+    assert any(f"odd axis in {int(files[0][1])}" in r.getMessage() for r in caplog.records if r.name == "py.warnings")

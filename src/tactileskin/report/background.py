@@ -62,12 +62,17 @@ def _in_child(fn, folder: Path, fd: int) -> None:
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        # new file objects on the standard streams: the ones copied may be the progress bar's
+        # proxies, or hold a lock another thread had taken as the process was copied
+        sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 - for the child's short life
+        sys.stderr = open(2, "w", closefd=False)  # noqa: SIM115
         keep = _Keep()
         root = logging.getLogger()
         root.handlers = [keep]
         for lg in list(logging.Logger.manager.loggerDict.values()):
             if isinstance(lg, logging.Logger):
                 lg.handlers = []
+        logging.captureWarnings(True)  # a warning too reaches the parent (as a py.warnings record)
         try:
             payload = ("ok", _read_files(fn(folder)), keep.records)
         except BaseException as e:  # noqa: BLE001 - reported to the parent, which draws again
