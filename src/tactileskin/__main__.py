@@ -1,5 +1,3 @@
-import sys
+from tactileskin.cli import run
 
-from tactileskin.cli import main
-
-sys.exit(main())
+run()
