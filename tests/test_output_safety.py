@@ -284,7 +284,7 @@ _KILLED = textwrap.dedent("""
     sys.path.insert(0, {tests!r})
     from test_output_safety import fake_result
 
-    def dying_vtu(path, fields):
+    def dying_vtu(path, fields, *args, **kwargs):
         with fileio.atomic_path(path) as tmp:
             tmp.write_text("half a file")
             os.kill(os.getpid(), signal.{sig})

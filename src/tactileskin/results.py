@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from tactileskin import fileio, outdir, staging, validate
+from tactileskin import fileio, outdir, quality, staging, validate
 from tactileskin.errors import ConvergenceError, ParameterError
 
 
@@ -325,8 +326,6 @@ class Result:
         """The result's numbers, with its status ("ok" or "suspect: reasons") and flags
         (tactileskin.quality: no contact, material law outside its range, locking, coarse
         mesh, a peak at the bonded edge, ...)."""
-        from tactileskin import quality
-
         out = {
             "peak_mpa": self.peak,
             "span_mm": self.span,
@@ -418,7 +417,8 @@ class Result:
         """The result as a pyvista.UnstructuredGrid, the content of result.vtu: the reference
         mesh with the nodal fields named with their unit (`displacement_mm` is the active
         vectors: grid.warp_by_vector() gives the deformed skin), the named boundaries as
-        facet cells with cell data `boundary_id` (0: the skin), their names in field data.
+        facet cells with cell data `boundary_id` (0: the skin), their names in field data,
+        cell data `suspect` (1 on every cell of a suspect result, else 0).
         Needs pyvista (pip install 'tactileskin[render]'); raises MissingDependency without."""
         from tactileskin.errors import MissingDependency, require_pyvista
 
@@ -426,7 +426,7 @@ class Result:
             raise ParameterError("result fields", None, "a result with its mesh fields (Result.fields)",
                                  hint="a result read back from a summary has no mesh")
         pv = require_pyvista("Result.to_pyvista()")
-        mesh = _meshio_mesh(self.fields)
+        mesh = _meshio_mesh(self.fields, status=self.status)
         try:
             grid = pv.from_meshio(mesh)
         except ImportError as e:  # pragma: no cover - a broken VTK install
@@ -451,7 +451,8 @@ class Result:
 
     def write_owned(self, directory) -> Path:
         """Write OWN_FILES (profile.csv, contact.csv, summary.json, result.vtu (reference mesh,
-        displacement_mm and the other fields named with their unit, boundaries by name);
+        displacement_mm and the other fields named with their unit, boundaries by name, the status
+        as the cell array `suspect` and a comment, vtu_status);
         with a history, result.pvd over result_steps/; with sensors, sensors.csv; 3D: also
         bone_map.csv, the map P(s, z), and profile_max_z.csv, P_max(s) = max over z with the z
         where it occurs) into `directory`, creating it. All of them are staged and moved in
@@ -477,8 +478,8 @@ class Result:
         table("profile.csv", _csv(["s_mm", "pressure_mpa"], s, p))
         table("contact.csv", self._contact_csv())
         if self.fields is not None:
-            _write_vtu(directory / "result.vtu", self.fields)
-        _write_steps(directory, self.fields)
+            _write_vtu(directory / "result.vtu", self.fields, status=status)
+        _write_steps(directory, self.fields, status)
         if self.bone_map is not None:
             table("bone_map.csv", self.bone_map.to_csv())
             table("profile_max_z.csv", _csv(["s_mm", "pressure_mpa", "z_mm"], *self.bone_map.max_over_z()))
@@ -574,13 +575,14 @@ def _pad3(v) -> np.ndarray:
     return v
 
 
-def _meshio_mesh(fields: dict, point_data: dict | None = None):
+def _meshio_mesh(fields: dict, point_data: dict | None = None, status: str | None = None):
     """The meshio.Mesh of `fields` (fe.output.vtk_fields): the cells with cell data
     `boundary_id` 0, then each named boundary's facets with its id; its field data
     {name: [id, dim]} names the ids (as gmsh and meshio keep them). The facet fields of
     fields["facet_data"] ({field: {boundary: (F,) values}}, e.g. contact_pressure_MPa on
     outer_surface) are cell data, zero on the other cells; not with a `point_data` override
-    (the increments of result.pvd, which hold the displacement only)."""
+    (the increments of result.pvd, which hold the displacement only). With the result's
+    `status`, cell data SUSPECT_ARRAY: 1 on every cell if it is not "ok", else 0."""
     import meshio  # only when writing files (keeps the solver import light)
 
     pts = _pad3(fields["points"])
@@ -597,17 +599,53 @@ def _meshio_mesh(fields: dict, point_data: dict | None = None):
     for fname, per_boundary in (fields.get("facet_data") or {}).items() if point_data is None else ():
         cell_data[fname] = [np.asarray(per_boundary[n], float) if n in per_boundary else np.zeros(len(b[1]))
                             for n, b in zip(names, blocks)]
+    if status is not None:
+        flag = int(quality.kind(status) != "ok")
+        cell_data[SUSPECT_ARRAY] = [np.full(len(b[1]), flag, np.int8) for b in blocks]
     return meshio.Mesh(pts, blocks, point_data=pdata, cell_data=cell_data, field_data=field_data)
 
 
-def _write_vtu(path: Path, fields: dict, point_data: dict | None = None) -> None:
-    """One .vtu of `fields` (see `_meshio_mesh`), the boundary names kept as VTK field data."""
-    mesh = _meshio_mesh(fields, point_data)
+def _write_vtu(path: Path, fields: dict, point_data: dict | None = None, status: str | None = None) -> None:
+    """One .vtu of `fields` (see `_meshio_mesh`), the boundary names kept as VTK field data;
+    with the result's `status` (summary.json's) the SUSPECT_ARRAY flag and the text in a comment."""
+    mesh = _meshio_mesh(fields, point_data, status)
     field_data = mesh.field_data
     with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
         mesh.write(tmp, file_format="vtu")
         if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it
             add_vtu_field_data(Path(tmp), field_data)
+        if status is not None:
+            _add_vtu_status(Path(tmp), status)
+
+
+# A cell array of result.vtu: 1 on every cell of a suspect result, 0 of an ok one. Numeric, as
+# ParaView lists and colours it and meshio (the package's reader) refuses string arrays; not
+# field data, which holds the boundary names.
+SUSPECT_ARRAY = "suspect"
+# ... and the status text itself, in an XML comment before the grid (VTK and meshio skip it)
+_STATUS_COMMENT = "<!-- tactileskin status: "
+
+
+def _add_vtu_status(path: Path, status: str) -> None:
+    """Put `status` in a comment after the XML declaration. A comment cannot hold "--" (a
+    reason says "use --quality"): a "-" after a "-" is written "\\-", a backslash "\\\\"
+    (vtu_status reads it back), so "--quality" reads "-\\-quality"."""
+    text = re.sub(r"(?<=-)-", r"\\-", status.replace("\\", "\\\\"))
+    data = path.read_bytes()
+    i = data.index(b"?>") + 2 if data.startswith(b"<?xml") else 0
+    path.write_bytes(data[:i] + ("\n" + _STATUS_COMMENT + text + " -->").encode("utf-8") + data[i:])
+
+
+def vtu_status(path) -> str | None:
+    """The status text a result.vtu was written with (summary.json's "ok" or "suspect: ..."),
+    None for a file without one (written before, or not a result)."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16).decode("utf-8", "replace")
+    i = head.find(_STATUS_COMMENT)
+    j = head.find(" -->", i)
+    if i < 0 or j < 0:
+        return None
+    return re.sub(r"\\(.)", r"\1", head[i + len(_STATUS_COMMENT):j])
 
 
 def add_vtu_field_data(path: Path, field_data: dict) -> None:
@@ -623,10 +661,10 @@ def add_vtu_field_data(path: Path, field_data: dict) -> None:
 STEPS_DIR = "result_steps"  # the .vtu of each increment, listed by result.pvd
 
 
-def _write_steps(directory: Path, fields: dict) -> None:
+def _write_steps(directory: Path, fields: dict, status: str | None = None) -> None:
     """result.pvd, a ParaView time series over result_steps/step_NNNN.vtu (the displacement
     of each converged increment on the reference mesh; the final state's stresses and
-    pressure are in result.vtu), when the fields have steps."""
+    pressure are in result.vtu), when the fields have steps; each step with the result's status."""
     steps = fields.get("steps") if fields else None
     if not steps:
         return
@@ -634,7 +672,7 @@ def _write_steps(directory: Path, fields: dict) -> None:
     entries = []
     for i, (t, u) in enumerate(steps):
         name = f"step_{i:04d}.vtu"
-        _write_vtu(sd / name, fields, {"displacement_mm": u})
+        _write_vtu(sd / name, fields, {"displacement_mm": u}, status)
         entries.append(f'    <DataSet timestep="{t:.9g}" group="" part="0" file="{STEPS_DIR}/{name}"/>')
     fileio.atomic_write_text(directory / "result.pvd",
                              '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'

@@ -1,0 +1,102 @@
+"""result.vtu says whether its result is suspect, as summary.json and every CSV of the folder do:
+a numeric cell array `suspect` (1 on every cell of a suspect result, 0 of an ok one; ParaView
+lists and colours it, and meshio reads it, which refuses string arrays) and summary.json's
+status text in an XML comment before the grid (every VTK and meshio reader skips it). The
+package's readers (renders, probes, charts) read the file as before."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import meshio
+import numpy as np
+import pytest
+
+from tactileskin import quality
+from tactileskin.fe import solve
+from tactileskin.fe.probe import result_sampler
+from tactileskin.planner import with_quality
+from tactileskin.report.render import render_case
+from tactileskin.results import SUSPECT_ARRAY, read_vtu, vtu_status
+from tactileskin.scene import Scene
+
+OK = with_quality(Scene(thickness=3.0, indenter="curved"), "preview")
+# coarser than the preview preset: suspect, with contact (test_status_columns' COARSE_2D)
+SUSPECT = Scene(thickness=3.0, indenter="curved", mesh_size=2.0, refinement=2)
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = {}
+    for name, sc in (("ok", OK), ("suspect", SUSPECT)):
+        res = solve(sc, history=True)
+        out[name] = (res, res.write(tmp_path_factory.mktemp(name) / "r"))
+    return out
+
+
+def test_an_ok_and_a_suspect_result_differ_in_the_file(written):
+    for name, (res, out) in written.items():
+        status = json.loads((out / "summary.json").read_text())["status"]
+        assert quality.kind(status) == name, status
+        m = meshio.read(out / "result.vtu")
+        flag = m.cell_data[SUSPECT_ARRAY]
+        assert [len(b) for b in flag] == [len(c.data) for c in m.cells]  # every cell, boundaries too
+        assert {int(v) for b in flag for v in np.unique(b)} == {int(name == "suspect")}
+        # the status text, summary.json's, as the file holds it and reads back
+        assert vtu_status(out / "result.vtu") == status
+        text = (out / "result.vtu").read_text(encoding="utf-8")
+        assert "<!-- tactileskin status: " in text
+        # a comment may not hold "--" (XML): the file is still well-formed
+        import xml.etree.ElementTree as ET
+
+        ET.parse(out / "result.vtu")
+        # the increments of result.pvd belong to the same result
+        for step in sorted((out / "result_steps").glob("step_*.vtu")):
+            assert vtu_status(step) == status
+            sm = meshio.read(step)
+            assert {int(v) for b in sm.cell_data[SUSPECT_ARRAY] for v in np.unique(b)} == {int(name == "suspect")}
+
+
+def test_a_status_holding_double_dashes_round_trips(written, tmp_path):
+    """The coarse-mesh reason says "use --quality": an XML comment cannot hold "--"."""
+    res, out = written["suspect"]
+    status = res.summary()["status"]
+    assert "--" in status
+    assert vtu_status(out / "result.vtu") == status
+
+
+def test_the_files_round_trip_and_the_packages_readers_read_them(written, tmp_path):
+    for name, (res, out) in written.items():
+        vtu = out / "result.vtu"
+        m = read_vtu(vtu)
+        # meshio writes back what it read (the flag included) and reads that again
+        meshio.write(tmp_path / f"{name}.vtu", m)
+        back = meshio.read(tmp_path / f"{name}.vtu")
+        np.testing.assert_array_equal(back.points, m.points)
+        for k in m.cell_data:
+            for a, b in zip(back.cell_data[k], m.cell_data[k]):
+                np.testing.assert_array_equal(a, b)
+        assert set(back.point_data) == set(m.point_data)
+        # field data holds the boundary names only (the flag is no boundary)
+        assert set(m.field_data) == set(res.fields["boundaries"])
+        # the probe's stresses at the nodes are the file's
+        X = m.points[:5, :2]
+        sig = result_sampler(vtu)(X)
+        np.testing.assert_allclose(sig[:, 0, 0], m.point_data["sxx_MPa"][:5], rtol=1e-9, atol=1e-12)
+        png = render_case(vtu, tmp_path / f"{name}.png", title=name)
+        assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_file_without_the_comment_has_no_status(tmp_path):
+    p = tmp_path / "x.vtu"
+    meshio.write(p, meshio.Mesh(np.zeros((3, 3)), [("triangle", np.array([[0, 1, 2]]))]))
+    assert vtu_status(p) is None
+
+
+def test_to_pyvista_carries_the_flag(written):
+    pytest.importorskip("pyvista")
+    for name, (res, out) in written.items():
+        grid = res.to_pyvista()
+        assert set(np.unique(grid.cell_data[SUSPECT_ARRAY]).tolist()) == {int(name == "suspect")}
+        assert not re.search("suspect|status", " ".join(grid.field_data.keys()))
