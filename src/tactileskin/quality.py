@@ -260,3 +260,20 @@ def kind(status_text: str) -> str:
     """'ok', 'suspect' or 'failed' of a status string."""
     k = str(status_text).split(":", 1)[0].strip()
     return k if k in ("ok", "suspect", "failed") else "failed"
+
+
+def suspect_title(text: str, status: str | None, width: int = 72, max_lines: int = 3) -> str:
+    """A figure's title `text`, with "SUSPECT: <reasons>" (the status text, summary.json's)
+    below it when `status` is not "ok": wrapped to `width` characters so that it stays inside
+    the figure (one 100-character line ran past both sides of an 8-inch one), at most
+    `max_lines` lines, the last cut with "..." (the whole text is in summary.json). None (a
+    file written without its status): `text` alone."""
+    import textwrap
+
+    if status is None or kind(status) == "ok":
+        return text
+    word = kind(status).upper()
+    lines = textwrap.wrap(f"{word}: " + str(status).split(":", 1)[-1].strip(), width, break_on_hyphens=False)
+    if len(lines) > max_lines:
+        lines = lines[:max_lines - 1] + [lines[max_lines - 1][:width - 3] + "..."]
+    return "\n".join([text, *lines])

@@ -218,17 +218,7 @@ def _figure_title(res, text: str) -> str:
     was titled as any other)."""
     if res.bone_map is None and res.sensors is None:
         return text
-    status = str(res.summary().get("status", "ok"))
-    if quality.kind(status) == "ok":
-        return text
-    import textwrap
-
-    # wrapped: one centred line of 100 characters ran past both sides of the 8-inch map,
-    # "SUSPECT" cut off; 72 fit it (the narrowest figure) at the title's size
-    lines = textwrap.wrap("SUSPECT: " + status.split(":", 1)[-1].strip(), 72)
-    if len(lines) > 3:
-        lines = lines[:2] + [lines[2][:69] + "..."]
-    return "\n".join([text, *lines])
+    return quality.suspect_title(text, str(res.summary().get("status", "ok")))
 
 
 def _write_map_figure(res, path, label: str) -> None:

@@ -119,7 +119,7 @@ def render_figure(vtu: Path, title: str = "", scene=None):
     ax.add_artist(AnchoredSizeBar(ax.transData, bar, f"{bar:g} mm", loc="lower left", pad=0.6,
                                   sep=4, frameon=True, size_vertical=0.01 * h))
     fig.colorbar(im, ax=ax, label="mean pressure P (MPa)", shrink=0.9)
-    ax.set_title(title or "deformed section, mean pressure", loc="left", fontsize="medium")
+    ax.set_title(_titled(vtu, title or "deformed section, mean pressure", 64), loc="left", fontsize="medium")
     return fig
 
 
@@ -142,6 +142,15 @@ def render_case(vtu: Path, png: Path, title: str = "", scene=None) -> Path:
     finally:
         plt.close(fig)
     return atomic_write_bytes(png, buf.getvalue())
+
+
+def _titled(vtu: Path, title: str, width: int) -> str:
+    """`title` with the SUSPECT note of the result's status, as result.vtu holds it
+    (results.vtu_status; a file written without one: the title alone)."""
+    from tactileskin.quality import suspect_title
+    from tactileskin.results import vtu_status
+
+    return suspect_title(title, vtu_status(vtu), width)
 
 
 def _quiet_vtk() -> None:
@@ -169,6 +178,7 @@ def _render_3d(vtu: Path, png: Path, title: str = "") -> Path:
         p.add_mesh(grid, scalars=field, cmap=CMAP, show_edges=False,
                    scalar_bar_args={"title": "mean pressure P (MPa)"})
         p.show_axes()
+        title = _titled(vtu, title, 80)
         if title:
             p.add_text(title, font_size=10)
         buf = io.BytesIO()
