@@ -174,3 +174,34 @@ def test_a_layout_name_with_a_line_separator_other_than_newline_keeps_its_rows(t
     assert list(rd.ids) == [f"{name}-{i}" for i in range(n)]
     assert list(rd.layout) == [name] * n
     np.testing.assert_allclose(rd.pressure, r.sensors.pressure)
+
+
+def test_a_no_contact_results_contact_csv_says_why(tmp_path, capsys):
+    """contact.csv of a result without contact held its header alone: a reader (csv, pandas)
+    saw no row, so no status, and nothing said why it was empty. It now has one row, its
+    numbers empty (no point is invented: pandas reads NaN) and the status saying why."""
+    import pandas as pd
+
+    (tmp_path / "s.toml").write_text(SENSORS_TOML)
+    out = tmp_path / "o"
+    # no contact: the depth is far below the contact tolerance (test_result_status)
+    assert main(["solve", "-t", "3", "-i", "curved", "--quality", "preview", "--depth", "1e-6",
+                 "--sensors", str(tmp_path / "s.toml"), "--out", str(out)]) == 3
+    status = json.loads((out / "summary.json").read_text())["status"]
+    assert status.startswith("suspect: no contact")
+    assert_status_everywhere(out, status, ["profile.csv", "contact.csv", "sensors.csv"])
+    with open(out / "contact.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 1 and {k: v for k, v in rows[0].items() if k != "status"} == \
+        {"x_mm": "", "y_mm": "", "contact_pressure_mpa": ""}
+    df = pd.read_csv(out / "contact.csv")
+    assert df["contact_pressure_mpa"].isna().all() and df["status"].tolist() == [status]
+    assert df.drop(columns="status").dropna(how="all").empty  # no contact point
+
+
+def test_an_ok_tables_rows_are_not_padded():
+    from tactileskin.results import with_status
+
+    assert with_status("a,b\n", "ok") == "a,b,status\n"
+    assert with_status("a,b\n", "suspect: x, y") == 'a,b,status\n,,"suspect: x, y"\n'
+    assert with_status("a,b\n1,2\n", "suspect: x") == "a,b,status\n1,2,suspect: x\n"

@@ -545,13 +545,18 @@ def with_status(text: str, status: str) -> str:
     with the column STATUS_COLUMN appended: `status` (summary.json's "ok" or "suspect: reasons")
     on every row, quoted where it holds a comma or a quote. Last, so the other columns keep
     their positions. Rows are split at line feeds only, as a CSV reader does: str.splitlines
-    also breaks at U+2028, NEL, form feed, ..., which a sensor layout's name may hold."""
+    also breaks at U+2028, NEL, form feed, ..., which a sensor layout's name may hold.
+    A table without rows of a result that is not ok (contact.csv of one without contact) gets
+    one, its other fields empty (read as NaN: no point is invented), so that the status saying
+    why is read; its header alone showed no status."""
     buf = io.StringIO()
     csv.writer(buf, lineterminator="").writerow([status])
     cell = buf.getvalue()
     lines = text.split("\n")
     if lines[-1] == "":
         lines.pop()
+    if len(lines) == 1 and quality.kind(status) != "ok":
+        lines.append("," * lines[0].count(","))
     return "".join([lines[0] + "," + STATUS_COLUMN + "\n", *(line + "," + cell + "\n" for line in lines[1:])])
 
 
