@@ -79,3 +79,19 @@ def test_the_note_is_the_summarys_status():
     t = quality.suspect_title("x", "suspect: " + why, width=40)
     assert t.startswith("x\nSUSPECT: no contact") and " ".join(t.split("\n")[1:]) == "SUSPECT: " + why
     assert quality.suspect_title("x", None) == "x"  # a file without a status (written before)
+
+
+def test_the_3d_render_of_a_suspect_result_says_so(tmp_path, monkeypatch):
+    """The pyvista render's title text (coarse-mesh 3D pad of test_status_columns, ~10 s)."""
+    pv = pytest.importorskip("pyvista")
+    from tactileskin.report.render import render_case
+
+    texts = []
+    add_text = pv.Plotter.add_text
+    monkeypatch.setattr(pv.Plotter, "add_text", lambda self, text, **kw: texts.append(text) or add_text(self, text, **kw))
+    res = solve(Scene(dim=3, thickness=1.0, indenter="flat", mesh_size=4.0, refinement=2, depth=0.1,
+                      viscoelastic=False))
+    assert res.status.startswith("suspect: mesh coarser")
+    out = res.write(tmp_path / "r")
+    assert render_case(out / "result.vtu", tmp_path / "r.png", title="t1 flat 3d").is_file()
+    assert len(texts) == 1 and texts[0].startswith("t1 flat 3d\nSUSPECT: mesh coarser"), texts
