@@ -223,3 +223,31 @@ def test_own_map_errors_recover_independent_errors():
     assert e == pytest.approx(expected, rel=1e-4, abs=5e-5)
     assert misfit < 1e-6
     assert d[1, 2] == pytest.approx(math.hypot(expected[1], expected[2]), rel=1e-4)
+
+
+def test_spot_scale_against_the_level_itself_fits_no_own_errors(tmp_path):
+    """spot_scale_t5 with --reference equal to --level: the reference is the k = s = 1 variant
+    itself, so a fit of per-mesh errors over them would read both as error-free and put the
+    whole distance on the other mesh; the file has the distances only."""
+    import json
+
+    spec = importlib.util.spec_from_file_location(
+        "spot_scale_t5", Path(__file__).resolve().parents[1] / "benchmarks" / "spot_scale_t5.py")
+    ss = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ss)
+    s = np.linspace(0.0, 8.0, 41)
+    z = np.linspace(0.0, 12.0, 61)
+    for k, bump in ((1.0, 0.0), (3.0, 0.05)):
+        p = np.outer(np.ones(z.size), np.exp(-s))
+        p[10:20, 5:10] += bump
+        rec = {"thickness": 5.0, "mesh_size": 1.6, "refinement": 8.0, "dofs": 100, "cpu_s": 1.0,
+               "wall_s": 1.0, "increments": 1, "newton_iterations": 2 if k == 1.0 else 1, "peak": 1.0 + bump,
+               "span": 2.0, "map": {"s": s.tolist(), "z": z.tolist(), "pressure": p.tolist()}}
+        path = ss.raw_path(tmp_path, 5.0, "silicone", "\u283f", 1.6, 8.0, k, 1.0)
+        path.write_text(json.dumps(rec), encoding="utf-8")
+    out = tmp_path / "out.md"
+    assert ss.main(["--thickness", "5", "--materials", "silicone", "--text", "\u283f", "--level", "1.6/8",
+                    "--reference", "1.6/8", "--variants", "1/1,3/1", "--raw", str(tmp_path), "--out", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert "| 3 / 1 | 100 |" in text and "+5.00%" in text
+    assert "every mesh against every other" not in text and "own error" not in text
