@@ -235,7 +235,10 @@ BONE_SCALE_MAX = 2.3
 # saved 2-5 % of the dofs and up to 19 % of the Newton iterations but moved the silicone dot's
 # bone map by 4.5-4.6 % (L2); against 0.8 / 8 their map errors are 2.6-4.1 % (the current plan
 # 4.5 %), but the saving (<= 19 % of the Newton iterations) does not meet T3 alone
-# (benchmarks/results/spot_scale_t5.md): not adopted.
+# (benchmarks/results/spot_scale_t5.md). The full cell at k = 3 (t = 5, 1.6 / 8): Newton
+# 104 -> 79, CPU -48 %, but its bone map moves 4.35 % (L2) from k = 1's, whose error against
+# 0.8 / 8 is 3.18 %: k = 3's lies anywhere in 1.2-7.5 % until the 0.8 / 8 cell is solved
+# again (benchmarks/results/spot_scale_t5_cell.md): not adopted.
 SPOT_FACTOR = 1.0
 STRIP_FACTOR = 1.0
 
