@@ -155,7 +155,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     """
     import pandas as pd
 
-    from tactileskin.cache import ResultCache
+    from tactileskin.cache import ResultCache, out_cache
     from tactileskin.report.outputs import PROFILE_COLUMNS, profile_rows
 
     for name, value in (("out", out), ("cache", cache)):
@@ -167,7 +167,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         validate.boolean(value, name)  # serial="no" is truthy: it ran serially
     scs = scenes(grid, quality=quality, base=base)
     if cache is None:
-        cache = Path(out) / "cache" if out is not None else default_cache_dir()
+        cache = out_cache(out) if out is not None else default_cache_dir()
     rc = ResultCache(cache)
     if out is None:
         records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, None, report)

@@ -324,6 +324,23 @@ class CaseLock:
 DERIVED_MANIFEST = "files.json"
 
 
+def out_cache(out) -> Path:
+    """`out`/cache, the default cache of a command writing into `out`. A symbolic link there
+    is refused (OutputError naming it): followed, it put the case entries and locks outside
+    `out`, or read a user's folder as the cache. A shared cache is named explicitly (--cache)."""
+    from tactileskin.fileio import OutputError
+
+    path = Path(out) / "cache"
+    if path.is_symlink():
+        try:
+            target = os.readlink(path)
+        except OSError:
+            target = "?"
+        raise OutputError(path, f"it is a symbolic link (to {target}), and the out folder's cache is its own; "
+                                "to share a cache folder, name it with --cache (cache= in Python)")
+    return path
+
+
 class ResultCache:
     def __init__(self, root: str | Path):
         self.root = Path(root)
