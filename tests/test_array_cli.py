@@ -94,7 +94,7 @@ def no_solves(monkeypatch):
     ("[array]\nthicknesses = \"x\"\n", ["thicknesses", "a list of numbers > 0 mm"]),   # was a ValueError traceback
     ("[array]\nseed = \"x\"\n", ["seed='x'", "an integer >= 0"]),                       # ditto
     ("[array]\npitches = \"abc\"\n", ["pitches", "[0.0809, 20] mm"]),   # was "ufunc 'isfinite'..."; the memory's bound
-    ("[array]\nnoise_fs = \"abc\"\n", ["noise_fs", "[0, 10]"]),
+    ("[array]\nnoise_fs = \"abc\"\n", ["noise_fs", "[0, 1] x full scale"]),
     ("[array]\nmax_depth = \"abc\"\n", ["max_depth='abc'", "> 0 mm"]),
     ("[array]\nthicknesses = [1, \"x\"]\n", ["thicknesses", "'x'", "> 0 mm"]),
     ("[array]\ntaxel_fraction = \"a\"\n", ["taxel_fraction", "[0, 1]"]),

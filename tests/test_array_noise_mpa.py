@@ -87,6 +87,11 @@ def test_cli_noise_mpa_reaches_the_report_and_the_csv(tmp_path, monkeypatch, clo
     (["--noise", "0.01", "--noise-mpa", "0.001"], None, ["noise_mpa (--noise-mpa)", "not with --noise"]),
     ([], "[array]\nnoise_fs = [0.01]\nnoise_mpa = [0.001]\n", ["noise_mpa (--noise-mpa)", "not with noise_fs"]),
     ([], "[array]\nnoise_mpa = \"x\"\n", ["noise_mpa (--noise-mpa)='x'", "(0, 10000] MPa"]),
+    # --noise is a fraction of full scale: 5 (meant as 5 %) charted 500 % noise, accuracy at
+    # chance, after the chart's 42 solves
+    (["--noise", "5"], None, ["noise_fs (--noise)=5.0", "[0, 1] x full scale", "0.05 is 5 %"]),
+    (["--noise", "0.01,1.5"], None, ["noise_fs (--noise)=1.5", "[0, 1] x full scale"]),
+    ([], "[array]\nnoise_fs = [10]\n", ["noise_fs (--noise)=10", "[0, 1] x full scale"]),
 ])
 def test_bad_noise_mpa_is_one_line_before_any_solve(tmp_path, capsys, monkeypatch, flags, config, words):
     def refuse(*a, **k):

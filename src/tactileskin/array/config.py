@@ -32,6 +32,10 @@ LETTERS_MODELS = ("interaction", "sum", "full")
 CHART_MESH = (1.2, 8.0)
 
 
+# x full scale: a noise std as large as the largest reading (accuracy near chance); a fraction,
+# so --noise 5 meant as 5 % (500 % noise, a chart at chance after all its solves) is refused
+NOISE_FS_MAX = 1.0
+
 # MPa: a noise std past any skin's pressure (a unit slip; 1e308 was charted with noise_fs = inf)
 NOISE_MPA_MAX = 1e4
 
@@ -152,7 +156,8 @@ class ChartConfig:
         plo, punit = self._pitch_floor()
         for name, flag, lo, hi, lo_open, unit in (("thicknesses", "-t", 0.0, None, True, "mm"),  # the skin: its range
                                                   ("pitches", "--pitch", plo, PITCH[1], False, punit),
-                                                  ("noise_fs", "--noise", 0.0, 10.0, False, "x full scale")):
+                                                  ("noise_fs", "--noise", 0.0, NOISE_FS_MAX, False,
+                                                   "x full scale (a fraction: 0.05 is 5 %)")):
             if getattr(self, name) is not None:  # noise_fs: None with noise_mpa
                 set_(name, _numbers(getattr(self, name), f"{name} ({flag})", lo, hi, unit, lo_open))
         if self.sensor_depth is not None:  # inside every skin of the chart: below its surface, above its bone

@@ -65,7 +65,7 @@ def load_config(path) -> dict:
               "bonded surface (or at --sensor-depth / --sensor-height) over an 8 mm window. Default 0.5,0.75,1,1.5,2,4.")
 @click.option("--noise", default=None, help="Noise std as fractions of full scale: each set's largest pressure at that "
               "thickness, so one fraction is a different noise in MPa at each thickness (array_chart.md gives it). "
-              "Default 0.01,0.05,0.1.")
+              "In [0, 1] (0.05 is 5 %). Default 0.01,0.05,0.1.")
 @click.option("--noise-mpa", default=None, help="Noise std in MPa instead of --noise, the same at every thickness "
               "and set (a real sensor's noise floor), e.g. '0.001,0.005'.")
 @click.option("--taxel", type=float, default=None, help="Taxel side as a fraction of the pitch (0 = point). Default 0.8.")
