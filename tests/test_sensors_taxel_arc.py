@@ -40,3 +40,33 @@ def test_a_taxel_near_the_nail_end_is_judged_by_its_physical_side():
     over = sensors.SensorLayout.from_dict({"name": "a", "s": [lim - 0.1], "depth": 2.5, "taxel": 2.0})
     with pytest.raises(Exception, match="taxel"):
         sensors.resolve([over], coords, 2)
+
+
+@pytest.mark.parametrize("t,depth", [(3.0, 1.0), (5.0, 2.5), (3.0, 0.0)])
+def test_the_side_and_edge_checks_take_one_surface_length(t, depth):
+    """The side check said the surface at depth 1 mm (t = 3) is 27.1047 mm long, the edge
+    check refused a centred taxel from 27.0794 mm (its own coarser arc table): a side the
+    message called valid was refused. Both now measure one table of the surface."""
+    coords = sensors.coordinates_for(Scene(thickness=t))
+    lim = coords.s_limit(depth)
+    arc = _arc(coords, -lim, lim, depth)  # the surface's polyline, independently of sensors.py
+
+    def fits(s, side):
+        lay = sensors.SensorLayout.from_dict({"name": "a", "s": [s], "depth": depth, "taxel": float(side)})
+        try:
+            sensors.resolve([lay], coords, 2)
+        except Exception as e:
+            assert "taxel" in str(e)
+            return False
+        return True
+
+    with pytest.raises(Exception, match=r"valid: \(0, ([\d.]+)\] mm") as e:
+        sensors.resolve([sensors.SensorLayout.from_dict({"name": "a", "s": [0.0], "depth": depth,
+                                                        "taxel": 1e3})], coords, 2)
+    stated = float(str(e.value).split("valid: (0, ")[1].split("]")[0])
+    assert stated == pytest.approx(arc, abs=2e-4)
+    assert fits(0.0, stated - 1e-3) and not fits(0.0, stated + 1e-3)
+    # off centre: the edge nearer the end decides, at the surface's own arc from the centre
+    s = 0.4 * lim
+    room = 2 * _arc(coords, s, lim, depth)
+    assert fits(s, room - 1e-3) and not fits(s, room + 1e-3)
