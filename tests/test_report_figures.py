@@ -518,3 +518,24 @@ def test_run_settings_give_the_numbers_of_each_material(tmp_path):
     mat.write_text(toml.format(mu="0.012"))
     after = "\n".join(run_settings(scenes))
     assert after != before and "mu = [0.08, 0.012]" in after
+
+
+def test_the_drawing_digest_follows_the_font_files_bytes(tmp_path, monkeypatch):
+    """The kept figures were named by each font file's path and size: a font replaced by
+    another of the same size (its time stamp kept, touch -r) drew other glyphs, but a rerun
+    copied the figures drawn with the old one. The font's bytes are hashed now."""
+    import os
+
+    from matplotlib import font_manager
+
+    real = font_manager.findfont(font_manager.FontProperties(family=["DejaVu Sans"]))
+    font = tmp_path / "font.ttf"
+    font.write_bytes(Path(real).read_bytes())
+    monkeypatch.setattr(font_manager, "findfont", lambda *a, **k: str(font))
+    before, st = figures.drawing_digest(), font.stat()
+    data = bytearray(font.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    font.write_bytes(bytes(data))
+    os.utime(font, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert font.stat().st_size == st.st_size and font.stat().st_mtime_ns == st.st_mtime_ns
+    assert figures.drawing_digest() != before
