@@ -124,6 +124,24 @@ def test_key_and_loads_follow_geometry_files_within_a_process(geometry):
     assert cache_key(sc) == k
 
 
+def test_a_comment_in_a_geometry_file_keeps_the_keys(geometry):
+    """The key hashed the geometry files' bytes: a comment added to the user's indenters.toml
+    (TACTILESKIN_GEOMETRY), or its lines re-spaced, re-solved every cached case with the same
+    numbers. It hashes what the file says (its parsed values); a value still changes it."""
+    sc = Scene(indenter="curved")
+    k = cache_key(sc)
+    f = geometry / "indenters.toml"
+    text = f.read_text()
+    f.write_text("# my notes: the curved radius is the paper's\n" + text.replace("radius = 12.0", "radius   =   12.0"))
+    assert cache_key(sc) == k
+    f.write_text(text.replace("radius = 12.0", "radius = 12.5"))
+    assert cache_key(sc) != k
+    f.write_text(text.replace("radius = 12.0", "radius = 12"))  # an integer: not the same TOML value
+    assert cache_key(sc) != k
+    f.write_text("[[[not toml")  # unreadable: keyed by its bytes, the solve names the error
+    assert cache_key(sc) != k
+
+
 def test_key_follows_schema_and_version(monkeypatch):
     import tactileskin.cache as cache_mod
 

@@ -7,8 +7,9 @@ names, so the cache is keyed by `cache_key(scene)`, the SHA-256 of
 - the material's law name and numbers (its parameters, and its Prony terms for a viscoelastic scene:
   an elastic solve ignores them), read from the preset table or the
   user's material file: editing the file changes the key, renaming or moving it does not;
-- the bytes of every geometry parameter file a solve reads (`params.geometry_digest()`:
-  fingertip, indenters, Braille standards; not molds.toml, read by `build` alone);
+- the values of every geometry parameter file a solve reads (`params.geometry_digest()`, parsed, so
+  a comment does not change the key: fingertip, indenters, Braille standards; not molds.toml, read
+  by `build` alone; the shipped files are package data, hashed by their bytes with the code);
 - the bytes of files the indenter kind reads (`Indenter.cache_content`: a user's STL) and the
   skin reads (`Skin.cache_content`: a user's .msh or STEP), not their paths;
 - `scene.SCHEMA_VERSION`, the package version and `code_digest()`: the bytes of the package's

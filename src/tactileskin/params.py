@@ -11,6 +11,7 @@ import atexit
 import contextlib
 import functools
 import hashlib
+import json
 import os
 import tomllib
 from importlib import resources
@@ -88,7 +89,11 @@ _PARSED: dict[tuple[str, bytes], dict] = {}
 def load(name: str) -> dict:
     """Parsed <geometry_dir>/<name>.toml (memoised by content; treat as read-only)."""
     path = geometry_dir() / f"{name}.toml"
-    data = _read_capped(path, "parameter file")
+    return _parsed(name, _read_capped(path, "parameter file"), path)
+
+
+def _parsed(name: str, data: bytes, path) -> dict:
+    """`data` (the bytes of `name`.toml) parsed, memoised by content."""
     hit = _PARSED.get((name, data))
     if hit is None:
         hit = _parse(data, path, "parameter file")
@@ -124,9 +129,10 @@ NOT_SOLVED = ("molds.toml",)
 
 
 def geometry_digest() -> str:
-    """SHA-256 of every geometry parameter file but NOT_SOLVED (names and bytes, sorted by
-    name): part of the result cache's key, so that editing a dimension invalidates the cached
-    results."""
+    """SHA-256 of every geometry parameter file but NOT_SOLVED (names and parsed values, sorted
+    by name): part of the result cache's key, so that editing a dimension invalidates the cached
+    results, and a comment or re-spacing (the same values) does not re-solve them. A file that
+    is not valid TOML enters by its bytes (its solve names the error)."""
     folder = geometry_dir()
     try:
         paths = sorted((p for p in folder.iterdir() if p.name.endswith(".toml") and p.is_file()
@@ -137,5 +143,11 @@ def geometry_digest() -> str:
     h = hashlib.sha256()
     for p in paths:
         data = _read_capped(p, "parameter file")
+        try:
+            parsed = _parsed(p.stem, data, p)
+            # floats as repr (exact), 1 and 1.0 apart as TOML has them; dates and times as text
+            data = b"toml\0" + json.dumps(parsed, sort_keys=True, default=str).encode()
+        except ParameterError:
+            pass
         h.update(p.name.encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
     return h.hexdigest()
