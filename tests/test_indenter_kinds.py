@@ -409,3 +409,34 @@ def test_the_sphere_radius_is_bounded_by_its_printed_part(tmp_path, capsys):
     from tactileskin.geometry.indenters.sphere import MAX_RADIUS
 
     assert MAX_RADIUS == 100.0
+
+
+def test_a_file_edited_while_it_is_read_is_not_kept_as_the_old_bytes(tmp_path, monkeypatch):
+    """The loaded surface is memoised by (path, SHA-256 of the bytes hashed first), but the
+    file was read again to load it: an edit landing between the two (a script rewriting the
+    STL while a sweep runs) kept the new surface under the old bytes' digest, so once the file
+    was back to those bytes every solve in the process took the other surface, under the key
+    of the first."""
+    trimesh = pytest.importorskip("trimesh")
+    from tactileskin.geometry.indenters import file as file_mod
+
+    f = tmp_path / "ind.stl"
+    trimesh.creation.icosphere(subdivisions=2, radius=2.0).export(f)
+    old = f.read_bytes()
+    trimesh.creation.icosphere(subdivisions=2, radius=2.5).export(tmp_path / "other.stl")
+    real, calls = file_mod._read, []
+
+    def edited_meanwhile(path, *a):
+        if not calls:
+            path.write_bytes((tmp_path / "other.stl").read_bytes())
+        calls.append(path)
+        return real(path, *a)
+
+    monkeypatch.setattr(file_mod, "_read", edited_meanwhile)
+    file_mod._load.cache_clear()
+    with pytest.raises(ParameterError, match="indenter_file.*changed while it was read"):
+        file_mod.load_surface(f)
+    f.write_bytes(old)
+    v, _ = file_mod.load_surface(f)
+    assert np.ptp(v[:, 0]) == pytest.approx(4.0, rel=0.02)  # the 2 mm ball's, not the 2.5 mm one's
+    file_mod._load.cache_clear()

@@ -98,8 +98,14 @@ def _read(path: Path):
 
 @functools.lru_cache(maxsize=8)
 def _load(path: str, digest: str):
-    """Cached by content: the same bytes load once per process."""
-    return _read(Path(path))
+    """Cached by content: the same bytes load once per process. The file is hashed again
+    after the read: an edit between the first hash and the read would keep another surface
+    under these bytes' digest (and so under their cache key) for the life of the process."""
+    out = _read(Path(path))
+    if file_digest(path) != digest:
+        raise ParameterError("indenter_file", path, _VALID, "it changed while it was read; run again once it is "
+                             "written")
+    return out
 
 
 def load_surface(path) -> tuple[np.ndarray, np.ndarray]:
