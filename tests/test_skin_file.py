@@ -623,3 +623,33 @@ def test_an_indenter_on_a_curved_step_top_touches_at_once(tmp_path, indenter):
     assert scene.thickness == pytest.approx(2.8, abs=1e-9)
     assert first_contact_travel(scene) == pytest.approx(0.0, abs=1e-9)
     require_contact(scene)  # no ParameterError
+
+
+def test_a_skin_file_edited_while_it_is_read_is_not_kept_as_the_old_bytes(tmp_path, monkeypatch):
+    """As an indenter file's surface: the skin file's analysis (its thickness among the rest)
+    is memoised by the bytes hashed first, but the file was read again to analyse it, so an edit
+    in between kept the other block's thickness under the first bytes' digest and key."""
+    from tactileskin.mesh import skinfile
+    from tactileskin.skins import file as skin_file
+
+    f = _gmsh_block(tmp_path / "a.msh", dim=2, t=2.0)
+    old = f.read_bytes()
+    other = _gmsh_block(tmp_path / "b.msh", dim=2, t=3.0).read_bytes()
+    real, calls = skinfile.load_msh, []
+
+    def edited_meanwhile(path, *a, **k):
+        if not calls:
+            f.write_bytes(other)
+        calls.append(path)
+        return real(path, *a, **k)
+
+    monkeypatch.setattr(skinfile, "load_msh", edited_meanwhile)
+    skin_file._analyse.cache_clear()
+    skin_file._coordinates.cache_clear()
+    with pytest.raises(ParameterError, match="skin_file.*changed while it was read"):
+        skin_file._analyse(*skin_file._key(type("S", (), {"skin_file": str(f), "skin_bonded": None,
+                                                                 "skin_outer": None})()))
+    f.write_bytes(old)
+    assert Scene(skin="file", skin_file=str(f)).thickness == pytest.approx(2.0)  # not the 3 mm block's
+    skin_file._analyse.cache_clear()
+    skin_file._coordinates.cache_clear()
