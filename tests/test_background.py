@@ -134,3 +134,58 @@ def test_the_childs_warnings_reach_this_process_as_records(caplog):
             files = bg.files()
     assert int(files[0][1]) != os.getpid()
     assert any(f"odd axis in {int(files[0][1])}" in r.getMessage() for r in caplog.records if r.name == "py.warnings")
+
+
+def test_a_signal_just_after_the_fork_never_runs_this_process_code_in_the_child(tmp_path):
+    """Ctrl-C reaching the child between fork() and its own handlers raised KeyboardInterrupt
+    in the child, which then unwound through its parent's code (the sweep's `finally` blocks,
+    main's 'interrupted', the exit handlers): signals are held across fork()."""
+    import subprocess
+
+    script = tmp_path / "race.py"
+    script.write_text(
+        "import os, signal\n"
+        "from tactileskin import threads\n"
+        "threads.other_threads = list\n"
+        "from tactileskin.report import background\n"
+        "from tactileskin.report.background import Background\n"
+        "real_fork = os.fork\n"
+        "def fork():\n"
+        "    pid = real_fork()\n"
+        "    if pid == 0:\n"
+        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        "        for _ in range(1000):\n"
+        "            pass\n"
+        "    return pid\n"
+        "background.os.fork = fork\n"
+        "def draw(folder):\n"
+        "    p = os.path.join(folder, 'a.txt')\n"
+        "    open(p, 'w').write(str(os.getpid()))\n"
+        "    return [p]\n"
+        "me = os.getpid()\n"
+        "try:\n"
+        "    with Background(draw) as bg:\n"
+        "        files = bg.files()\n"
+        "    print('drawn in', 'parent' if int(files[0][1]) == me else 'child', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('KeyboardInterrupt in', 'parent' if os.getpid() == me else 'child', flush=True)\n")
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "PYTHONPATH": str(Path(background.__file__).parents[2])})
+    assert r.stdout.splitlines() == ["drawn in child"], r.stdout + r.stderr
+
+
+def test_a_failed_fork_draws_here(monkeypatch, tmp_path):
+    """fork() refused (EAGAIN: the process limit) is one more case of drawing here, not an
+    error of the sweep, and leaves no private folder behind."""
+    import tempfile
+
+    def refuse():
+        raise BlockingIOError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(background.os, "fork", refuse)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    with Background(write_pids) as bg:
+        assert bg.pid is None
+        files = bg.files()
+    assert int(files[0][1]) == os.getpid()
+    assert list(tmp_path.iterdir()) == []

@@ -34,7 +34,13 @@ def can_fork() -> bool:
     (threads.other_threads: a lock it holds as fork() copies the process stays held)."""
     from tactileskin.threads import other_threads
 
-    return sys.platform.startswith("linux") and not other_threads()
+    import threading
+
+    # Background._fork sets Python handlers of SIGINT and SIGTERM: the main thread's to set,
+    # and to put back (getsignal None: a handler not set from Python, which cannot be)
+    return (sys.platform.startswith("linux") and threading.current_thread() is threading.main_thread()
+            and all(signal.getsignal(s) is not None for s in (signal.SIGINT, signal.SIGTERM))
+            and not other_threads())
 
 
 def _read_files(paths) -> list[tuple[str, bytes]]:
@@ -54,12 +60,13 @@ class _Keep(logging.Handler):
         self.records.append(record)
 
 
-def _in_child(fn, folder: Path, fd: int) -> None:
+def _in_child(fn, folder: Path, fd: int, other_end: int) -> None:
     """Run fn(folder), send ("ok", files, records) or ("error", text, records), and end the
     process without its parent's exit handlers (os._exit: they close the parent's cluster,
     release its locks)."""
     code = 1
     try:
+        os.close(other_end)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         # new file objects on the standard streams: the ones copied may be the progress bar's
@@ -100,16 +107,45 @@ class Background:
 
     def __enter__(self) -> "Background":
         if can_fork():
-            self.folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
-            r, w = os.pipe()
-            pid = os.fork()
-            if pid == 0:
-                os.close(r)
-                _in_child(self.fn, self.folder, w)
-            os.close(w)
-            self.pid, self.fd = pid, r
+            try:
+                self._fork()
+            except OSError as e:  # no folder, no pipe or fork() refused (EAGAIN): draw here
+                log.debug("no second process for drawing (%s); drawing here", e)
+            except BaseException:  # Ctrl-C as the child started: no `with` block to end it
+                self._end_child()
+                raise
+            finally:
+                if self.pid is None:  # no child: its folder is not wanted
+                    self._end_child()
         self.started = time.perf_counter()
         return self
+
+    def _fork(self) -> None:
+        self.folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
+        r, w = os.pipe()
+        # Ctrl-C / SIGTERM only noted across fork() and the child's start: a handler raising in
+        # the child before _in_child set its own unwound through this process's code there, and
+        # one raising here before self.pid was set left the child unended (masking the signals
+        # is not enough: another thread takes them and this one runs the handler)
+        held: list[int] = []
+        previous = {s: signal.signal(s, lambda signum, frame: held.append(signum))
+                    for s in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            try:
+                pid = os.fork()
+            except OSError:
+                os.close(r)
+                os.close(w)
+                raise
+            if pid == 0:
+                _in_child(self.fn, self.folder, w, r)
+            os.close(w)
+            self.pid, self.fd = pid, r
+        finally:
+            for s, h in previous.items():
+                signal.signal(s, h)
+        for s in held[:1]:
+            signal.raise_signal(s)  # now, with this process's handlers (and its child known)
 
     def _receive(self, deadline: float) -> bytes | None:
         chunks = []
@@ -142,9 +178,7 @@ class Background:
         finally:
             shutil.rmtree(folder, ignore_errors=True)
 
-    def _end_child(self) -> None:
-        if self.pid is None:
-            return
+    def _reap(self) -> None:
         try:
             os.kill(self.pid, signal.SIGKILL)  # done already (os._exit) or to be given up
         except ProcessLookupError:
@@ -152,9 +186,15 @@ class Background:
         os.waitpid(self.pid, 0)
         os.close(self.fd)
         self.pid = self.fd = None
-        if self.folder is not None:
-            shutil.rmtree(self.folder, ignore_errors=True)
-            self.folder = None
+
+    def _end_child(self) -> None:
+        try:
+            if self.pid is not None:
+                self._reap()
+        finally:  # a second Ctrl-C while the child is ended still removes its folder
+            if self.folder is not None:
+                shutil.rmtree(self.folder, ignore_errors=True)
+                self.folder = None
 
     def __exit__(self, *exc) -> None:
         self._end_child()
