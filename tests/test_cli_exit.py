@@ -46,3 +46,16 @@ def test_a_running_thread_gets_the_normal_exit_which_waits_for_it():
              "threading.Thread(target=late).start()")
     r = _run(["--help"], extra=extra)
     assert r.returncode == 0 and "thread finished" in r.stderr and "exit handler ran" in r.stderr
+
+
+@pytest.mark.parametrize("fd", [1, 2])
+def test_a_closed_standard_stream_is_not_a_failed_flush(fd):
+    """`tactileskin ... >&-` (or 2>&-, a service without streams): Python starts with that
+    sys.stdout / sys.stderr None and exits 0 after a successful run; run() counted the None
+    stream's flush (AttributeError) as a failed one and exited 120."""
+    import os
+
+    code = "import sys\nsys.argv = ['tactileskin', '--version']\nfrom tactileskin.cli import run\nrun()\n"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                       preexec_fn=lambda: os.close(fd))
+    assert r.returncode == 0, (r.returncode, r.stderr)

@@ -173,9 +173,13 @@ def run() -> None:
         sys.exit(code)
     atexit._run_exitfuncs()
     for stream in (sys.stdout, sys.stderr):
+        # as Python's own exit: a stream that is None (started with that fd closed, `>&-`) or
+        # closed is not flushed, and not a failure
+        if stream is None or getattr(stream, "closed", False):
+            continue
         try:
             stream.flush()
-        except (OSError, ValueError, AttributeError):  # closed, or a pipe whose reader left
+        except (OSError, ValueError):  # a pipe whose reader left, a full disk
             code = code or 120  # Python's own status when the final flush fails
     os._exit(code)
 
