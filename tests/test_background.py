@@ -189,3 +189,20 @@ def test_a_failed_fork_draws_here(monkeypatch, tmp_path):
         files = bg.files()
     assert int(files[0][1]) == os.getpid()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failed_childs_log_records_are_not_repeated_by_the_drawing_here(caplog):
+    """A child whose fn logged and then raised is redone here, which logs the same again: the
+    child's records were re-emitted as well, every warning of that figure shown twice."""
+    from tactileskin.errors import TactileSkinError
+
+    def logs_and_fails(folder):
+        logging.getLogger("tactileskin.report.figures").warning("odd axis")
+        raise TactileSkinError("figure broke")
+
+    with caplog.at_level(logging.WARNING):
+        with pytest.raises(TactileSkinError, match="figure broke"):
+            with Background(logs_and_fails) as bg:
+                assert bg.pid is not None
+                bg.files()
+    assert [r.getMessage() for r in caplog.records if r.name == "tactileskin.report.figures"] == ["odd axis"]

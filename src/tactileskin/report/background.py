@@ -167,10 +167,11 @@ class Background:
                 status, value, records = pickle.loads(data) if data else ("error", "no answer", [])
             except Exception as e:  # noqa: BLE001 - a cut message: draw here
                 status, value, records = "error", f"unreadable answer ({e})", []
-            for rec in records:
-                logging.getLogger(rec.name).handle(rec)
             if status == "ok":
+                for rec in records:
+                    logging.getLogger(rec.name).handle(rec)
                 return value
+            # a failed child's records are not handed on: fn, run again here, logs its own
             log.debug("drawing in a second process failed (%s); drawing here", value)
         folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
         try:
