@@ -206,3 +206,28 @@ def test_a_failed_childs_log_records_are_not_repeated_by_the_drawing_here(caplog
                 assert bg.pid is not None
                 bg.files()
     assert [r.getMessage() for r in caplog.records if r.name == "tactileskin.report.figures"] == ["odd axis"]
+
+
+def test_drawing_here_writes_into_the_callers_folder_not_a_temporary_one(monkeypatch, tmp_path):
+    """With `here` (the sweep's output folder) fn run in this process writes there, as drawing
+    in one process did: a temporary folder that cannot be made or written (a full or read-only
+    /tmp) failed the sweep, which had never needed it, and an error named a file in a
+    temporary folder already removed."""
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "no-such-dir"))
+    out = tmp_path / "out"
+    out.mkdir()
+    with Background(write_pids, here=out) as bg:
+        assert bg.pid is None  # no private folder: no child
+        files = bg.files()
+    assert [n for n, _ in files] == ["b.txt", "a.txt"] and int(files[0][1]) == os.getpid()
+
+    def refused(folder):
+        raise PermissionError(13, "Permission denied", str(Path(folder) / "fig.png"))
+
+    monkeypatch.setattr(threads, "other_threads", lambda: ["a user's thread"])
+    with pytest.raises(PermissionError) as e:
+        with Background(refused, here=out) as bg:
+            bg.files()
+    assert e.value.filename == str(out / "fig.png")

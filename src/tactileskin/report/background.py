@@ -95,11 +95,13 @@ def _in_child(fn, folder: Path, fd: int, other_end: int) -> None:
 
 class Background:
     """`with Background(fn) as bg: ...; files = bg.files()`: fn(folder) drawn in a child, or
-    here when files() finds the child's work missing. Leaving the block kills a child not
-    collected (an error or Ctrl-C here) and removes its folder."""
+    here when files() finds the child's work missing, into `here` (the caller's output folder:
+    files and errors as drawing in one process) or else a private temporary folder. Leaving
+    the block kills a child not collected (an error or Ctrl-C here) and removes its folder."""
 
-    def __init__(self, fn) -> None:
+    def __init__(self, fn, here: Path | None = None) -> None:
         self.fn = fn
+        self.here = here
         self.pid: int | None = None
         self.fd: int | None = None
         self.folder: Path | None = None
@@ -173,6 +175,8 @@ class Background:
                 return value
             # a failed child's records are not handed on: fn, run again here, logs its own
             log.debug("drawing in a second process failed (%s); drawing here", value)
+        if self.here is not None:
+            return _read_files(self.fn(self.here))
         folder = Path(tempfile.mkdtemp(prefix="tactileskin-draw-"))
         try:
             return _read_files(self.fn(folder))

@@ -175,7 +175,8 @@ def _figures(records, rows, out: Path, cache, meanwhile=lambda: None) -> list[Pa
     there, here = jobs[:BACKGROUND_JOBS], jobs[BACKGROUND_JOBS:]
     make_dirs(out)
     _plt()  # imported before the fork: the child needs no import of its own
-    with Background(lambda folder: [p for job in there for p in job(folder)]) as bg:
+    # drawn here (no child, or it failed) straight into `out`, as in one process
+    with Background(lambda folder: [p for job in there for p in job(folder)], here=out) as bg:
         mine = [p for job in here for p in job(out)]
         meanwhile()
         paths = [atomic_write_bytes(out / fname, data) for fname, data in bg.files()] + mine
