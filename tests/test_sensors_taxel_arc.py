@@ -70,3 +70,15 @@ def test_the_side_and_edge_checks_take_one_surface_length(t, depth):
     s = 0.4 * lim
     room = 2 * _arc(coords, s, lim, depth)
     assert fits(s, room - 1e-3) and not fits(s, room + 1e-3)
+
+
+@pytest.mark.parametrize("t", [1.0, 3.0, 5.0])
+def test_the_surface_arc_table_is_within_its_stated_bound(t):
+    """_surface_arc is within 1e-4 mm of the polyline, as it says: on 401 points it was 1.7e-4 mm
+    short over the whole contact surface at t = 5 (2.2e-4 mm part way along it)."""
+    coords = sensors.coordinates_for(Scene(thickness=t))
+    for depth in np.linspace(0.0, t, 5):
+        lim = coords.s_limit(depth)
+        S, A = sensors._surface_arc(coords, depth, lim)
+        for s in np.linspace(-lim, lim, 9)[1:]:
+            assert np.interp(s, S, A) == pytest.approx(_arc(coords, -lim, s, depth), abs=1e-4), (depth, s)

@@ -406,11 +406,12 @@ def _check_range(where, what, v, lo, hi, unit="mm", note=""):
 
 def _surface_arc(coords, depth: float, lim: float) -> tuple[np.ndarray, np.ndarray]:
     """(S, A): the arc length A on the surface at `depth` from s = -lim to each S in [-lim, lim]
-    (trapezoids of coords.frame's area element on 401 points; within 1e-4 mm of the polyline
-    through 20001). The one measure of the surface both taxel checks take: the side check and
-    the edge check each had their own (27.1047 and 27.0794 mm at t = 3, depth 1), so a side
-    the first called valid the second refused."""
-    S = np.linspace(-lim, lim, 401)
+    (trapezoids of coords.frame's area element on 801 points; within 1e-4 mm of the polyline
+    through 4001 at t = 1-5, any depth). The one
+    measure of the surface both taxel checks take: the side check and the edge check each had
+    their own (27.1047 and 27.0794 mm at t = 3, depth 1), so a side the first called valid the
+    second refused."""
+    S = np.linspace(-lim, lim, 801)
     jac = coords.frame(S, np.full(S.size, depth))[3]
     return S, np.concatenate([[0.0], np.cumsum(0.5 * (jac[1:] + jac[:-1]) * np.diff(S))])
 
