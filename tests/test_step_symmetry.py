@@ -4,6 +4,7 @@ same way, as a .msh quarter is; an almost symmetric skin or an asymmetric indent
 whole model."""
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -139,3 +140,31 @@ def test_the_mesh_command_says_a_step_skin_is_modelled_as_its_quarter(tmp_path, 
     out = " ".join(capsys.readouterr().out.split())  # the table wraps at the terminal's width
     assert "model │ quarter (x >= 0, z >= 0) │" in out
     assert "bonded boundary measure (mm^2) │ 16 │" in out
+
+
+def test_a_step_skin_edited_while_its_symmetry_is_read_is_not_kept_as_the_old_bytes(tmp_path, monkeypatch):
+    """The symmetry of a STEP skin is memoised by the SHA-256 of the bytes hashed first, but
+    the file was imported again to test it: an edit in between kept the other solid's symmetry
+    under the first bytes' digest, so once the file was back to them an asymmetric skin was cut
+    at x = 0 (or a symmetric one solved whole) for the life of the process."""
+    from tactileskin.errors import ParameterError
+    from tactileskin.mesh import skinfile
+
+    f = tmp_path / "skin.step"
+    old = Path(_dome(f, dx=0.5)).read_bytes()
+    other = Path(_dome(tmp_path / "sym.step")).read_bytes()
+    real, calls = skinfile._import_step, []
+
+    def edited_meanwhile(gmsh, path):
+        if not calls:
+            f.write_bytes(other)
+        calls.append(path)
+        return real(gmsh, path)
+
+    monkeypatch.setattr(skinfile, "_import_step", edited_meanwhile)
+    skinfile._solid_symmetry.cache_clear()
+    with pytest.raises(ParameterError, match="skin_file.*changed while it was read"):
+        step_symmetry(f)
+    f.write_bytes(old)
+    assert step_symmetry(f) == (False, True)  # the moved block's, not the symmetric one's
+    skinfile._solid_symmetry.cache_clear()
