@@ -6,26 +6,12 @@ explicit --cache option."""
 from __future__ import annotations
 
 import pytest
+from test_output_safety import counted_cases  # noqa: F401 - the fixture: every case fails at once
 
-import tactileskin.sweep as sw
 from tactileskin.cli import main
 from tactileskin.fileio import OutputError
 
 SWEEP = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render"]
-
-
-@pytest.fixture
-def counted_cases(monkeypatch):
-    from tactileskin.errors import ConvergenceError
-
-    calls = []
-
-    def fail(scene):
-        calls.append(scene)
-        raise ConvergenceError("not solved in this test", {})
-
-    monkeypatch.setattr(sw, "solve_case", fail)
-    return calls
 
 
 def _linked_cache(tmp_path, argv):
