@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tactileskin.errors import ParameterError
 from tactileskin.fe import material_law
 from tactileskin.materials import EXP_CAP, LOG_C_CAP, Hyperfoam, get_material
 from tactileskin.materials.hyperfoam import pk2_tangent, pk2_tangent_plane, pk2_tangent_solid
@@ -338,3 +339,44 @@ def test_a_cap_edited_in_hyperfoam_py_is_not_run_by_a_stale_compiled_kernel(tmp_
     src.write_text(text.replace("\nLOG_C_CAP = 30.0 ", "\nLOG_C_CAP = 20.0 "))
     r = probe()
     assert r.returncode != 0 and "LOG_C_CAP" in r.stderr, r.stdout   # not the cached kernel's 30
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")
+@pytest.mark.parametrize("name", MATERIALS)
+def test_kept_spectral_data_gives_the_fresh_tangent_bits(name):
+    """pk2_kept_solid's S and ok are those of the S-only loop, and tangent_kept_solid's D
+    those of the S + D loop at the same C, bit for bit (the same arithmetic on the same
+    eigen-decomposition): admissible states, C = I, coincident stretches and the guard's
+    clipped points. D from another state's kept data is not this state's D."""
+    from tactileskin.materials.hyperfoam import pk2_kept_solid, tangent_kept_solid
+
+    mat = MATERIALS[name]
+    bad2 = inadmissible_states(mat)
+    bad = np.zeros((len(bad2), 3, 3))
+    bad[:, :2, :2], bad[:, 2, 2] = bad2, 1.0
+    C = np.concatenate([solid_states(name), bad])
+    C = C[:len(C) // 2 * 2].reshape(2, -1, 3, 3)          # any leading shape
+    S, D, ok = pk2_tangent_solid(mat, C)
+    Sk, okk, kept = pk2_kept_solid(mat, C)
+    assert kept.shape == C.shape[:-2] + (18,)
+    assert np.array_equal(Sk, S) and np.array_equal(okk, ok) and not ok.all() and ok.any()
+    assert np.array_equal(tangent_kept_solid(mat, kept), D)
+    other = pk2_kept_solid(mat, np.flip(C, axis=1))[2]
+    assert not np.array_equal(tangent_kept_solid(mat, other), D)
+    with pytest.raises(ParameterError, match="kept"):
+        tangent_kept_solid(mat, kept[..., :9])
+
+
+def test_threaded_kept_tangent_has_the_serial_bits():
+    from tactileskin.materials import hyperfoam
+    from tactileskin.materials.hyperfoam import pk2_kept_solid, tangent_kept_solid
+    from tactileskin.threads import numba_threads
+
+    mat = MATERIALS["silicone"]
+    C = np.concatenate([solid_states("silicone")] * (hyperfoam.PARALLEL_MIN_POINTS // 300 + 1))
+    with numba_threads(1):
+        S, D, ok = pk2_tangent_solid(mat, C)
+    with numba_threads(2):
+        Sk, okk, kept = pk2_kept_solid(mat, C)
+        Dk = tangent_kept_solid(mat, kept)
+    assert np.array_equal(Sk, S) and np.array_equal(okk, ok) and np.array_equal(Dk, D)

@@ -59,15 +59,27 @@ def material_law(law):
     D is still the full (..., 3, 3, 3, 3), so a 3D state that happens to be plane is
     served correctly too. law(C, tangent=False) returns (S, None, ok) where the law can
     skip D (hyperfoam on both paths; residual-only evaluations).
-    """
 
-    def evaluate(C, tangent=True):
+    law(C, tangent=False, keep=True) returns (S, None, ok, kept): where the law can (hyperfoam
+    on the 3x3 path) `kept` is the spectral data from which `law.tangent_kept(kept)` gives D
+    at the same C without the eigenproblem (fe.Model: the tangent at the iterate whose
+    residual was just evaluated); None elsewhere (the caller then asks law(C, True)).
+    """
+    keeps = hasattr(law, "pk2_kept") and hasattr(law, "tangent_kept")
+
+    def evaluate(C, tangent=True, keep=False):
         C = np.asarray(C, dtype=float)
         if (C.ndim >= 2 and C.shape[-2:] == (3, 3) and np.all(C[..., 2, 2] == 1.0)
                 and not np.any(C[..., 2, :2]) and not np.any(C[..., :2, 2])):
-            return law.pk2_tangent_plane(C[..., :2, :2], out_of_plane=True, tangent=tangent)
-        return law.pk2_tangent(C, tangent=tangent)
+            out = law.pk2_tangent_plane(C[..., :2, :2], out_of_plane=True, tangent=tangent)
+        elif keep and keeps and not tangent:
+            S, ok, kept = law.pk2_kept(C)
+            return S, None, ok, kept
+        else:
+            out = law.pk2_tangent(C, tangent=tangent)
+        return (*out, None) if keep else out
 
+    evaluate.tangent_kept = law.tangent_kept if keeps else None
     return evaluate
 
 

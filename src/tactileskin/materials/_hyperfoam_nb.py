@@ -311,8 +311,9 @@ def _eigh3(A, V):
 
 
 @numba.njit(inline="always")
-def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, first, last):
-    """The point loop of solid_kernel over the points first .. last - 1."""
+def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, first, last):
+    """The point loop of solid_kernel over the points first .. last - 1 (keep: the spectral
+    data into K, see KEPT)."""
     m = mu.shape[0]
     A = np.empty((3, 3))
     V = np.empty((3, 3))
@@ -371,51 +372,140 @@ def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, first, last):
                 # k (c^(alpha/2) - J^(-alpha beta)) / c = k (exp(x1) - exp(x2)), x1 - x2 = alpha (ln c/2 + beta ln J)
                 f[a] += k * _diff(cq[a], ev * ic[a], al * (0.5 * lc[a] + bl))
             if tangent:
-                for a in range(3):
-                    gd[a] += k * (q * cq[a] * ic[a] + ev * ic[a] * ic[a])
-                g01 += _pair(k, q, cq[0], cq[1], e[0], e[1], lc[0], lc[1], ell01, ev * ic[0] * ic[1])
-                g02 += _pair(k, q, cq[0], cq[2], e[0], e[2], lc[0], lc[2], ell02, ev * ic[0] * ic[2])
-                g12 += _pair(k, q, cq[1], cq[2], e[1], e[2], lc[1], lc[2], ell12, ev * ic[1] * ic[2])
+                d01, d02, d12 = _gamma_term(k, q, cq, ic, ev, e, lc, ell01, ell02, ell12, gd)
+                g01 += d01
+                g02 += d02
+                g12 += d12
                 qv += 2.0 * mu[i] * beta * ev                # J dp/dJ
         ok[p] = okp
-        for a in range(3):                                   # P[a] = n_a n_a in pairs (ab)
-            for r in range(6):
-                P[a, r] = V[_PAIR_I[r], a] * V[_PAIR_J[r], a]
         for i in range(3):
             for j in range(i, 3):
                 sij = f[0] * V[i, 0] * V[j, 0] + f[1] * V[i, 1] * V[j, 1] + f[2] * V[i, 2] * V[j, 2]
                 S[p, i, j] = S[p, j, i] = sij
+        if keep:
+            Kp = K[p]
+            for i in range(3):
+                for j in range(3):
+                    Kp[3 * i + j] = V[i, j]
+            for a in range(3):
+                Kp[9 + a], Kp[12 + a], Kp[15 + a] = e[a], lc[a], ic[a]
         if not tangent:
             continue
+        _d_point(V, gd, g01, g02, g12, ic, qv, P, T, Ci, D[p])
+
+
+@numba.njit(inline="always")
+def _gamma_term(k, q, cq, ic, ev, e, lc, ell01, ell02, ell12, gd):
+    """One term's share of the divided differences gamma: adds the diagonal into gd, returns
+    the pairs (0,1), (0,2), (1,2)."""
+    for a in range(3):
+        gd[a] += k * (q * cq[a] * ic[a] + ev * ic[a] * ic[a])
+    return (_pair(k, q, cq[0], cq[1], e[0], e[1], lc[0], lc[1], ell01, ev * ic[0] * ic[1]),
+            _pair(k, q, cq[0], cq[2], e[0], e[2], lc[0], lc[2], ell02, ev * ic[0] * ic[2]),
+            _pair(k, q, cq[1], cq[2], e[1], e[2], lc[1], lc[2], ell12, ev * ic[1] * ic[2]))
+
+
+@numba.njit(inline="always")
+def _d_point(V, gd, g01, g02, g12, ic, qv, P, T, Ci, Dp):
+    """D (81) of one point from its eigenvectors V, gamma and qv (P, T, Ci: scratch)."""
+    for a in range(3):                                       # P[a] = n_a n_a in pairs (ab)
         for r in range(6):
-            Ci[r] = ic[0] * P[0, r] + ic[1] * P[1, r] + ic[2] * P[2, r]
-            x0 = gd[0] * P[0, r] + g01 * P[1, r] + g02 * P[2, r]   # (gamma P)[a, r]
-            x1 = g01 * P[0, r] + gd[1] * P[1, r] + g12 * P[2, r]
-            x2 = g02 * P[0, r] + g12 * P[1, r] + gd[2] * P[2, r]
-            for c in range(6):
-                T[6 * c + r] = P[0, c] * x0 + P[1, c] * x1 + P[2, c] * x2
-        Dp = D[p]
-        for j in range(81):
-            Dp[j] = T[_T1[j]] + T[_T2[j]] + qv * Ci[_CI1[j]] * Ci[_CI2[j]]
+            P[a, r] = V[_PAIR_I[r], a] * V[_PAIR_J[r], a]
+    for r in range(6):
+        Ci[r] = ic[0] * P[0, r] + ic[1] * P[1, r] + ic[2] * P[2, r]
+        x0 = gd[0] * P[0, r] + g01 * P[1, r] + g02 * P[2, r]   # (gamma P)[a, r]
+        x1 = g01 * P[0, r] + gd[1] * P[1, r] + g12 * P[2, r]
+        x2 = g02 * P[0, r] + g12 * P[1, r] + gd[2] * P[2, r]
+        for c in range(6):
+            T[6 * c + r] = P[0, c] * x0 + P[1, c] * x1 + P[2, c] * x2
+    for j in range(81):
+        Dp[j] = T[_T1[j]] + T[_T2[j]] + qv * Ci[_CI1[j]] * Ci[_CI2[j]]
+
+
+# the per-point spectral data a stress evaluation keeps for a later D at the same state
+# (`_solid` with keep, `_solid_d`): eigenvectors V (9, row-major), e (3), ln c (3), 1/c (3)
+KEPT = 18
+
+
+@numba.njit(inline="always")
+def _solid_d(K, mu, alpha, beta, D, first, last):
+    """D of points first .. last - 1 from their kept spectral data K (n, KEPT): the tangent
+    branch of `_solid` without the eigenproblem, logarithms and stress, the same arithmetic
+    (so the same bits as `_solid` with tangent at the state that wrote K)."""
+    m = mu.shape[0]
+    V = np.empty((3, 3))
+    e = np.empty(3)
+    lc = np.empty(3)
+    ic = np.empty(3)
+    cq = np.empty(3)
+    pw = np.empty(3)
+    gd = np.empty(3)
+    P = np.empty((3, 6))
+    T = np.empty(36)
+    Ci = np.empty(6)
+    for p in range(first, last):
+        Kp = K[p]
+        for i in range(3):
+            for j in range(3):
+                V[i, j] = Kp[3 * i + j]
+        for a in range(3):
+            e[a], lc[a], ic[a] = Kp[9 + a], Kp[12 + a], Kp[15 + a]
+        lJ = 0.5 * (lc[0] + lc[1] + lc[2])
+        bl = beta * lJ
+        gd[0] = gd[1] = gd[2] = 0.0
+        g01 = g02 = g12 = 0.0
+        qv = 0.0
+        ell01 = math.log1p((e[0] - e[1]) / (1.0 + e[1]))
+        ell02 = math.log1p((e[0] - e[2]) / (1.0 + e[2]))
+        ell12 = math.log1p((e[1] - e[2]) / (1.0 + e[2]))
+        for i in range(m):
+            al = alpha[i]
+            k = 2.0 * mu[i] / al
+            ev = _pos(-al * bl)
+            q = 0.5 * al - 1.0
+            for a in range(3):
+                pw[a] = _pos(0.5 * al * lc[a])
+                cq[a] = pw[a] * ic[a]
+            d01, d02, d12 = _gamma_term(k, q, cq, ic, ev, e, lc, ell01, ell02, ell12, gd)
+            g01 += d01
+            g02 += d02
+            g12 += d12
+            qv += 2.0 * mu[i] * beta * ev
+        _d_point(V, gd, g01, g02, g12, ic, qv, P, T, Ci, D[p])
 
 
 # compiled on first call (no signature): programs that never solve in 3D do not pay its ~6 s
 # compile on a fresh install; hyperfoam.pk2_tangent_solid passes one layout (C-contiguous)
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent):
-    """S (n, 3, 3), D (n, 81) (untouched unless `tangent`) and ok (n,) of the points C
-    (n, 3, 3), written into S, D, ok: `hyperfoam.pk2_tangent` point by point, with the
-    eigenproblem of C - I solved by `_eigh3`."""
-    _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, 0, C.shape[0])
+def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep):
+    """S (n, 3, 3), D (n, 81) (untouched unless `tangent`), ok (n,) and, with `keep`, the
+    spectral data K (n, KEPT) of the points C (n, 3, 3), written into S, D, ok, K:
+    `hyperfoam.pk2_tangent` point by point, with the eigenproblem of C - I solved by `_eigh3`."""
+    _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, 0, C.shape[0])
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, chunks):
+def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, chunks):
     """solid_kernel on `chunks` contiguous point ranges run by numba's threads (as many at
     once as numba.set_num_threads allows); the same arithmetic per point, so the same bits."""
     n = C.shape[0]
     for c in numba.prange(chunks):
-        _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, c * n // chunks, (c + 1) * n // chunks)
+        _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, c * n // chunks,
+               (c + 1) * n // chunks)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def solid_tangent_kernel(K, mu, alpha, beta, D):
+    """D (n, 81) of the points whose spectral data K (n, KEPT) `solid_kernel` kept."""
+    _solid_d(K, mu, alpha, beta, D, 0, K.shape[0])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def solid_tangent_kernel_parallel(K, mu, alpha, beta, D, chunks):
+    """solid_tangent_kernel on `chunks` point ranges on numba's threads (the same bits)."""
+    n = K.shape[0]
+    for c in numba.prange(chunks):
+        _solid_d(K, mu, alpha, beta, D, c * n // chunks, (c + 1) * n // chunks)
 
 
 def as_kernel_input(x, shape):

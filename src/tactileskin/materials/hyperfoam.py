@@ -58,7 +58,7 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2",
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "pk2_kept_solid", "tangent_kept_solid",
            "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
@@ -163,6 +163,14 @@ class Hyperfoam:
     def pk2_tangent(self, C, *, detF=None, tangent=True):
         """The compiled 3x3 point loop (`pk2_tangent_solid`); tangent=False skips D."""
         return pk2_tangent_solid(self, C, detF=detF, tangent=tangent)
+
+    def pk2_kept(self, C, *, detF=None):
+        """(S, ok, kept): S of `pk2_tangent(tangent=False)` and the spectral data from which
+        `tangent_kept(kept)` gives D at the same C (`pk2_kept_solid`)."""
+        return pk2_kept_solid(self, C, detF=detF)
+
+    def tangent_kept(self, kept):
+        return tangent_kept_solid(self, kept)
 
     def pk2_tangent_plane(self, C2, *, detF=None, out_of_plane=False, tangent=True):
         return pk2_tangent_plane(self, C2, detF=detF, out_of_plane=out_of_plane, tangent=tangent)
@@ -434,6 +442,45 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     PARALLEL_MIN_POINTS points on numba's threads (threads.numba_parallel_threads(); the same bits)."""
     C = np.asarray(C, dtype=float)
     _check_shape("C", C, 3)
+    S, D, ok, _ = _solid(mat, C, detF, tangent, False)
+    return S, D, ok
+
+
+def pk2_kept_solid(mat: Hyperfoam, C, *, detF=None):
+    """(S, ok, kept): S and ok as `pk2_tangent_solid(..., tangent=False)` (the same bits) and
+    the per-point spectral data `kept` (..., 18) from which `tangent_kept_solid` gives D at
+    this C without solving the eigenproblem again (Newton's accepted iterate: the residual
+    of the line search, then the tangent at the same state)."""
+    C = np.asarray(C, dtype=float)
+    _check_shape("C", C, 3)
+    S, _, ok, kept = _solid(mat, C, detF, False, True)
+    return S, ok, kept
+
+
+def tangent_kept_solid(mat: Hyperfoam, kept):
+    """D (..., 3, 3, 3, 3) from the spectral data `kept` (..., 18) of `pk2_kept_solid` for
+    the same material: the same bits as `pk2_tangent_solid(C)[1]` at the C that kept it."""
+    from tactileskin.materials import _hyperfoam_nb as nb
+    from tactileskin.threads import numba_parallel_threads
+
+    kept = np.asarray(kept)
+    if kept.dtype != np.float64 or kept.shape[-1:] != (nb.KEPT,):
+        raise ParameterError("kept", f"{kept.dtype} {kept.shape}", f"float64 (..., {nb.KEPT}) from pk2_kept_solid")
+    lead = kept.shape[:-1]
+    n = math.prod(lead)
+    Kk = np.ascontiguousarray(kept.reshape(n, nb.KEPT))
+    D = np.empty((n, 81))
+    args = (Kk, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float), float(mat.beta), D)
+    threads = numba_parallel_threads()
+    if threads > 1 and n >= PARALLEL_MIN_POINTS:
+        nb.solid_tangent_kernel_parallel(*args, 4 * threads)
+    else:
+        nb.solid_tangent_kernel(*args)
+    return D.reshape(lead + (3, 3, 3, 3))
+
+
+def _solid(mat: Hyperfoam, C, detF, tangent: bool, keep: bool):
+    """(S, D or None, ok, kept or None) of C by the compiled point loop."""
     from tactileskin.materials import _hyperfoam_nb as nb
     from tactileskin.threads import numba_parallel_threads
 
@@ -441,9 +488,10 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
     Ck, dk = np.ascontiguousarray(Ck), np.ascontiguousarray(dk)   # one compiled specialisation
     S = np.empty((n, 3, 3))
     D = np.empty((n, 81)) if tangent else np.empty((0, 0))
+    K = np.empty((n, nb.KEPT)) if keep else np.empty((0, 0))
     ok = np.empty(n, dtype=bool)
     args = (Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
-            float(mat.beta), S, D, ok, tangent)
+            float(mat.beta), S, D, ok, tangent, K, keep)
     threads = numba_parallel_threads()
     if threads > 1 and n >= PARALLEL_MIN_POINTS:
         nb.solid_kernel_parallel(*args, 4 * threads)
@@ -451,7 +499,8 @@ def pk2_tangent_solid(mat: Hyperfoam, C, *, detF=None, tangent: bool = True):
         nb.solid_kernel(*args)
     ok = ok.reshape(lead)
     _log_debug_inadmissible(ok)
-    return S.reshape(lead + (3, 3)), (D.reshape(lead + (3, 3, 3, 3)) if tangent else None), ok
+    return (S.reshape(lead + (3, 3)), (D.reshape(lead + (3, 3, 3, 3)) if tangent else None), ok,
+            K.reshape(lead + (nb.KEPT,)) if keep else None)
 
 
 # --- plane strain ---------------------------------------------------------------------------

@@ -195,6 +195,7 @@ class QLVHistory:
         self.S0_prev = self.S0_old       # S0 one increment before S0_old
         self.dt_prev = None
         self.H = np.zeros((prony.n_terms,) + tuple(shape))
+        self.commits = 0   # commit() calls: H changes in place, so identity cannot tell states apart
 
     def factors(self, dt: float):
         """(gamma, decay, gain, back) for a step dt from the committed state; gamma =
@@ -226,3 +227,4 @@ class QLVHistory:
         self.S0_prev, self.S0_old = self.S0_old, S0
         if dt > 0.0:
             self.dt_prev = dt
+        self.commits += 1
