@@ -102,6 +102,31 @@ def law_times(repeat: int) -> None:
         print(f"{th} thread(s): " + "; ".join(f"{k} {c:.1f} ({w:.1f})" for k, (c, w) in res.items()))
     same = np.array_equal(tangent_kept_solid(hf, kept), pk2_tangent_solid(hf, C)[1])
     print(f"D from kept == D of S + D bit for bit: {same}")
+    # the model's units: a residual evaluation afresh against one at the same u (only the
+    # contact part computed), a tangent with D from the law against D from the kept data
+    u = ev._u
+    for th in (1, 2):
+        model.threads = th
+
+        def fresh_tangent():
+            model.reuse_state = False
+            model.tangent(model.evaluate(u, 0.0, 1.0, tangent=False))
+            model.reuse_state = True
+
+        def kept_tangent():
+            model._last = None
+            model.tangent(model.evaluate(u, 0.0, 1.0, tangent=False))
+
+        def fresh_residual():
+            model._last = None
+            model.evaluate(u, 0.0, 1.0, tangent=False)
+
+        model.evaluate(u, 0.0, 1.0, tangent=False)
+        res = timed({"residual afresh": fresh_residual,
+                     "residual, state reused": lambda: model.evaluate(u, 0.0, 1.0, tangent=False),
+                     "residual + tangent, D from the law": fresh_tangent,
+                     "residual + tangent, D from kept": kept_tangent}, repeat)
+        print(f"Model, {th} thread(s): " + "; ".join(f"{k} {c:.1f} ({w:.1f})" for k, (c, w) in res.items()))
 
 
 def main(argv=None) -> int:
@@ -134,9 +159,11 @@ def main(argv=None) -> int:
     for (s, t), rs in res.items():
         r0 = rs[0]
         same = {(r["incr"], r["newton"], r["peak"]) for r in rs}
-        print(f"t = {t:g} {s}: CPU {np.median([r['cpu'] for r in rs]):.1f} s "
-              f"({', '.join(f'{r['cpu']:.1f}' for r in rs)}), wall {np.median([r['wall'] for r in rs]):.1f} s "
-              f"({', '.join(f'{r['wall']:.1f}' for r in rs)}), {r0['incr']} / {r0['newton']}, peak {r0['peak']!r}"
+        cpus = ", ".join(f"{r['cpu']:.1f}" for r in rs)
+        walls = ", ".join(f"{r['wall']:.1f}" for r in rs)
+        print(f"t = {t:g} {s}: CPU {np.median([r['cpu'] for r in rs]):.1f} s ({cpus}), "
+              f"wall {np.median([r['wall'] for r in rs]):.1f} s ({walls}), {r0['incr']} / {r0['newton']}, "
+              f"peak {r0['peak']!r}"
               + ("" if len(same) == 1 else f" (runs differ: {sorted(same)})"))
         print("   counts:", json.dumps(r0["counts"], sort_keys=True), " phases (median wall s):",
               json.dumps({k: round(float(np.median([r["phases"].get(k, 0.0) for r in rs])), 2)
