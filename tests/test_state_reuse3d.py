@@ -137,3 +137,22 @@ def test_solve_same_answer_with_and_without_reuse():
     assert out[True][2] == out[False][2]
     c = out[True][3]
     assert c["law_tangent"] <= 1 and c["tangent_kept"] >= out[True][2] - 1
+
+
+def test_no_reuse_after_the_history_restarts_its_parabola():
+    """fe.loading starts each segment with the chord (history.dt_prev = None) without a
+    commit: the QLV stress at the same u and dt changes, so the state must not be reused."""
+    model = _model()
+    u1, u = _state(model, 3), _state(model, 5)
+    model.commit(model.evaluate(u1, T, DT, tangent=False), u1, T, DT)
+    assert model.history.dt_prev == DT and model.prony.n_terms > 0
+    ev1 = model.evaluate(u, T + DT, DT, tangent=False)
+    model.history.dt_prev = None                     # as fe.loading.run_program at a segment start
+    ev2 = model.evaluate(u, T + DT, DT, tangent=False)
+    fresh = _model(reuse=False)
+    fresh.commit(fresh.evaluate(u1, T, DT, tangent=False), u1, T, DT)
+    fresh.history.dt_prev = None
+    ev0 = fresh.evaluate(u, T + DT, DT, tangent=True)
+    assert not np.array_equal(ev1.R, ev0.R)          # the chord's stress differs from the parabola's
+    assert model.counts["state_reused"] == 0
+    assert np.array_equal(ev2.R, ev0.R) and np.array_equal(model.tangent(ev2), ev0.K)

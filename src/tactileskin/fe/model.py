@@ -174,7 +174,7 @@ class Model:
         # history are the same, and of the stress evaluation's spectral data for the tangent;
         # False: every evaluation computes afresh (the tests' oracle)
         self.reuse_state = True
-        self._last = None  # (u copy, dt bytes, history, history.commits), _State
+        self._last = None  # (u copy, dt bytes, history, (history.commits, dt_prev)), _State
         self.counts = defaultdict(int)  # law_stress / law_tangent / tangent_kept calls, state_reused
 
         # Dirichlet dofs
@@ -248,11 +248,13 @@ class Model:
 
     def _reusable(self, u: np.ndarray, dt: float) -> _State | None:
         """The last admissible state if it was evaluated at these very u (bit for bit), dt and
-        committed history, else None."""
+        committed history (its commits and its previous step dt_prev, which fe.loading resets
+        at a segment's start without a commit), else None."""
         if not self.reuse_state or self._last is None:
             return None
         (u0, dt0, hist, commits), state = self._last
-        if hist is not self.history or commits != hist.commits or np.float64(dt).tobytes() != dt0:
+        if (hist is not self.history or commits != (hist.commits, hist.dt_prev)
+                or np.float64(dt).tobytes() != dt0):
             return None
         u = np.ascontiguousarray(u, dtype=np.float64)
         if u.shape != u0.shape or not np.array_equal(u.view(np.int64), u0.view(np.int64)):
@@ -330,7 +332,7 @@ class Model:
             st = _State(kin, S0, S, gamma, fint, D0, kept)
             if self.reuse_state:
                 self._last = ((np.array(u, dtype=np.float64), np.float64(dt).tobytes(), self.history,
-                               self.history.commits), st)
+                               (self.history.commits, self.history.dt_prev)), st)
         kin, S0, S, gamma, fint = st.kin, st.S0, st.S, st.gamma, st.fint
         R = fint.copy()
         cinfo = None
