@@ -311,22 +311,21 @@ def _eigh3(A, V):
 
 
 @numba.njit(inline="always")
+def _point_scratch():
+    """Per-thread scratch of the 3D point loops (`_solid`, `_solid_d`): V (3, 3), e, ln c,
+    1/c, c^q, c^(alpha/2), gamma's diagonal (3 each), P (3, 6), T (36), C^-1 pairs (6)."""
+    return (np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+            np.empty(3), np.empty((3, 6)), np.empty(36), np.empty(6))
+
+
+@numba.njit(inline="always")
 def _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, first, last):
     """The point loop of solid_kernel over the points first .. last - 1 (keep: the spectral
     data into K, see KEPT)."""
     m = mu.shape[0]
     A = np.empty((3, 3))
-    V = np.empty((3, 3))
-    e = np.empty(3)
-    lc = np.empty(3)
-    ic = np.empty(3)
-    cq = np.empty(3)
-    pw = np.empty(3)
     f = np.empty(3)
-    gd = np.empty(3)
-    P = np.empty((3, 6))
-    T = np.empty(36)
-    Ci = np.empty(6)
+    V, e, lc, ic, cq, pw, gd, P, T, Ci = _point_scratch()
     for p in range(first, last):
         finite = True
         for i in range(3):
@@ -433,16 +432,7 @@ def _solid_d(K, mu, alpha, beta, D, first, last):
     branch of `_solid` without the eigenproblem, logarithms and stress, the same arithmetic
     (so the same bits as `_solid` with tangent at the state that wrote K)."""
     m = mu.shape[0]
-    V = np.empty((3, 3))
-    e = np.empty(3)
-    lc = np.empty(3)
-    ic = np.empty(3)
-    cq = np.empty(3)
-    pw = np.empty(3)
-    gd = np.empty(3)
-    P = np.empty((3, 6))
-    T = np.empty(36)
-    Ci = np.empty(6)
+    V, e, lc, ic, cq, pw, gd, P, T, Ci = _point_scratch()
     for p in range(first, last):
         Kp = K[p]
         for i in range(3):
