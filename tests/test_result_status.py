@@ -531,3 +531,23 @@ def test_a_press_too_shallow_for_the_mesh_says_so_not_that_the_indenter_never_pr
     r = solve(with_quality(Scene(thickness=1.0, indenter="braille", depth=1e-3), "preview"))
     (flag,) = [f for f in quality.flags(r.summary()) if f.code == "no_contact"]
     assert "never pressed" not in flag.reason and "shallower than the mesh resolves" in flag.reason
+
+
+def test_a_bone_pulled_in_tension_under_the_load_is_flagged_not_its_noise_peak(tmp_path):
+    # an auxetic hyperfoam (nu = -0.99, a value Hyperfoam accepts): under the 20 % press of the
+    # flat plate (contact pressure 0.023 MPa, reaction 0.028 N/mm) the bone's mean pressure is
+    # tensile, -0.0021 MPa at s = 0, and the profile's largest value is 4e-10 MPa far from the
+    # load: peak, span (2.5 mm) and area (negative) described nothing, status "ok"
+    from tactileskin.fe import solve
+
+    assert quality.status({**NORMAL, "profile_min_mpa": -0.29}) == "ok"     # compressive under the load
+    (f,) = quality.flags({**NORMAL, "profile_min_mpa": -0.31})
+    assert f.code == "tensile_bone" and "-0.31" in f.reason
+    mat = tmp_path / "auxetic.toml"
+    mat.write_text("[hyperfoam]\nmu = [0.09]\nalpha = [2.0]\nnu = -0.99\n")
+    r = solve(Scene(thickness=1, material=str(mat), mesh_size=1, refinement=5))
+    summ = r.summary()
+    assert summ["reaction_n_per_mm"] > 0.01 and summ["contact_points"] > 5
+    assert summ["profile_min_mpa"] < -1e3 * summ["peak_mpa"]
+    assert [f["code"] for f in summ["flags"]] == ["tensile_bone"]
+    assert summ["status"].startswith("suspect: ")

@@ -415,6 +415,8 @@ class ResultCache:
                 raise ValueError("non-finite values")
             if np.any(np.diff(s) <= 0):
                 raise ValueError("s is not increasing")
+            # entries written before the summary had it: quality's tensile-bone check reads it
+            summary.setdefault("profile_min_mpa", float(np.min(pr)))
             name = "scene.toml"
             if _stored_fields(p / name, scene) != _plain(_scene_fields(scene)):
                 raise ValueError("describes another scene")

@@ -82,7 +82,7 @@ MIN_DOT_INDENTATION_OVER_SIZE = 0.45
 
 @dataclass(frozen=True)
 class Flag:
-    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "buckling" | "mirrored_x" | "mirrored_z" | "non_finite"
+    code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "buckling" | "mirrored_x" | "mirrored_z" | "tensile_bone" | "non_finite"
     reason: str
 
     def to_dict(self) -> dict:
@@ -110,7 +110,7 @@ def reaction_of(summary: dict):
 def flags(summary: dict) -> list[Flag]:
     """Reasons not to trust a result, from its summary numbers (empty: a normal result).
 
-    Keys read: peak_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
+    Keys read: peak_mpa, profile_min_mpa, reaction_n_per_mm (2D) or reaction_n (3D), contact_points, min_J, max_abs_stress_mpa,
     material_nu0, material_mu0_mpa, element_order, mesh_sizes_mm, peak_interior_mpa (+ its s and peak_edge_s_mm),
     profile_plane_from_map / profile_plane_unknown with peak_map_edge_* and profile_plane_z,
     indenter_cap, mirrored_x, mirrored_z (a
@@ -134,6 +134,15 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("no_contact", "no contact (" + ", ".join(none) + "): the indenter pressed no contact "
                         "point of the skin within the indentation depth (a press shallower than the mesh resolves: "
                         "a deeper press or a finer mesh)"))
+    low = _num(summary, "profile_min_mpa")
+    if not none and peak is not None and low is not None and low < -peak:
+        # an auxetic law (nu0 < 0) pulls the mean stress at the bone into tension under the load:
+        # the profile's largest value is then noise far from it (nu = -0.99: 4e-10 MPa against
+        # -0.0021 at s = 0, contact pressure 0.023 MPa), and peak, span and area describe nothing
+        out.append(Flag("tensile_bone", f"the bone's mean pressure is tensile under the load (down to {low:.4g} MPa, "
+                        f"more than the peak {peak:.4g} MPa): peak, span and area do not describe the press (the "
+                        "material's volumetric response, e.g. an auxetic law with nu0 < 0, pulls the bone; "
+                        "read the contact pressure or the reaction instead)"))
     stress, mu0 = _num(summary, "max_abs_stress_mpa"), _num(summary, "material_mu0_mpa")
     if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa beyond {MAX_ABS_STRESS_MPA:g} MPa "

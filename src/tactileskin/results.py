@@ -330,6 +330,8 @@ class Result:
             "peak_mpa": self.peak,
             "span_mm": self.span,
             "auc_mpa_mm": self.auc,
+            # the most tensile value of P(s): quality judges whether the bone is pressed at all
+            **({"profile_min_mpa": float(np.min(self.pressure))} if len(self.pressure) else {}),
             reaction_key(self.dim): float(self.reaction),
             "contact_points": int(len(self.contact_x)),
             # extremes of the material law's state (fe.output.law_state)
