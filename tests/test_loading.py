@@ -509,3 +509,20 @@ def test_a_ramp_that_ends_where_it_starts_in_float_time_is_refused_at_run_time()
     model = SimpleNamespace(t=100.0, d=0.1, history=None, m=2)
     with pytest.raises(ParameterError, match=r"loading segment 0 .*depth to 0.1 mm at 1e\+06 mm/s.*1e-06 s"):
         run_program(model, [Segment("depth", 0.1000000002, rate=1e6)], d_max=1.0, d_guess=0.1)
+
+
+def test_a_force_below_what_the_contact_resolves_names_the_force_not_the_lock_up(mesh, tmp_path):
+    from tactileskin.fe import solve
+
+    # the stiffest law a material file may hold (mu0 = 1e4 MPa) asked for the smallest force
+    # (1e-4 N/mm): the reaction rises from 0 (no contact point pressed yet) to more than the
+    # first increment's target within a travel step of ~1e-12 mm, below what the travel
+    # resolves; no increment converged and the error blamed "the material law's lock-up" and
+    # told to "try a smaller depth or force"
+    mat = tmp_path / "stiff.toml"
+    mat.write_text("[hyperfoam]\nmu = [1e4]\nalpha = [2.0]\nnu = 0.3\n")
+    with pytest.raises(ParameterError, match="force") as e:
+        solve(BASE.replace(force=1e-4, material=str(mat)), mesh=mesh)
+    msg = str(e.value)
+    assert e.value.name == "force" and "smaller" not in msg and "lock-up" not in msg
+    assert "no contact" in msg and "larger force" in msg and "depth" in msg

@@ -176,6 +176,36 @@ def read_sensors(scene, model, result, *, z_symmetric: bool = False, sites=None)
     return sensors.read(sites, sampler)
 
 
+def _unresolved_force(scene, asked: float, e) -> None:
+    """Raise ParameterError naming the force when the first force increment failed between a trial
+    that pressed no contact point and one already past its target: the reaction rises faster than
+    the travel resolves so small a force (the stiffest law a file may hold, mu0 = 1e4 MPa, asked for
+    1e-4 N/mm: 0 N/mm to 2.6e-4 within 4e-7 mm of travel; the error blamed the law's lock-up and said
+    to try a smaller force)."""
+    from tactileskin.errors import ParameterError
+    from tactileskin.loading import force_unit
+
+    diag = getattr(e, "diagnosis", None) or {}
+    travels, errors, F = diag.get("travels_mm"), diag.get("force_errors"), diag.get("target")
+    if not travels or not errors or F is None or not F > 0:
+        return
+    trials = sorted((float(d), float(f) + F) for d, f in zip(travels, errors))
+    over = [(d, r) for d, r in trials if r > F]
+    if not over:
+        return
+    d_hi, r_hi = over[0]
+    free = [d for d, r in trials if r <= 0.0 and d < d_hi]
+    if not free:
+        return
+    unit = force_unit(scene.dim)
+    raise ParameterError(
+        "force", asked, "a force whose ramp the contact resolves on this skin and mesh",
+        f"no increment converged: its target {F:.3g} {unit} lies between no contact at travel {free[-1]:.6g} mm and "
+        f"{r_hi:.3g} {unit} at {d_hi:.6g} mm, {d_hi - free[-1]:.2g} mm further: the skin's reaction rises faster "
+        "than the travel resolves so small a force; give a larger force, or solve with depth control "
+        "(a depth just past the first touch)") from None
+
+
 def _run_history(scene, model, section, program, options, progress, history: bool = False):
     """Run a force-controlled or multi-segment loading history (fe.loading.run_program).
     The Result is the peak-load state: the end of the depth or force ramp with the largest
@@ -226,6 +256,8 @@ def _run_history(scene, model, section, program, options, progress, history: boo
                                       progress=progress, on_segment=on_segment)
     except ConvergenceError as e:
         forced = [g.target for g in program if g.kind == "force"]
+        if _force_controlled(program, done[0]) and not last:
+            _unresolved_force(scene, scene.force if scene.force is not None else max(forced), e)
         lock_up = "increments" in str(e)
         if not _force_controlled(program, done[0]) or not last or not (lock_up or "trial travels" in str(e)):
             raise

@@ -173,7 +173,7 @@ class ForceIncrement:
         last = pts[-1] if pts else (model.d, 0.0)
         raise _Failure(f"force control: reaction not within {self._tolerance(model, F, last[0], last[1] + F):.3g} "
                        f"of {F:.6g} after {MAX_TRIALS} trial travels",
-                       {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts]})
+                       {"travels_mm": [p[0] for p in pts], "force_errors": [p[1] for p in pts], "target": F})
 
     @staticmethod
     def _reachable(lo, hi, F: float, model) -> None:
