@@ -526,3 +526,19 @@ def test_a_force_below_what_the_contact_resolves_names_the_force_not_the_lock_up
     msg = str(e.value)
     assert e.value.name == "force" and "smaller" not in msg and "lock-up" not in msg
     assert "no contact" in msg and "larger force" in msg and "depth" in msg
+
+
+def test_a_first_force_increment_out_of_reach_names_the_force(mesh, tmp_path):
+    from tactileskin.fe import solve
+
+    # the softest law a material file may hold (mu0 = 1e-6 MPa) asked for the largest force
+    # (1e4 N/mm): the first increment's 0.197 N/mm was out of reach (4.5e-6 N/mm at 0.89 mm, a
+    # trial at 1.2 mm failed), no increment converged, and the error named no parameter and
+    # blamed "the material law's lock-up, elements too coarse" or the mesh
+    mat = tmp_path / "soft.toml"
+    mat.write_text("[hyperfoam]\nmu = [1e-6]\nalpha = [2.0]\nnu = 0.3\n")
+    with pytest.raises(ParameterError, match="force") as e:
+        solve(BASE.replace(force=1e4, material=str(mat)), mesh=mesh)
+    msg = str(e.value)
+    assert e.value.name == "force" and "lock-up" not in msg and "finer mesh" not in msg
+    assert "out of reach" in msg and "0.893 mm" in msg and "depth" in msg

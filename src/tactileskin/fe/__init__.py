@@ -177,16 +177,29 @@ def read_sensors(scene, model, result, *, z_symmetric: bool = False, sites=None)
 
 
 def _unresolved_force(scene, asked: float, e) -> None:
-    """Raise ParameterError naming the force when the first force increment failed between a trial
-    that pressed no contact point and one already past its target: the reaction rises faster than
-    the travel resolves so small a force (the stiffest law a file may hold, mu0 = 1e4 MPa, asked for
-    1e-4 N/mm: 0 N/mm to 2.6e-4 within 4e-7 mm of travel; the error blamed the law's lock-up and said
-    to try a smaller force)."""
+    """Raise ParameterError naming the force when no force increment converged because the first
+    one's target was out of reach of its trials (too much force), or lay between a trial that
+    pressed no contact point and one already past it: the reaction rises faster than the travel
+    resolves so small a force (the stiffest law a file may hold, mu0 = 1e4 MPa, asked for 1e-4 N/mm:
+    0 N/mm to 2.6e-4 within 5e-7 mm of travel; the error blamed the law's lock-up and said to try a
+    smaller force). Otherwise return (the caller re-raises)."""
     from tactileskin.errors import ParameterError
     from tactileskin.loading import force_unit
 
     diag = getattr(e, "diagnosis", None) or {}
+    unit = force_unit(scene.dim)
     travels, errors, F = diag.get("travels_mm"), diag.get("force_errors"), diag.get("target")
+    if "out of reach" in str(diag.get("reason", "")) and F is not None and diag.get("reached") is not None:
+        # the first increment's force lies past a failed trial: too much force for this skin, not
+        # its mesh or the law's lock-up (the softest law a file may hold, mu0 = 1e-6 MPa, asked
+        # for 1e4 N/mm: 4.5e-6 N/mm at 0.89 mm of a 1.2 mm cap; the error named no parameter)
+        raise ParameterError(
+            "force", asked, f"a force the skin carries within its travel (at most {scene.max_travel:.3g} mm "
+            "= 0.6 x thickness)",
+            f"no increment converged: its target {F:.3g} {unit} was out of reach, the reaction {diag['reached']:.3g} "
+            f"{unit} at travel {diag['travel_mm']:.3g} mm and a trial at {diag['failed_mm']:.3g} mm failed; give a "
+            f"smaller force, or solve with depth (up to {scene.max_travel:.3g} mm) to see the force this skin "
+            "carries") from None
     if not travels or not errors or F is None or not F > 0:
         return
     trials = sorted((float(d), float(f) + F) for d, f in zip(travels, errors))
@@ -197,7 +210,6 @@ def _unresolved_force(scene, asked: float, e) -> None:
     free = [d for d, r in trials if r <= 0.0 and d < d_hi]
     if not free:
         return
-    unit = force_unit(scene.dim)
     raise ParameterError(
         "force", asked, "a force whose ramp the contact resolves on this skin and mesh",
         f"no increment converged: its target {F:.3g} {unit} lies between no contact at travel {free[-1]:.6g} mm and "

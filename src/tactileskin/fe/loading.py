@@ -188,7 +188,7 @@ class ForceIncrement:
             raise _Failure(f"force control: {F:.6g} {_unit(model)} out of reach of this increment's trial travels "
                            f"(the reaction is {lo[1] + F:.6g} at travel {lo[0]:.6g} mm, a trial at {hi[0]:.6g} mm "
                            "failed)",
-                           {"travel_mm": lo[0], "reached": lo[1] + F, "failed_mm": hi[0]})
+                           {"travel_mm": lo[0], "reached": lo[1] + F, "failed_mm": hi[0], "target": F})
 
     def _on_way(self, F: float, model) -> str:
         """' on the way to GOAL unit' when the ramp's force F at this increment is not the
