@@ -253,3 +253,19 @@ def test_a_file_skin_without_a_map_warns_once_per_solve(plane_strain, monkeypatc
     (msg,) = [m for m in caplog.messages if "no bone map" in m]
     assert "bonded surface" in msg and "folds" in msg and "s = 0, z = 0 mm" in msg
     assert "invalid" not in msg and "bone map point" not in msg
+
+
+@pytest.mark.parametrize("section_z", [0.0, 2.5])
+def test_the_section_plane_the_figure_names_is_drawn(tmp_path, section_z):
+    # the title says "dashed: section plane"; a centred dot's plane is z = 0, the map's lower
+    # edge, where the axes' spine hid the line (no pixel of its red in the PNG)
+    import matplotlib.image as mpimg
+
+    from tactileskin.report.bone_map import write_bone_map_figure
+
+    s, z = np.linspace(0, 12, 121), np.linspace(0, 10, 41)
+    P = 0.004 * np.exp(-((s[None, :] - 0.3) ** 2 + (z[:, None] - section_z) ** 2) / 0.2)
+    png = write_bone_map_figure(BoneMap(s, z, P, section_z), tmp_path / "m.png", "synthetic")
+    rgb = mpimg.imread(png)[:, :, :3] * 255
+    red = np.abs(rgb - np.array([214, 39, 40])).sum(axis=-1) < 60  # tab:red
+    assert red.sum() > 200  # a dashed line across both panels, not a stray pixel

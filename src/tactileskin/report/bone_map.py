@@ -51,7 +51,9 @@ def write_bone_map_figure(bone_map, path, title: str = "") -> Path:
         norm = matplotlib.colors.Normalize(vmin=min(0.0, float(P.min())), vmax=float(P.max()))
         for k, ax in enumerate(axes[0]):
             im = ax.pcolormesh(s, z, P, cmap="viridis", shading=shading, norm=norm)
-            ax.axhline(bone_map.section_z, color="tab:red", lw=1.0, ls="--")
+            # over the spines (zorder 2.5) and unclipped: a centred dot's plane is z = 0, the
+            # map's edge, where the spine covered the line the title names
+            ax.axhline(bone_map.section_z, color="tab:red", lw=1.5, ls="--", zorder=3, clip_on=False)
             ax.set_aspect("equal")
             ax.set_xlabel("s (mm)")
             ax.set_ylabel("z (mm)")
