@@ -266,3 +266,13 @@ def test_results_parquet_types_a_column_no_case_filled_as_the_dataframe_does(tmp
     for c in ("reaction_n", "target_force_n_per_mm", "target_force_n", "peak_mpa", "reaction_n_per_mm"):
         assert schema.field(c).type == pa.float64(), c
     assert schema.field("error").type == pa.string() and schema.field("dofs").type == pa.int64()
+
+
+@pytest.mark.parametrize("fields", [dict(), dict(depth=0.15)], ids=["depth_fraction", "depth"])
+def test_summary_states_the_depth_a_depth_ramp_pressed_to(fields):
+    # summary.json gave a force-controlled result's travel (`loading`) but not a depth ramp's:
+    # only the scene's depth_fraction, so the depth solved to (mm) could not be read from it
+    r = ts.solve(thickness=1.0, material="silicone", indenter="flat", viscoelastic=False, mesh_size=1.0,
+                 refinement=5.0, **fields)
+    want = fields.get("depth", 0.2 * 1.0)
+    assert r.summary()["depth_mm"] == pytest.approx(want, rel=1e-9)

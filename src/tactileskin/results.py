@@ -333,6 +333,8 @@ class Result:
             # the most tensile value of P(s): quality judges whether the bone is pressed at all
             **({"profile_min_mpa": float(np.min(self.pressure))} if len(self.pressure) else {}),
             reaction_key(self.dim): float(self.reaction),
+            # the depth a depth ramp pressed to (mm from first touch); force control and histories: `loading`
+            **({"depth_mm": float(self.stats["depth_mm"])} if "depth_mm" in self.stats else {}),
             "contact_points": int(len(self.contact_x)),
             # extremes of the material law's state (fe.output.law_state)
             **{k: float(self.stats[k]) for k in ("min_J", "max_abs_stress_mpa", "max_pressure_mpa", "material_nu0",

@@ -439,6 +439,8 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     t2 = time.perf_counter()
     if res is None:
         res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())
+        # a depth ramp's travel from first touch (summary.json depth_mm; a history's is in `loading`)
+        res.stats["depth_mm"] = float(model.d)
     if scene.sensors:
         res.sensors = read_sensors(scene, model, res, z_symmetric=bool(getattr(sm, "z_symmetric", False)),
                                    sites=sites)
