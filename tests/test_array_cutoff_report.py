@@ -214,3 +214,17 @@ def test_an_accuracy_just_under_the_bar_does_not_read_as_the_bar(tmp_path, monke
     monkeypatch.setattr(array_chart, "_save", grab)
     array_chart.write_figures(ch, tmp_path)
     assert texts == ["0.946"], texts
+
+
+def test_the_filter_table_tells_the_indentation_from_the_sensor_depth():
+    """With --sensor-depth 1 the table read 'depth (mm) | 0.4' beside 'Sensor plane: 1 mm below
+    the contact surface': that column is the stimulus's travel, not where the taxels sit."""
+    ch = Chart(ChartConfig(thicknesses=(2.0,), pitches=(0.75,), noise_fs=(0.01,), sets=("paper",), sensor_depth=1.0))
+    ch.labels["paper"] = ["flat", "curved", "braille"]
+    ch.cutoffs.append({"material": "silicone", "thickness_mm": 2.0, "skin": "fingertip", "depth_mm": 0.4,
+                       "peak_mpa": 0.008, "kc_rad_per_mm": 2.48, "nyquist_pitch_mm": 1.27,
+                       "halfspace_nyquist_pitch_mm": 0.81})
+    head = next(ln for ln in markdown(ch).splitlines() if ln.startswith("| material | t (mm) |"))
+    cols = [c.strip() for c in head.strip("|").split("|")]
+    assert "depth (mm)" not in cols and cols[2] == "indentation (mm)", cols
+    assert cols[-1] == "half-space Nyquist pitch at depth 1 mm (mm)"

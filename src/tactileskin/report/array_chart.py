@@ -170,7 +170,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
              f"{cfg.n_train} training reads per stimulus); rules: " + _rules(cfg, method) + ". "
              f"Computed in {chart.seconds:.0f} s.", "",
              "### The skin as a spatial filter", "",
-             "| material | t (mm) | depth (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth "
+             "| material | t (mm) | indentation (mm) | skin | single-dot peak (MPa) | measured cut-off (rad/mm) | Nyquist pitch (mm) | half-space Nyquist pitch at depth "
              + ("t" if _on_bone(cfg) else f"{cfg.sensor_depth:g} mm" if cfg.sensor_height is None
                 else f"t - {cfg.sensor_height:g} mm") + " (mm) |",
              "|---|---|---|---|---|---|---|---|"]
@@ -184,7 +184,7 @@ def markdown(chart, validation=None, method: str = "template") -> str:
                      f"{c['peak_mpa']:.4f} | {kc_s} | {ny_s} | {c['halfspace_nyquist_pitch_mm']:.2f} |")
     lines += ["", "Cut-off where the spectrum of the single dot's map along s (its projection over z: the "
               "map's 2D spectrum along k_s; or of the half-space kernel (1 + kt) e^-kt) falls to 10 %; Nyquist pitch pi / k_c: the coarsest pitch that samples the map without aliasing, not a limit on telling known stimuli apart (the accuracy tables below say that). The paper's rule (half the 1.5 mm span of the Braille pressure at t = 1) gives 0.75 mm at t = 1. "
-              "Depth (each stimulus's travel into the skin from first touch: depth control, not force): 20 % of t"
+              "Indentation (each stimulus's travel into the skin from first touch: depth control, not force): 20 % of t"
               + _cap_text(cfg) + "." + _pad_text(cfg), ""]
     for set_ in cfg.sets:
         for material in cfg.materials:
@@ -319,7 +319,7 @@ def validation_table(rows, title: str, mesh: bool = False) -> list[str]:
     errors of the pointwise maps and, where present, of the maps as the chart's finest taxels
     read them; `mesh`: a column for r['mesh']."""
     taxel = any("max_abs_over_peak_taxel" in r for r in rows)
-    head = ("| " + ("mesh | " if mesh else "") + "material | t (mm) | depth (mm) | text | model | rel. L2 | max error / peak | peak error"
+    head = ("| " + ("mesh | " if mesh else "") + "material | t (mm) | indentation (mm) | text | model | rel. L2 | max error / peak | peak error"
             + (" | taxel: max error / peak | taxel: peak error" if taxel else "") + " | within 5 % |")
     out = [title, "", head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
