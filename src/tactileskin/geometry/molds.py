@@ -155,26 +155,65 @@ def vertical_cylinder(x: float, z: float, y_from: float, y_to: float, diameter: 
                                   plane=bd.Plane((x, y_from, z), x_dir=(1, 0, 0), z_dir=(0, 1, 0)))
 
 
+# offset edges shorter than this (mm) are artefacts of OCC's offset, far below a printer's
+# resolution (t = 3.355469 mm: two of 2.6 and 3.5 um, whose offset curves ended 1e-6 mm from
+# their neighbours; rebuilt, the wire was open, and with them forced shut the fused seat was
+# an invalid solid): dropped, the neighbours meeting at the middle of the gap
+SHORTEST_OFFSET_EDGE = 1e-5
+# OCC's offset of the core section at t = 3.3554 mm returned 3 of its 19 edges (a 7 mm gap);
+# 0.2 mm +- 2e-7 mm gives them all: the distance is retried with these factors (a clearance
+# 1e-6 of itself off) until the edges meet
+OFFSET_RETRIES = (1.0, 1.0 + 1e-6, 1.0 - 1e-6, 1.0 + 1e-5)
+
+
 def _bspline_offset(wire: bd.Wire, distance: float) -> bd.Wire:
     """`wire` offset by `distance` (mm) in its plane, round at convex corners, with every
     offset curve replaced by a B-spline within 1e-7 mm of it: the STEP writer drops the faces
     swept from OCC's offset curves (the mold halves' STEP files lost 22 of 48 and 18 of 36
-    faces and re-read as open shells), as solids.py builds the interface as a B-spline."""
+    faces and re-read as open shells), as solids.py builds the interface as a B-spline.
+    Edges shorter than SHORTEST_OFFSET_EDGE are dropped (their neighbours' end poles moved to
+    the middle of the gap) where the offset's edges come in wire order; an offset whose edges
+    do not meet is made again at a distance 1e-6 of itself off (OFFSET_RETRIES)."""
     from OCP.Approx import Approx_Curve3d
     from OCP.BRepAdaptor import BRepAdaptor_Curve
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.GeomAbs import GeomAbs_C2
+    from OCP.gp import gp_Pnt
 
-    edges = []
-    for e in wire.offset_2d(distance, kind=bd.Kind.ARC).edges():
-        if e.geom_type == bd.GeomType.OFFSET:
+    for factor in OFFSET_RETRIES:
+        edges = list(wire.offset_2d(distance * factor, kind=bd.Kind.ARC).edges())
+        n = len(edges)
+        in_order = all((edges[i] @ 1 - edges[(i + 1) % n] @ 0).length < 1e-4 for i in range(n))
+        if in_order:
+            break
+    kept = [k for k in range(n) if not in_order or edges[k].length >= SHORTEST_OFFSET_EDGE] or list(range(n))
+    # where kept edge k must end: beside a dropped edge, the middle of the gap it leaves (None:
+    # its own end)
+    ends = {}
+    for j, k in enumerate(kept):
+        nxt = kept[(j + 1) % len(kept)]
+        ends[k] = (edges[k] @ 1 + edges[nxt] @ 0) * 0.5 if nxt != (k + 1) % n else None
+
+    def pnt(v) -> gp_Pnt:
+        return gp_Pnt(v.X, v.Y, v.Z)
+
+    out = []
+    for j, k in enumerate(kept):
+        e = edges[k]
+        first, last = ends[kept[j - 1]], ends[k]
+        if e.geom_type == bd.GeomType.OFFSET or first is not None or last is not None:
             approx = Approx_Curve3d(BRepAdaptor_Curve(e.wrapped), 1e-7, GeomAbs_C2, 200, 9)
             if not (approx.IsDone() and approx.HasResult()):
                 raise CadError(f"offsetting the mold seat by {distance:g} mm: no B-spline within 1e-7 mm "
                                f"(max error {approx.MaxError():g} mm)")
-            e = bd.Edge(BRepBuilderAPI_MakeEdge(approx.Curve()).Edge())
-        edges.append(e)
-    return bd.Wire(edges)
+            curve = approx.Curve()  # clamped: its first and last poles are its ends
+            if first is not None:
+                curve.SetPole(1, pnt(first))
+            if last is not None:
+                curve.SetPole(curve.NbPoles(), pnt(last))
+            e = bd.Edge(BRepBuilderAPI_MakeEdge(curve).Edge())
+        out.append(e)
+    return bd.Wire(out)
 
 
 def core_seat(sec: Section, clearance: float) -> bd.Solid:
