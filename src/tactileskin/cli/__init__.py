@@ -162,8 +162,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def run() -> None:
     """The console script (and `python -m tactileskin`): main(), then the process ends without
-    Python's teardown of every module's objects, ~0.25 s CPU of a cached sweep rerun's ~1.3 s
-    (benchmarks/cli_exit.py). The exit handlers (dask closing its clusters, logging's flush)
+    Python's teardown of every module's objects (a cached preview rerun 1.12 -> 0.96 s, idle;
+    benchmarks/results/cli_exit.md). The exit handlers (dask closing its clusters, logging's flush)
     and the streams' flush run first, as at a normal exit; a thread still running (none of
     the package's) gets the normal exit, which waits for it."""
     import atexit
