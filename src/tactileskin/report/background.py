@@ -1,7 +1,8 @@
 """A second pair of hands for drawing: `Background(fn)` runs fn(folder) in a fork()ed child
 while this process goes on, and `files()` returns the (name, bytes) of the files fn wrote
-into its private folder (fn returns their paths). The sweep draws half its figures there, half here (2 cores: the
-figures and renders of the 18-case preview: 2.05 -> 1.09 s wall, idle; benchmarks/results/figure_split.md).
+into its private folder (fn returns their paths). The sweep draws half its figures there,
+half here (2 cores: the figures and renders of the 18-case preview 2.05 -> 1.09 s wall, idle;
+benchmarks/results/figure_split.md).
 
 The child writes nothing the user sees: only a private temporary folder, which this process
 removes. Whatever goes wrong there (no fork() here, the child crashed, was killed or hung,
@@ -19,6 +20,7 @@ import shutil
 import signal
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -33,8 +35,6 @@ def can_fork() -> bool:
     """fork() is safe here: Linux, and no thread of this process runs code of its own
     (threads.other_threads: a lock it holds as fork() copies the process stays held)."""
     from tactileskin.threads import other_threads
-
-    import threading
 
     # Background._fork sets Python handlers of SIGINT and SIGTERM: the main thread's to set,
     # and to put back (getsignal None: a handler not set from Python, which cannot be)
