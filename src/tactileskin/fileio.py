@@ -255,6 +255,19 @@ def file_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def read_unchanged(read, path, digest: str, digest_of, name: str, valid: str):
+    """read(path) for a memo keyed by `digest`, the file's digest (digest_of) taken before the
+    read; refused (ParameterError naming `name`) if the file no longer has it afterwards: an
+    edit in between would keep another file's contents under this digest, and so under its
+    cache key, for the life of the process."""
+    from tactileskin.errors import ParameterError
+
+    out = read(path)
+    if digest_of(path) != digest:
+        raise ParameterError(name, str(path), valid, "it changed while it was read; run again once it is written")
+    return out
+
+
 def fix_tree_modes(root) -> None:
     """Give files written by third-party code inside a staging folder normal permissions."""
     fm, dm = file_mode(), dir_mode()

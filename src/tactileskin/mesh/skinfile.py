@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from tactileskin.errors import MeshError, ParameterError
+from tactileskin.fileio import read_unchanged
 from tactileskin.mesh import _gmsh
 from tactileskin.mesh.skinmesh import SYMMETRY_Z, SkinMesh, check_quality, jacobian_ratio
 
@@ -360,14 +361,8 @@ def step_symmetry(path, bonded=None) -> tuple[bool, bool]:
 
 @functools.lru_cache(maxsize=16)
 def _solid_symmetry(path: str, digest: str) -> tuple[bool, bool]:
-    """The solid's symmetry, memoised by its bytes' digest. The file is hashed again after it
-    was imported: an edit in between would keep another solid's symmetry (a cut at x = 0 or
-    none) under these bytes' digest, and so under their cache key, for the life of the process."""
-    out = _symmetry_of(path)
-    if file_digest(path) != digest:
-        raise ParameterError("skin_file", path, _VALID_FILE, "it changed while it was read; run again once it "
-                             "is written")
-    return out
+    """The solid's symmetry, memoised by its bytes' digest (fileio.read_unchanged)."""
+    return read_unchanged(_symmetry_of, path, digest, file_digest, "skin_file", _VALID_FILE)
 
 
 def _symmetry_of(path: str) -> tuple[bool, bool]:

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from tactileskin.errors import ParameterError
+from tactileskin.fileio import read_unchanged
 from tactileskin.skins.base import Skin
 from tactileskin.skins.file_coordinates import BONDED, OUTER, FileCoordinates, FileGeometry
 from tactileskin.skins.registry import register
@@ -209,16 +210,11 @@ def check_placement(geo: FileGeometry, path, kind: str, bonded, outer) -> None:
 
 @functools.lru_cache(maxsize=16)
 def _analyse(kind: str, path: str, digest: str, bonded, outer) -> FileGeometry:
-    """The file's geometry, memoised by its bytes' digest. The file is hashed again after it
-    was read: an edit in between would keep another skin (its thickness, top, faces) under
-    these bytes' digest, and so under their cache key, for the life of the process."""
+    """The file's geometry, memoised by its bytes' digest (fileio.read_unchanged)."""
     from tactileskin.mesh import skinfile
 
-    out = _analysed(kind, path, bonded, outer)
-    if skinfile.file_digest(path) != digest:
-        raise ParameterError("skin_file", path, "a .msh or STEP file of the skin",
-                             "it changed while it was read; run again once it is written")
-    return out
+    return read_unchanged(lambda p: _analysed(kind, p, bonded, outer), path, digest, skinfile.file_digest,
+                          "skin_file", skinfile._VALID_FILE)
 
 
 def _analysed(kind: str, path: str, bonded, outer) -> FileGeometry:

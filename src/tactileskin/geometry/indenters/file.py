@@ -32,6 +32,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tactileskin.errors import CadError, ParameterError
+from tactileskin.fileio import read_unchanged
 from tactileskin.geometry.indenters.base import Indenter, hertz_halfwidth, stem_params
 from tactileskin.geometry.indenters.registry import register
 
@@ -98,14 +99,8 @@ def _read(path: Path):
 
 @functools.lru_cache(maxsize=8)
 def _load(path: str, digest: str):
-    """Cached by content: the same bytes load once per process. The file is hashed again
-    after the read: an edit between the first hash and the read would keep another surface
-    under these bytes' digest (and so under their cache key) for the life of the process."""
-    out = _read(Path(path))
-    if file_digest(path) != digest:
-        raise ParameterError("indenter_file", path, _VALID, "it changed while it was read; run again once it is "
-                             "written")
-    return out
+    """Cached by content: the same bytes load once per process (fileio.read_unchanged)."""
+    return read_unchanged(_read, Path(path), digest, file_digest, "indenter_file", _VALID)
 
 
 def load_surface(path) -> tuple[np.ndarray, np.ndarray]:
