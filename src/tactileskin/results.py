@@ -621,10 +621,13 @@ def _write_vtu(path: Path, fields: dict, point_data: dict | None = None, status:
     field_data = mesh.field_data
     with fileio.atomic_path(path) as tmp, fileio.os_errors(path):
         mesh.write(tmp, file_format="vtu")
-        if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it
-            add_vtu_field_data(Path(tmp), field_data)
-        if status is not None:
-            _add_vtu_status(Path(tmp), status)
+        if field_data or status is not None:  # one rewrite of the file for both
+            data = Path(tmp).read_bytes()
+            if field_data:  # meshio's VTU writer drops field data: add it as VTK reads it
+                data = _with_field_data(data, field_data)
+            if status is not None:
+                data = _with_status(data, status)
+            Path(tmp).write_bytes(data)
 
 
 # A cell array of result.vtu: 1 on every cell of a suspect result, 0 of an ok one. Numeric, as
@@ -635,14 +638,13 @@ SUSPECT_ARRAY = "suspect"
 _STATUS_COMMENT = "<!-- tactileskin status: "
 
 
-def _add_vtu_status(path: Path, status: str) -> None:
-    """Put `status` in a comment after the XML declaration. A comment cannot hold "--" (a
-    reason says "use --quality"): a "-" after a "-" is written "\\-", a backslash "\\\\"
-    (vtu_status reads it back), so "--quality" reads "-\\-quality"."""
+def _with_status(data: bytes, status: str) -> bytes:
+    """A .vtu's bytes with `status` in a comment after the XML declaration. A comment cannot
+    hold "--" (a reason says "use --quality"): a "-" after a "-" is written "\\-", a backslash
+    "\\\\" (vtu_status reads it back), so "--quality" reads "-\\-quality"."""
     text = re.sub(r"(?<=-)-", r"\\-", status.replace("\\", "\\\\"))
-    data = path.read_bytes()
     i = data.index(b"?>") + 2 if data.startswith(b"<?xml") else 0
-    path.write_bytes(data[:i] + ("\n" + _STATUS_COMMENT + text + " -->").encode("utf-8") + data[i:])
+    return data[:i] + ("\n" + _STATUS_COMMENT + text + " -->").encode("utf-8") + data[i:]
 
 
 def vtu_status(path) -> str | None:
@@ -659,12 +661,15 @@ def vtu_status(path) -> str | None:
 
 def add_vtu_field_data(path: Path, field_data: dict) -> None:
     """Add {name: [id, dim]} to a .vtu as VTK field data (meshio's VTU writer drops it)."""
+    path.write_bytes(_with_field_data(path.read_bytes(), field_data))
+
+
+def _with_field_data(data: bytes, field_data: dict) -> bytes:
     arrays = "".join(f'<DataArray type="Int32" Name="{name}" NumberOfTuples="1" NumberOfComponents="2" '
                      f'format="ascii">{v[0]} {v[1]}</DataArray>\n' for name, v in field_data.items())
-    data = path.read_bytes()
     tag = b"<UnstructuredGrid>"
     i = data.index(tag) + len(tag)
-    path.write_bytes(data[:i] + b"\n<FieldData>\n" + arrays.encode() + b"</FieldData>" + data[i:])
+    return data[:i] + b"\n<FieldData>\n" + arrays.encode() + b"</FieldData>" + data[i:]
 
 
 STEPS_DIR = "result_steps"  # the .vtu of each increment, listed by result.pvd
