@@ -478,13 +478,12 @@ def resolve(lays, coords, dim: int, z_range: tuple[float, float] | None = None) 
         else:
             _check_range(where, "height", lay.height, 0.0, t)
         lim = coords.s_limit(d) if hasattr(coords, "s_limit") else smax
-        _check_range(where, "s", s, -lim, lim,
-                     note=f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
+        at_nail = f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else ""
+        _check_range(where, "s", s, -lim, lim, note=at_nail)
         if h:  # the taxel's edges: taxel/2 of arc length on the depth surface each side
             table = _surface_arc(coords, d, lim)
             _check_side(where, lay.taxel, d, lim, float(table[1][-1]))
-            _check_edges(where, s, lay.taxel, table, d,
-                         f" at depth {d:g} mm (the skin ends at the nail)" if lim < smax - _TOL else "")
+            _check_edges(where, s, lay.taxel, table, d, at_nail)
         if dim == 3 and z_range is not None:
             _check_range(where, "z" + (" +- taxel/2" if h else ""), np.concatenate([z - h, z + h]), *z_range)
         S.append(s), Z.append(z), D.append(np.full(len(s), d))
