@@ -230,15 +230,12 @@ BONE_SCALE_MAX = 2.3
 
 
 # Factors on the contact spot's size (at most half the far size) and on the plate strip's
-# (the bone balls and bone ROI keep theirs), for benchmarks/spot_scale_t5.py. The presets'
-# errors (data/presets.json "cases3d") were measured at 1, 1. At t = 5 mm, 1.6 / 8, k = 1.5-3
-# saved 2-5 % of the dofs and up to 19 % of the Newton iterations but moved the silicone dot's
-# bone map by 4.5-4.6 % (L2); against 0.8 / 8 their map errors are 2.6-4.1 % (the current plan
-# 4.5 %), but the saving (<= 19 % of the Newton iterations) does not meet T3 alone
-# (benchmarks/results/spot_scale_t5.md). The full cell at k = 3 (t = 5, 1.6 / 8): Newton
-# 104 -> 79, CPU -48 %, but its bone map moves 4.35 % (L2) from k = 1's, whose error against
-# 0.8 / 8 is 3.18 %: k = 3's lies anywhere in 1.2-7.5 % until the 0.8 / 8 cell is solved
-# again (benchmarks/results/spot_scale_t5_cell.md): not adopted.
+# (the bone balls and bone ROI keep theirs), for benchmarks/spot_scale_t5.py; the presets'
+# errors (data/presets.json "cases3d") were measured at 1, 1. At t = 5 mm, 1.6 / 8, k = 3 is
+# within the accuracy targets against 0.8 / 8 (dot map 4.07 %, cell map 3.75 %, peaks < 1 %)
+# and cuts the dot's wall 28.0 -> ~20 s, but is not yet the plan: a rule tied to the `default`
+# preset (not to the thickness alone, which would also coarsen the `fine` reference) and its
+# stored errors are missing (benchmarks/results/spot_scale_t5.md, spot_scale_t5_cell.md).
 SPOT_FACTOR = 1.0
 STRIP_FACTOR = 1.0
 
