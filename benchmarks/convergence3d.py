@@ -188,7 +188,7 @@ def solve_level(t: float, material: str, text: str, h: float, r: float, out: Pat
     atomic_write_json(out, {
         "thickness": t, "material": material, "text": text, "mesh_size": h, "refinement": r,
         "plan": plan, "dofs": int(res.stats["dofs"]), "cpu_s": cpu, "wall_s": wall,
-        **(study_scales(case_key(t, material, text)) if plan == "local" else {}),
+        **(study_scales(case_key(t, material, text), h, r) if plan == "local" else {}),
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "increments": int(res.stats.get("increments", 0)),
         "newton_iterations": int(res.stats.get("newton_iterations", 0)),
@@ -292,7 +292,7 @@ def cheapest_within(levels: list[dict], peak_tol: float = PEAK_TOL, map_tol: flo
     return min(ok, key=lambda d: d["dofs"]) if ok else None
 
 
-SCALES = ("bone_scale", "spot_scale")  # the local plan's scales a level records
+SCALES = ("bone_scale", "spot_scale", "spot_factor")  # the local plan's scales a level records
 
 
 def write_presets(path: Path, key: str, study: dict) -> None:
@@ -307,7 +307,9 @@ def write_presets(path: Path, key: str, study: dict) -> None:
              for v in cases.get(key, {}).get("levels", [])}
 
     def scale(d):
-        kept = known.get((d["mesh_size"], d["refinement"]), {})
+        # a raw record without "spot_factor" was meshed at 1 (not at a kept level's factor: the
+        # file may hold one size at two factors)
+        kept = dict(known.get((d["mesh_size"], d["refinement"]), {}), spot_factor=1.0)
         return {k: d.get(k, kept.get(k)) for k in SCALES if d.get(k, kept.get(k)) is not None}
 
     cases[key] = {

@@ -65,6 +65,48 @@ def compare(level: dict, ref: dict) -> dict:
             "map_l2": l2, "map_peak_error": mp / mr - 1.0}
 
 
+def study_errors(level: dict, ref: dict, case: dict) -> dict:
+    """Errors of a level against the convergence study's references (presets.json "cases3d":
+    Richardson limits or the finest level, convergence3d.analyse), from `ref`, a solve of the
+    study's finest level: each reference is ref's value / (1 + the finest level's stored error).
+    The map L2 is against `ref` (the study measures maps against its finest level)."""
+    finest = case["levels"][-1]
+    if (finest["mesh_size"], finest["refinement"]) != (ref["mesh_size"], ref["refinement"]):
+        raise ValueError("--reference must be the study's finest level")
+
+    def err(value, ref_value, stored):
+        return value / (ref_value / (1.0 + stored)) - 1.0
+
+    t = float(ref["thickness"])
+    return {"peak_error": err(level["peak"], ref["peak"], finest["peak_error"]),
+            "span_error": err(level["span"], ref["span"], finest["span_error"]),
+            "map_peak_error": err(c3.interior_map_peak(level), c3.interior_map_peak(ref), finest["map_peak_error"]),
+            "map_l2": c3.map_l2([level["map"], ref["map"]], ref_index=1, grid_index=0, z_margin=t)[0]}
+
+
+def store_level(path: Path, key: str, level: dict, k: float) -> dict:
+    """Put a variant level (strip factor 1) into presets.json "cases3d"[key] with its errors
+    against the study's references (study_errors) and "spot_factor" k, in dofs order, in place
+    of a stored level of the same sizes and factor. Returns the stored record."""
+    from tactileskin.fileio import atomic_write_json
+    from tactileskin.presets import SCALE_BEFORE_RECORDS
+
+    data = json.loads(path.read_text(encoding="utf-8"))
+    case = data["cases3d"][key]
+    rec = {"mesh_size": level["mesh_size"], "refinement": level["refinement"], "dofs": level["dofs"],
+           **{e: round(level[e], 6) for e in ("peak_error", "map_l2", "span_error", "map_peak_error")},
+           "cpu_s": round(level["cpu_s"], 1), "maxrss_mb": round(level["maxrss_mb"]),
+           "bone_scale": level["bone_scale"], "spot_factor": k}
+
+    def same(v):
+        return ((v["mesh_size"], v["refinement"]) == (rec["mesh_size"], rec["refinement"])
+                and v.get("spot_factor", SCALE_BEFORE_RECORDS["spot_factor"]) == k)
+
+    case["levels"] = sorted([v for v in case["levels"] if not same(v)] + [rec], key=lambda v: v["dofs"])
+    atomic_write_json(path, data)
+    return rec
+
+
 def table(rows: list[dict], ref: dict) -> str:
     out = ["| spot k / strip s | dofs | CPU s | wall s | incr. / Newton | peak MPa | peak err. | span err. | "
            "map L2 | map peak err. |", "|---|---|---|---|---|---|---|---|---|---|"]
@@ -130,6 +172,8 @@ def main(argv=None) -> int:
     ap.add_argument("--variants", default="1/1,1.5/1,2/1,3/1", help="spot factor k / strip factor s, comma-separated")
     ap.add_argument("--raw", type=Path, required=True)
     ap.add_argument("--out", type=Path, default=HERE / "results" / "spot_scale_t5.md")
+    ap.add_argument("--store", type=Path, help="presets.json: store each variant with s = 1 and k != 1 as a "
+                    "level of the study's case, errors against the study's references (--reference: its finest level)")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     variants = [tuple(float(x) for x in v.split("/")) for v in args.variants.split(",")]
@@ -163,6 +207,17 @@ def main(argv=None) -> int:
         parts.append(f"### {key}: every mesh against every other (map L2)\n\n"
                      + map_noise([refs[m]] + rows[m], names))
         print(parts[-1])
+    if args.store:
+        for m in materials:
+            key = c3.case_key(args.thickness, m, args.text)
+            case = json.loads(args.store.read_text(encoding="utf-8"))["cases3d"][key]
+            for d in rows[m]:
+                e = study_errors(d, refs[m], case)
+                if d["s"] == 1.0 and d["k"] != 1.0:
+                    print(key, "stored", store_level(args.store, key, d | e, d["k"]))
+                else:  # the study's own level again: how far the re-solved reference moves its errors
+                    print(key, f"k {d['k']:g} s {d['s']:g} against the study:",
+                          {n: f"{v:+.4%}" for n, v in e.items()})
     from tactileskin.fileio import atomic_write_text
 
     head = (f"# Contact-spot size at t = {args.thickness:g} mm (benchmarks/spot_scale_t5.py)\n\n"

@@ -286,13 +286,15 @@ def _t5_dot_plan(**kw):
 @pytest.mark.parametrize("k, s", [(2.0, 1.0), (3.0, 1.0), (1.0, 1.5), (10.0, 10.0)])
 def test_the_spot_and_strip_factors_scale_only_the_contact_sizes(monkeypatch, k, s):
     """benchmarks/spot_scale_t5.py's knobs: the contact spot's size times k (at most half the
-    far size), the plate strip's times s (at most the far size); the bone balls and the bone
-    ROI keep theirs, and the defaults (k = s = 1, what the presets were measured at) are the plan."""
+    far size; k replaces the thick-spot rule's factor), the plate strip's times s (at most the
+    far size); the bone balls and the bone ROI keep theirs."""
     from tactileskin.mesh import sizing
 
     kw = {"mesh_size": 1.6, "refinement": 8.0}
+    assert sizing.SPOT_FACTOR is None and sizing.STRIP_FACTOR == 1.0  # the plan: the thick-spot rule
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", 1.0)
     base = _t5_dot_plan(**kw)
-    assert sizing.SPOT_FACTOR == 1.0 and sizing.STRIP_FACTOR == 1.0
+    assert base.patches[0][4] == pytest.approx(0.2)
     assert base.strip == base.strip_roi == pytest.approx(np.sqrt(0.2 * 1.6))
     monkeypatch.setattr(sizing, "SPOT_FACTOR", k)
     monkeypatch.setattr(sizing, "STRIP_FACTOR", s)
@@ -302,3 +304,59 @@ def test_the_spot_and_strip_factors_scale_only_the_contact_sizes(monkeypatch, k,
     assert p.bone_patches == base.bone_patches and p.strip_roi == base.strip_roi
     assert p.roi_layer == base.roi_layer
     assert (p.estimate < base.estimate) == (k > 1.0 or s > 1.0)
+
+
+def _spot_sizes(**fields):
+    from tactileskin.mesh import sizing
+
+    sc = Scene(dim=3, **fields)
+    sec = sc.section()
+    p = sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True)
+    return [b[4] for b in p.patches], p
+
+
+@pytest.mark.parametrize("text", ["", "\u283f"])
+def test_the_thick_spot_rule_coarsens_the_default_contact_spot_at_t5_only(monkeypatch, text):
+    """At t = 5 mm the `default` (1.6 / 8) meshes a dot's contact spot at 3x its fine size (the
+    stored levels with "spot_factor" 3, spot_scale_t5.md); the bone balls and the strip keep
+    their sizes, and the mesh has fewer nodes. The `fine` preset (0.8 / 8, the study's
+    reference) keeps the spot at its fine size."""
+    from tactileskin.mesh import sizing
+    from tactileskin.mesh.slab3d import build_slab_mesh
+    from tactileskin.planner import with_quality
+
+    sc = with_quality(Scene(dim=3, thickness=5.0, indenter="braille", braille_text=text), "default")
+    fine = sc.mesh_size / sc.refinement
+    assert fine == pytest.approx(sizing.THICK_SPOT_H)
+    now, p = _spot_sizes(**{k: getattr(sc, k) for k in ("thickness", "indenter", "braille_text", "mesh_size",
+                                                         "refinement")})
+    assert now == pytest.approx([3.0 * fine] * len(now))
+    nodes = build_slab_mesh(sc).mesh.p.shape[1]
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", 1.0)  # the spot at its fine size
+    before, q = _spot_sizes(thickness=5.0, indenter="braille", braille_text=text, mesh_size=1.6, refinement=8.0)
+    assert before == pytest.approx([fine] * len(now))
+    assert p.bone_patches == q.bone_patches and p.strip == q.strip and p.strip_roi == q.strip_roi
+    assert nodes < 0.96 * build_slab_mesh(sc).mesh.p.shape[1]
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", None)
+    f = with_quality(sc, "fine")
+    assert f.mesh_size / f.refinement < sizing.THICK_SPOT_H
+    spots, _ = _spot_sizes(thickness=5.0, indenter="braille", braille_text=text, mesh_size=f.mesh_size,
+                           refinement=f.refinement)
+    assert spots == pytest.approx([f.mesh_size / f.refinement] * len(spots))
+
+
+def test_the_thick_spot_rule_leaves_thinner_skins_wider_spots_and_finer_meshes_alone(monkeypatch):
+    from tactileskin.mesh import sizing
+
+    cases = [dict(thickness=t, indenter="braille", braille_text=x, mesh_size=h, refinement=8.0)
+             for t in (1.0, 3.0, 4.9) for x in ("", "\u283f") for h in (0.8, 1.6, 2.4)]
+    cases += [dict(thickness=5.0, indenter="braille", braille_text="", mesh_size=1.2, refinement=8.0),
+              dict(thickness=5.0, indenter="sphere", indenter_radius=2.5, mesh_size=1.6, refinement=8.0)]
+    now = [_spot_sizes(**c)[0] for c in cases]
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", 1.0)
+    assert now == [_spot_sizes(**c)[0] for c in cases]
+    assert sizing.spot_factor(5.0, 0.72, 0.2) == 1.0  # the override
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", None)
+    assert sizing.spot_factor(5.0, 0.72, 0.2) == sizing.spot_factor(8.0, 0.5, 0.3) == 3.0
+    assert sizing.spot_factor(4.9, 0.72, 0.2) == sizing.spot_factor(5.0, 2.0, 0.2) == 1.0
+    assert sizing.spot_factor(5.0, 0.72, 0.199) == 1.0

@@ -82,29 +82,45 @@ def case_thickness(key: str) -> float | None:
 def preset_level(key: str, case: dict, quality: str) -> dict | None:
     """The level of convergence-study case `key` (presets.json "cases3d") meshed as the 3D
     Braille preset `quality` at the case's thickness, or None if the study did not solve it.
-    A level that records the patch scales it was meshed with ("bone_scale", "spot_scale")
-    counts only if the local plan gives those scales now (study_scales): the same sizes with
-    another layout are another mesh."""
+    A level counts only if the local plan gives the patch scales it was meshed with now
+    (study_scales; "bone_scale" and "spot_scale" where recorded, "spot_factor" 1 where not):
+    the same sizes with another layout are another mesh."""
     t = case_thickness(key)
     h, r = mesh(3, quality, braille=True, thickness=t)  # the local plan's sizes (dots, spheres)
-    now = study_scales(key)
+    now = study_scales(key, h, r)
+
+    def same(v, k):
+        got = v.get(k, SCALE_BEFORE_RECORDS.get(k))
+        return got is None or _same(got, now[k])
+
     return next((v for v in case["levels"] if _same(v["mesh_size"], h) and _same(v["refinement"], r)
-                 and all(k not in v or _same(v[k], now[k]) for k in now)), None)
+                 and all(same(v, k) for k in now)), None)
 
 
-def study_scales(key: str) -> dict:
-    """The local plan's scales for a convergence-study case key: {"bone_scale"} of the
+# a level that does not record a scale was meshed with this value of it (levels solved before
+# mesh.sizing.spot_factor had every spot at its fine size); other scales are not compared there
+SCALE_BEFORE_RECORDS = {"spot_factor": 1.0}
+
+
+def study_scales(key: str, mesh_size: float, refinement: float) -> dict:
+    """The local plan's scales for a convergence-study case key meshed at (mesh_size,
+    refinement): {"bone_scale", "spot_factor"} (mesh.sizing.bone_scale, spot_factor) of the
     standard American dots, and for a sphere case ("t1-silicone-sphere-R2.5", the scene's
     default depth) also its "spot_scale" (mesh.sizing.patch_scale of the ball's spot)."""
     import re
 
+    from tactileskin.mesh.sizing import bone_scale, patch_scale, spot_factor, spot_fine
+
     t = case_thickness(key)
+    fine = float(mesh_size) / float(refinement)
     ball = re.search(r"-sphere-R([0-9.]+)$", key)
     if ball is None:
-        return {"bone_scale": study_bone_scale(t)}
+        from tactileskin.geometry import braille
+
+        a = braille.get_standard("standard_american").base_radius
+        return {"bone_scale": study_bone_scale(t), "spot_factor": round(spot_factor(t, a, fine), 4)}
     from tactileskin.errors import ParameterError
     from tactileskin.geometry.indenters import indenter_for_scene
-    from tactileskin.mesh.sizing import bone_scale, patch_scale
     from tactileskin.scene import Scene
 
     try:
@@ -112,9 +128,11 @@ def study_scales(key: str) -> dict:
     except ParameterError:
         # a user's geometry (TACTILESKIN_GEOMETRY) that does not take the study's thickness:
         # the study's level is not this geometry's mesh (and every command used to fail here)
-        return {"bone_scale": math.nan, "spot_scale": math.nan}
+        return {"bone_scale": math.nan, "spot_scale": math.nan, "spot_factor": math.nan}
     (_, _, a), = indenter_for_scene(sc, warn=False).contact_patches(sc.indentation)
-    return {"bone_scale": round(bone_scale(t, a), 4), "spot_scale": round(patch_scale(a), 4)}
+    h = spot_fine(float(mesh_size), fine, a)
+    return {"bone_scale": round(bone_scale(t, a), 4), "spot_scale": round(patch_scale(a), 4),
+            "spot_factor": round(spot_factor(t, a, h), 4)}
 
 
 def study_bone_scale(thickness: float) -> float:

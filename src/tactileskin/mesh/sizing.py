@@ -229,15 +229,33 @@ PATCH_RADIUS = 1.25
 BONE_SCALE_MAX = 2.3
 
 
-# Factors on the contact spot's size (at most half the far size) and on the plate strip's
-# (the bone balls and bone ROI keep theirs), for benchmarks/spot_scale_t5.py; the presets'
-# errors (data/presets.json "cases3d") were measured at 1, 1. At t = 5 mm, 1.6 / 8, k = 3 is
-# within the accuracy targets against 0.8 / 8 (dot map 4.07 %, cell map 3.75 %, peaks < 1 %)
-# and cuts the dot's wall 28.0 -> ~20 s, but is not yet the plan: a rule tied to the `default`
-# preset (not to the thickness alone, which would also coarsen the `fine` reference) and its
-# stored errors are missing (benchmarks/results/spot_scale_t5.md, spot_scale_t5_cell.md).
-SPOT_FACTOR = 1.0
+# Contact spot under a thick skin (issue 13, T3): the bone map cannot see the contact patch's
+# detail through t >= 5 mm, and the spot's fine cells cost Newton iterations (the contact set
+# cycles over them). From THICK_SPOT_T, a dot-sized spot (patch_scale 1) meshed at a fine size
+# of at least THICK_SPOT_H gets THICK_SPOT_FACTOR times that size (at most half the far size).
+# Measured at t = 5 mm, 1.6 / 8 (the `default` there) against 0.8 / 8: dot map 4.52 -> 4.07 %,
+# cell map 3.18 -> 3.75 %, peaks within +0.4 to +0.9 %, the dot's CPU -31 %, the cell's -43 to
+# -48 % (benchmarks/results/spot_scale_t5.md, spot_scale_t5_cell.md; stored in presets.json
+# "cases3d" as levels with "spot_factor" 3). The size bound keeps finer levels (the study's
+# 1.2 / 8 and its reference 0.8 / 8, the `fine` preset) on the plan they were measured with, so
+# the factor vanishes as the mesh is refined; thinner skins were measured at 1 only.
+THICK_SPOT_T = 5.0
+THICK_SPOT_H = 0.2
+THICK_SPOT_FACTOR = 3.0
+# Overrides for benchmarks/spot_scale_t5.py: SPOT_FACTOR (None: the rule above) replaces every
+# spot's factor; STRIP_FACTOR scales the plate strip's size (the bone balls and ROI keep theirs).
+SPOT_FACTOR: float | None = None
 STRIP_FACTOR = 1.0
+
+
+def spot_factor(thickness: float, a: float, h: float) -> float:
+    """Contact-spot size / the spot's fine size `h` (mm) of the local plan for a spot of radius
+    bound `a` (mm) under a skin `thickness` mm thick."""
+    if SPOT_FACTOR is not None:
+        return float(SPOT_FACTOR)
+    if thickness >= THICK_SPOT_T - 1e-9 and patch_scale(a) == 1.0 and h >= THICK_SPOT_H - 1e-9:
+        return THICK_SPOT_FACTOR
+    return 1.0
 
 
 def bone_scale(thickness: float, base_radius: float) -> float:
@@ -279,6 +297,12 @@ def patch_scale(a: float) -> float:
     return math.sqrt(max(1.0, a / braille.get_standard("standard_american").base_radius))
 
 
+def spot_fine(coarse: float, fine: float, a: float) -> float:
+    """The fine size (mm) at a contact spot of radius bound `a` of a local plan with these far
+    and fine sizes: a spot much wider than a dot (a flat file face) still gets ratio 2."""
+    return max(fine, min(0.5 * coarse, fine * patch_scale(a)))
+
+
 def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_symmetric: bool,
                spots=None) -> SizePlan:
     """Local size plan of a 3D slab (fingertip) or block (pad) pressed in compact spots (the
@@ -304,10 +328,9 @@ def local_plan(scene, section, coarse: float, ratio: float, *, length: float, z_
     box = (x0, float(section.half_width), z0, z1)
     patches, bones = [], []
     for x, z, a in spots:
-        # a spot much wider than a dot (a flat file face) still gets the strip plan's ratio 2
-        h = max(fine, min(0.5 * coarse, fine * patch_scale(a)))
+        h = spot_fine(coarse, fine, a)
         hb = min(coarse, h * bone_scale(t, a))
-        hs = max(h, min(0.5 * coarse, h * SPOT_FACTOR))
+        hs = max(h, min(0.5 * coarse, h * spot_factor(t, a, h)))
         po, n = _dot_frame(section, x)
         pb = po - t * n
         for balls, c, r, size in ((patches, po, PATCH_RADIUS * a, hs), (bones, pb, a + t, hb)):
