@@ -6,7 +6,11 @@ reports dofs, CPU s (time.process_time of the solve, one BLAS thread), wall s, i
 Newton iterations, peak and span, and the per-phase wall times; writes the table to
 benchmarks/results/braille3d_default.md.
 
-    .venv/bin/python benchmarks/braille3d_default.py [--thickness 1 3] [--text ""] [--material silicone]
+    .venv/bin/python benchmarks/braille3d_default.py [--thickness 1 3] [--text ""] \
+        [--material silicone polyurethane] [--repeat 2] [--section "what changed"]
+
+Each run adds a section under the title of benchmarks/results/braille3d_default.md (the earlier
+sections, and the notes written into them, are kept).
 """
 
 from __future__ import annotations
@@ -54,23 +58,33 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--thickness", type=float, nargs="+", default=[1.0, 3.0])
     ap.add_argument("--text", default="")
-    ap.add_argument("--material", default="silicone")
+    ap.add_argument("--material", nargs="+", default=["silicone"])
+    ap.add_argument("--repeat", type=int, default=1, help="runs of each case, interleaved")
+    ap.add_argument("--section", help="title of the new section in the results file")
     ap.add_argument("--one", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.one:
-        print(json.dumps(one(a.thickness[0], a.text, a.material)))
+        print(json.dumps(one(a.thickness[0], a.text, a.material[0])))
         return 0
     rows = []
-    for t in a.thickness:
-        cmd = [sys.executable, __file__, "--one", "--thickness", f"{t:g}", "--text", a.text, "--material", a.material]
+    load0 = os.getloadavg()[0]
+    for t, m in [(t, m) for _ in range(a.repeat) for t in a.thickness for m in a.material]:
+        cmd = [sys.executable, __file__, "--one", "--thickness", f"{t:g}", "--text", a.text, "--material", m]
         p = subprocess.run(cmd, check=True, capture_output=True, text=True,
                            env=dict(os.environ, PYTHONPATH=str(ROOT / "src")))
         rows.append(json.loads(p.stdout.strip().splitlines()[-1]))
         print(table(rows[-1:]).splitlines()[-1], flush=True)
     from tactileskin.fileio import atomic_write_text
 
-    atomic_write_text(OUT, "# `default` 3D Braille solve times (benchmarks/braille3d_default.py)\n\n" + table(rows)
-                      + f"\n\nMeasured {_dt.date.today().isoformat()}; see the note below for the machine's load.\n")
+    # a new section under the title; the earlier sections (measurements and their reading, by
+    # hand) are kept
+    title = "# `default` 3D Braille solve times (benchmarks/braille3d_default.py)\n\n"
+    old = OUT.read_text(encoding="utf-8") if OUT.exists() else title
+    rest = old[len(title):] if old.startswith(title) else old
+    section = (f"## {a.section or 'Run'} ({_dt.date.today().isoformat()})\n\n"
+               f"`{' '.join(['benchmarks/braille3d_default.py'] + (argv if argv is not None else sys.argv[1:]))}`; "
+               f"load average before the run {load0:.1f}, after {os.getloadavg()[0]:.1f}.\n\n" + table(rows) + "\n\n")
+    atomic_write_text(OUT, title + section + rest)
     return 0
 
 
