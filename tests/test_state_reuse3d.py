@@ -136,7 +136,7 @@ def test_solve_same_answer_with_and_without_reuse():
     assert np.array_equal(out[True][0], out[False][0]) and np.array_equal(out[True][1], out[False][1])
     assert out[True][2] == out[False][2]
     c = out[True][3]
-    assert c["law_tangent"] <= 1 and c["tangent_kept"] >= out[True][2] - 1
+    assert c.get("law_tangent", 0) <= 1 and c["tangent_kept"] >= out[True][2] - 1
 
 
 def test_no_reuse_after_the_history_restarts_its_parabola():

@@ -60,10 +60,11 @@ def material_law(law):
     served correctly too. law(C, tangent=False) returns (S, None, ok) where the law can
     skip D (hyperfoam on both paths; residual-only evaluations).
 
-    law(C, tangent=False, keep=True) returns (S, None, ok, kept): where the law can (hyperfoam
-    on the 3x3 path) `kept` is the spectral data from which `law.tangent_kept(kept)` gives D
-    at the same C without the eigenproblem (fe.Model: the tangent at the iterate whose
-    residual was just evaluated); None elsewhere (the caller then asks law(C, True)).
+    law(C, tangent=False, keep=True) returns (S, None, ok, kept): where the law can (hyperfoam,
+    on both paths) `kept` is the spectral data from which `law.tangent_kept(kept)` gives D
+    at the same C without the eigenproblem and the stress's powers (fe.Model: the tangent at
+    the iterate whose residual was just evaluated; `tangent_kept(kept, in_plane=True)` its
+    in-plane block, the same bits); None elsewhere (the caller then asks law(C, True)).
     """
     keeps = hasattr(law, "pk2_kept") and hasattr(law, "tangent_kept")
 
@@ -71,6 +72,9 @@ def material_law(law):
         C = np.asarray(C, dtype=float)
         if (C.ndim >= 2 and C.shape[-2:] == (3, 3) and np.all(C[..., 2, 2] == 1.0)
                 and not np.any(C[..., 2, :2]) and not np.any(C[..., :2, 2])):
+            if keep and keeps and not tangent and hasattr(law, "pk2_kept_plane"):
+                S, ok, kept = law.pk2_kept_plane(C[..., :2, :2], out_of_plane=True)
+                return S, None, ok, kept
             out = law.pk2_tangent_plane(C[..., :2, :2], out_of_plane=True, tangent=tangent)
         elif keep and keeps and not tangent:
             S, ok, kept = law.pk2_kept(C)
@@ -79,7 +83,7 @@ def material_law(law):
             out = law.pk2_tangent(C, tangent=tangent)
         return (*out, None) if keep else out
 
-    evaluate.tangent_kept = law.tangent_kept if keeps else None
+    evaluate.tangent_kept = law.tangent_kept if keeps else None   # (kept, in_plane=False) for hyperfoam
     return evaluate
 
 

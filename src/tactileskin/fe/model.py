@@ -145,6 +145,9 @@ class Model:
         self._law_tangent_kw = "tangent" in params
         # laws that keep the spectral data of a stress evaluation for the tangent at that state
         self._law_keeps = "keep" in params and getattr(law, "tangent_kept", None) is not None
+        # ... and can give the in-plane block of D alone (a 2D tangent uses no more; the full
+        # D's 81 entries and their strided slice cost a 2D preview sweep ~0.1 s)
+        self._kept_in_plane = self._law_keeps and "in_plane" in inspect.signature(law.tangent_kept).parameters
         self.mixed = formulation == "mixed"
         if qlv_order not in (1, 2):
             raise ParameterError("qlv_order", qlv_order, "1 (linear S0 per increment) or 2 (parabola)")
@@ -367,7 +370,8 @@ class Model:
             if st.D is None:
                 if st.kept is not None:
                     self.counts["tangent_kept"] += 1
-                    st.D = self.law.tangent_kept(st.kept)
+                    st.D = (self.law.tangent_kept(st.kept, in_plane=True) if m == 2 and self._kept_in_plane
+                            else self.law.tangent_kept(st.kept))
                 else:
                     st.D = self._law(ev.kin.C, True)[1]
                 st.kept = None   # D supersedes it

@@ -38,7 +38,7 @@ if (EXP_CAP, LOG_C_CAP, _CLIP) != (_hf.EXP_CAP, _hf.LOG_C_CAP, _hf._CLIP):
     raise TactileSkinError(f"materials/_hyperfoam_nb.py has EXP_CAP = {EXP_CAP:g}, LOG_C_CAP = {LOG_C_CAP:g}, "
                            f"hyperfoam.py {_hf.EXP_CAP:g}, {_hf.LOG_C_CAP:g}: write the same caps in both")
 
-__all__ = ["plane_kernel", "MODE_S", "MODE_D2", "MODE_D3"]
+__all__ = ["plane_kernel", "plane_tangent_kernel", "KEPT_PLANE", "MODE_S", "MODE_D2", "MODE_D3"]
 
 MODE_S, MODE_D2, MODE_D3 = 0, 1, 2   # S only; S + in-plane D (16); S + full D (81)
 
@@ -47,7 +47,13 @@ _ZERO81 = np.array([2, 5, 6, 7, 11, 14, 15, 16, 18, 19, 21, 22, 26, 29, 32, 33, 
                     46, 48, 49, 53, 54, 55, 57, 58, 62, 63, 64, 66, 67, 71, 74, 77, 78, 79], dtype=np.int64)
 
 _SIG = ("void(float64[:, :, :], float64[:], boolean, float64[:], float64[:], float64, "
-        "float64[:, :, ::1], float64[:, ::1], boolean[::1], int64)")
+        "float64[:, :, ::1], float64[:, ::1], boolean[::1], int64, float64[:, ::1], boolean)")
+_SIG_D = "void(float64[:, ::1], float64[:], float64[:], float64, float64[:, ::1], int64)"
+
+# the per-point data a plane-strain stress evaluation keeps for a later D at the same state
+# (`plane_kernel` with keep, `plane_tangent_kernel`): the projector's (11, 12) = (p11, p12),
+# e (2), ln c (2), 1/c (2), then per term J^(-alpha beta), c_0^(alpha/2), c_1^(alpha/2)
+KEPT_PLANE = 8
 
 
 @numba.njit(inline="always")
@@ -87,10 +93,97 @@ def _pair(k, q, cqa, cqb, ea, eb, la, lb, ell, evab):
     return k * (dd + evab)
 
 
+@numba.njit(inline="always")
+def _plane_gamma(k, q, mu_i, beta, ev, pw0, pw1, ic0, ic1, e0, e1, lc0, lc1, ell01):
+    """One term's share of gamma (00, 11, 22, 01, 02, 12) and of qv = J dp/dJ."""
+    cq0 = pw0 * ic0                                          # c^q, q = alpha/2 - 1
+    cq1 = pw1 * ic1
+    # diagonal: g'(c_a) + J^(-alpha beta) / c_a^2
+    d00 = k * (q * cq0 * ic0 + ev * ic0 * ic0)
+    d11 = k * (q * cq1 * ic1 + ev * ic1 * ic1)
+    d22 = k * (q + ev)
+    # pairs (0,1), (0,2), (1,2); c_3 = 1: ln(c_a / c_3) = ln c_a
+    d01 = _pair(k, q, cq0, cq1, e0, e1, lc0, lc1, ell01, ev * ic0 * ic1)
+    d02 = _pair(k, q, cq0, 1.0, e0, 0.0, lc0, 0.0, lc0, ev * ic0)
+    d12 = _pair(k, q, cq1, 1.0, e1, 0.0, lc1, 0.0, lc1, ev * ic1)
+    return d00, d11, d22, d01, d02, d12, 2.0 * mu_i * beta * ev   # qv's term: J dp/dJ
+
+
+@numba.njit(inline="always")
+def _plane_d(p11, p12, g00, g11, g22, g01, g02, g12, ic0, ic1, qv, Dp, mode):
+    """D (16 for MODE_D2, 81 for MODE_D3) of one point into Dp from its principal directions
+    (p11, p12: n_1 n_1's 11 and 12), gamma and qv."""
+    P1_0, P1_1, P1_2 = p11, p12, 1.0 - p11
+    P0_0, P0_1, P0_2 = 1.0 - p11, -p12, p11
+    # T = P^T gamma P over the in-plane directions, P[a] = (11, 12, 22) of n_a n_a
+    X00 = g00 * P0_0 + g01 * P1_0
+    X01 = g00 * P0_1 + g01 * P1_1
+    X02 = g00 * P0_2 + g01 * P1_2
+    X10 = g01 * P0_0 + g11 * P1_0
+    X11 = g01 * P0_1 + g11 * P1_1
+    X12 = g01 * P0_2 + g11 * P1_2
+    T00 = P0_0 * X00 + P1_0 * X10
+    T01 = P0_0 * X01 + P1_0 * X11
+    T02 = P0_0 * X02 + P1_0 * X12
+    T10 = P0_1 * X00 + P1_1 * X10
+    T11 = P0_1 * X01 + P1_1 * X11
+    T12 = P0_1 * X02 + P1_1 * X12
+    T20 = P0_2 * X00 + P1_2 * X10
+    T21 = P0_2 * X01 + P1_2 * X11
+    T22 = P0_2 * X02 + P1_2 * X12
+    Ci0 = ic0 * P0_0 + ic1 * P1_0                        # C^-1 in-plane (11, 12, 22)
+    Ci1 = ic0 * P0_1 + ic1 * P1_1
+    Ci2 = ic0 * P0_2 + ic1 * P1_2
+    qC0, qC1, qC2 = qv * Ci0, qv * Ci1, qv * Ci2
+    # D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd, (ab) -> 0 (11), 1 (12), 2 (22)
+    d0000 = T00 + T00 + qC0 * Ci0
+    d0001 = T01 + T10 + qC0 * Ci1
+    d0010 = T10 + T01 + qC0 * Ci1
+    d0011 = T11 + T11 + qC0 * Ci2
+    d0100 = T01 + T01 + qC1 * Ci0
+    d0101 = T02 + T11 + qC1 * Ci1
+    d0110 = T11 + T02 + qC1 * Ci1
+    d0111 = T12 + T12 + qC1 * Ci2
+    d1000 = T10 + T10 + qC1 * Ci0
+    d1001 = T11 + T20 + qC1 * Ci1
+    d1010 = T20 + T11 + qC1 * Ci1
+    d1011 = T21 + T21 + qC1 * Ci2
+    d1100 = T11 + T11 + qC2 * Ci0
+    d1101 = T12 + T21 + qC2 * Ci1
+    d1110 = T21 + T12 + qC2 * Ci1
+    d1111 = T22 + T22 + qC2 * Ci2
+    if mode == MODE_D2:
+        Dp[0], Dp[1], Dp[2], Dp[3] = d0000, d0001, d0010, d0011
+        Dp[4], Dp[5], Dp[6], Dp[7] = d0100, d0101, d0110, d0111
+        Dp[8], Dp[9], Dp[10], Dp[11] = d1000, d1001, d1010, d1011
+        Dp[12], Dp[13], Dp[14], Dp[15] = d1100, d1101, d1110, d1111
+        return
+    for j in _ZERO81:
+        Dp[j] = 0.0
+    # in-plane block: index 27 i + 9 j + 3 k + l
+    Dp[0], Dp[1], Dp[3], Dp[4] = d0000, d0001, d0010, d0011
+    Dp[9], Dp[10], Dp[12], Dp[13] = d0100, d0101, d0110, d0111
+    Dp[27], Dp[28], Dp[30], Dp[31] = d1000, d1001, d1010, d1011
+    Dp[36], Dp[37], Dp[39], Dp[40] = d1100, d1101, d1110, d1111
+    # D_ab33 = D_33ab = qv Cinv_ab; D_3333 = 2 gamma_33 + qv
+    Dp[8], Dp[17], Dp[35], Dp[44] = qC0, qC1, qC1, qC2
+    Dp[72], Dp[73], Dp[75], Dp[76] = qC0, qC1, qC1, qC2
+    Dp[80] = 2.0 * g22 + qv
+    # D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab
+    G0 = g02 * P0_0 + g12 * P1_0
+    G1 = g02 * P0_1 + g12 * P1_1
+    G2 = g02 * P0_2 + g12 * P1_2
+    Dp[20], Dp[23], Dp[47], Dp[50] = G0, G1, G1, G2        # D_a3b3
+    Dp[24], Dp[25], Dp[51], Dp[52] = G0, G1, G1, G2        # D_a33b
+    Dp[56], Dp[59], Dp[65], Dp[68] = G0, G1, G1, G2        # D_3ab3
+    Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
+
+
 @numba.njit(_SIG, cache=True, nogil=True, error_model="numpy")
-def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
+def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode, K, keep):
     """Plane-strain S (n, 3, 3), D (n, 16) or (n, 81) (mode MODE_D2 / MODE_D3; untouched for
-    MODE_S) and ok (n,) of the points C2 (n, 2, 2), written into S, D, ok."""
+    MODE_S) and ok (n,) of the points C2 (n, 2, 2), written into S, D, ok; with `keep` (MODE_S)
+    the data K (n, KEPT_PLANE + 3 terms) from which `plane_tangent_kernel` gives D."""
     n = C2.shape[0]
     m = mu.shape[0]
     for p in range(n):
@@ -137,6 +230,10 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
         f0 = f1 = f2 = 0.0
         g00 = g11 = g22 = g01 = g02 = g12 = 0.0
         qv = 0.0
+        if keep:
+            Kp = K[p]
+            Kp[0], Kp[1], Kp[2], Kp[3] = p11, p12, e0, e1
+            Kp[4], Kp[5], Kp[6], Kp[7] = lc0, lc1, ic0, ic1
         for i in range(m):
             al = alpha[i]
             k = 2.0 * mu[i] / al
@@ -154,91 +251,55 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode):
             f0 += k * _diff(pw0 * ic0, ev * ic0, al * (0.5 * lc0 + bl))
             f1 += k * _diff(pw1 * ic1, ev * ic1, al * (0.5 * lc1 + bl))
             f2 += k * _diff(1.0, ev, al * (0.0 + bl))
+            if keep:
+                Kp[KEPT_PLANE + 3 * i], Kp[KEPT_PLANE + 3 * i + 1], Kp[KEPT_PLANE + 3 * i + 2] = ev, pw0, pw1
             if tangent:
-                q = 0.5 * al - 1.0
-                cq0 = pw0 * ic0                              # c^q, q = alpha/2 - 1
-                cq1 = pw1 * ic1
-                # diagonal: g'(c_a) + J^(-alpha beta) / c_a^2
-                g00 += k * (q * cq0 * ic0 + ev * ic0 * ic0)
-                g11 += k * (q * cq1 * ic1 + ev * ic1 * ic1)
-                g22 += k * (q + ev)
-                # pairs (0,1), (0,2), (1,2); c_3 = 1: ln(c_a / c_3) = ln c_a
-                g01 += _pair(k, q, cq0, cq1, e0, e1, lc0, lc1, ell01, ev * ic0 * ic1)
-                g02 += _pair(k, q, cq0, 1.0, e0, 0.0, lc0, 0.0, lc0, ev * ic0)
-                g12 += _pair(k, q, cq1, 1.0, e1, 0.0, lc1, 0.0, lc1, ev * ic1)
-                qv += 2.0 * mu[i] * beta * ev                # J dp/dJ
+                d00, d11, d22, d01, d02, d12, dq = _plane_gamma(k, 0.5 * al - 1.0, mu[i], beta, ev, pw0, pw1,
+                                                                ic0, ic1, e0, e1, lc0, lc1, ell01)
+                g00 += d00
+                g11 += d11
+                g22 += d22
+                g01 += d01
+                g02 += d02
+                g12 += d12
+                qv += dq
         ok[p] = okp
         S[p, 0, 0] = f0 * P0_0 + f1 * P1_0
         S[p, 0, 1] = S[p, 1, 0] = f0 * P0_1 + f1 * P1_1
         S[p, 1, 1] = f0 * P0_2 + f1 * P1_2
         S[p, 2, 2] = f2
         S[p, 0, 2] = S[p, 1, 2] = S[p, 2, 0] = S[p, 2, 1] = 0.0
-        if not tangent:
-            continue
-        # T = P^T gamma P over the in-plane directions, P[a] = (11, 12, 22) of n_a n_a
-        X00 = g00 * P0_0 + g01 * P1_0
-        X01 = g00 * P0_1 + g01 * P1_1
-        X02 = g00 * P0_2 + g01 * P1_2
-        X10 = g01 * P0_0 + g11 * P1_0
-        X11 = g01 * P0_1 + g11 * P1_1
-        X12 = g01 * P0_2 + g11 * P1_2
-        T00 = P0_0 * X00 + P1_0 * X10
-        T01 = P0_0 * X01 + P1_0 * X11
-        T02 = P0_0 * X02 + P1_0 * X12
-        T10 = P0_1 * X00 + P1_1 * X10
-        T11 = P0_1 * X01 + P1_1 * X11
-        T12 = P0_1 * X02 + P1_1 * X12
-        T20 = P0_2 * X00 + P1_2 * X10
-        T21 = P0_2 * X01 + P1_2 * X11
-        T22 = P0_2 * X02 + P1_2 * X12
-        Ci0 = ic0 * P0_0 + ic1 * P1_0                        # C^-1 in-plane (11, 12, 22)
-        Ci1 = ic0 * P0_1 + ic1 * P1_1
-        Ci2 = ic0 * P0_2 + ic1 * P1_2
-        qC0, qC1, qC2 = qv * Ci0, qv * Ci1, qv * Ci2
-        # D_abcd = T[(ac),(bd)] + T[(ad),(bc)] + qv Cinv_ab Cinv_cd, (ab) -> 0 (11), 1 (12), 2 (22)
-        d0000 = T00 + T00 + qC0 * Ci0
-        d0001 = T01 + T10 + qC0 * Ci1
-        d0010 = T10 + T01 + qC0 * Ci1
-        d0011 = T11 + T11 + qC0 * Ci2
-        d0100 = T01 + T01 + qC1 * Ci0
-        d0101 = T02 + T11 + qC1 * Ci1
-        d0110 = T11 + T02 + qC1 * Ci1
-        d0111 = T12 + T12 + qC1 * Ci2
-        d1000 = T10 + T10 + qC1 * Ci0
-        d1001 = T11 + T20 + qC1 * Ci1
-        d1010 = T20 + T11 + qC1 * Ci1
-        d1011 = T21 + T21 + qC1 * Ci2
-        d1100 = T11 + T11 + qC2 * Ci0
-        d1101 = T12 + T21 + qC2 * Ci1
-        d1110 = T21 + T12 + qC2 * Ci1
-        d1111 = T22 + T22 + qC2 * Ci2
-        if mode == MODE_D2:
-            Dp = D[p]
-            Dp[0], Dp[1], Dp[2], Dp[3] = d0000, d0001, d0010, d0011
-            Dp[4], Dp[5], Dp[6], Dp[7] = d0100, d0101, d0110, d0111
-            Dp[8], Dp[9], Dp[10], Dp[11] = d1000, d1001, d1010, d1011
-            Dp[12], Dp[13], Dp[14], Dp[15] = d1100, d1101, d1110, d1111
-            continue
-        Dp = D[p]
-        for j in _ZERO81:
-            Dp[j] = 0.0
-        # in-plane block: index 27 i + 9 j + 3 k + l
-        Dp[0], Dp[1], Dp[3], Dp[4] = d0000, d0001, d0010, d0011
-        Dp[9], Dp[10], Dp[12], Dp[13] = d0100, d0101, d0110, d0111
-        Dp[27], Dp[28], Dp[30], Dp[31] = d1000, d1001, d1010, d1011
-        Dp[36], Dp[37], Dp[39], Dp[40] = d1100, d1101, d1110, d1111
-        # D_ab33 = D_33ab = qv Cinv_ab; D_3333 = 2 gamma_33 + qv
-        Dp[8], Dp[17], Dp[35], Dp[44] = qC0, qC1, qC1, qC2
-        Dp[72], Dp[73], Dp[75], Dp[76] = qC0, qC1, qC1, qC2
-        Dp[80] = 2.0 * g22 + qv
-        # D_a3b3 = D_a33b = D_3ab3 = D_3a3b = sum_c gamma_c3 P_c,ab
-        G0 = g02 * P0_0 + g12 * P1_0
-        G1 = g02 * P0_1 + g12 * P1_1
-        G2 = g02 * P0_2 + g12 * P1_2
-        Dp[20], Dp[23], Dp[47], Dp[50] = G0, G1, G1, G2        # D_a3b3
-        Dp[24], Dp[25], Dp[51], Dp[52] = G0, G1, G1, G2        # D_a33b
-        Dp[56], Dp[59], Dp[65], Dp[68] = G0, G1, G1, G2        # D_3ab3
-        Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
+        if tangent:
+            _plane_d(p11, p12, g00, g11, g22, g01, g02, g12, ic0, ic1, qv, D[p], mode)
+
+
+@numba.njit(_SIG_D, cache=True, nogil=True, error_model="numpy")
+def plane_tangent_kernel(K, mu, alpha, beta, D, mode):
+    """D (n, 16) or (n, 81) (MODE_D2 / MODE_D3) of the points whose data K `plane_kernel`
+    kept: its tangent branch without the eigenproblem, logarithms, powers and stress, the same
+    arithmetic on the same values (so the same bits as `plane_kernel` with that mode)."""
+    m = mu.shape[0]
+    for p in range(K.shape[0]):
+        Kp = K[p]
+        p11, p12, e0, e1 = Kp[0], Kp[1], Kp[2], Kp[3]
+        lc0, lc1, ic0, ic1 = Kp[4], Kp[5], Kp[6], Kp[7]
+        ell01 = math.log1p((e0 - e1) / (1.0 + e1))
+        g00 = g11 = g22 = g01 = g02 = g12 = 0.0
+        qv = 0.0
+        for i in range(m):
+            al = alpha[i]
+            k = 2.0 * mu[i] / al
+            ev, pw0, pw1 = Kp[KEPT_PLANE + 3 * i], Kp[KEPT_PLANE + 3 * i + 1], Kp[KEPT_PLANE + 3 * i + 2]
+            d00, d11, d22, d01, d02, d12, dq = _plane_gamma(k, 0.5 * al - 1.0, mu[i], beta, ev, pw0, pw1,
+                                                            ic0, ic1, e0, e1, lc0, lc1, ell01)
+            g00 += d00
+            g11 += d11
+            g22 += d22
+            g01 += d01
+            g02 += d02
+            g12 += d12
+            qv += dq
+        _plane_d(p11, p12, g00, g11, g22, g01, g02, g12, ic0, ic1, qv, D[p], mode)
 
 
 # D_ijkl (index 27 i + 9 j + 3 k + l) = T[6 (ik) + (jl)] + T[6 (il) + (jk)] + qv Ci[(ij)] Ci[(kl)],

@@ -58,7 +58,7 @@ EXP_CAP = 300.0    # largest admissible exponent: e^300 ~ 2e130 (finite even whe
 LOG_C_CAP = 30.0   # |ln c_a| <= 30: principal stretches in [3.1e-7, 3.3e6]
 _CLIP = EXP_CAP + 4.0 * LOG_C_CAP  # internal clip: every exp() argument stays below this
 
-__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "pk2_kept_solid", "tangent_kept_solid",
+__all__ = ["Hyperfoam", "energy", "pk2_tangent", "pk2_tangent_plane", "pk2", "pk2_kept_solid", "tangent_kept_solid", "pk2_kept_plane", "tangent_kept_plane",
            "cauchy_principal", "EXP_CAP", "LOG_C_CAP"]
 
 
@@ -169,11 +169,21 @@ class Hyperfoam:
         `tangent_kept(kept)` gives D at the same C (`pk2_kept_solid`)."""
         return pk2_kept_solid(self, C, detF=detF)
 
-    def tangent_kept(self, kept):
-        return tangent_kept_solid(self, kept)
+    def tangent_kept(self, kept, in_plane: bool = False):
+        """D from the data `pk2_kept` or `pk2_kept_plane` kept; in_plane: only the in-plane
+        block D[..., :2, :2, :2, :2] (the same bits; a 2D model's tangent needs no more)."""
+        if isinstance(kept, PlaneKept):
+            return tangent_kept_plane(self, kept, in_plane=in_plane)
+        D = tangent_kept_solid(self, kept)
+        return np.ascontiguousarray(D[..., :2, :2, :2, :2]) if in_plane else D
 
     def pk2_tangent_plane(self, C2, *, detF=None, out_of_plane=False, tangent=True):
         return pk2_tangent_plane(self, C2, detF=detF, out_of_plane=out_of_plane, tangent=tangent)
+
+    def pk2_kept_plane(self, C2, *, detF=None, out_of_plane=False):
+        """(S, ok, kept): S of `pk2_tangent_plane(tangent=False)` and the data from which
+        `tangent_kept(kept)` gives its D at the same C2 (`pk2_kept_plane`)."""
+        return pk2_kept_plane(self, C2, detF=detF, out_of_plane=out_of_plane)
 
     # fitting (materials.fit): x = (mu_1..mu_n, alpha_1..alpha_n), nu given
     @staticmethod
@@ -534,7 +544,7 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     S = np.empty((n, 3, 3))
     ok = np.empty(n, dtype=bool)
     nb.plane_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
-                    float(mat.beta), S, D, ok, mode)
+                    float(mat.beta), S, D, ok, mode, np.empty((0, 0)), False)
     ok = ok.reshape(lead)
     _log_debug_inadmissible(ok)
     if tangent:
@@ -542,6 +552,59 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     else:
         D = None
     return S.reshape(lead + (3, 3)), D, ok
+
+
+class PlaneKept:
+    """What a plane-strain stress evaluation keeps for the D at its state (`pk2_kept_plane`):
+    the per-point data K (n, KEPT_PLANE + 3 terms), the points' shape, the D asked for (the
+    in-plane block or the full D) and the material it was evaluated with."""
+
+    __slots__ = ("K", "lead", "out_of_plane", "params")
+
+    def __init__(self, K, lead, out_of_plane, params):
+        self.K, self.lead, self.out_of_plane, self.params = K, lead, out_of_plane, params
+
+
+def _plane_params(mat: Hyperfoam) -> tuple:
+    return tuple(float(x) for x in mat.mu), tuple(float(x) for x in mat.alpha), float(mat.beta)
+
+
+def pk2_kept_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False):
+    """(S, ok, kept): S and ok as `pk2_tangent_plane(..., tangent=False)` (the same bits) and
+    the per-point data `kept` (a PlaneKept: the principal directions, logarithms and powers)
+    from which `tangent_kept_plane` gives D (the in-plane block, or with out_of_plane the full
+    D) at this C2 without a second point loop of S (Newton's accepted iterate: the residual of
+    the line search, then the tangent at the same state)."""
+    C2 = np.asarray(C2, dtype=float)
+    _check_shape("C2", C2, 2)
+    from tactileskin.materials import _hyperfoam_nb as nb
+
+    lead, n, Ck, dk, has_detF = _kernel_inputs(C2, 2, detF)
+    S = np.empty((n, 3, 3))
+    ok = np.empty(n, dtype=bool)
+    K = np.empty((n, nb.KEPT_PLANE + 3 * mat.n_terms))
+    nb.plane_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
+                    float(mat.beta), S, np.empty((0, 0)), ok, nb.MODE_S, K, True)
+    ok = ok.reshape(lead)
+    _log_debug_inadmissible(ok)
+    return S.reshape(lead + (3, 3)), ok, PlaneKept(K, lead, bool(out_of_plane), _plane_params(mat))
+
+
+def tangent_kept_plane(mat: Hyperfoam, kept: PlaneKept, *, in_plane: bool = False):
+    """D (..., 2, 2, 2, 2), or (..., 3, 3, 3, 3) if kept with out_of_plane and not in_plane,
+    from the data of `pk2_kept_plane` for the same material: the same bits as
+    `pk2_tangent_plane(C2)[1]` (or its in-plane block) at the C2 that kept it."""
+    from tactileskin.materials import _hyperfoam_nb as nb
+
+    if not isinstance(kept, PlaneKept) or kept.params != _plane_params(mat):
+        raise ParameterError("kept", type(kept).__name__ if not isinstance(kept, PlaneKept) else "another material's",
+                             "the PlaneKept of pk2_kept_plane for this material")
+    n = kept.K.shape[0]
+    full = kept.out_of_plane and not in_plane
+    mode, D = (nb.MODE_D3, np.empty((n, 81))) if full else (nb.MODE_D2, np.empty((n, 16)))
+    nb.plane_tangent_kernel(kept.K, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
+                            float(mat.beta), D, mode)
+    return D.reshape(kept.lead + ((3, 3, 3, 3) if full else (2, 2, 2, 2)))
 
 
 def cauchy_principal(mat: Hyperfoam, stretches):
