@@ -13,7 +13,8 @@ Newton count) so that the trees' results can be compared bit for bit.
 --units: in one process, the CPU ms of one Newton iterate's model work on the t = 5 silicone
 Braille case (the sweep's largest 2D preview solve) at its solved state: residual + tangent with
 the law evaluated afresh for the tangent (Model.reuse_state False: S, then S + D) against D from
-the stress evaluation's kept data, interleaved, medians of --repeat x 10.
+the stress evaluation's kept data, interleaved, medians of --repeat x 10; and the QLV trial
+stress of a residual (QLVHistory.stress against the numpy expression it replaced).
 
     .venv/bin/python benchmarks/state_reuse2d.py --src OLD/src NEW/src [--repeat 3] [--quality preview]
     .venv/bin/python benchmarks/state_reuse2d.py --units [--repeat 3]
@@ -114,6 +115,28 @@ def units(repeat: int) -> None:
     print(f"  law again for the tangent (S, then S + D): {np.median(times[False]):.2f} ms")
     print(f"  D from the kept data:                       {np.median(times[True]):.2f} ms")
     print(f"  tangents bit for bit the same: {np.array_equal(K_new, K_old)}")
+    # the QLV trial stress of every residual: QLVHistory.stress against the numpy expression
+    h, S0 = model.history, iterate(True)._state.S0
+
+    def numpy_stress():
+        gamma, decay, gain, back = h.factors(dt)
+        S = gamma * S0
+        for i in range(len(decay)):
+            S = S + decay[i] * h.H[i] - gain[i] * h.S0_old
+            if back[i]:
+                S = S - back[i] * (h.S0_old - h.S0_prev)
+        return S
+
+    qt = {0: [], 1: []}
+    for _ in range(30 * repeat):
+        for k, f in ((0, numpy_stress), (1, lambda: h.stress(S0, dt))):
+            c0 = time.process_time()
+            for _ in range(10):
+                f()
+            qt[k].append((time.process_time() - c0) / 10 * 1e3)
+    print(f"  QLV trial stress ({h.prony.n_terms} terms): numpy expression {np.median(qt[0]):.3f} ms, "
+          f"QLVHistory.stress {np.median(qt[1]):.3f} ms, the same bits: "
+          f"{np.array_equal(numpy_stress(), h.stress(S0, dt)[0])}")
 
 
 def run(src: str, quality: str) -> dict:

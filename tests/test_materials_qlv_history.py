@@ -57,3 +57,27 @@ def test_elastic_history_passes_the_stress_through():
     assert gamma == 1.0 and np.array_equal(S, S0)
     with pytest.raises(ParameterError, match="qlv_order"):
         Prony.elastic().history((3, 3), order=3)
+
+
+@pytest.mark.parametrize("material", ["silicone", "polyurethane", None])
+def test_trial_stress_is_the_term_by_term_numpy_update_bit_for_bit(material):
+    """QLVHistory.stress (a compiled loop) gives the bits of the numpy expression it replaces,
+    S = gamma S0 + sum_i (decay_i H_i - gain_i S0_old - back_i (S0_old - S0_prev)) term by
+    term, on the chord's first step, the parabola's later steps, and with no terms (elastic)."""
+    p = Prony.elastic() if material is None else get_material(material).prony
+    rng = np.random.default_rng(3)
+    shape = (7, 3, 3, 3)
+    h = p.history(shape, order=2)
+    for step, dt in enumerate((0.02, 0.05, 0.011, 0.3)):
+        S0 = rng.standard_normal(shape) * 10.0 ** rng.uniform(-3, 1, shape)
+        gamma, decay, gain, back = h.factors(dt)
+        ref = gamma * S0
+        for i in range(len(decay)):
+            ref = ref + decay[i] * h.H[i] - gain[i] * h.S0_old
+            if back[i]:
+                ref = ref - back[i] * (h.S0_old - h.S0_prev)
+        S, g = h.stress(S0, dt)
+        assert g == gamma and S.shape == shape
+        assert np.array_equal(S, ref), f"step {step}: max |diff| {np.abs(S - ref).max():.3g}"
+        assert step < 2 or material is None or np.any(back)   # the parabola's term exercised
+        h.commit(S0, dt)

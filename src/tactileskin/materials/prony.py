@@ -209,8 +209,24 @@ class QLVHistory:
         return float(self.prony.g_inf + gain.sum()), decay, gain, back
 
     def stress(self, S0, dt: float):
-        """(S, gamma): the viscoelastic PK2 at the end of a trial step dt with elastic S0."""
+        """(S, gamma): the viscoelastic PK2 at the end of a trial step dt with elastic S0
+        (S = gamma S0 + sum_i [decay_i H_i - gain_i S0_old - back_i (S0_old - S0_prev)], term by
+        term in that order; a compiled loop, `_prony_nb.qlv_stress`, for float64 stresses of the
+        history's shape)."""
         gamma, decay, gain, back = self.factors(dt)
+        S0 = np.asarray(S0)
+        if S0.dtype == np.float64 and S0.shape == self.S0_old.shape:
+            # imported on first use, as the law's loops (numba's start-up)
+            from tactileskin.materials._prony_nb import qlv_stress
+
+            def flat(x):
+                return np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
+
+            S = np.empty(S0.shape)
+            qlv_stress(flat(S0), np.ascontiguousarray(self.H, dtype=np.float64).reshape(len(self.H), S0.size),
+                       flat(self.S0_old), flat(self.S0_prev), float(gamma), flat(decay), flat(gain), flat(back),
+                       S.reshape(-1))
+            return S, gamma
         S = gamma * S0
         for i in range(len(decay)):
             S = S + decay[i] * self.H[i] - gain[i] * self.S0_old
