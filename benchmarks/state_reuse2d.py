@@ -14,7 +14,8 @@ Newton count) so that the trees' results can be compared bit for bit.
 Braille case (the sweep's largest 2D preview solve) at its solved state: residual + tangent with
 the law evaluated afresh for the tangent (Model.reuse_state False: S, then S + D) against D from
 the stress evaluation's kept data, interleaved, medians of --repeat x 10; and the QLV trial
-stress of a residual (QLVHistory.stress against the numpy expression it replaced).
+stress of a residual (QLVHistory.stress against the numpy expression it replaced); and the
+contact part of a residual + tangent with the gaps and einsum path computed again or kept.
 
     .venv/bin/python benchmarks/state_reuse2d.py --src OLD/src NEW/src [--repeat 3] [--quality preview]
     .venv/bin/python benchmarks/state_reuse2d.py --units [--repeat 3]
@@ -137,6 +138,26 @@ def units(repeat: int) -> None:
     print(f"  QLV trial stress ({h.prony.n_terms} terms): numpy expression {np.median(qt[0]):.3f} ms, "
           f"QLVHistory.stress {np.median(qt[1]):.3f} ms, the same bits: "
           f"{np.array_equal(numpy_stress(), h.stress(S0, dt)[0])}")
+    # the contact part of a tangent at the residual's state: gaps evaluated again and the einsum
+    # path planned again (as before) against the kept gaps and path
+    surf, c = model.surface, model.contact
+    d, eps, lam = model.travel(t), model.penalty(), surf.lam
+    ct = {0: [], 1: []}
+
+    def contact_tangent(keep):
+        surf.evaluate(u, c.indenter, d, eps, lam, False)
+        if not keep:
+            surf._last_gap, surf._paths = None, {}
+        return surf.evaluate(u, c.indenter, d, eps, lam, True)[1]
+
+    for _ in range(30 * repeat):
+        for k in (0, 1):
+            c0 = time.process_time()
+            for _ in range(10):
+                contact_tangent(k)
+            ct[k].append((time.process_time() - c0) / 10 * 1e3)
+    print(f"  contact residual + tangent ({surf.w.size} points): gaps and path again {np.median(ct[0]):.3f} ms, "
+          f"kept {np.median(ct[1]):.3f} ms, the same bits: {np.array_equal(contact_tangent(0), contact_tangent(1))}")
 
 
 def run(src: str, quality: str) -> dict:

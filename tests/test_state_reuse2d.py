@@ -157,3 +157,68 @@ def test_plane_kept_of_another_material_is_refused():
     _, _, kept = a.pk2_kept_plane(_plane_points())
     with pytest.raises(Exception, match="kept"):
         b.tangent_kept(kept)
+
+
+def _contact_fresh(model, u, d, eps, lam, tangent, sticky=None, curvature=False, indenter=None):
+    """ContactSurface.evaluate on a new surface of the same model (no gaps kept)."""
+    from tactileskin.fe.contact import ContactSurface
+
+    s = ContactSurface(model.mesh, model.element, model.boundaries["top"], 2, intorder=3)
+    return s.evaluate(u, indenter or model.contact.indenter, d, eps, lam, tangent, sticky, curvature)
+
+
+def _same(a, b):
+    fa, Ka, (ga, la, xa, na) = a
+    fb, Kb, (gb, lb, xb, nb) = b
+    return (np.array_equal(fa, fb) and (Ka is None) == (Kb is None) and (Ka is None or np.array_equal(Ka, Kb))
+            and all(np.array_equal(p, q) for p, q in ((ga, gb), (la, lb), (xa, xb), (na, nb))))
+
+
+def test_contact_tangent_takes_the_residuals_gaps_and_no_stale_ones():
+    """The contact tangent at the residual's state takes its gaps (x, g, n); another surface
+    displacement (one ulp of one surface dof), travel or indenter evaluates them afresh, and
+    every result equals a surface that keeps nothing, bit for bit; the kept arrays are read-only."""
+    model = _model()
+    s, ind = model.surface, model.contact.indenter
+    u = _state(model, 1)
+    eps, lam = model.penalty(), np.zeros(s.shape)
+    calls = []
+
+    class Counting:
+        def gap(self, x, d):
+            calls.append(1)
+            return ind.gap(x, d)
+
+    cind = Counting()
+    r = s.evaluate(u, cind, T, eps, lam, False)
+    assert np.any(r[2][1] > 0) and len(calls) == 1
+    sticky = r[2][1] > 0.0
+    for tangent, st, curv in ((True, None, False), (True, sticky, False), (True, None, True)):
+        n0 = len(calls)
+        out = s.evaluate(u.copy(), cind, T, eps, lam, tangent, st, curv)
+        assert len(calls) == n0 + (2 * 2 if curv else 0)    # the gaps kept; dn/dx's differences only
+        assert _same(out, _contact_fresh(model, u, T, eps, lam, tangent, st, curv))
+    with pytest.raises(ValueError):
+        r[2][0][0, 0] = 1.0                               # the kept g is read-only
+    k = int(s.sdofs[3, 1]) * 2 + 1                        # a surface node's y dof
+    u2 = u.copy()
+    u2[k] = np.nextafter(u2[k], np.inf)
+    for args in ((u2, cind, T), (u, cind, 1.01 * T), (u, Counting(), T)):
+        n0 = len(calls)
+        out = s.evaluate(args[0], args[1], args[2], eps, lam, True)
+        assert len(calls) == n0 + 1                       # evaluated afresh
+        assert _same(out, _contact_fresh(model, args[0], args[2], eps, lam, True))
+    u3 = u.copy()                                         # the same array changed in place
+    s.evaluate(u3, cind, T, eps, lam, False)
+    u3[k] += 1e-3
+    assert _same(s.evaluate(u3, cind, T, eps, lam, True), _contact_fresh(model, u3, T, eps, lam, True))
+
+
+def test_contact_einsum_path_kept_per_shape_gives_the_planned_bits():
+    model = _model()
+    s = model.surface
+    rng = np.random.default_rng(5)
+    spec = "fq,fqa,fqb,fqik->faibk"
+    for f in (1, 2, 3, 7, 1, 2, len(s.w)):
+        ops = (rng.random((f, 2)), rng.random((f, 2, 3)), rng.random((f, 2, 3)), rng.random((f, 2, 2, 2)))
+        assert np.array_equal(s._einsum(spec, *ops), np.einsum(spec, *ops, optimize=True))
