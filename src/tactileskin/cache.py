@@ -266,6 +266,7 @@ class CaseRecord:
     path: Path
     case: str = ""      # the case id within its sweep (sweep.case_ids), set by the report
     variant: str = ""   # the id's suffix naming the fields that tell it apart ("d0.2-r2")
+    variant_label: str = ""  # the same as legends name it, with units ("d = 0.2 mm, rate 2 mm/s")
 
 
 def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:

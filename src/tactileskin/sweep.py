@@ -259,20 +259,52 @@ def _base_id(sc: Scene) -> str:
     return sc.label()
 
 
-# Fields outside the base id that change a result, with the suffix naming each value.
+# Fields outside the base id that change a result: (value, id suffix, legend text). The
+# suffix is short (file names: fig9_...-F0.03.png); the legend text says the unit.
+def _force_text(s: Scene) -> str:
+    if s.force is None:
+        return "depth control"
+    return f"F = {s.force:g} " + ("N" if s.dim == 3 else "N/mm")  # 3D: the whole indenter; 2D: per mm
+
+
 _ID_FIELDS = (
-    (lambda s: round(s.indentation, 9), lambda s: f"d{s.indentation:.4g}"),
-    (lambda s: s.force, lambda s: "F" + ("-" if s.force is None else f"{s.force:g}")),
-    (lambda s: s.rate, lambda s: f"r{s.rate:g}"),
-    (lambda s: s.mesh_size, lambda s: f"h{s.mesh_size:g}"),
-    (lambda s: s.refinement, lambda s: f"ref{s.refinement:g}"),
-    (lambda s: s.order, lambda s: f"p{s.order}"),
-    (lambda s: s.formulation, lambda s: s.formulation.value),
-    (lambda s: s.viscoelastic, lambda s: "visco" if s.viscoelastic else "elastic"),
-    (lambda s: s.braille_standard, lambda s: s.braille_standard),
-    (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
-    (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name),  # two files, one name
+    (lambda s: round(s.indentation, 9), lambda s: f"d{s.indentation:.4g}",
+     # under force control the depth is the travel found (an output): the force names the case
+     lambda s: "" if s.force is not None else f"d = {s.indentation:.4g} mm"),
+    (lambda s: s.force, lambda s: "F" + ("-" if s.force is None else f"{s.force:g}"), _force_text),
+    (lambda s: s.rate, lambda s: f"r{s.rate:g}", lambda s: f"rate {s.rate:g} mm/s"),
+    (lambda s: s.mesh_size, lambda s: f"h{s.mesh_size:g}", lambda s: f"h = {s.mesh_size:g} mm"),
+    (lambda s: s.refinement, lambda s: f"ref{s.refinement:g}", lambda s: f"refinement {s.refinement:g}"),
+    (lambda s: s.order, lambda s: f"p{s.order}", lambda s: f"P{s.order}"),
+    (lambda s: s.formulation, lambda s: s.formulation.value, lambda s: s.formulation.value),
+    (lambda s: s.viscoelastic, lambda s: "visco" if s.viscoelastic else "elastic",
+     lambda s: "visco" if s.viscoelastic else "elastic"),
+    (lambda s: s.braille_standard, lambda s: s.braille_standard, lambda s: s.braille_standard),
+    (lambda s: s.fingertip, lambda s: "ft-" + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default"),
+     lambda s: "fingertip " + (",".join(f"{k}={v:g}" for k, v in s.fingertip) or "default")),
+    # two files, one name: the material's label tells them apart in tables and figures
+    (lambda s: s.material, lambda s: "@" + Path(s.material).parent.name, lambda s: ""),
 )
+
+
+def _variants(scenes: list[Scene], which: int) -> list[str]:
+    """Per scene, the id suffix (which = 1) or legend text (which = 2) of the fields that
+    differ within some group of equal base ids; "" for a scene whose base id is unique."""
+    groups = defaultdict(list)
+    for i, s in enumerate(scenes):
+        groups[_base_id(s)].append(i)
+    shared = [g for g in groups.values() if len(g) > 1]
+    named = [f for f in _ID_FIELDS if any(len({f[0](scenes[i]) for i in g}) > 1 for g in shared)]
+    in_shared = {i for g in shared for i in g}
+    sep = "-" if which == 1 else ", "
+    variants = [sep.join(t for t in (f[which](s) for f in named) if t) if i in in_shared else ""
+                for i, s in enumerate(scenes)]
+    suffixes = [v if which == 1 else sep.join(f[1](s) for f in named) for v, s in zip(variants, scenes)]
+    ids = [_base_id(s) + (f"-{v}" if v else "") for s, v in zip(scenes, suffixes)]
+    n = Counter(ids)
+    # still equal: the scenes differ in a field not named above (or are the same scene)
+    return [v + ((sep if v else "") + f"k{s.key()[:6]}" if n[i] > 1 else "")
+            for v, i, s in zip(variants, ids, scenes)]
 
 
 def case_variants(scenes: Sequence[Scene]) -> list[str]:
@@ -280,20 +312,13 @@ def case_variants(scenes: Sequence[Scene]) -> list[str]:
     material, indenter, Braille text, dim): "" for a scene whose base id is unique, else the
     values of every field that differs within some group of equal base ids, e.g. "d0.2" or
     "d0.2-r2" (the same fields for all such scenes, so their ids read alike)."""
-    scenes = list(scenes)
-    groups = defaultdict(list)
-    for i, s in enumerate(scenes):
-        groups[_base_id(s)].append(i)
-    shared = [g for g in groups.values() if len(g) > 1]
-    named = [text for value, text in _ID_FIELDS
-             if any(len({value(scenes[i]) for i in g}) > 1 for g in shared)]
-    in_shared = {i for g in shared for i in g}
-    variants = ["-".join(text(s) for text in named) if i in in_shared else "" for i, s in enumerate(scenes)]
-    ids = [_base_id(s) + (f"-{v}" if v else "") for s, v in zip(scenes, variants)]
-    n = Counter(ids)
-    # still equal: the scenes differ in a field not named above (or are the same scene)
-    return [v + (("-" if v else "") + f"k{s.key()[:6]}" if n[i] > 1 else "")
-            for v, i, s in zip(variants, ids, scenes)]
+    return _variants(list(scenes), 1)
+
+
+def case_variant_labels(scenes: Sequence[Scene]) -> list[str]:
+    """case_variants as figure legends name them, with units: "F = 0.03 N/mm" (2D), "F = 0.5 N"
+    (3D), "d = 0.2 mm", "rate 2 mm/s"; a force case's depth (its travel, an output) is not named."""
+    return _variants(list(scenes), 2)
 
 
 def case_ids(scenes: Sequence[Scene]) -> list[str]:

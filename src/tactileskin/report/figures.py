@@ -97,15 +97,27 @@ def _axes_keys(records):
 
 def _series(indenter: str, text: str, variant: str) -> str:
     """The name of a case within a (material, thickness) panel: indenter, Braille text and
-    the case id's variant suffix (sweep.case_variants), so two depths are two series."""
+    the variant's legend text (sweep.case_variant_labels, with units), so two depths are two series."""
     return indenter + (f" '{text}'" if text else "") + (f" {variant}" if variant else "")
+
+
+def _variant_label(r) -> str:
+    """A record's or row's variant as legends name it (its id suffix when it has no label)."""
+    get = r.get if isinstance(r, dict) else (lambda k, d=None: getattr(r, k, d))
+    return get("variant_label") or get("variant") or ""
+
+
+def _row_labels(rows) -> dict:
+    """(variant, dim) -> legend text of the rows' variants (one id suffix is "F0.03" in 2D and 3D:
+    N/mm and N)."""
+    return {(r.get("variant") or "", r.get("dim", 2)): _variant_label(r) for r in rows}
 
 
 def _ind_name(r) -> str:
     label, text = r.scene.indenter_label(), r.scene.braille_text
     if text and label.endswith(f"[{text}]"):
         label = label[: -len(text) - 2]  # the text is named separately
-    return _series(label, text, getattr(r, "variant", ""))
+    return _series(label, text, _variant_label(r))
 
 
 def _order(indenter: str) -> int:
@@ -203,6 +215,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
     for ax in axes.flat[len(mats):]:  # the panels past the last material (per row, none was: 3 on 2 x 2)
         ax.set_visible(False)
     w = 0.8 / max(len(series), 1)
+    vlabel = _row_labels(rows)
     for k, m in enumerate(mats):
         ax = axes[k // cols][k % cols]
         for q, (*sk, ind) in enumerate(series):
@@ -212,7 +225,7 @@ def metric_figure(rows: list[dict], metric: str, ylabel: str, stem: str, title: 
                      and list(key(r)) == sk and r.get("status", "ok") == "ok"]
                 vals.append(v[0] if v else np.nan)
             ax.bar(np.arange(len(thick)) + (q - (len(series) - 1) / 2) * w, vals, w,
-                   label=_series(ind, sk[1], sk[2]) + (f" {sk[3]}d" if len(dims) > 1 else ""),
+                   label=_series(ind, sk[1], vlabel[(sk[2], sk[3])]) + (f" {sk[3]}d" if len(dims) > 1 else ""),
                    color=COLOURS.get(ind),
                    hatch=_HATCHES[(variants.index(sk[2]) + len(variants) * dim_list.index(sk[3])) % len(_HATCHES)])
         ax.set_xticks(np.arange(len(thick)), [f"{t:g}" for t in thick],
@@ -243,6 +256,7 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     key = lambda r: (_order(r["indenter"]), r["indenter"], r.get("braille_text") or "",  # noqa: E731
                      r.get("variant") or "", r.get("dim", 2), r["material"])
     series = sorted({key(r) for r in ok})
+    vlabel = _row_labels(ok)
     fig, axes = plt.subplots(1, len(METRICS), figsize=(4.0 * len(METRICS), 3.4), squeeze=False,
                              constrained_layout=True)
     for ax, (metric, label) in zip(axes[0], METRICS):
@@ -255,7 +269,7 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
             t, v = zip(*pts)
             ax.plot(t, v, _DASHES[mi % len(_DASHES)], marker=MATERIAL_MARKERS[mi % len(MATERIAL_MARKERS)],
                     color=COLOURS.get(ind), ms=4,
-                    label=f"{_series(ind, text, variant)}{f' {dim}d' if len(dims) > 1 else ''}, {mat}")
+                    label=f"{_series(ind, text, vlabel[(variant, dim)])}{f' {dim}d' if len(dims) > 1 else ''}, {mat}")
         ax.set_xlabel("skin thickness t (mm)")
         ax.set_ylabel(label)
         ax.set_ylim(bottom=0)

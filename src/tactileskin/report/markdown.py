@@ -305,6 +305,11 @@ def _with_left_out(verdict: str, left: list[str]) -> str:
     return f"n/a: {', '.join(left)} left out (the ok cases alone: {verdict})"
 
 
+def _variant_labels(records) -> dict:
+    """variant id suffix -> its text with units (sweep.case_variant_labels: "F = 0.03 N/mm")."""
+    return {getattr(r, "variant", ""): getattr(r, "variant_label", "") or getattr(r, "variant", "") for r in records}
+
+
 def discrimination_table(records, rows=()) -> list[str]:
     """The discrimination table of the sweep's groups; `rows` (the sweep's rows, failed cases
     too) mark a group that misses a case, whose verdict then covers the ok cases only."""
@@ -318,10 +323,11 @@ def discrimination_table(records, rows=()) -> list[str]:
             pairs[(r.scene.material, r.scene.thickness, getattr(r, "variant", ""))] += 1
         return [NO_TRUSTED_PAIRS if _suspect_records(records) and max(pairs.values(), default=0) >= 2 else NO_PAIRS]
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
+    named = _variant_labels(records)
     for (mat, t, variant), profs in groups:
         d, verdict = _discrimination_cells(profs)
         verdict = _with_left_out(verdict, left.get((mat, t, variant), []))
-        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {d} | {verdict} |")
+        lines.append(f"| {mat} | {t:g} | {named.get(variant, variant) or '–'} | {d} | {verdict} |")
     return lines
 
 
@@ -359,14 +365,15 @@ def _model_cell(d: dict, dim: int) -> str:
     return d.get(dim, "n/a")
 
 
-def discrimination_table_by_model(groups: list[dict]) -> list[str]:
-    """The table of `discrimination_by_model` groups."""
+def discrimination_table_by_model(groups: list[dict], records=()) -> list[str]:
+    """The table of `discrimination_by_model` groups (`records` name the variants)."""
+    named = _variant_labels(records)
     r, t3 = BRAILLE_MODELS[2], BRAILLE_MODELS[3]
     lines = [f"| material | t (mm) | variant | distances, {r} | verdict, {r} | distances, {t3} | "
              f"verdict, {t3} | changes |", "|---|---|---|---|---|---|---|---|"]
     for m in groups:
         mat, t, variant = m["group"]
-        lines.append(f"| {mat} | {t:g} | {variant or '–'} | {_model_cell(m['distances'], 2)} | "
+        lines.append(f"| {mat} | {t:g} | {named.get(variant, variant) or '–'} | {_model_cell(m['distances'], 2)} | "
                      f"{_model_cell(m['verdict'], 2)} | {_model_cell(m['distances'], 3)} | "
                      f"{_model_cell(m['verdict'], 3)} | {'**changes**' if m['changed'] else '–'} |")
     return lines
@@ -741,7 +748,7 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
             "(see tactileskin/discrimination.py for why).", ""]
     if two_models:
         groups = discrimination_by_model(records, rows)
-        out += discrimination_table_by_model(groups)
+        out += discrimination_table_by_model(groups, records)
         changed = [m["group"] for m in groups if m["changed"]]
         dims = {r.get("dim", 2) for r in rows if r.get("indenter") == "braille"}
         out += ["", ("Discrimination verdicts the 3D dots change: "

@@ -1,0 +1,47 @@
+"""A force-controlled sweep's figure legends name the force with its unit: they read "F0.03"
+(the case id's suffix), N/mm in 2D and N in 3D left to the reader. The ids keep their short
+suffix (file names); the legends use sweep.case_variant_labels."""
+
+from __future__ import annotations
+
+import pytest
+
+from tactileskin.scene import Scene
+from tactileskin.sweep import case_ids, case_variant_labels
+
+
+def test_variant_labels_name_the_force_with_its_unit():
+    two = [Scene(thickness=1.0, force=f) for f in (0.03, 0.06)]
+    assert case_ids(two) == ["t1-silicone-flat-2d-F0.03", "t1-silicone-flat-2d-F0.06"]  # ids unchanged
+    assert case_variant_labels(two) == ["F = 0.03 N/mm", "F = 0.06 N/mm"]
+    three = [Scene(thickness=1.0, indenter="sphere", indenter_radius=2.5, dim=3, force=f) for f in (0.5, 1.0)]
+    assert case_variant_labels(three) == ["F = 0.5 N", "F = 1 N"]
+
+
+def test_variant_labels_give_units_to_depth_and_rate_and_say_depth_control():
+    depths = [Scene(thickness=1.0, depth=d) for d in (0.1, 0.2)]
+    assert case_variant_labels(depths) == ["d = 0.1 mm", "d = 0.2 mm"]
+    rates = [Scene(thickness=1.0, rate=r) for r in (1.0, 2.0)]
+    assert case_variant_labels(rates) == ["rate 1 mm/s", "rate 2 mm/s"]
+    # a force case beside a depth case: the force case's depth is its travel (an output), not named
+    mixed = [Scene(thickness=1.0, force=0.03), Scene(thickness=1.0, depth=0.1)]
+    assert case_variant_labels(mixed) == ["F = 0.03 N/mm", "d = 0.1 mm, depth control"]
+    assert case_variant_labels([Scene(thickness=1.0)]) == [""]
+
+
+@pytest.mark.usefixtures("close_figures")
+def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
+    from tactileskin.cli import main
+
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text('[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\nindenters = ["flat", "curved"]\n'
+                   'forces = [0.03, 0.06]\n[scene]\ndim = 2\n')
+    out = tmp_path / "out"
+    assert main(["sweep", "--config", str(cfg), "--quality", "preview", "--serial", "--no-render",
+                 "--out", str(out)]) == 0
+    for stem in ("fig10_profiles", "fig11_peak", "metrics_vs_thickness"):
+        svg = (out / f"{stem}.svg").read_text()  # text kept as text (figures._plt)
+        assert "flat F = 0.03 N/mm" in svg and "curved F = 0.06 N/mm" in svg, stem
+        assert "F0.03" not in svg, stem
+    # the report's discrimination table names the variant alike
+    assert "| silicone | 1 | F = 0.03 N/mm |" in (out / "report.md").read_text()
