@@ -512,7 +512,7 @@ def test_run_settings_give_the_numbers_of_each_material(tmp_path):
     mat.write_text(toml.format(mu="0.010"))
     scenes = [Scene(thickness=1.0, material=str(mat)), Scene(thickness=1.0, material="polyurethane")]
     before = "\n".join(run_settings(scenes))
-    assert f"`{mat}`: hyperfoam alpha = [0.001, 15.5], mu = [0.08, 0.01], nu = 0.49; " \
+    assert "`mysil` (mysil.toml): hyperfoam alpha = [0.001, 15.5], mu = [0.08, 0.01], nu = 0.49; " \
            "Prony g = [0.015, 0.044, 0.029], tau = [0.025, 0.15, 0.3] s" in before
     assert "`polyurethane`: hyperfoam alpha = [5.5, 8.25], mu = [0.1, 0.063], nu = 0.47; " in before
     mat.write_text(toml.format(mu="0.012"))

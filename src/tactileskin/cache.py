@@ -267,6 +267,12 @@ class CaseRecord:
     case: str = ""      # the case id within its sweep (sweep.case_ids), set by the report
     variant: str = ""   # the id's suffix naming the fields that tell it apart ("d0.2-r2")
     variant_label: str = ""  # the same as legends name it, with units ("d = 0.2 mm, rate 2 mm/s")
+    material_label: str = ""  # the material as tables and figures name it (scene.material_labels)
+
+
+def material_of(rec) -> str:
+    """A record's material as tables and figures name it: its label, else the scene's material."""
+    return getattr(rec, "material_label", "") or rec.scene.material
 
 
 def read_profile(path: Path) -> tuple[np.ndarray, np.ndarray]:

@@ -452,6 +452,35 @@ class Scene:
         return cls.from_dict(resolve_paths(read_toml(path, "scene file"), path))
 
 
+def material_labels(materials) -> dict[str, str]:
+    """{material: label} for the materials of one sweep, as its tables and figures name them:
+    a preset by its name, a .toml file by its stem ('gel' for /home/alice/gel.toml; its full
+    path was long and showed the user's folders). A file whose stem is a preset's name or
+    another material's label is named by the last parts of its path that tell it apart
+    ('silicone.toml'; 'a/gel.toml' and 'b/gel.toml'), so no two materials share a label and a
+    file is never read as the preset of its name (the paper checks key on the preset names)."""
+    from tactileskin.materials import list_materials
+
+    names = sorted({str(m) for m in materials})
+    files = [m for m in names if m.endswith(".toml")]
+    out = {m: m for m in names if m not in files}
+    taken = set(out) | set(list_materials())
+    stems = [Path(f).stem for f in files]
+    for f, stem in zip(files, stems):
+        if stem not in taken and stems.count(stem) == 1:
+            out[f] = stem
+    rest = [f for f in files if f not in out]
+    k = 1
+    while rest:
+        tails = {f: "/".join(Path(f).parts[-k:]) for f in rest}
+        for f, tail in tails.items():
+            if list(tails.values()).count(tail) == 1 or k >= len(Path(f).parts):
+                out[f] = tail
+        rest = [f for f in rest if f not in out]
+        k += 1
+    return out
+
+
 from tactileskin import scene_doc as _scene_doc  # noqa: E402 (needs the class)
 
 Scene.__doc__ = _scene_doc.docstring(Scene)

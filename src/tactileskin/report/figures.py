@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from tactileskin import quality
+from tactileskin.cache import material_of
 from tactileskin.fileio import atomic_write_bytes, make_dirs
 
 INDENTER_ORDER = ("flat", "curved", "braille")
@@ -90,7 +91,7 @@ def _save(fig, out: Path, stem: str) -> list[Path]:
 
 
 def _axes_keys(records):
-    mats = sorted({r.scene.material for r in records})
+    mats = sorted({material_of(r) for r in records})
     thick = sorted({r.scene.thickness for r in records})
     return mats, thick
 
@@ -169,7 +170,7 @@ def profiles_figure(records, out: Path) -> list[Path]:
             used.add(id(ax))
             order = lambda r: (_order(r.scene.indenter.value), r.scene.braille_text,  # noqa: E731
                                getattr(r, "variant", ""), r.scene.dim)
-            for r in sorted((r for r in records if r.scene.material == m and r.scene.thickness == t), key=order):
+            for r in sorted((r for r in records if material_of(r) == m and r.scene.thickness == t), key=order):
                 k = variants.index(getattr(r, "variant", "")) + len(variants) * dims.index(r.scene.dim)
                 name = _ind_name(r) + (f" {r.scene.dim}d" if len(dims) > 1 else "")
                 line, = ax.plot(r.s, r.pressure, _DASHES[k % len(_DASHES)], color=COLOURS.get(r.scene.indenter.value),

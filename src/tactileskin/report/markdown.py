@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from pathlib import Path
 
 from tactileskin import quality
+from tactileskin.cache import material_of
 from tactileskin.discrimination import THRESHOLD, discriminate
 from tactileskin.errors import TactileSkinError
 
@@ -112,7 +114,7 @@ def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False,
             continue
         name = sc.indenter_label()
         variant = "" if paper_only else getattr(rec, "variant", "")
-        groups[(sc.material, sc.thickness, variant)].setdefault(name, (rec.s, rec.pressure))
+        groups[(material_of(rec), sc.thickness, variant)].setdefault(name, (rec.s, rec.pressure))
     return sorted(groups.items())
 
 
@@ -320,7 +322,7 @@ def discrimination_table(records, rows=()) -> list[str]:
         # the table groups them: two depths of one indenter are no pair)
         pairs = defaultdict(int)
         for r in records:
-            pairs[(r.scene.material, r.scene.thickness, getattr(r, "variant", ""))] += 1
+            pairs[(material_of(r), r.scene.thickness, getattr(r, "variant", ""))] += 1
         return [NO_TRUSTED_PAIRS if _suspect_records(records) and max(pairs.values(), default=0) >= 2 else NO_PAIRS]
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     named = _variant_labels(records)
@@ -623,17 +625,22 @@ def _material_lines(scenes) -> list[str]:
     def fmt(d: dict) -> str:
         return ", ".join(f"{k} = {v!r}" for k, v in d.items())
 
+    from tactileskin.scene import material_labels
+
     out = ["Materials (the numbers the cases are keyed and solved with; moduli in MPa, times in s):", ""]
-    for name in sorted({sc.material for sc in scenes}, key=str):
+    labels = material_labels(sc.material for sc in scenes)
+    for name in sorted(labels, key=lambda m: labels[m]):
+        # a file by its label and file name, as the tables name it (not its path: the user's folders)
+        shown = f"`{labels[name]}`" + (f" ({Path(name).name})" if name.endswith(".toml") else "")
         try:
             c = material_content(name)
         except TactileSkinError as e:  # a file removed since the solve: its numbers are not known here
-            out.append(f"- `{name}`: not readable now ({e})")
+            out.append(f"- {shown}: not readable now ({e})")
             continue
         prony = c.pop("prony", {})
         law = "; ".join(f"{k} {fmt(v)}" for k, v in c.items())
         visco = f"Prony {fmt(prony)} s" if prony.get("g") else "no Prony terms"
-        out.append(f"- `{name}`: {law}; {visco}")
+        out.append(f"- {shown}: {law}; {visco}")
     return out + [""]
 
 

@@ -31,16 +31,19 @@ def collect(outcomes, cache):
     (sweep.case_ids), unique within the sweep. A cached record was validated by the cache
     (finite metrics and profile), which is the gate against damaged entries."""
     from tactileskin.report.markdown import at_paper_conditions
+    from tactileskin.scene import material_labels
     from tactileskin.sweep import case_ids, case_variant_labels, case_variants
 
     scenes = [oc.scene for oc in outcomes]
     ids, variants, labels = case_ids(scenes), case_variants(scenes), case_variant_labels(scenes)
+    # a material file by its stem in every table and figure (not its path: the user's folders)
+    mat_label = material_labels(sc.material for sc in scenes)
     records, rows, failures = [], [], []
     for oc, case, variant, vlabel in zip(outcomes, ids, variants, labels):
         sc = oc.scene
         # the key the sweep computed (its entry's name), not the files' as they are now
         row = dict(case=case, variant=variant, variant_label=vlabel, paper=at_paper_conditions(sc), key=oc.key or cache.key(sc),
-                   thickness_mm=sc.thickness, material=sc.material,
+                   thickness_mm=sc.thickness, material=mat_label[sc.material],
                    indenter=sc.indenter.value, braille_text=sc.braille_text, depth_mm=sc.indentation,
                    rate_mm_s=sc.rate, dim=sc.dim)
         if sc.force is not None:  # force control: the force asked for (the reaction columns hold what it reached)
@@ -53,6 +56,7 @@ def collect(outcomes, cache):
         else:
             rec = oc.record if oc.record is not None else cache.load(sc)
             rec.case, rec.variant, rec.variant_label = case, variant, vlabel
+            rec.material_label = mat_label[sc.material]
             records.append(rec)
             # recomputed from the numbers (not the stored string): the ranges are quality's
             row.update(status=quality.status(rec.summary), **{k: rec.summary.get(k) for k in

@@ -17,7 +17,9 @@ def _label(result) -> str:
     sc = result.scene or {}
     if "thickness" not in sc:
         return "bone pressure"
-    return f"t = {sc['thickness']:g} mm, {sc.get('material', '?')}, {sc.get('indenter', '?')} ({sc.get('dim', 2)}D)"
+    mat = str(sc.get("material", "?"))
+    mat = Path(mat).stem if mat.endswith(".toml") else mat  # a file by its name, not its path (the user's folders)
+    return f"t = {sc['thickness']:g} mm, {mat}, {sc.get('indenter', '?')} ({sc.get('dim', 2)}D)"
 
 
 def _s_label(result) -> str:
