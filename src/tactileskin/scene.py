@@ -167,7 +167,7 @@ class Scene:
     # loading (tactileskin.loading; None / () not given, absent from to_dict so keys are unchanged)
     force: float | None = None             # force control: target force (N on the whole indenter in 3D, N/mm of the half section in 2D)
     force_rate: float | None = None        # N/s (N/mm/s); None: load_time
-    load_time: float | None = None         # s to reach `force`; None: depth_fraction * t / rate
+    load_time: float | None = None         # s to reach `force`; None: DEPTH_FRACTION * t / rate
     loading: tuple = field(default_factory=tuple)  # loading.Segment after the first ramp, TOML [[loading]]
 
     def __post_init__(self):
@@ -261,6 +261,10 @@ class Scene:
                                      "give depth or force")
             set_("force", check_range("force", self.force, loading.MIN_FORCE, loading.MAX_FORCE,
                                       unit="N (N/mm in 2D)"))
+            if self.depth_fraction != DEPTH_FRACTION:  # the travel is the output: the record would show an input
+                raise ParameterError("depth_fraction", self.depth_fraction,
+                                     "not with force (force control finds the travel)",
+                                     "the time to reach the force: force_rate or load_time")
         for name in ("force_rate", "load_time"):
             if getattr(self, name) is not None and self.force is None:
                 raise ParameterError(name, getattr(self, name), "only with force")
@@ -279,7 +283,7 @@ class Scene:
     @property
     def indentation(self) -> float:
         """Largest prescribed indentation depth (mm): depth or depth_fraction * t and the
-        depths of `loading`; under force control depth_fraction * t is the expected travel
+        depths of `loading`; under force control DEPTH_FRACTION * t is the expected travel
         that sizes the mesh's contact zone."""
         first = self.depth if self.depth is not None else self.depth_fraction * self.thickness
         return max([first] + [g.target for g in self.loading if g.kind == "depth"])
@@ -347,13 +351,13 @@ class Scene:
     def replace(self, **changes) -> "Scene":
         """A changed copy. Changing `dim`, `indenter` or `thickness` re-derives mesh defaults
         left at default (3D Braille's depend on the thickness); changing `indenter` drops kind
-        parameters the new kind does not read; a `depth` replaces a depth_fraction."""
+        parameters the new kind does not read; a `depth` or a `force` replaces a depth_fraction."""
         names = [f.name for f in dataclasses.fields(self)]
         unknown = sorted(set(changes) - set(names))
         if unknown:
             raise ParameterError("scene field", unknown[0], "one of " + ", ".join(names))
-        if changes.get("depth") is not None and "depth_fraction" not in changes:
-            changes["depth_fraction"] = DEPTH_FRACTION  # a depth given now replaces the fraction
+        if (changes.get("depth") is not None or changes.get("force") is not None) and "depth_fraction" not in changes:
+            changes["depth_fraction"] = DEPTH_FRACTION  # a depth or force given now replaces the fraction
         new_dim = changes.get("dim", self.dim)
         if "dim" in changes:  # looked up below (DEFAULT_MESH): a list is refused as __post_init__ does
             new_dim = validate.integer(new_dim, "dim", "2 or 3")
@@ -395,7 +399,7 @@ class Scene:
                 continue
             if f.name == "sensors":  # none: absent, so that scenes without sensors keep their keys
                 v = [lay.to_dict() for lay in v] or None
-            if f.name == "depth_fraction" and self.depth is not None:  # not in effect: not recorded
+            if f.name == "depth_fraction" and (self.depth is not None or self.force is not None):  # not in effect: not recorded
                 continue
             if f.name == "loading":  # likewise: absent unless the history has more segments
                 v = [g.to_dict() for g in v] or None

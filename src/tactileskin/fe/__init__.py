@@ -109,7 +109,7 @@ def model_for_scene(scene, mesh=None) -> tuple[Model, object]:
         bcs.append(Dirichlet("symmetry", (0,)))
     if m == 3 and getattr(mesh, "z_symmetric", False):
         bcs.append(Dirichlet("end_back", (2,)))
-    # travel: the largest depth, or under force control the expected travel depth_fraction x t
+    # travel: the largest depth, or under force control the expected travel 0.2 t (DEPTH_FRACTION)
     contact = Contact(indenter_for_scene(scene), boundary="outer_surface", rate=scene.rate,
                       travel=scene.indentation)
     model = Model(mesh.mesh, mesh.boundaries, material_law(law), bcs, prony=prony,
