@@ -402,7 +402,7 @@ def test_a_suspect_figure_title_fits_its_figure(tmp_path, monkeypatch, figure):
     from tactileskin.sensors import SensorReadings
 
     why = ("the peak 0.02813 MPa is at s = 2 mm, within one skin thickness of where the bonded skin "
-           "ends: a corner singularity that grows with mesh refinement; the interior peak is 0.02262 MPa at s = 0 mm")
+           "ends: a corner singularity that grows with mesh refinement, and the interior peak is 0.02262 MPa at s = 0 mm")
     bm = BoneMap(s=np.linspace(0, 2, 5), z=np.linspace(0, 2, 5), pressure=np.ones((5, 5)))
     res = types.SimpleNamespace(bone_map=bm, sensors=None, summary=lambda: {"status": "suspect: " + why})
     title = _figure_title(res, "bone pressure, pad4x4-t2-polyurethane-flat-3d")

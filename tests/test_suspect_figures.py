@@ -95,3 +95,40 @@ def test_the_3d_render_of_a_suspect_result_says_so(tmp_path, monkeypatch):
     out = res.write(tmp_path / "r")
     assert render_case(out / "result.vtu", tmp_path / "r.png", title="t1 flat 3d").is_file()
     assert len(texts) == 1 and texts[0].startswith("t1 flat 3d\nSUSPECT: mesh coarser"), texts
+
+
+def test_a_title_with_more_reasons_than_lines_says_how_many_more():
+    """At most three status lines: the fourth reason and those after it were cut without a word
+    ('...' in the middle of the third line). The title now ends with '(+N more)', N the reasons
+    it leaves out, and shows whole reasons only (the first is cut when it alone is too long)."""
+    reasons = [f"reason {k} " + "x" * 40 for k in range(1, 6)]  # 49 characters each
+    t = quality.suspect_title("x", "suspect: " + "; ".join(reasons), width=72)
+    lines = t.split("\n")
+    assert len(lines) <= 4 and all(len(ln) <= 72 for ln in lines[1:]), lines
+    body = " ".join(lines[1:])
+    shown = [r for r in reasons if r in body]
+    assert len(shown) >= 2 and body.endswith(f"(+{len(reasons) - len(shown)} more)"), body
+    assert [r for r in reasons if r.split()[1] in body.split()] == shown  # no reason cut in two
+    long = "y" * 400
+    t = quality.suspect_title("x", f"suspect: {long}; short one", width=40).split("\n")
+    assert len(t) == 4 and t[-1].endswith("... (+1 more)") and all(len(ln) <= 40 for ln in t[1:]), t
+    assert quality.suspect_title("x", f"suspect: {long}", width=40).split("\n")[-1].endswith("y...")
+
+
+def test_no_reason_holds_the_separator_of_the_status():
+    """'; ' parts the status's reasons (a title counts them): no reason may hold it."""
+    summaries = [dict(peak_mpa=0.1, profile_min_mpa=-1.0, reaction_n_per_mm=1.0, contact_points=5),
+                 dict(peak_mpa=0.1, reaction_n=1.0, max_abs_stress_mpa=3.0, material_mu0_mpa=0.09),
+                 dict(element_order=1, material_nu0=0.49),
+                 dict(profile_plane_from_map=True, peak_map_edge_mpa=1.0, peak_map_edge_s_mm=1.0,
+                      peak_map_edge_z_mm=1.0, profile_plane_z=0.0),
+                 dict(peak_mpa=0.1, peak_interior_mpa=0.05, peak_edge_s_mm=3.0, peak_interior_s_mm=0.0),
+                 dict(indenter_cap={"contact_mm": 1.0, "face_half_mm": 0.5, "axis": "x"}),
+                 dict(indenter_cap={"travel_mm": 1.0, "cap_mm": 0.5}),
+                 dict(buckling={"strain": 0.2, "euler_strain": 0.03})]
+    found = [f for s in summaries for f in quality.flags(s)]
+    assert {f.code for f in found} >= {"tensile_bone", "stress_range", "locking", "edge_peak", "indenter_cap",
+                                       "buckling"}
+    assert not [f.reason for f in found if "; " in f.reason]
+    with pytest.raises(ValueError, match="'; '"):
+        quality.Flag("x", "a; b")

@@ -80,10 +80,17 @@ MIN_CONTACT_POINTS_3D = 3
 MIN_DOT_INDENTATION_OVER_SIZE = 0.45
 
 
+SEPARATOR = "; "  # parts the reasons of a status ("suspect: <reason>; <reason>"): no reason holds it
+
+
 @dataclass(frozen=True)
 class Flag:
     code: str      # "no_contact" | "stress_range" | "volume_range" | "locking" | "coarse_mesh" | "edge_peak" | "no_bone_map" | "indenter_cap" | "buckling" | "mirrored_x" | "mirrored_z" | "tensile_bone" | "non_finite"
     reason: str
+
+    def __post_init__(self):
+        if SEPARATOR in self.reason:  # a code error: status() joins the reasons with it, titles count them
+            raise ValueError(f"a Flag reason must not hold {SEPARATOR!r}: {self.reason!r}")
 
     def to_dict(self) -> dict:
         return {"code": self.code, "reason": self.reason}
@@ -141,7 +148,7 @@ def flags(summary: dict) -> list[Flag]:
         # -0.0021 at s = 0, contact pressure 0.023 MPa), and peak, span and area describe nothing
         out.append(Flag("tensile_bone", f"the bone's mean pressure is tensile under the load (down to {low:.4g} MPa, "
                         f"more than the peak {peak:.4g} MPa): peak, span and area do not describe the press (the "
-                        "material's volumetric response, e.g. an auxetic law with nu0 < 0, pulls the bone; "
+                        "material's volumetric response, e.g. an auxetic law with nu0 < 0, pulls the bone, so "
                         "read the contact pressure or the reaction instead)"))
     stress, mu0 = _num(summary, "max_abs_stress_mpa"), _num(summary, "material_mu0_mpa")
     if stress is not None and not (abs(stress) <= MAX_ABS_STRESS_MPA):
@@ -157,7 +164,7 @@ def flags(summary: dict) -> list[Flag]:
         out.append(Flag("stress_range", f"stress {stress:.4g} MPa = {abs(stress) / mu0:.3g} mu0 beyond "
                         f"{MAX_STRESS_OVER_MU0_3D:g} mu0 in 3D (mu0 = {mu0:.4g} MPa): the material locks up under "
                         "this press and the 3D meshes do not resolve it (an R 2.5 sphere 0.6 mm into 1 mm silicone "
-                        "read the peak 15 % / 6 % high at preview / default against fine, which still moved 6 %); "
+                        "read the peak 15 % / 6 % high at preview / default against fine, which still moved 6 %), so "
                         "use a smaller depth or force"))
     J, nu0 = _num(summary, "min_J"), _num(summary, "material_nu0")
     lo, hi = J_RANGE
@@ -167,7 +174,7 @@ def flags(summary: dict) -> list[Flag]:
     if _num(summary, "element_order") == 1 and (nu0 is None or nu0 >= NU_LOCKING):
         out.append(Flag("locking", "linear (P1) displacement elements with a nearly incompressible law"
                         + (f" (nu0 = {nu0:.3g})" if nu0 is not None else "") + " lock: the t = 1 mm flat plate "
-                        "read 2-3x the bone pressure, and refining does not cure it; use order 2"))
+                        "read 2-3x the bone pressure, and refining does not cure it: use order 2"))
     if summary.get("profile_plane_unknown"):
         out.append(Flag("no_bone_map", "no bone map of this skin file's bonded surface (not a graph over x: "
                         f"s = x - x_top folds), so the profile is on z = {_num(summary, 'profile_plane_z') or 0:g} mm, "
@@ -178,7 +185,7 @@ def flags(summary: dict) -> list[Flag]:
                         f"{_num(summary, 'peak_map_edge_s_mm'):g} mm, z = {_num(summary, 'peak_map_edge_z_mm'):g} mm, "
                         "within one skin thickness of where the bonded skin ends, and the profile was taken on "
                         f"the interior's plane z = {_num(summary, 'profile_plane_z'):g} mm: the load is near the "
-                        "skin's end (or that is a corner singularity); move it inward or lengthen the skin"))
+                        "skin's end (or that is a corner singularity), so move it inward or lengthen the skin"))
     sizes = summary.get("mesh_sizes_mm")
     why = []
     if isinstance(sizes, dict):
@@ -214,26 +221,26 @@ def flags(summary: dict) -> list[Flag]:
     if pi is not None and peak is not None:
         out.append(Flag("edge_peak", f"the peak {peak:.4g} MPa is at s = {_num(summary, 'peak_edge_s_mm'):g} mm, "
                         "within one skin thickness of where the bonded skin ends: a corner singularity that "
-                        f"grows with mesh refinement; the interior peak is {pi:.4g} MPa at s = "
+                        f"grows with mesh refinement, and the interior peak is {pi:.4g} MPa at s = "
                         f"{_num(summary, 'peak_interior_s_mm'):g} mm"))
     cap = summary.get("indenter_cap")
     if isinstance(cap, dict) and _num(cap, "contact_mm") is not None:
         out.append(Flag("indenter_cap", f"the contact reaches {_num(cap, 'contact_mm'):.3g} mm from the indenter's "
                         f"centre along {cap.get('axis', 'x')}, past its printed working face (half width "
                         f"{_num(cap, 'face_half_mm') or math.nan:.3g} mm): there the printed part has its sides or "
-                        "mount, the model more of the face (a cylinder's whole circle); use a larger radius or a "
+                        "mount, the model more of the face (a cylinder's whole circle), so use a larger radius or a "
                         "smaller depth or force"))
     elif isinstance(cap, dict):
         out.append(Flag("indenter_cap", f"the indenter travelled {_num(cap, 'travel_mm') or math.nan:.3g} mm, past its printed "
                         f"working face ({_num(cap, 'cap_mm') or math.nan:.3g} mm: a sphere's cap is 0.95 R high, its mount "
-                        "plate starts there; a cylinder's face is a strip one chord wide, its edges and mount start "
+                        "plate starts there, and a cylinder's face is a strip one chord wide, its edges and mount start "
                         "at the chord's sagitta, met by the undeformed skin's top): the printed part would press "
-                        "with those, which the model does not have; use a larger radius or a smaller depth or force"))
+                        "with those, which the model does not have, so use a larger radius or a smaller depth or force"))
     buck = summary.get("buckling")
     if isinstance(buck, dict):
         out.append(Flag("buckling", f"pressed to {_num(buck, 'strain') or math.nan:.3g} of its thickness, past the "
                         f"{_num(buck, 'euler_strain') or math.nan:.3g} at which this slender pad buckles under the "
-                        "plate (Euler, clamped to the board and guided by the plate); the model cannot buckle "
+                        "plate (Euler, clamped to the board and guided by the plate), and the model cannot buckle "
                         "and reads the unbuckled state: a real pad bends sideways and presses less"))
     if summary.get("mirrored_x"):
         out.append(Flag("mirrored_x", "the indenter is not symmetric about x = 0, but the model is the "
@@ -256,7 +263,7 @@ def status(summary: dict) -> str:
 
 
 def status_of(found: list[Flag]) -> str:
-    return "ok" if not found else "suspect: " + "; ".join(f.reason for f in found)
+    return "ok" if not found else "suspect: " + SEPARATOR.join(f.reason for f in found)
 
 
 def failed_status(error) -> str:
@@ -275,14 +282,25 @@ def suspect_title(text: str, status: str | None, width: int = 72, max_lines: int
     """A figure's title `text`, with "SUSPECT: <reasons>" (the status text, summary.json's)
     below it when `status` is not "ok": wrapped to `width` characters so that it stays inside
     the figure (one 100-character line ran past both sides of an 8-inch one), at most
-    `max_lines` lines, the last cut with "..." (the whole text is in summary.json). None (a
-    file written without its status): `text` alone."""
+    `max_lines` lines. Reasons that do not fit are left out whole and counted, "(+2 more)"
+    (the whole text is in summary.json); a first reason too long alone is cut with "...".
+    None (a file written without its status): `text` alone."""
     import textwrap
 
     if status is None or kind(status) == "ok":
         return text
     word = kind(status).upper()
-    lines = textwrap.wrap(f"{word}: " + str(status).split(":", 1)[-1].strip(), width, break_on_hyphens=False)
-    if len(lines) > max_lines:
-        lines = lines[:max_lines - 1] + [lines[max_lines - 1][:width - 3] + "..."]
+    reasons = str(status).split(":", 1)[-1].strip().split(SEPARATOR)
+
+    def wrap(s: str) -> list[str]:
+        return textwrap.wrap(s, width, break_on_hyphens=False)
+
+    n = len(reasons)
+    for k in range(n, 0, -1):  # as many whole reasons as fit, the rest counted
+        lines = wrap(f"{word}: " + SEPARATOR.join(reasons[:k]) + (f" (+{n - k} more)" if k < n else ""))
+        if len(lines) <= max_lines:
+            return "\n".join([text, *lines])
+    more = f" (+{n - 1} more)" if n > 1 else ""
+    lines = wrap(f"{word}: " + reasons[0])[:max_lines]
+    lines[-1] = lines[-1][:width - 3 - len(more)] + "..." + more
     return "\n".join([text, *lines])
