@@ -91,3 +91,36 @@ def test_a_2d_render_is_kept_in_the_cache_and_copied_on_a_rerun(case, tmp_path):
     m.write(other)
     changed = outputs._render(counted, other, tmp_path / "c" / "fig9_c.png", rec, cache)
     assert len(calls) == 2 and changed.read_bytes() != first.read_bytes()
+
+
+def test_a_force_case_draws_the_indenter_at_the_travel_it_reached(tmp_path, monkeypatch):
+    """Force control: the sweep's Fig. 9 drew the indenter 'at full depth (0.2 mm)', the
+    scene's default 20 % of t, on a skin pressed 0.056 mm (F = 0.03 N/mm): the outline floated
+    inside the skin and its legend named a depth the case never had. It is drawn at the travel
+    of the result's state (summary loading.profile_travel_mm) and says so."""
+    from tactileskin.cli import main
+    from tactileskin.report import render
+
+    seen = []
+    real = render.render_case
+
+    def spy(vtu, png, **kw):
+        seen.append(kw)
+        return real(vtu, png, **kw)
+
+    monkeypatch.setattr(render, "render_case", spy)
+    out = tmp_path / "o"
+    assert main(["sweep", "-t", "1", "-m", "polyurethane", "-i", "flat", "--force", "0.03", "--quality",
+                 "preview", "--serial", "--out", str(out)]) == 0
+    assert len(seen) == 1
+    travel = seen[0]["depth"]
+    assert 0.01 < travel < 0.15  # not the scene's 0.2 mm
+    sc = seen[0]["scene"]
+    fig = render_figure(next((out / "cache").rglob("result.vtu")), "t", sc, depth=travel)
+    try:
+        ax = fig.axes[0]
+        poly = next(p for p in ax.patches if isinstance(p, Polygon))
+        assert poly.get_xy()[:200, 1].min() == pytest.approx(sc.section().top - travel, abs=1e-9)
+        assert poly.get_label() == f"indenter at the travel reached ({travel:.3g} mm)"
+    finally:
+        plt.close(fig)

@@ -203,14 +203,17 @@ def _render(render_case, vtu: Path, png: Path, rec, cache) -> Path:
     from tactileskin.fileio import atomic_write_bytes, file_sha256
     from tactileskin.report.figures import drawing_digest
 
+    # force control, a history: the indenter where the result's state has it, not at the
+    # scene's nominal depth (drawn 0.2 mm deep on a skin pressed 0.056 mm)
+    depth = (rec.summary.get("loading") or {}).get("profile_travel_mm")
     if rec.scene.dim != 2:  # pyvista's off-screen render: not known to repeat its bytes
-        return render_case(vtu, png, title=rec.case, scene=rec.scene)
-    payload = [drawing_digest(), file_sha256(vtu), rec.scene.to_dict(), rec.case, png.name]
+        return render_case(vtu, png, title=rec.case, scene=rec.scene, depth=depth)
+    payload = [drawing_digest(), file_sha256(vtu), rec.scene.to_dict(), rec.case, png.name, depth]
     name = "render-" + hashlib.sha256(json.dumps(payload, sort_keys=True, default=repr).encode()).hexdigest()[:24]
     kept = cache.load_files(name)
     if kept is not None and [f for f, _ in kept] == [png.name]:
         return atomic_write_bytes(png, kept[0][1])
-    path = render_case(vtu, png, title=rec.case, scene=rec.scene)
+    path = render_case(vtu, png, title=rec.case, scene=rec.scene, depth=depth)
     try:
         cache.store_files(name, [path])
     except (TactileSkinError, OSError) as e:  # the render is written; only the copy is lost

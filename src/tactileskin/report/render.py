@@ -68,17 +68,17 @@ def _section(vtu: Path):
     return X, np.concatenate(tris), np.asarray(m.point_data[field], float), field
 
 
-def indenter_outline(scene, x_max: float, cap: float) -> np.ndarray | None:
-    """(k, 2) closed outline of the indenter at full depth in the 2D section, x in [0, x_max]
-    (the half model): its working face y = surface_y(x, d = indentation) and a band `cap`
-    above it; None when the kind has no 2D section."""
+def indenter_outline(scene, x_max: float, cap: float, depth: float | None = None) -> np.ndarray | None:
+    """(k, 2) closed outline of the indenter in the 2D section, x in [0, x_max] (the half
+    model): its working face y = surface_y(x, d = depth, default the scene's indentation) and
+    a band `cap` above it; None when the kind has no 2D section."""
     from tactileskin.geometry.indenters import indenter_for_scene
 
     ind = indenter_for_scene(scene, warn=False)
     half = min(0.5 * ind.width, x_max)
     x = np.linspace(0.0, half, 200)
     try:
-        y = np.asarray(ind.surface_y(x, d=scene.indentation), float)
+        y = np.asarray(ind.surface_y(x, d=scene.indentation if depth is None else depth), float)
     except Exception as e:  # noqa: BLE001 - a kind without a 2D face: no outline, still a render
         log.debug("no indenter outline: %s", e)
         return None
@@ -86,8 +86,10 @@ def indenter_outline(scene, x_max: float, cap: float) -> np.ndarray | None:
     return np.vstack([np.column_stack([x, y]), [[half, top], [0.0, top]], [[x[0], y[0]]]])
 
 
-def render_figure(vtu: Path, title: str = "", scene=None):
-    """The matplotlib figure of a 2D result.vtu (see the module doc); the caller closes it."""
+def render_figure(vtu: Path, title: str = "", scene=None, depth: float | None = None):
+    """The matplotlib figure of a 2D result.vtu (see the module doc); the caller closes it.
+    `depth`: the indenter's travel in the result's state when the scene does not prescribe it
+    (force control, a history: summary loading.profile_travel_mm); None: the scene's depth."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -103,11 +105,12 @@ def render_figure(vtu: Path, title: str = "", scene=None):
                            constrained_layout=True)
     im = ax.tripcolor(X[:, 0], X[:, 1], tris, P, shading="gouraud", cmap=CMAP,
                       vmin=min(0.0, float(P.min())), vmax=float(P.max()))
-    outline = indenter_outline(scene, xmax, 0.08 * h) if scene is not None and scene.dim == 2 else None
+    outline = indenter_outline(scene, xmax, 0.08 * h, depth) if scene is not None and scene.dim == 2 else None
     top = ymax
     if outline is not None:
         ax.add_patch(Polygon(outline, closed=True, facecolor="0.85", edgecolor="black", lw=1.0, alpha=0.9,
-                             label=f"indenter at full depth ({scene.indentation:g} mm)", zorder=3))
+                             label=(f"indenter at full depth ({scene.indentation:g} mm)" if depth is None
+                                    else f"indenter at the travel reached ({depth:.3g} mm)"), zorder=3))
         top = max(top, float(outline[:, 1].max()))
         ax.legend(loc="upper right", fontsize="small", framealpha=0.9)
     ax.set_xlim(xmin - 0.02 * w, xmax + 0.02 * w)
@@ -123,7 +126,7 @@ def render_figure(vtu: Path, title: str = "", scene=None):
     return fig
 
 
-def render_case(vtu: Path, png: Path, title: str = "", scene=None) -> Path:
+def render_case(vtu: Path, png: Path, title: str = "", scene=None, depth: float | None = None) -> Path:
     """Render `vtu` (the solver's result.vtu) deformed, coloured by mean pressure, into `png`
     (atomically). 2D: matplotlib (`render_figure`; `scene` adds the indenter outline); 3D:
     pyvista off-screen (needs the `render` extra; MissingDependency without)."""
@@ -135,7 +138,7 @@ def render_case(vtu: Path, png: Path, title: str = "", scene=None) -> Path:
         return _render_3d(vtu, png, title)
     import matplotlib.pyplot as plt
 
-    fig = render_figure(vtu, title, scene)
+    fig = render_figure(vtu, title, scene, depth)
     try:
         buf = io.BytesIO()
         fig.savefig(buf, format="png", dpi=150)
