@@ -237,8 +237,8 @@ def test_a_centre_row_profile_leaves_its_spread_empty(tmp_path, scan, sim):
         assert main(["film", "analyze", str(scan), "--rows", rows, "--box-px", "40", "20", "120", "50",
                      "--out", str(film)]) == 0
         table = columns(film)
-        assert len(table) > 10 and all(float(r["pressure"]) >= 0 for r in table)
-        sd = [r["pressure_sd"] for r in table]
+        assert len(table) > 10 and all(float(r["pressure_mpa_per_mm"]) >= 0 for r in table)
+        sd = [r["pressure_sd_mpa_per_mm"] for r in table]
         if rows == "centre":
             assert sd == [""] * len(table)
         else:

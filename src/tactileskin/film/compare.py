@@ -110,14 +110,20 @@ def _read_json(path, what: str, valid: str) -> dict:
 
 
 def load_film(film_dir) -> tuple[np.ndarray, np.ndarray, dict]:
-    """profile.csv (s_mm, pressure) and summary.json written by ``FilmProfile.write``."""
+    """profile.csv (s_mm, pressure_<unit>; earlier files: pressure) and summary.json written
+    by ``FilmProfile.write``."""
+    from tactileskin.film.scan import unit_suffix
+
     film_dir = Path(film_dir)
-    s, p = read_profile_csv(film_dir / "profile.csv", "s_mm", "pressure")
     meta = _read_json(film_dir / "summary.json", "film result",
                       "a directory written by `film analyze`")
     if not isinstance(meta.get("unit", "MPa"), str):
         raise ParameterError("film result unit", meta.get("unit"), "text, e.g. MPa",
                              hint=str(film_dir / "summary.json"))
+    path = film_dir / "profile.csv"
+    col = "pressure_" + unit_suffix(meta.get("unit", "MPa"))
+    head = read_text(path, "profile", "a readable profile.csv").split("\n", 1)[0]
+    s, p = read_profile_csv(path, "s_mm", col if col in head.split(",") else "pressure")
     return s, p, meta
 
 

@@ -241,17 +241,29 @@ class FilmProfile:
         plots._check_cmap(cmap)
         out = Path(out)
         names = {"profile": "profile.csv", "summary": "summary.json", "map": "pressure_map.png"}
-        lines = ["s_mm,pressure,pressure_sd,band90_lo,band90_hi"]
+        # the calibration's unit in every pressure column (MPa/mm under Eq. 8, MPa under a press
+        # calibration) and the status on every row, as the solver's profile.csv has it
+        u = unit_suffix(self.unit)
+        lines = [f"s_mm,pressure_{u},pressure_sd_{u},band90_lo_{u},band90_hi_{u},status"]
+        status = "ok" if not self.warnings else "suspect: " + "; ".join(str(w) for w in self.warnings)
+        cell = '"' + status.replace('"', '""') + '"' if any(c in status for c in ',"\n') else status
         for k in range(self.s_mm.size):
             lo = f"{self.band_lo[k]:.6g}" if self.band_lo is not None else ""
             hi = f"{self.band_hi[k]:.6g}" if self.band_hi is not None else ""
             sd = f"{self.pressure_sd[k]:.6g}" if self.pressure_sd is not None else ""
-            lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},{sd},{lo},{hi}")
+            lines.append(f"{self.s_mm[k]:.6g},{self.pressure[k]:.6g},{sd},{lo},{hi},{cell}")
         with staging.staged_files(out, ANALYZE_NAMES + COMPARE_NAMES, last=names["summary"]) as tmp:
             fileio.atomic_write_text(tmp / names["profile"], "\n".join(lines) + "\n")
             fileio.atomic_write_json(tmp / names["summary"], self.summary())
             plots.pressure_map(self, tmp / names["map"], cmap=cmap)
         return {k: out / v for k, v in names.items()}
+
+
+def unit_suffix(unit: str) -> str:
+    """A unit as a column-name suffix: 'MPa' -> 'mpa', 'MPa/mm' -> 'mpa_per_mm'."""
+    import re
+
+    return re.sub(r"[^a-z0-9]+", "_", str(unit).lower().replace("/", "_per_")).strip("_") or "unitless"
 
 
 def _scan_array(scan) -> tuple[str, np.ndarray, str]:
