@@ -45,3 +45,21 @@ def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
         assert "F0.03" not in svg, stem
     # the report's discrimination table names the variant alike
     assert "| silicone | 1 | F = 0.03 N/mm |" in (out / "report.md").read_text()
+
+
+@pytest.mark.usefixtures("close_figures")
+def test_each_series_of_the_thickness_figure_has_its_own_style(tmp_path, monkeypatch):
+    """Two forces of one indenter and material were drawn alike (marker and line style by
+    material only, colour by indenter): at one thickness 'flat F = 0.03 N/mm, gel' and 'flat
+    F = 0.06 N/mm, gel' were two identical blue circles, told apart by nothing but position."""
+    from tactileskin.report import figures
+
+    rows = [dict(status="ok", material=m, thickness_mm=1.0, indenter=ind, braille_text="", variant=v,
+                 variant_label=f"F = {v[1:]} N/mm", dim=2, peak_mpa=p, span_mm=1.0, auc_mpa_mm=0.1)
+            for m in ("gel", "silicone") for ind in ("flat", "curved") for v, p in (("F0.03", 0.03), ("F0.06", 0.05))]
+    got = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, out, stem: got.setdefault(stem, fig) and [])
+    figures.thickness_figure(rows, tmp_path)
+    lines = got["metrics_vs_thickness"].axes[0].get_lines()
+    styles = {(ln.get_color(), ln.get_marker(), ln.get_linestyle(), ln.get_fillstyle()) for ln in lines}
+    assert len(lines) == 8 and len(styles) == 8, sorted(styles)

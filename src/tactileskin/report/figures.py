@@ -248,7 +248,7 @@ METRICS = (("peak_mpa", "peak P (MPa)"), ("span_mm", "span (mm)"), ("auc_mpa_mm"
 
 def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
     """Peak, span and AUC against skin thickness: one panel per metric, one line per
-    indenter (colour) and material (marker, line style) and case variant; ok cases only.
+    indenter (colour) and material, Braille text and case variant (marker, line style); ok cases only.
     The figure a thickness is chosen from (docs/metrics.md)."""
     plt = _plt()
     ok = [r for r in rows if r.get("status", "ok") == "ok" and r.get("peak_mpa") is not None]
@@ -258,6 +258,9 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
                      r.get("variant") or "", r.get("dim", 2), r["material"])
     series = sorted({key(r) for r in ok})
     vlabel = _row_labels(ok)
+    # one style per (material, text, variant, dim), the colour naming the indenter: by material
+    # alone, two forces of one indenter were identical markers (at one thickness, no line)
+    looks = sorted({(sk[5], sk[2], sk[3], sk[4]) for sk in series}, key=lambda x: (mats.index(x[0]), x[1:]))
     fig, axes = plt.subplots(1, len(METRICS), figsize=(4.0 * len(METRICS), 3.4), squeeze=False,
                              constrained_layout=True)
     for ax, (metric, label) in zip(axes[0], METRICS):
@@ -266,9 +269,10 @@ def thickness_figure(rows: list[dict], out: Path) -> list[Path]:
             if not pts:
                 continue
             _, ind, text, variant, dim, mat = sk
-            mi = mats.index(mat)
+            j = looks.index((mat, text, variant, dim))  # = the material's index without variants
             t, v = zip(*pts)
-            ax.plot(t, v, _DASHES[mi % len(_DASHES)], marker=MATERIAL_MARKERS[mi % len(MATERIAL_MARKERS)],
+            ax.plot(t, v, _DASHES[j % len(_DASHES)], marker=MATERIAL_MARKERS[j % len(MATERIAL_MARKERS)],
+                    fillstyle="full" if (j // len(MATERIAL_MARKERS)) % 2 == 0 else "none",
                     color=COLOURS.get(ind), ms=4,
                     label=f"{_series(ind, text, vlabel[(variant, dim)])}{f' {dim}d' if len(dims) > 1 else ''}, {mat}")
         ax.set_xlabel("skin thickness t (mm)")
