@@ -44,7 +44,10 @@ def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
         assert "flat F = 0.03 N/mm" in svg and "curved F = 0.06 N/mm" in svg, stem
         assert "F0.03" not in svg, stem
     # the report's discrimination table names the variant alike
-    assert "| silicone | 1 | F = 0.03 N/mm |" in (out / "report.md").read_text()
+    report = (out / "report.md").read_text()
+    assert "| silicone | 1 | F = 0.03 N/mm |" in report
+    # the Cases table's depth of a force case is the travel it reached, not a prescribed depth
+    assert "Depth of a force-controlled case: the travel the indenter reached" in report
 
 
 @pytest.mark.usefixtures("close_figures")
