@@ -89,8 +89,10 @@ class Flag:
     reason: str
 
     def __post_init__(self):
-        if SEPARATOR in self.reason:  # a code error: status() joins the reasons with it, titles count them
-            raise ValueError(f"a Flag reason must not hold {SEPARATOR!r}: {self.reason!r}")
+        # status() joins the reasons with SEPARATOR and titles count them by it: a reason holding
+        # it (a number formatted into it, a later text) is mended, not raised on at the end of a solve
+        if SEPARATOR in self.reason:
+            object.__setattr__(self, "reason", self.reason.replace(SEPARATOR, ", "))
 
     def to_dict(self) -> dict:
         return {"code": self.code, "reason": self.reason}
