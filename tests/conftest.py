@@ -18,3 +18,22 @@ def close_figures():
     yield
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close("all")
+
+
+def pytest_sessionstart(session):
+    # the package's sources as this session starts (tactileskin's own import-time snapshot,
+    # cache.code_changes compares against the same): an edit in the checkout under test while
+    # the suite runs fails every test that caches a solve ('restart Python'), by design
+    import tactileskin  # noqa: F401 (light: its heavy modules load on first use)
+
+
+def pytest_terminal_summary(terminalreporter):
+    import tactileskin
+
+    now, then = tactileskin._source_hashes(), tactileskin._IMPORTED_SOURCES
+    changed = sorted(k for k in now.keys() | then.keys() if now.get(k) != then.get(k))
+    if changed:
+        names = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" if len(changed) > 5 else "")
+        terminalreporter.write_line(
+            f"tactileskin's sources changed during this test run ({names}): the tests that cache a solve "
+            "fail then by design (cache.code_changes); rerun on a checkout nobody edits meanwhile", yellow=True)
