@@ -129,9 +129,9 @@ def test_a_field_given_twice_or_a_bad_quality_in_a_file_is_refused(tmp_path):
 
 
 def test_dev_without_arguments_prints_its_usage_and_succeeds():
-    r = subprocess.run([str(ROOT / "dev")], capture_output=True, text=True, timeout=30)
+    r = subprocess.run([str(ROOT / "dev")], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "./dev run" in r.stdout
-    r = subprocess.run([str(ROOT / "dev"), "nonsense"], capture_output=True, text=True, timeout=30)
+    r = subprocess.run([str(ROOT / "dev"), "nonsense"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "nonsense" in r.stderr
 
 

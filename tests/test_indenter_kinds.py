@@ -396,9 +396,9 @@ def test_the_sphere_radius_is_bounded_by_its_printed_part(tmp_path, capsys):
     Scene(dim=3, indenter="sphere", indenter_radius=100.0)
     Scene(dim=3, indenter="cylinder", indenter_radius=1000.0)
     out = tmp_path / "b"
-    t0 = time.perf_counter()
+    t0 = time.process_time()  # CPU seconds: the 327 s build, not a loaded machine's wall clock
     assert main(["build", "-i", "sphere", "--indenter-radius", "1000", "-o", str(out)]) == 2
-    assert time.perf_counter() - t0 < 20.0
+    assert time.process_time() - t0 < 20.0
     err = " ".join(capsys.readouterr().err.split())
     assert "(0.1, 100] mm" in err and "Traceback" not in err, err
     assert not list(out.glob("*.stl")) if out.exists() else True

@@ -197,16 +197,16 @@ def test_sweep_options_given_empty_are_refused_not_the_default_axes(tmp_path, ca
 
 
 def test_grid_resolves_every_material_before_any_work():
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(ParameterError, match="material='bogus'"):
         sweep.expand_grid(thicknesses=(1.0, 3.0), materials=("silicone", "bogus"), indenters=("flat",))
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
     with pytest.raises(ParameterError, match="not a string"):
         sweep.expand_grid(materials="silicone")
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     with pytest.raises(ParameterError, match="at most 10000 cases"):
         sweep.expand_grid(thicknesses=sweep.parse_values("1:5:0.005", "t"), depths=(0.1, 0.2, 0.3, 0.4, 0.5))
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
 
 
 @pytest.mark.parametrize("args,needle", [
@@ -217,11 +217,15 @@ def test_grid_resolves_every_material_before_any_work():
     (["--scheduler", "http://h:8786"], "--scheduler="),
     (["--workers", "0"], "--workers"),
 ])
-def test_sweep_cli_refuses_bad_input_before_starting(tmp_path, capsys, args, needle):
+def test_sweep_cli_refuses_bad_input_before_starting(tmp_path, capsys, monkeypatch, args, needle):
+    def started(*a, **kw):
+        raise AssertionError("the sweep started")
+
+    monkeypatch.setattr(sweep, "run_sweep", started)
     out = tmp_path / "out"
-    t0 = time.perf_counter()
+    t0 = time.process_time()  # CPU seconds: a loaded machine's wall clock says nothing of the work done
     assert main(["sweep", "--serial", "--no-render", "--out", str(out), *args]) == 2
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
     cap = capsys.readouterr()
     text = (cap.err + cap.out).replace("\n", "")
     assert needle in text and "Traceback" not in text
@@ -241,6 +245,8 @@ def test_unreachable_scheduler_is_a_parameter_error(monkeypatch):
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     monkeypatch.setattr(sweep, "SCHEDULER_TIMEOUT_S", 0.5)
+    import dask.distributed  # noqa: F401 (its first import, seconds on a loaded machine, is not what is timed)
+
     t0 = time.perf_counter()
     with pytest.raises(ParameterError, match="no connection within 0.5 s"):
         sweep.connect(f"tcp://127.0.0.1:{port}")
@@ -284,10 +290,10 @@ def test_braille_text_is_capped():
     ok = "a" * braille.MAX_CELLS   # on a pad wide enough to hold it (the skin's top is checked too)
     assert Scene(indenter="braille", skin="pad", pad_width=250, braille_text=ok).braille_text == ok
     for text in ("a" * (braille.MAX_CELLS + 1), "A" * (braille.MAX_CELLS // 2 + 1), "x" * 1_000_000):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         with pytest.raises(ParameterError, match="at most 40 braille cells"):
             Scene(indenter="braille", braille_text=text)
-        assert time.perf_counter() - t0 < 1.0
+        assert time.process_time() - t0 < 1.0
     with pytest.raises(ParameterError):
         braille.dot_centres("b" * 200)
 
@@ -334,10 +340,10 @@ def test_mesh_cli_refuses_before_gmsh(tmp_path, capsys):
     import tactileskin.mesh.slab3d  # noqa: F401 (imports are not what is timed)
 
     out = tmp_path / "m.vtu"
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     assert main(["mesh", "--dim", "3", "-t", "3", "--mesh-size", "0.3", "--refinement", "3",
                  "--out", str(out)]) == 2
-    assert time.perf_counter() - t0 < 1.0
+    assert time.process_time() - t0 < 1.0
     err = capsys.readouterr().err.replace("\n", "")
     assert "mesh_size=0.3" in err and "dofs" in err and "Traceback" not in err
     assert not out.exists()
