@@ -277,3 +277,66 @@ def test_the_t5_default_is_measured_with_its_coarse_contact_spot():
     for key, case in cases.items():
         if not key.startswith("t5-"):
             assert all(v.get("spot_factor", 1.0) == 1.0 for v in case["levels"]), key
+
+
+def test_rewriting_a_t5_case_keeps_its_stored_default_level(tmp_path, capsys):
+    """convergence3d.write_presets rewrites a case from the study's levels (spot factor 1); the
+    t = 5 `default`'s level (1.6 / 8 at spot factor 3, spot_scale_t5.py --store) is not one of
+    them and was dropped: the t = 5 default then read as not measured."""
+    import json
+
+    key = "t5-silicone-\u2801"
+    case = presets.load()["cases3d"][key]
+    path = tmp_path / "presets.json"
+    path.write_text(json.dumps({"cases3d": {key: case}}), encoding="utf-8")
+    k1 = [v for v in case["levels"] if v.get("spot_factor", 1.0) == 1.0]
+    # the study's raw levels: no "spot_factor" (solved before it was recorded: factor 1)
+    levels = [{**v, "peak": 1.0} for v in k1]
+    ref = {"value": case["reference_peak"], "method": case["reference_method"], "order": case["observed_order"]}
+    cv.write_presets(path, key, {"levels": levels, "reference": ref})
+    got = json.loads(path.read_text(encoding="utf-8"))["cases3d"][key]
+    assert [(v["mesh_size"], v.get("spot_factor")) for v in got["levels"]] == \
+        [(1.6, 3.0), (1.6, 1.0), (1.2, 1.0), (0.8, 1.0)]
+    assert presets.preset_level(key, got, "default") == presets.preset_level(key, case, "default")
+    assert capsys.readouterr().err == ""
+    # a study with another reference keeps it too, and says its errors are against the former one
+    cv.write_presets(path, key, {"levels": levels, "reference": dict(ref, value=1.01 * ref["value"])})
+    got = json.loads(path.read_text(encoding="utf-8"))["cases3d"][key]
+    assert [v.get("spot_factor") for v in got["levels"]] == [3.0, 1.0, 1.0, 1.0]
+    assert "former references" in capsys.readouterr().err
+    # a study without its 1.2 / 8 drops that level (the study's levels are its own)
+    cv.write_presets(path, key, {"levels": [v for v in levels if v["mesh_size"] != 1.2], "reference": ref})
+    got = json.loads(path.read_text(encoding="utf-8"))["cases3d"][key]
+    assert [(v["mesh_size"], v.get("spot_factor")) for v in got["levels"]] == [(1.6, 3.0), (1.6, 1.0), (0.8, 1.0)]
+
+
+def test_the_study_solves_its_levels_at_spot_factor_1(tmp_path, monkeypatch):
+    """convergence3d --one solves a level of the study's h-family: at t = 5 mm its 1.6 / 8 was
+    meshed with the 3x contact spot of the `default` (mesh.sizing.spot_factor) and its
+    1.2 / 8 and 0.8 / 8 without, so a re-run study mixed two plans in one Richardson family."""
+    import json
+    import types
+
+    from tactileskin import fe
+    from tactileskin.mesh import sizing, slab3d
+
+    monkeypatch.setattr(sizing, "SPOT_FACTOR", None)
+    seen = []
+
+    class Map:
+        s, z, pressure = np.zeros(2), np.zeros(2), np.zeros((2, 2))
+
+        def peak(self):
+            return 0.0, 0.0, 0.0
+
+    def fake_solve(scene, mesh=None, **kw):
+        seen.append(sizing.spot_factor(scene.thickness, 0.72, scene.mesh_size / scene.refinement))
+        return types.SimpleNamespace(stats={"dofs": 1}, bone_map=Map(), peak=1.0, span=1.0)
+
+    monkeypatch.setattr(fe, "solve", fake_solve)
+    monkeypatch.setattr(slab3d, "build_slab_mesh", lambda scene, local=True: None)
+    assert cv.main(["--one", "1.6/8", "--thickness", "5", "--material", "silicone", "--text", "",
+                    "--raw", str(tmp_path)]) == 0
+    assert seen == [1.0]
+    rec = json.loads(next(tmp_path.glob("*.json")).read_text(encoding="utf-8"))
+    assert rec["spot_factor"] == 1.0
