@@ -542,3 +542,25 @@ def test_a_first_force_increment_out_of_reach_names_the_force(mesh, tmp_path):
     msg = str(e.value)
     assert e.value.name == "force" and "lock-up" not in msg and "finer mesh" not in msg
     assert "out of reach" in msg and "0.893 mm" in msg and "depth" in msg
+
+
+@pytest.mark.parametrize("fields, needle", [
+    # the scene's own first ramp follows the rule of a [[loading]] ramp: >= MIN_RAMP_TIME
+    (dict(thickness=3, rate=1e6), r"^rate=1000000.0 is invalid; valid: <= 6e\+05 mm/s.*1e-06 s"),
+    (dict(thickness=3, depth=0.5, rate=1e6), r"^rate=1000000.0 is invalid; valid: <= 5e\+05 mm/s"),
+    (dict(force=0.5, force_rate=1e6), r"^force_rate=1000000.0 is invalid; valid: <= 5e\+05 N/s"),
+    (dict(force=0.5, load_time=1e-12), r"^load_time=1e-12 is invalid; valid: \[1e-06, 1e\+06\] s"),
+    (dict(thickness=3, force=0.5, rate=1e6), r"^rate=1000000.0 is invalid; valid: <= 6e\+05 mm/s"),
+])
+def test_the_first_ramp_has_the_shortest_ramp_time_of_a_loading_segment(fields, needle):
+    with pytest.raises(ParameterError, match=needle):
+        Scene(**fields)
+
+
+def test_one_rate_range_for_the_scene_and_loading_segments():
+    from tactileskin import loading, scene
+
+    assert scene.RATE is loading.RATE
+    with pytest.raises(ParameterError, match=r"loading\[0\].rate.*\[1e-06, 1e\+06\]"):
+        Scene(loading=[{"depth": 0.1, "rate": 2e6}])
+    Scene(thickness=3, rate=6e5)  # 0.6 mm in 1e-6 s: the lower end runs as a segment's does

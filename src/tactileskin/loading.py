@@ -32,6 +32,7 @@ MAX_TIME = 1e6       # s: a segment longer than ~11 days is a units mistake
 # float time (t0 + 1e-20 == t0 after a 0.2 s ramp: the solve divided by zero). Far above the
 # spacing of floats at the longest history (20 x MAX_TIME: 4e-9 s)
 MIN_RAMP_TIME = 1e-6
+RATE = (1e-6, 1e6)   # mm/s or N/s (N/mm/s): any ramp's rate, the scene's `rate` and `force_rate` too
 MAX_FORCE = 1e4      # N (N/mm): far beyond any soft skin under a fingertip-sized indenter
 # N (N/mm): below it the ramp's first targets are within the reaction's own resolution (1 mm
 # silicone under the flat plate in 2D: 1e-7 N/mm stalled in its first increment, its reaction
@@ -104,7 +105,7 @@ def segment_from(value, where: str, *, max_depth: float, default_rate: float) ->
         return Segment(kind, target, time=check_range(f"{where}.time", d["time"], MIN_RAMP_TIME, MAX_TIME,
                                                       unit="s"))
     rate = d.get("rate", default_rate)
-    return Segment(kind, target, rate=check_range(f"{where}.rate", rate, 1e-6, 1e6, unit=unit))
+    return Segment(kind, target, rate=check_range(f"{where}.rate", rate, *RATE, unit=unit))
 
 
 def segments_from(value, *, max_depth: float, default_rate: float) -> tuple[Segment, ...]:
@@ -114,6 +115,16 @@ def segments_from(value, *, max_depth: float, default_rate: float) -> tuple[Segm
     items = validate.sequence(value, "loading", "[[loading]] tables", MAX_SEGMENTS)
     return tuple(segment_from(v, f"loading[{i}]", max_depth=max_depth, default_rate=default_rate)
                  for i, v in enumerate(items))
+
+
+def check_ramp(name: str, rate: float, start: float, target: float, unit: str) -> None:
+    """Refuse a ramp from `start` to `target` at `rate` that takes under MIN_RAMP_TIME (as a
+    `time` below it: the ramp can end where it starts in float time); names `name`."""
+    duration = abs(target - start) / rate
+    if duration < MIN_RAMP_TIME:
+        raise ParameterError(name, rate, f"<= {abs(target - start) / MIN_RAMP_TIME:.3g} {unit}: "
+                             f"the ramp from {start:.12g} to {target:.12g} takes {duration:.3g} s, "
+                             f"under the shortest ramp, {MIN_RAMP_TIME:g} s")
 
 
 def check_program(program: list[Segment]) -> None:
@@ -130,10 +141,7 @@ def check_program(program: list[Segment]) -> None:
         if start is not None and seg.rate is not None and math.isclose(seg.target, start, abs_tol=1e-12):
             raise ParameterError(f"{where}.{seg.kind}", seg.target, f"a value other than the previous {start:g}",
                                  "use hold = seconds to stay")
-        if start is not None and seg.rate is not None and seg.duration(start) < MIN_RAMP_TIME:
-            # as a time below MIN_RAMP_TIME: the ramp can end where it starts in float time
-            unit = "mm/s" if seg.kind == "depth" else "N/s (N/mm/s in 2D)"
-            raise ParameterError(f"{where}.rate", seg.rate, f"<= {abs(seg.target - start) / MIN_RAMP_TIME:.3g} {unit}: "
-                                 f"the ramp from {start:.12g} to {seg.target:.12g} takes {seg.duration(start):.3g} s, "
-                                 f"under the shortest ramp, {MIN_RAMP_TIME:g} s")
+        if start is not None and seg.rate is not None:
+            check_ramp(f"{where}.rate", seg.rate, start, seg.target,
+                       "mm/s" if seg.kind == "depth" else "N/s (N/mm/s in 2D)")
         control, value = seg.kind, seg.target

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
+from tactileskin import loading as _loading
 from tactileskin import presets as _presets
 from tactileskin import validate
 from tactileskin.errors import ParameterError, check_range
@@ -129,7 +130,7 @@ DEPTH_FRACTION = 0.2  # Scene.depth_fraction's default
 MAX_DEPTH_FRACTION = 0.6               # depth <= 0.6 t (and depth_fraction <= 0.6)
 MESH_SIZE = (0.01, 5.0)                # mesh_size (mm)
 REFINEMENT = (1.0, 20.0)               # refinement (coarse / refined size ratio)
-RATE = (1e-6, 1e6)                     # rate (mm/s) and force_rate (N/s)
+RATE = _loading.RATE                   # rate (mm/s) and force_rate (N/s), as a [[loading]] ramp's
 
 
 @dataclass(frozen=True)
@@ -273,11 +274,23 @@ class Scene:
         if self.force_rate is not None:
             set_("force_rate", check_range("force_rate", self.force_rate, *RATE, unit="N/s (N/mm/s in 2D)"))
         if self.load_time is not None:
-            set_("load_time", check_range("load_time", self.load_time, 0.0, loading.MAX_TIME, lo_open=True,
+            set_("load_time", check_range("load_time", self.load_time, loading.MIN_RAMP_TIME, loading.MAX_TIME,
                                           unit="s"))
+        self._check_first_ramp()
         set_("loading", loading.segments_from(self.loading or [], max_depth=self.max_travel,
                                               default_rate=self.rate) if self.loading else ())
         loading.check_program(self.program())
+
+    def _check_first_ramp(self) -> None:
+        """The first ramp (from first touch) takes at least loading.MIN_RAMP_TIME, as a
+        [[loading]] ramp does; the error names the field that sets its duration."""
+        from tactileskin import loading
+
+        if self.force is not None and self.force_rate is not None:
+            loading.check_ramp("force_rate", self.force_rate, 0.0, self.force, "N/s (N/mm/s in 2D)")
+        elif self.force is None or self.load_time is None:  # load_time's own range holds the rest
+            travel = self.depth if self.depth is not None else self.depth_fraction * self.thickness
+            loading.check_ramp("rate", self.rate, 0.0, travel, "mm/s")
 
     # --- derived -----------------------------------------------------------------------
     @property
