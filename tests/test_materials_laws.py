@@ -209,3 +209,40 @@ def test_the_presets_and_a_soft_gel_are_within_the_plausible_moduli():
     for law, table in (("hyperfoam", {"mu": [0.080, 0.010], "alpha": [0.001, 15.5], "nu": 0.49}),
                        ("neo_hookean", {"mu": 1e-3, "kappa": 0.5}), ("hyperfoam", {"mu": [0.1], "alpha": [2.0], "nu": 0.0})):
         law_from_dict(law, table, "material 'x'")
+
+
+@pytest.mark.parametrize("law, table", [
+    ("neo_hookean", "mu = 0.1\nkappa = 1e-30\n"),
+    ("neo_hookean", "mu = 0.1\nkappa = 0.01\n"),
+    ("mooney_rivlin", "c10 = 0.05\nc01 = 0.0\nkappa = 1e-9\n"),
+    ("yeoh", "c = [0.05]\nkappa = 1e-9\n"),
+    ("ogden", "mu = [0.1]\nalpha = [2.0]\nkappa = 1e-9\n"),
+])
+def test_a_bulk_modulus_too_small_for_a_stable_law_names_kappa_and_its_range(tmp_path, law, table):
+    """kappa << mu makes the law's uniaxial stress fall under compression: the file was refused
+    as 'not a stable law', naming the file only. The error names kappa and the smallest kappa
+    that is stable with the file's other parameters; that value loads, and up to 5000 mu0."""
+    import re
+
+    from tactileskin.materials import get_material
+
+    p = tmp_path / "m.toml"
+    p.write_text(f'law = "{law}"\n[{law}]\n{table}')
+    with pytest.raises(ParameterError, match=rf"^material 'm' {law}.kappa=.* is invalid; valid: \[") as e:
+        get_material(str(p))
+    lo, hi = (float(v) for v in re.search(r"valid: \[(\S+), (\S+)\] MPa", str(e.value)).groups())
+    assert str(p) in str(e.value)
+    for kappa in (lo, hi):
+        p.write_text(f'law = "{law}"\n[{law}]\n' + re.sub(r"kappa = \S+", f"kappa = {kappa!r}", table))
+        assert get_material(str(p)).law.kappa == kappa
+    p.write_text(f'law = "{law}"\n[{law}]\n' + re.sub(r"kappa = \S+", f"kappa = {lo * 0.9!r}", table))
+    with pytest.raises(ParameterError, match=rf"{law}.kappa"):
+        get_material(str(p))
+
+
+def test_a_bulk_modulus_too_large_names_kappa_and_its_range():
+    from tactileskin.materials.laws import law_from_dict
+
+    with pytest.raises(ParameterError, match=r"material 'x' neo_hookean.kappa=1000000000.0 is invalid; valid: "
+                                             r"\[.*, 500\] MPa"):
+        law_from_dict("neo_hookean", {"mu": 0.1, "kappa": 1e9}, "material 'x'")

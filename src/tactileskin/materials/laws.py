@@ -13,8 +13,10 @@ A new law is its module plus one line in `_MODULES`.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib
+import math
 
 from tactileskin import validate
 from tactileskin.errors import ParameterError
@@ -54,15 +56,80 @@ MAX_BULK_OVER_SHEAR = 5000.0  # nu0 = 0.4999
 
 def law_from_dict(name: str, table, what: str):
     """An instance of law `name` from its parameter table, its small-strain moduli checked
-    against MU0_RANGE and MAX_BULK_OVER_SHEAR."""
+    against MU0_RANGE and MAX_BULK_OVER_SHEAR (a ParameterError naming the bulk parameter,
+    kappa or nu, and its range)."""
     from tactileskin.errors import check_range
 
     cls = get_law(validate.string(name, f"{what} law", "a law name"))
     law = cls.from_dict(table, f"{what} {name}")
     check_range(f"{what} {name}: small-strain shear modulus mu0", law.mu0, *MU0_RANGE, unit="MPa")
-    check_range(f"{what} {name}: bulk / shear modulus K0 / mu0 (nu0 = {nu0(law):.6g})", law.K0 / law.mu0,
-                None, MAX_BULK_OVER_SHEAR)
+    if not law.K0 / law.mu0 <= MAX_BULK_OVER_SHEAR:
+        raise bulk_error(law, f"{what} {name}", f"K0 / mu0 = {law.K0 / law.mu0:.6g} is over "
+                         f"{MAX_BULK_OVER_SHEAR:g} (nu0 = {nu0(law):.6g} over {_nu_of(MAX_BULK_OVER_SHEAR):.6g})")
     return law
+
+
+# the parameter that sets each law's small-strain bulk modulus: nu for the hyperfoam, kappa (MPa)
+# for the others; its valid range depends on the law's other parameters (mu0 and stability)
+def _bulk_name(law) -> str:
+    return "nu" if law.law == "hyperfoam" else "kappa"
+
+
+def _nu_of(ratio: float) -> float:
+    """The Poisson ratio of a bulk / shear modulus ratio."""
+    return (3 * ratio - 2) / (2 * (3 * ratio + 1))
+
+
+def _with_ratio(law, ratio: float):
+    """`law` with its bulk parameter set so that K0 / mu0 = ratio."""
+    value = _nu_of(ratio) if _bulk_name(law) == "nu" else ratio * law.mu0
+    return dataclasses.replace(law, **{_bulk_name(law): value})
+
+
+def _sig(x: float, up: bool, digits: int) -> float:
+    """x to `digits` significant digits, rounded up or down (a printed bound that is itself valid)."""
+    e = 10.0 ** (math.floor(math.log10(abs(x))) - digits + 1)
+    v = (math.ceil if up else math.floor)(x / e) * e
+    return float(f"{v:.{digits}g}")
+
+
+def bulk_range(law) -> tuple[float | None, float]:
+    """The valid range of `law`'s bulk parameter (kappa MPa, or nu) with its other parameters:
+    from the smallest at which its uniaxial stress rises with stretch (materials.fit.STABLE_RANGE;
+    None: no value up to the largest is stable) to the largest, K0 / mu0 = MAX_BULK_OVER_SHEAR.
+    A bisection in log(K0 / mu0), stability assumed to grow with the bulk modulus: for error
+    messages only (~50 stability checks)."""
+    from tactileskin.materials.fit import unstable_stretch
+
+    def stable(r):
+        try:
+            trial = _with_ratio(law, r)
+        except ParameterError:  # nu rounds to -1
+            return False
+        return unstable_stretch(trial, nu0(trial)) is None
+
+    value = lambda r: _nu_of(r) if _bulk_name(law) == "nu" else r * law.mu0  # noqa: E731
+    hi = MAX_BULK_OVER_SHEAR
+    if not stable(hi):
+        return None, _sig(value(hi), False, 4)
+    lo = min(law.K0 / law.mu0, 1.0)
+    while stable(lo) and lo > 1e-30:
+        lo /= 1e3
+    a, b = math.log(lo), math.log(hi)        # unstable at a, stable at b
+    for _ in range(50):
+        m = 0.5 * (a + b)
+        a, b = (a, m) if stable(math.exp(m)) else (m, b)
+    return _sig(value(math.exp(b)), True, 3), _sig(value(hi), False, 4)
+
+
+def bulk_error(law, where: str, why: str) -> ParameterError:
+    """A ParameterError naming `where`.kappa (or .nu) and its valid range (bulk_range)."""
+    lo, hi = bulk_range(law)
+    name = _bulk_name(law)
+    unit = " MPa" if name == "kappa" else ""
+    valid = (f"[{lo:g}, {hi:g}]{unit}" if lo is not None else
+             f"<= {hi:g}{unit}, and the law's other parameters stable (none of its values is)")
+    return ParameterError(f"{where}.{name}", getattr(law, name), valid + f" with mu0 = {law.mu0:g} MPa", why)
 
 
 def nu0(law) -> float:

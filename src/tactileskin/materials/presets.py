@@ -129,10 +129,14 @@ def _check_stable(mat: Material, path: Path) -> None:
     compression; it stalled after 0.004 mm in 3D with a message blaming the mesh, and read "ok"
     in 2D (9.7 MPa)."""
     from tactileskin.materials.fit import STABLE_RANGE, unstable_stretch
-    from tactileskin.materials.laws import nu0
+    from tactileskin.materials.laws import bulk_error, bulk_range, nu0
 
     at = unstable_stretch(mat.law, nu0(mat.law))
     if at is not None:
+        lo, _ = bulk_range(mat.law)
+        if lo is not None:  # a larger bulk modulus makes it stable: name that parameter
+            raise bulk_error(mat.law, f"material {mat.name!r} {mat.law_name}",
+                             f"below it the law's uniaxial stress does not rise with stretch at {at:.3g} ({path})")
         lo, hi = STABLE_RANGE
         raise ParameterError("material file", str(path), f"a stable law: its uniaxial stress rising with stretch "
                              f"over {lo:g}-{hi:g}", f"the {mat.law_name} law of {mat.name!r} does not at stretch {at:.3g}")
