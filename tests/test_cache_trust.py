@@ -778,3 +778,23 @@ def test_an_editor_lock_file_in_the_package_is_not_code(tmp_path):
     held, _ = _run_python(pkg, code)          # imported while the lock is there
     lock.unlink()
     assert held["key"] == plain["key"] and held["changes"] == []
+
+
+def test_a_date_in_a_geometry_file_is_refused_naming_its_key_and_keys_apart_from_its_text(geometry):
+    """tomllib reads `radius = 2024-01-01` as a date; the key dumped it with default=str, the
+    same as the string "2024-01-01"; a solve met float(date): a TypeError traceback. No geometry
+    value is a date or time: the file is refused naming the key, and keyed by its bytes."""
+    from tactileskin.errors import ParameterError
+
+    sc = Scene(indenter="curved")
+    f = geometry / "indenters.toml"
+    text = f.read_text()
+    keys = set()
+    for value in ('"2024-01-01"', "2024-01-01", "'12:00:00'", "12:00:00", "2024-01-01T12:00:00Z"):
+        f.write_text(text.replace("radius = 12.0", f"radius = {value}"))
+        keys.add(cache_key(sc))
+        if '"' not in value and "'" not in value:
+            with pytest.raises(ParameterError, match=r"indenters.toml: curved.radius=.* is invalid; valid: a number "
+                                                     r"or text, not a TOML date or time"):
+                params.load("indenters")
+    assert len(keys) == 5

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import datetime
 import functools
 import hashlib
 import json
@@ -97,10 +98,26 @@ def _parsed(name: str, data: bytes, path) -> dict:
     hit = _PARSED.get((name, data))
     if hit is None:
         hit = _parse(data, path, "parameter file")
+        _refuse_dates(hit, f"{name}.toml: ")
         if len(_PARSED) > 64:  # only edits add entries; keep the memo small
             _PARSED.clear()
         _PARSED[(name, data)] = hit
     return hit
+
+
+def _refuse_dates(value, where: str, key: str = "") -> None:
+    """No geometry parameter is a date or time: tomllib reads `radius = 2024-01-01` as one, which
+    a reader's float() met as a TypeError traceback and the cache key could not tell from the
+    text "2024-01-01"; a ParameterError names the file and the key."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _refuse_dates(v, where, f"{key}.{k}" if key else str(k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            _refuse_dates(v, where, f"{key}[{i}]")
+    elif isinstance(value, (datetime.date, datetime.time)):  # datetime is a date
+        raise ParameterError(where + key, value.isoformat(), "a number or text, not a TOML date or time",
+                             "quote it if it is text")
 
 
 def geometry_changes() -> list[str] | None:
@@ -145,8 +162,8 @@ def geometry_digest() -> str:
         data = _read_capped(p, "parameter file")
         try:
             parsed = _parsed(p.stem, data, p)
-            # floats as repr (exact), 1 and 1.0 apart as TOML has them; dates and times as text
-            data = b"toml\0" + json.dumps(parsed, sort_keys=True, default=str).encode()
+            # floats as repr (exact), 1 and 1.0 apart as TOML has them (dates and times are refused)
+            data = b"toml\0" + json.dumps(parsed, sort_keys=True).encode()
         except ParameterError:
             pass
         h.update(p.name.encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
