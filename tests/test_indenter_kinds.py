@@ -440,3 +440,32 @@ def test_a_file_edited_while_it_is_read_is_not_kept_as_the_old_bytes(tmp_path, m
     v, _ = file_mod.load_surface(f)
     assert np.ptp(v[:, 0]) == pytest.approx(4.0, rel=0.02)  # the 2 mm ball's, not the 2.5 mm one's
     file_mod._load.cache_clear()
+
+
+def test_a_half_written_indenter_file_is_called_changed_not_unreadable(tmp_path, monkeypatch):
+    """A file being written while it is read fails to parse (truncated) before the digest is
+    checked again: the error said 'cannot read it', as for a damaged file, though the file had
+    changed meanwhile (its full form reads). It now says it changed while it was read."""
+    trimesh = pytest.importorskip("trimesh")
+    from tactileskin.geometry.indenters import file as file_mod
+
+    f = tmp_path / "ind.stl"
+    trimesh.creation.icosphere(subdivisions=2, radius=2.0).export(f)
+    full = f.read_bytes()
+    real = file_mod._read
+
+    def half_written(path, *a):
+        path.write_bytes(full[: len(full) // 2])  # the writer is half way
+        try:
+            return real(path, *a)
+        finally:
+            path.write_bytes(full[: len(full) // 2 + 100])  # and goes on
+
+    monkeypatch.setattr(file_mod, "_read", half_written)
+    file_mod._load.cache_clear()
+    with pytest.raises(ParameterError, match="indenter_file.*changed while it was read") as e:
+        file_mod.load_surface(f)
+    assert "cannot read" not in str(e.value)
+    monkeypatch.setattr(file_mod, "_read", real)
+    f.write_bytes(full)
+    assert len(file_mod.load_surface(f)[0]) > 0

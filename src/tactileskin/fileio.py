@@ -262,10 +262,26 @@ def read_unchanged(read, path, digest: str, digest_of, name: str, valid: str):
     cache key, for the life of the process."""
     from tactileskin.errors import ParameterError
 
-    out = read(path)
+    changed = "it changed while it was read; run again once it is written"
+    try:
+        out = read(path)
+    except Exception as e:  # a half-written file fails to parse (any error): say what happened
+        if _digest_or_none(digest_of, path) != digest:
+            raise ParameterError(name, str(path), valid, changed) from e
+        raise
     if digest_of(path) != digest:
-        raise ParameterError(name, str(path), valid, "it changed while it was read; run again once it is written")
+        raise ParameterError(name, str(path), valid, changed)
     return out
+
+
+def _digest_or_none(digest_of, path):
+    """digest_of(path), or None if the file cannot be read now (removed meanwhile: changed too)."""
+    from tactileskin.errors import ParameterError
+
+    try:
+        return digest_of(path)
+    except (OSError, ParameterError):
+        return None
 
 
 def fix_tree_modes(root) -> None:
