@@ -100,3 +100,24 @@ def test_to_pyvista_carries_the_flag(written):
         grid = res.to_pyvista()
         assert set(np.unique(grid.cell_data[SUSPECT_ARRAY]).tolist()) == {int(name == "suspect")}
         assert not re.search("suspect|status", " ".join(grid.field_data.keys()))
+
+
+@pytest.mark.parametrize("status", [
+    "suspect: sensor '\x01a\x1b[31m' \\u0041 \\x-- end\r\nnext\tline -",
+    "suspect: \ud800 lone surrogate, \ufffe\uffff not characters, \x7f\x85 kept, \\\\ -->",
+])
+def test_a_status_with_control_characters_is_valid_xml_and_round_trips(tmp_path, status):
+    """XML 1.0 allows no control character but tab, newline and CR (a parser turns CR LF into
+    LF) and no U+FFFE, U+FFFF; a lone surrogate cannot be UTF-8 at all. A status text holding
+    one (a name given by the user in a reason) made result.vtu invalid XML, or failed the write."""
+    import xml.etree.ElementTree as ET
+
+    from tactileskin.results import _write_vtu
+
+    fields = {"points": np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), "cell_type": "triangle",
+              "cells": np.array([[0, 1, 2]]), "point_data": {}}
+    p = tmp_path / "result.vtu"
+    _write_vtu(p, fields, status=status)
+    ET.parse(p)
+    assert vtu_status(p) == status
+    assert meshio.read(p).cell_data[SUSPECT_ARRAY][0].tolist() == [1]

@@ -638,11 +638,18 @@ SUSPECT_ARRAY = "suspect"
 _STATUS_COMMENT = "<!-- tactileskin status: "
 
 
+# what an XML 1.0 comment may not hold as text: control characters but tab and newline (CR
+# too: a parser turns CR LF into LF), surrogates (no UTF-8 form) and the non-characters U+FFFE/F
+_NOT_XML = re.compile("[\x00-\x08\x0b-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
 def _with_status(data: bytes, status: str) -> bytes:
     """A .vtu's bytes with `status` in a comment after the XML declaration. A comment cannot
     hold "--" (a reason says "use --quality"): a "-" after a "-" is written "\\-", a backslash
-    "\\\\" (vtu_status reads it back), so "--quality" reads "-\\-quality"."""
-    text = re.sub(r"(?<=-)-", r"\\-", status.replace("\\", "\\\\"))
+    "\\\\", a character XML does not allow (_NOT_XML) "\\uXXXX;" (vtu_status reads them back),
+    so "--quality" reads "-\\-quality"."""
+    text = _NOT_XML.sub(lambda m: f"\\u{ord(m.group()):04x};", status.replace("\\", "\\\\"))
+    text = re.sub(r"(?<=-)-", r"\\-", text)
     i = data.index(b"?>") + 2 if data.startswith(b"<?xml") else 0
     return data[:i] + ("\n" + _STATUS_COMMENT + text + " -->").encode("utf-8") + data[i:]
 
@@ -656,7 +663,8 @@ def vtu_status(path) -> str | None:
     j = head.find(" -->", i)
     if i < 0 or j < 0:
         return None
-    return re.sub(r"\\(.)", r"\1", head[i + len(_STATUS_COMMENT):j])
+    return re.sub(r"\\(?:u([0-9a-f]{4});|(.))", lambda m: chr(int(m.group(1), 16)) if m.group(1) else m.group(2),
+                  head[i + len(_STATUS_COMMENT):j], flags=re.S)
 
 
 def add_vtu_field_data(path: Path, field_data: dict) -> None:
