@@ -231,3 +231,71 @@ def test_drawing_here_writes_into_the_callers_folder_not_a_temporary_one(monkeyp
         with Background(refused, here=out) as bg:
             bg.files()
     assert e.value.filename == str(out / "fig.png")
+
+
+def _gone(pid: int) -> bool:
+    """The process has ended (a zombie counts: an init that does not reap leaves it)."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except FileNotFoundError:
+        return True
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
+@pytest.mark.parametrize("late", [False, True])
+def test_the_child_ends_with_its_parent_and_removes_its_folder(tmp_path, late):
+    """A sweep SIGKILLed while its figure child drew left the child drawing on (its share's
+    time, seconds), holding the output folder's lock descriptor, and its /tmp folder for good.
+    The child now ends with its parent and removes the folder; `late`: the parent dies before
+    the child has asked to (the child finds it reparented)."""
+    import signal
+    import subprocess
+
+    script = tmp_path / "orphan.py"
+    script.write_text(
+        "import os, sys, time\n"
+        "from tactileskin import threads\n"
+        "threads.other_threads = list\n"
+        "from tactileskin.report import background\n"
+        "from tactileskin.report.background import Background\n"
+        "parent = os.getpid()\n"
+        "real_fork = os.fork\n"
+        "def fork():\n"
+        "    pid = real_fork()\n"
+        f"    if pid == 0 and {late}:\n"
+        "        while os.getppid() == parent:\n"
+        "            time.sleep(0.01)\n"
+        "    return pid\n"
+        "background.os.fork = fork\n"
+        "def draw(folder):\n"
+        "    p = os.path.join(folder, 'a.txt')\n"
+        "    open(p, 'w').write('x')\n"
+        "    for _ in range(3000):\n"
+        "        time.sleep(0.01)\n"
+        "    return [p]\n"
+        "with Background(draw) as bg:\n"
+        "    print(bg.pid, bg.folder, flush=True)\n"
+        "    time.sleep(120)\n")
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True,
+                         env={**os.environ, "PYTHONPATH": str(Path(background.__file__).parents[2])})
+    pid = None
+    try:
+        pid, folder = p.stdout.readline().split()
+        pid = int(pid)
+        if not late:
+            deadline = time.monotonic() + 30
+            while not (Path(folder) / "a.txt").exists() and time.monotonic() < deadline:
+                time.sleep(0.01)  # the child is drawing
+        p.send_signal(signal.SIGKILL)
+        p.wait(timeout=30)
+        deadline = time.monotonic() + 20  # the child draws for 30 s: well apart under load
+        while not (_gone(pid) and not Path(folder).exists()) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert _gone(pid), "the child outlived its parent"
+        assert not Path(folder).exists(), "the child's folder outlived it"
+    finally:
+        p.kill()
+        p.wait()
+        if pid is not None and not _gone(pid):
+            os.kill(pid, signal.SIGKILL)

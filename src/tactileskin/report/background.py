@@ -60,7 +60,31 @@ class _Keep(logging.Handler):
         self.records.append(record)
 
 
-def _in_child(fn, folder: Path, fd: int, other_end: int) -> None:
+_PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def _end_with(parent: int, folder: Path) -> None:
+    """End this child, its folder removed, when `parent` ends: a parent SIGKILLed mid-sweep
+    left it drawing on (seconds), holding the output lock's descriptor, and its folder in /tmp
+    for good. The kernel sends SIGTERM at the parent's death (PR_SET_PDEATHSIG); a parent gone
+    before that was asked shows as another parent pid."""
+    def end(signum, frame):
+        shutil.rmtree(folder, ignore_errors=True)
+        os._exit(1)
+
+    signal.signal(signal.SIGTERM, end)
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+    except (OSError, AttributeError):  # no prctl: the child ends when its share is drawn
+        pass
+    if os.getppid() != parent:
+        end(None, None)
+
+
+def _in_child(fn, folder: Path, fd: int, other_end: int, parent: int) -> None:
     """Run fn(folder), send ("ok", files, records) or ("error", text, records), and end the
     process without its parent's exit handlers (os._exit: they close the parent's cluster,
     release its locks)."""
@@ -68,7 +92,7 @@ def _in_child(fn, folder: Path, fd: int, other_end: int) -> None:
     try:
         os.close(other_end)
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        _end_with(parent, folder)  # SIGTERM too ends the child, its folder removed
         # new file objects on the standard streams: the ones copied may be the progress bar's
         # proxies, or hold a lock another thread had taken as the process was copied
         sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115 - for the child's short life
@@ -132,6 +156,7 @@ class Background:
         held: list[int] = []
         previous = {s: signal.signal(s, lambda signum, frame: held.append(signum))
                     for s in (signal.SIGINT, signal.SIGTERM)}
+        parent = os.getpid()
         try:
             try:
                 pid = os.fork()
@@ -140,7 +165,7 @@ class Background:
                 os.close(w)
                 raise
             if pid == 0:
-                _in_child(self.fn, self.folder, w, r)
+                _in_child(self.fn, self.folder, w, r, parent)
             os.close(w)
             self.pid, self.fd = pid, r
         finally:
