@@ -45,7 +45,7 @@ FIELDS: dict[str, tuple[str, str, str]] = {
     "force": ("N (3D, the whole indenter), N/mm (2D, the half section)", "(0, 10000]; instead of depth and depth_fraction",
               "force control: the target reaction"),
     "force_rate": ("N/s (N/mm/s in 2D)", "[1e-6, 1e6]; with force, not with load_time", "force ramp rate"),
-    "load_time": ("s", "(0, 1e6]; with force, not with force_rate",
+    "load_time": ("s", "[1e-6, 1e6]; with force, not with force_rate",
                   "time to reach the force (None: 0.2 t / rate, the default depth ramp's)"),
     "loading": ("mm, N, s", "[[loading]] segments after the first ramp: depth (mm) or force at a rate "
                 "or in a time, hold (s)", "indent-hold-release history (history.csv)"),
