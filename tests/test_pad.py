@@ -347,3 +347,25 @@ def test_a_slender_pad_pressed_past_its_buckling_strain_is_suspect():
     assert quality.status(solve(stocky).summary()) == "ok"
     ball = Scene(dim=3, skin="pad", indenter="sphere", indenter_radius=2.5, thickness=10.0, pad_width=2.0)
     assert ball.skin_kind.buckling_strain(ball) is None
+
+
+
+def test_a_pad_too_wide_for_the_flat_plate_is_refused_at_once_naming_its_range():
+    """--skin pad --pad-width 500 under the default flat plate (a plane over the whole top:
+    the compression of a 167 t wide bonded layer is confined and locks up at ~0.08 mm) meshed
+    22015 cells at the fine size over the whole top and was still cutting back after 300 s
+    (200 mm failed in 62 s CPU, 236 s wall; 100 mm in 43 s CPU). Under the plate the width (and in 3D the
+    length) is refused past 100 mm at once; real fingertip and robot pads (up to ~100 mm) and
+    a local press on a wide pad (a cylinder on 500 mm solves in 3 s) stay valid."""
+    from tactileskin.skins import pad
+
+    for name in ("pad_width", "pad_length"):
+        with pytest.raises(ParameterError, match=rf"^{name}=500.0 is invalid; valid: \[1, 100\] mm under the flat "
+                                                 r"plate.*cylinder"):
+            Scene(skin="pad", dim=3, mesh_size=2.0, **{name: 500.0})
+        assert getattr(Scene(skin="pad", dim=3, mesh_size=2.0, **{name: 100.0}), name) == 100.0
+    with pytest.raises(ParameterError, match=r"^pad_width=500.0 .*\[1, 100\] mm under the flat plate"):
+        Scene(skin="pad", pad_width=500.0)
+    assert Scene(skin="pad", pad_length=500.0).pad_length == 500.0  # 2D: the length is not modelled
+    assert Scene(skin="pad", pad_width=500.0, indenter="cylinder", indenter_radius=5.0).pad_width == 500.0
+    assert pad.SIZE == (1.0, 500.0)

@@ -51,8 +51,8 @@ FIELDS: dict[str, tuple[str, str, str]] = {
                 "or in a time, hold (s)", "indent-hold-release history (history.csv)"),
     "skin": ("-", "a registered skin: 'fingertip' (the paper's), 'pad', 'dome' or 'file' (tactileskin.skins)",
              "the skin geometry"),
-    "pad_width": ("mm", "[1, 500]; pad only (default 20)", "x extent of the whole pad"),
-    "pad_length": ("mm", "[1, 500]; pad only (default 20)", "z extent of the pad (3D block)"),
+    "pad_width": ("mm", "[1, 500], [1, 100] under the flat plate; pad only (default 20)", "x extent of the whole pad"),
+    "pad_length": ("mm", "[1, 500], [1, 100] under the flat plate in 3D; pad only (default 20)", "z extent of the pad (3D block)"),
     "skin_file": ("mm", "a gmsh .msh with named physical groups or a STEP solid, 0.1 mm to 1 m; file only",
                   "the user's skin geometry (fixes dim and thickness)"),
     "skin_bonded": ("-", ".msh: physical-group name(s), comma-separated; STEP: 'normal:-y[:TOL_DEG]' or "

@@ -92,7 +92,7 @@ class _HelpText:
         from tactileskin.errors import range_text
         from tactileskin.skins import pad
 
-        return "in " + range_text(*pad.SIZE)
+        return f"in {range_text(*pad.SIZE)} (up to {pad.PLATE_SIZE:g} mm under the flat plate)"
 
     @staticmethod
     def pad(which: str) -> str:

@@ -25,6 +25,11 @@ DEFAULT_WIDTH = 20.0    # mm, x extent of the whole pad
 DEFAULT_LENGTH = 20.0   # mm, z extent
 THICKNESS = (0.1, 50.0)  # mm
 SIZE = (1.0, 500.0)      # mm, width and length
+# mm: the largest width (and 3D length) under the flat plate, a plane pressing the whole top. A
+# wider bonded pad is confined and locks up early (t = 3 silicone at 20 %: 28 mm failed at 0.55 mm,
+# 100 mm at 0.22 mm in 43 s CPU, 500 mm at ~0.08 mm, still cutting back after 300 s); real
+# fingertip and robot pads are up to ~100 mm, and a local press on a wider pad solves
+PLATE_SIZE = 100.0
 FLAT_RADIUS = 1e6        # mm: "radius" of the flat top for contact-size estimates
 
 
@@ -102,9 +107,17 @@ class PadSkin(Skin):
     def check_scene(cls, scene) -> dict:
         w = DEFAULT_WIDTH if scene.pad_width is None else scene.pad_width
         length = DEFAULT_LENGTH if scene.pad_length is None else scene.pad_length
-        return {"thickness": check_range("thickness", scene.thickness, *THICKNESS, unit="mm"),
-                "pad_width": check_range("pad_width", w, *SIZE, unit="mm"),
-                "pad_length": check_range("pad_length", length, *SIZE, unit="mm")}
+        out = {"thickness": check_range("thickness", scene.thickness, *THICKNESS, unit="mm"),
+               "pad_width": check_range("pad_width", w, *SIZE, unit="mm"),
+               "pad_length": check_range("pad_length", length, *SIZE, unit="mm")}
+        if scene.indenter_kind.name == "flat":
+            for name in ("pad_width", "pad_length") if scene.dim == 3 else ("pad_width",):
+                if out[name] > PLATE_SIZE:
+                    raise ParameterError(name, out[name], f"[{SIZE[0]:g}, {PLATE_SIZE:g}] mm under the flat plate "
+                                         f"(up to {SIZE[1]:g} mm under the other indenters)",
+                                         "the plate presses the whole top: a wider bonded pad is confined and "
+                                         "locks up; for a local press use a cylinder or sphere indenter")
+        return out
 
     @classmethod
     def section(cls, scene) -> PadSection:
