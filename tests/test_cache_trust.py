@@ -798,3 +798,26 @@ def test_a_date_in_a_geometry_file_is_refused_naming_its_key_and_keys_apart_from
                                                      r"or text, not a TOML date or time"):
                 params.load("indenters")
     assert len(keys) == 5
+
+
+@pytest.mark.parametrize("old, new, key", [
+    ("radius = 12.0", 'radius = "12.0"', r"curved.radius"),
+    ("radius = 12.0", "radius = nan", r"curved.radius"),
+    ("radius = 12.0", "radius = true", r"curved.radius"),
+    ("radius = 12.0", "radius = [12.0]", r"curved.radius"),
+    ("radius = 12.0", "radius = {r = 12.0}", r"curved.radius"),
+])
+def test_a_geometry_value_of_the_wrong_type_is_refused_naming_its_key(geometry, old, new, key):
+    """A user's geometry file with text, nan, a boolean or a table where the shipped file has a
+    number ended in a ValueError or TypeError traceback (float('abc')) or in a nan geometry;
+    it is refused naming the file and the key. An integer is a number (radius = 12 solves)."""
+    from tactileskin.errors import ParameterError
+
+    f = geometry / "indenters.toml"
+    text = f.read_text()
+    assert old in text
+    f.write_text(text.replace(old, new))
+    with pytest.raises(ParameterError, match=rf"^indenters.toml: {key}=.* is invalid; valid: a finite number"):
+        params.load("indenters")
+    f.write_text(text.replace(old, "radius = 12"))
+    assert params.load("indenters")["curved"]["radius"] == 12

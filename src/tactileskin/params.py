@@ -13,6 +13,7 @@ import datetime
 import functools
 import hashlib
 import json
+import math
 import os
 import tomllib
 from importlib import resources
@@ -99,6 +100,8 @@ def _parsed(name: str, data: bytes, path) -> dict:
     if hit is None:
         hit = _parse(data, path, "parameter file")
         _refuse_dates(hit, f"{name}.toml: ")
+        if f"{name}.toml" not in NOT_SOLVED:  # the mold's reader (geometry.molds) names its own values
+            _check_numbers(hit, _shipped(name), f"{name}.toml: ")
         if len(_PARSED) > 64:  # only edits add entries; keep the memo small
             _PARSED.clear()
         _PARSED[(name, data)] = hit
@@ -118,6 +121,39 @@ def _refuse_dates(value, where: str, key: str = "") -> None:
     elif isinstance(value, (datetime.date, datetime.time)):  # datetime is a date
         raise ParameterError(where + key, value.isoformat(), "a number or text, not a TOML date or time",
                              "quote it if it is text")
+
+
+@functools.cache
+def _shipped(name: str) -> dict:
+    """The shipped `name`.toml parsed ({} for a file the package does not ship)."""
+    try:
+        return tomllib.loads((_packaged_dir() / f"{name}.toml").read_text("utf-8"))
+    except (OSError, tomllib.TOMLDecodeError):
+        return {}
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _check_numbers(value: dict, shipped: dict, where: str, key: str = "") -> None:
+    """Where the shipped file has a number (or a list of numbers), a user's file must have a
+    finite one (or a list of them): its readers take float() of it, which met text as a
+    ValueError traceback, a nan as a nan geometry. Keys the shipped file lacks (a user's own
+    Braille standard) and missing keys are the readers' to judge."""
+    for k, ref in shipped.items():
+        if k not in value:
+            continue
+        v, name = value[k], f"{key}.{k}" if key else str(k)
+        if isinstance(ref, dict):
+            if not isinstance(v, dict):
+                raise ParameterError(where + name, v, "a table, as the shipped file has")
+            _check_numbers(v, ref, where, name)
+        elif isinstance(ref, list) and all(_is_number(r) for r in ref):
+            if not (isinstance(v, list) and v and all(_is_number(x) for x in v)):
+                raise ParameterError(where + name, v, "a list of finite numbers, as the shipped file has")
+        elif _is_number(ref) and not _is_number(v):
+            raise ParameterError(where + name, v, "a finite number, as the shipped file has")
 
 
 def geometry_changes() -> list[str] | None:
