@@ -384,3 +384,20 @@ def test_a_headerless_strain_column_from_zero_is_named_as_such(tmp_path):
     f.write_text("".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(lam - 1.0, P)))
     with pytest.raises(FitDataError, match=r"line 1 .*strain.*'strain' header.*swapped"):
         read_uniaxial_csv(f)
+
+
+def test_a_fit_unstable_for_its_small_nu_names_the_nu_that_would_do():
+    """--nu -0.9 makes the fitted neo-Hookean's kappa 0.008 MPa (mu 0.34): unstable in
+    compression; the error said 'try another law or fewer terms', which cannot help. It names
+    --nu and the smallest Poisson ratio that is stable with the fitted mu."""
+    import re
+
+    from tactileskin.materials.fit import FitError
+
+    lam = np.array([0.8, 0.9, 1.0, 1.1, 1.2, 1.3])
+    P = 0.1 * (lam - 1.0)
+    with pytest.raises(FitError, match=r"give a larger --nu, at least ([-0-9.e]+)") as e:
+        fit("neo_hookean", lam, P, nu=-0.9)
+    nu_min = float(re.search(r"at least ([-0-9.e]+)", str(e.value)).group(1))
+    assert -0.9 < nu_min < 0.4999
+    assert fit("neo_hookean", lam, P, nu=nu_min).law.kappa > 0

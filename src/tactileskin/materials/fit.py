@@ -362,7 +362,21 @@ def _check_stable(law: str, mat, lam, nu) -> None:
     if at is not None:
         raise FitError(f"the fitted {law} law is not stable: its uniaxial stress does not rise with stretch "
                        f"at stretch {at:.3g} ({mat.to_dict() if hasattr(mat, 'to_dict') else mat}); "
-                       "try another law or fewer terms")
+                       + (_nu_hint(mat) if nu is not None else "") + "try another law or fewer terms")
+
+
+def _nu_hint(mat) -> str:
+    """'give a larger --nu, at least X; or ' where a larger bulk modulus makes the fitted law
+    stable (a small --nu gives kappa << mu, unstable in compression), else ''."""
+    from tactileskin.materials import laws
+
+    if not hasattr(mat, "K0") or not hasattr(mat, "law"):
+        return ""
+    lo, _ = laws.bulk_range(mat)
+    if lo is None:
+        return ""
+    nu = lo if mat.law == "hyperfoam" else laws._nu_of(lo / mat.mu0)
+    return f"give a larger --nu, at least {laws._sig(nu, True, 3):g}; or "
 
 
 def _check_loadable(law: str, mat, lam) -> None:
