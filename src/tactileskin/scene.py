@@ -290,7 +290,8 @@ class Scene:
             loading.check_ramp("force_rate", self.force_rate, 0.0, self.force, "N/s (N/mm/s in 2D)")
         elif self.force is None or self.load_time is None:  # load_time's own range holds the rest
             travel = self.depth if self.depth is not None else self.depth_fraction * self.thickness
-            loading.check_ramp("rate", self.rate, 0.0, travel, "mm/s")
+            if travel / loading.MIN_RAMP_TIME >= RATE[0]:  # else no rate does: the depth's contact check names it
+                loading.check_ramp("rate", self.rate, 0.0, travel, "mm/s")
 
     # --- derived -----------------------------------------------------------------------
     @property
