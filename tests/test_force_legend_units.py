@@ -66,3 +66,25 @@ def test_each_series_of_the_thickness_figure_has_its_own_style(tmp_path, monkeyp
     lines = got["metrics_vs_thickness"].axes[0].get_lines()
     styles = {(ln.get_color(), ln.get_marker(), ln.get_linestyle(), ln.get_fillstyle()) for ln in lines}
     assert len(lines) == 8 and len(styles) == 8, sorted(styles)
+
+
+def test_a_variant_shared_by_2d_and_3d_cases_names_both_units_in_the_discrimination_tables():
+    # one id suffix "F0.5" is 0.5 N/mm on the 2D cases and 0.5 N on the 3D dots: a table row
+    # holding both named it with the unit of whichever record came last
+    from types import SimpleNamespace
+
+    from tactileskin.report.markdown import discrimination_table_by_model
+    from tactileskin.sweep import case_variant_labels, case_variants
+
+    scenes = [Scene(thickness=1.0, indenter=i, dim=d, force=f) for i, d in (("flat", 2), ("braille", 2),
+                                                                            ("braille", 3)) for f in (0.5, 1.0)]
+    recs = [SimpleNamespace(scene=s, variant=v, variant_label=lab)
+            for s, v, lab in zip(scenes, case_variants(scenes), case_variant_labels(scenes))]
+    assert {r.variant for r in recs} == {"F0.5", "F1"}
+    groups = [dict(group=("silicone", 1.0, "F0.5"), distances={2: "d2", 3: "d3"}, verdict={2: "v2", 3: "v3"},
+                   changed=False)]
+    row = discrimination_table_by_model(groups, recs)[-1]
+    cell = row.split("|")[3]
+    assert "0.5 N/mm" in cell and "0.5 N (3D)" in cell, row
+    for order in (recs, recs[::-1]):  # not the last record's alone
+        assert discrimination_table_by_model(groups, order)[-1] == row

@@ -308,8 +308,15 @@ def _with_left_out(verdict: str, left: list[str]) -> str:
 
 
 def _variant_labels(records) -> dict:
-    """variant id suffix -> its text with units (sweep.case_variant_labels: "F = 0.03 N/mm")."""
-    return {getattr(r, "variant", ""): getattr(r, "variant_label", "") or getattr(r, "variant", "") for r in records}
+    """variant id suffix -> its text with units (sweep.case_variant_labels: "F = 0.03 N/mm").
+    One suffix on 2D and 3D cases ("F0.5": 0.5 N/mm and 0.5 N) names both, "F = 0.5 N/mm (2D) /
+    F = 0.5 N (3D)": a table row of such a variant holds both."""
+    by_dim = defaultdict(dict)
+    for r in records:
+        v = getattr(r, "variant", "")
+        by_dim[v][r.scene.dim] = getattr(r, "variant_label", "") or v
+    return {v: next(iter(d.values())) if len(set(d.values())) == 1
+            else " / ".join(f"{d[k]} ({k}D)" for k in sorted(d)) for v, d in by_dim.items()}
 
 
 def discrimination_table(records, rows=()) -> list[str]:
