@@ -47,7 +47,7 @@ def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
     report = (out / "report.md").read_text()
     assert "| silicone | 1 | F = 0.03 N/mm |" in report
     # the Cases table's depth of a force case is the travel it reached, not a prescribed depth
-    assert "Depth of a force-controlled case: the travel the indenter reached" in report
+    assert "Depth of a force-controlled case: the travel the indenter reached (an output" in report
 
 
 @pytest.mark.usefixtures("close_figures")
@@ -88,3 +88,24 @@ def test_a_variant_shared_by_2d_and_3d_cases_names_both_units_in_the_discriminat
     assert "0.5 N/mm" in cell and "0.5 N (3D)" in cell, row
     for order in (recs, recs[::-1]):  # not the last record's alone
         assert discrimination_table_by_model(groups, order)[-1] == row
+
+
+@pytest.mark.usefixtures("close_figures")
+def test_the_cases_note_says_which_state_a_force_case_with_later_segments_reports(tmp_path):
+    # force 0.03 N/mm, a hold, then 0.06 N/mm: the row's depth and reaction are those of the
+    # peak-load state (0.06), not of the target force the note named
+    import csv
+
+    from tactileskin.cli import main
+
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text('[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\nindenters = ["flat"]\nforces = [0.03]\n'
+                   '[scene]\ndim = 2\n[[scene.loading]]\nhold = 0.1\n[[scene.loading]]\nforce = 0.06\ntime = 0.2\n')
+    out = tmp_path / "out"
+    assert main(["sweep", "--config", str(cfg), "--quality", "preview", "--serial", "--no-render",
+                 "--out", str(out)]) == 0
+    with open(out / "results.csv", newline="") as fh:
+        row, = csv.DictReader(fh)
+    assert float(row["reaction_n_per_mm"]) == pytest.approx(0.06, rel=0.05)  # the peak load's state
+    note = [ln for ln in (out / "report.md").read_text().splitlines() if ln.startswith("Depth of a force-controlled")]
+    assert len(note) == 1 and "peak load" in note[0], note

@@ -708,8 +708,9 @@ def build_report(rows, records, failures, figures, renders, wall_s: float, scene
                    f"{'**suspect**' if k == 'suspect' else 'ok'} |" + run(r))
     out += ["", "Span: the extent of s where P ≥ 10 % of the peak (see docs/metrics.md).", ""]
     if any(r.get("target_force_n") is not None or r.get("target_force_n_per_mm") is not None for r in rows):
-        out += ["Depth of a force-controlled case: the travel the indenter reached at its target force (an "
-                "output, from first touch); the force it reached is its reaction.", ""]
+        out += ["Depth of a force-controlled case: the travel the indenter reached (an output, not a "
+                "prescribed depth) in the state its row reports, at its target force, or with later loading "
+                "segments at the peak load; the force it reached there is its reaction.", ""]
     with_sensors = [r.case for r in records if r.scene.sensors]
     if with_sensors:
         out += [f"Sensor readings of the {len(with_sensors)} case{'s' if len(with_sensors) > 1 else ''} with "
