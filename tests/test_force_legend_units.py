@@ -29,16 +29,22 @@ def test_variant_labels_give_units_to_depth_and_rate_and_say_depth_control():
     assert case_variant_labels([Scene(thickness=1.0)]) == [""]
 
 
-@pytest.mark.usefixtures("close_figures")
-def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
+def _preview_sweep(tmp_path, config: str):
+    """The folder of a serial 2D preview sweep of the sweep TOML `config` (no renders)."""
     from tactileskin.cli import main
 
     cfg = tmp_path / "sweep.toml"
-    cfg.write_text('[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\nindenters = ["flat", "curved"]\n'
-                   'forces = [0.03, 0.06]\n[scene]\ndim = 2\n')
+    cfg.write_text(config)
     out = tmp_path / "out"
     assert main(["sweep", "--config", str(cfg), "--quality", "preview", "--serial", "--no-render",
                  "--out", str(out)]) == 0
+    return out
+
+
+@pytest.mark.usefixtures("close_figures")
+def test_sweep_figure_legends_carry_the_force_unit(tmp_path):
+    out = _preview_sweep(tmp_path, '[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\n'
+                         'indenters = ["flat", "curved"]\nforces = [0.03, 0.06]\n[scene]\ndim = 2\n')
     for stem in ("fig10_profiles", "fig11_peak", "metrics_vs_thickness"):
         svg = (out / f"{stem}.svg").read_text()  # text kept as text (figures._plt)
         assert "flat F = 0.03 N/mm" in svg and "curved F = 0.06 N/mm" in svg, stem
@@ -96,14 +102,9 @@ def test_the_cases_note_says_which_state_a_force_case_with_later_segments_report
     # peak-load state (0.06), not of the target force the note named
     import csv
 
-    from tactileskin.cli import main
-
-    cfg = tmp_path / "sweep.toml"
-    cfg.write_text('[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\nindenters = ["flat"]\nforces = [0.03]\n'
-                   '[scene]\ndim = 2\n[[scene.loading]]\nhold = 0.1\n[[scene.loading]]\nforce = 0.06\ntime = 0.2\n')
-    out = tmp_path / "out"
-    assert main(["sweep", "--config", str(cfg), "--quality", "preview", "--serial", "--no-render",
-                 "--out", str(out)]) == 0
+    out = _preview_sweep(tmp_path, '[sweep]\nthicknesses = [1.0]\nmaterials = ["silicone"]\nindenters = ["flat"]\n'
+                         'forces = [0.03]\n[scene]\ndim = 2\n[[scene.loading]]\nhold = 0.1\n'
+                         '[[scene.loading]]\nforce = 0.06\ntime = 0.2\n')
     with open(out / "results.csv", newline="") as fh:
         row, = csv.DictReader(fh)
     assert float(row["reaction_n_per_mm"]) == pytest.approx(0.06, rel=0.05)  # the peak load's state
