@@ -71,3 +71,16 @@ def test_result_plot_names_a_material_file_by_its_stem(gel):
     res = solve(with_quality(Scene(thickness=1.0, material=str(gel)), "preview"))
     fig, ax = res.plot()
     assert ax.get_title(loc="left").startswith("t = 1 mm, nh_gel, flat (2D)")
+
+
+def test_result_plot_does_not_name_a_file_as_the_preset_of_its_stem():
+    # a user's silicone.toml is not the paper's silicone: the sweep tables say 'silicone.toml'
+    # (material_labels), Result.plot's title said 'silicone'
+    from types import SimpleNamespace
+
+    from tactileskin.report.result_plot import _label
+
+    res = SimpleNamespace(scene={"thickness": 1.0, "material": "/home/alice/silicone.toml", "indenter": "flat"})
+    assert _label(res) == "t = 1 mm, silicone.toml, flat (2D)"
+    res.scene["material"] = "/home/alice/gel.toml"
+    assert _label(res) == "t = 1 mm, gel, flat (2D)"

@@ -17,8 +17,11 @@ def _label(result) -> str:
     sc = result.scene or {}
     if "thickness" not in sc:
         return "bone pressure"
+    from tactileskin.scene import material_labels
+
     mat = str(sc.get("material", "?"))
-    mat = Path(mat).stem if mat.endswith(".toml") else mat  # a file by its name, not its path (the user's folders)
+    # a file by its name, not its path (the user's folders), as the sweep's tables name it
+    mat = material_labels([mat])[mat]
     return f"t = {sc['thickness']:g} mm, {mat}, {sc.get('indenter', '?')} ({sc.get('dim', 2)}D)"
 
 
