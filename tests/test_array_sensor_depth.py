@@ -324,3 +324,23 @@ def test_a_sensor_height_flag_replaces_the_configs_sensor_plane(tmp_path, capsys
     conf.write_text("[array]\nthicknesses = [1]\nsets = ['paper']\nsensor_depth = 0.5\n", encoding="utf-8")
     main(["array", "-o", str(tmp_path / "o"), "--config", str(conf), "--sensor-height", "0.3"])
     assert got and (got[0].sensor_depth, got[0].sensor_height) == (None, 0.3)
+
+
+@pytest.mark.parametrize("kw", [{"sensor_depth": 0.4}, {"sensor_height": 1.0}])
+def test_a_chart_read_inside_a_thick_skin_keeps_the_contact_spot_fine(kw):
+    """The t = 5 mm 3x contact spot (mesh.sizing.spot_factor) was measured on the bone map
+    only; 0.4 mm under it a dot read +36 %. A chart read inside the skin meshes its dots as a
+    scene with a sensor at that depth, so the spot keeps its fine size; a bone chart's dots keep
+    the rule."""
+    from tactileskin.mesh import sizing
+
+    def spots(sc):
+        sec = sc.section()
+        return [b[4] for b in sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True).patches]
+
+    cfg = {"thicknesses": (5.0,), "mesh_size": 1.6, "refinement": 8.0}
+    inside = chart.dot_scene(5.0, "silicone", chart.ChartConfig(**cfg, **kw), skin="fingertip")
+    bone = chart.dot_scene(5.0, "silicone", chart.ChartConfig(**cfg), skin="fingertip")
+    assert sizing.sensors_inside(inside) and not sizing.sensors_inside(bone)
+    assert spots(inside) == pytest.approx([0.2] * len(spots(inside)))
+    assert spots(bone) == pytest.approx([0.6] * len(spots(bone)))

@@ -57,9 +57,15 @@ def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str |
     from tactileskin.scene import Scene
 
     size, ratio = cfg.mesh_for(thickness)
+    sd = cfg.sensor_depth_at(thickness)
+    # a chart read inside the skin (raw_map_of at sd) is meshed as a scene with a sensor there:
+    # mesh.sizing keeps the contact spot fine for sensors in the skin (its thick-skin coarsening
+    # was measured on the bone map only; 0.4 mm deep under it a t = 5 dot read +36 %)
+    inside = sd is not None and sd < float(thickness) - 1e-9
     return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
                  braille_text=text, braille_standard=cfg.standard, mesh_size=size,
-                 refinement=ratio, depth=cfg.depth_for(thickness))
+                 refinement=ratio, depth=cfg.depth_for(thickness),
+                 sensors=({"name": "chart_depth", "s": [0.0], "depth": float(sd)},) if inside else ())
 
 
 def accuracy_text(a: float) -> str:
