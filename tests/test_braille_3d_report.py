@@ -343,3 +343,30 @@ def test_ridge_section_states_this_sweeps_ratios_and_those_outside_the_measured_
     assert ("Outside the measured range: t3-silicone-braille-2d / t3-silicone-braille-3d (span -9.6 %)"
             in text)
     assert "t1-silicone-braille-2d / t1-silicone-braille-3d (" not in text
+
+
+def _force_case(ind, dim, force, peak, w):
+    sc = Scene(thickness=1.0, indenter=ind, dim=dim, force=force)
+    return CaseRecord(sc, S, peak * np.exp(-(S / w) ** 2), {}, Path("."))
+
+
+def test_force_cases_of_2d_and_3d_share_no_load_and_get_no_verdict():
+    """A force variant is F N/mm on a 2D case and F N on a 3D one: the '3D dots' verdict of a
+    force sweep (flat, curved in 2D, Braille in 3D) compared profiles pressed by unrelated loads
+    ('distinguishable' from 0.2 N/mm against 0.2 N). Such a group has no verdict; the 2D ridge
+    model's (every case 2D, one load) keeps its own, as does a depth sweep."""
+    from tactileskin.sweep import case_variants
+
+    recs = [_force_case("flat", 2, 0.2, 0.5, 4.0), _force_case("curved", 2, 0.2, 0.4, 2.0),
+            _force_case("braille", 2, 0.2, 0.3, 0.8), _force_case("braille", 3, 0.2, 0.05, 1.0)]
+    for r, v in zip(recs, case_variants([r.scene for r in recs])):
+        r.variant = v
+    (g,) = markdown.discrimination_by_model(recs)
+    assert g["verdict"][2] == "distinguishable"
+    assert g["verdict"][3] == markdown.NO_COMMON_LOAD and not g["changed"]
+    table = markdown.discrimination_table(recs)
+    assert markdown.NO_COMMON_LOAD in table[-1]
+    both2d = markdown.discrimination_table(recs[:3])
+    assert both2d[-1].endswith("| distinguishable |")
+    depth_recs, _ = _paper_like()
+    assert not any(m["verdict"].get(3) == markdown.NO_COMMON_LOAD for m in markdown.discrimination_by_model(depth_recs))

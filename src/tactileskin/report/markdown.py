@@ -106,16 +106,35 @@ def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False,
     dimension (None: any). Suspect results are left out (a verdict on them would be a
     verdict on a wrong number)."""
     groups = defaultdict(dict)
+    for key, rec in _grouped(records, with_text, paper_only, braille_dim):
+        groups[key].setdefault(rec.scene.indenter_label(), (rec.s, rec.pressure))
+    return sorted(groups.items())
+
+
+def _grouped(records, with_text: bool, paper_only: bool, braille_dim: int | None):
+    """(group key, record) of each record a group of _profiles_by_group takes."""
     suspect = {id(r) for r in _suspect_records(records)}
     for rec in records:
         sc = rec.scene
         if ((sc.braille_text and not with_text) or (paper_only and not at_paper_conditions(sc))
                 or id(rec) in suspect or _other_dim(sc.indenter.value, sc.dim, braille_dim)):
             continue
-        name = sc.indenter_label()
         variant = "" if paper_only else getattr(rec, "variant", "")
-        groups[(material_of(rec), sc.thickness, variant)].setdefault(name, (rec.s, rec.pressure))
-    return sorted(groups.items())
+        yield (material_of(rec), sc.thickness, variant), rec
+
+
+NO_COMMON_LOAD = ("n/a (force control: the 2D cases are pressed by a force per mm of the section, "
+                  "the 3D cases by the whole force; they share no load)")
+
+
+def _load_mixed(records, braille_dim: int | None = None) -> set:
+    """Group keys (as _profiles_by_group with_text) whose force-controlled cases are of both
+    dimensions: one force variant is F N/mm in 2D and F N in 3D, so their profiles are no pair."""
+    dims = defaultdict(set)
+    for key, rec in _grouped(records, True, False, braille_dim):
+        if getattr(rec.scene, "force", None) is not None:
+            dims[key].add(rec.scene.dim)
+    return {k for k, d in dims.items() if len(d) > 1}
 
 
 PAPER_THICKNESSES = (1.0, 3.0, 5.0)  # the skins the paper's claims are about (mm)
@@ -333,9 +352,11 @@ def discrimination_table(records, rows=()) -> list[str]:
         return [NO_TRUSTED_PAIRS if _suspect_records(records) and max(pairs.values(), default=0) >= 2 else NO_PAIRS]
     lines = ["| material | t (mm) | variant | pairwise distances | verdict |", "|---|---|---|---|---|"]
     named = _variant_labels(records)
+    mixed = _load_mixed(records)
     for (mat, t, variant), profs in groups:
         d, verdict = _discrimination_cells(profs)
-        verdict = _with_left_out(verdict, left.get((mat, t, variant), []))
+        verdict = (NO_COMMON_LOAD if (mat, t, variant) in mixed
+                   else _with_left_out(verdict, left.get((mat, t, variant), [])))
         lines.append(f"| {mat} | {t:g} | {named.get(variant, variant) or '–'} | {d} | {verdict} |")
     return lines
 
@@ -347,6 +368,7 @@ def discrimination_by_model(records, rows=()) -> list[dict]:
     merged: dict[tuple, dict] = {}
     braille = defaultdict(dict)  # group -> {dim: its Braille profiles' names}
     left = {dim: _left_out(rows, dim) for dim in BRAILLE_MODELS}
+    mixed = {dim: _load_mixed(records, dim) for dim in BRAILLE_MODELS}
     for dim in BRAILLE_MODELS:
         for key, profs in _profiles_by_group(records, with_text=True, braille_dim=dim):
             m = merged.setdefault(key, dict(group=key, distances={}, verdict={}))
@@ -359,7 +381,9 @@ def discrimination_by_model(records, rows=()) -> list[dict]:
         # 'change' that was the missing pair's, not the model's)
         names = set().union(*braille[key].values())
         for dim in BRAILLE_MODELS:
-            if dim in m["verdict"] and braille[key].get(dim, set()) != names:
+            if dim in m["verdict"] and key in mixed[dim]:
+                m["verdict"][dim] = NO_COMMON_LOAD
+            elif dim in m["verdict"] and braille[key].get(dim, set()) != names:
                 m["verdict"][dim] = "n/a (a Braille case of it failed, is suspect or was not run)"
             elif dim in m["verdict"]:  # a flat or curved case (both models share it) failed
                 m["verdict"][dim] = _with_left_out(m["verdict"][dim], left[dim].get(key, []))
