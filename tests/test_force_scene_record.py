@@ -38,3 +38,18 @@ def test_the_solve_summary_of_a_force_case_lists_no_depth_fraction(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert "depth_fraction" not in summary["scene"] and summary["scene"]["force"] == 0.03
     assert summary["loading"]["control"] == "force" and summary["loading"]["reached_travel_mm"] > 0
+
+
+def test_a_failed_force_case_has_no_depth_in_results_csv():
+    """A force-controlled case's depth is the travel its solve reached: one that failed has none
+    (results.csv read 0.2 t, the default depth ramp's travel, as if pressed that far)."""
+    from tactileskin import sweep
+    from tactileskin.report import outputs
+
+    force = Scene(thickness=1.0, indenter="flat", force=0.03)
+    depth = Scene(thickness=1.0, indenter="curved")
+    ocs = [sweep.CaseOutcome(sc, "failed", 0.0, "no convergence", key=f"k{i}") for i, sc in enumerate((force, depth))]
+    _, rows, failures = outputs.collect(ocs, cache=None)
+    assert len(failures) == 2
+    assert rows[0]["depth_mm"] is None and rows[0]["target_force_n_per_mm"] == 0.03
+    assert rows[1]["depth_mm"] == depth.indentation  # a depth case's depth is its input

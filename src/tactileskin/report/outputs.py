@@ -22,7 +22,7 @@ RESULT_COLUMNS = ["case", "key", "status", "thickness_mm", "material", "indenter
                   "dofs", "increments", "newton_iterations", "wall_s", "error"]
 # the columns that hold numbers (MPa, mm, N, s) whether or not a row has one: a 2D sweep's
 # reaction_n, the target forces without force control, a failed case's metrics
-FLOAT_COLUMNS = ("target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
+FLOAT_COLUMNS = ("depth_mm", "target_force_n_per_mm", "target_force_n", "peak_mpa", "span_mm", "auc_mpa_mm", "reaction_n_per_mm",
                  "reaction_n", "min_J", "max_abs_stress_mpa", "wall_s")
 
 
@@ -52,6 +52,8 @@ def collect(outcomes, cache):
         row["source"] = {"cached": "cached", "done": "solved"}.get(oc.status, "failed")
         if oc.status == "failed":
             row.update(status=quality.failed_status(oc.error), error=oc.error)
+            if sc.force is not None:  # the depth is the solve's output: none without one (not 0.2 t)
+                row["depth_mm"] = None
             failures.append(oc)
         else:
             rec = oc.record if oc.record is not None else cache.load(sc)
