@@ -116,7 +116,9 @@ def read(path: str | Path | None) -> SceneFile:
     if fields:
         from tactileskin.scene import Scene
 
-        Scene.from_dict(fields)  # unknown or invalid fields fail here, naming the field
+        # unknown or invalid fields fail here, naming the field; with the listed indenter kind
+        # (its own fields: indenter_radius with sweep.indenters = ["sphere"])
+        Scene.from_dict({**fields, "indenter": axes["indenters"][0]} if axes.get("indenters") else fields)
     return SceneFile(fields, quality, axes, str(path))
 
 

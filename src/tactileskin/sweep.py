@@ -247,7 +247,10 @@ def load_spec(path: str | Path) -> dict:
 
     spec: dict = resolve_paths(sweep_lists(data.get("sweep", {})), path)
     if "scene" in data:
-        spec["base"] = Scene.from_dict(resolve_paths(validate.table(data["scene"], "[scene]"), path))
+        base = resolve_paths(validate.table(data["scene"], "[scene]"), path)
+        if "indenter" not in base and spec.get("indenters"):  # its kind's own fields need it there
+            base = {**base, "indenter": spec["indenters"][0]}
+        spec["base"] = Scene.from_dict(base)
     return spec
 
 
