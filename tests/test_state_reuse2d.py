@@ -222,3 +222,29 @@ def test_contact_einsum_path_kept_per_shape_gives_the_planned_bits():
     for f in (1, 2, 3, 7, 1, 2, len(s.w)):
         ops = (rng.random((f, 2)), rng.random((f, 2, 3)), rng.random((f, 2, 3)), rng.random((f, 2, 2, 2)))
         assert np.array_equal(s._einsum(spec, *ops), np.einsum(spec, *ops, optimize=True))
+
+
+def test_contact_gaps_kept_for_a_3d_surface_take_a_float32_displacement():
+    """The kept gaps are compared by the bits of the surface displacements: a float32 u of a 3D
+    model (3 components, 12 bytes per node) after a float64 one raised ValueError (an int64 view
+    of 12-byte rows); it evaluates as a fresh surface does (float64 arithmetic, the same bits)."""
+    from skfem import MeshTet
+
+    from tactileskin.fe.contact import ContactSurface
+    from tactileskin.fe.verification import Sphere
+
+    mesh = MeshTet.init_tensor(np.linspace(-1.0, 1.0, 4), np.linspace(-1.0, 0.0, 3), np.linspace(-1.0, 1.0, 4))
+    f = mesh.facets_satisfying
+    b = {"bottom": f(lambda x: np.isclose(x[1], -1.0)), "top": f(lambda x: np.isclose(x[1], 0.0))}
+    mat = get_material("silicone")
+    model = Model(mesh, b, material_law(mat.hyperfoam), [Dirichlet("bottom", (0, 1, 2))], prony=mat.prony,
+                  contact=Contact(Sphere(3.0), boundary="top"), stiffness=2 * mat.hyperfoam.mu0)
+    s, ind = model.surface, model.contact.indenter
+    u = np.zeros(model.ndof)
+    u[1::3] = -0.01 * (model.basis.doflocs[1] + 1.0)
+    eps, lam = model.penalty(), np.zeros(s.shape)
+    s.evaluate(u, ind, 0.05, eps, lam, True)
+    u32 = u.astype(np.float32)
+    out = s.evaluate(u32, ind, 0.05, eps, lam, True)
+    fresh = ContactSurface(mesh, model.element, b["top"], 3, intorder=2).evaluate(u32, ind, 0.05, eps, lam, True)
+    assert _same(out, fresh)

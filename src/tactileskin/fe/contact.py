@@ -56,7 +56,8 @@ class ContactSurface:
     def _gap(self, u, indenter, d):
         """(x, g, n) at the contact points: current positions, gaps and normals (the last
         evaluation's when the surface displacements, indenter and travel are the same)."""
-        Us = u.reshape(-1, self.m)[self.sdofs]
+        # float64 as the einsum below computes anyway: its bits compare as int64, whatever u's dtype
+        Us = np.asarray(u, dtype=np.float64).reshape(-1, self.m)[self.sdofs]
         last = self._last_gap
         if (last is not None and last[1] is indenter and last[2] == d
                 and np.array_equal(last[0].view(np.int64), Us.view(np.int64))):
