@@ -821,3 +821,27 @@ def test_a_geometry_value_of_the_wrong_type_is_refused_naming_its_key(geometry, 
         params.load("indenters")
     f.write_text(text.replace(old, "radius = 12"))
     assert params.load("indenters")["curved"]["radius"] == 12
+
+
+def test_a_key_missing_from_a_geometry_file_is_refused_naming_it(geometry):
+    """A user's geometry file without a value its reader needs (curved.radius) ended in a
+    KeyError traceback at the solve; it is now a ParameterError naming the file and the key,
+    and the CLI says so in one line with exit 2, writing nothing. An optional key read with
+    .get() is unchanged."""
+    import subprocess
+    import sys
+
+    from tactileskin.errors import ParameterError
+    from tactileskin.geometry.indenters import indenter_for_scene
+
+    f = geometry / "indenters.toml"
+    text = f.read_text()
+    f.write_text("\n".join(ln for ln in text.splitlines() if not ln.startswith("radius = 12.0")) + "\n")
+    with pytest.raises(ParameterError, match=r"^indenters.toml: curved.radius=None is invalid"):
+        indenter_for_scene(Scene(indenter="curved", thickness=1.0))
+    assert params.load("indenters")["curved"].get("radius") is None
+    out = geometry.parent / "out"
+    run = subprocess.run([sys.executable, "-m", "tactileskin", "solve", "--indenter", "curved", "-t", "1",
+                          "--quality", "preview", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr[-800:]
+    assert "indenters.toml: curved.radius" in run.stderr + run.stdout and not out.exists()

@@ -102,10 +102,33 @@ def _parsed(name: str, data: bytes, path) -> dict:
         _refuse_dates(hit, f"{name}.toml: ")
         if f"{name}.toml" not in NOT_SOLVED:  # the mold's reader (geometry.molds) names its own values
             _check_numbers(hit, _shipped(name), f"{name}.toml: ")
+        hit = _Table.of(hit, f"{name}.toml: ")
         if len(_PARSED) > 64:  # only edits add entries; keep the memo small
             _PARSED.clear()
         _PARSED[(name, data)] = hit
     return hit
+
+
+class _Table(dict):
+    """A parsed table whose missing key, read as table[key] (a reader's required value), is a
+    ParameterError naming the file and key (a user's file without `radius` ended in a KeyError
+    traceback); .get() of an optional key is unchanged."""
+
+    where = ""
+
+    @classmethod
+    def of(cls, value, where: str, key: str = ""):
+        if isinstance(value, dict):
+            t = cls({k: cls.of(v, where, f"{key}.{k}" if key else str(k)) for k, v in value.items()})
+            t.where = where + (key + "." if key else "")
+            return t
+        if isinstance(value, list):
+            return [cls.of(v, where, key) for v in value]
+        return value
+
+    def __missing__(self, key):
+        raise ParameterError(self.where + str(key), None, "a value (the file lacks the key)",
+                             "copy it from the shipped file in tactileskin/data/geometry")
 
 
 def _refuse_dates(value, where: str, key: str = "") -> None:
