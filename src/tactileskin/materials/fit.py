@@ -358,21 +358,23 @@ def unstable_stretch(mat, nu=None, lo: float = STABLE_RANGE[0], hi: float = STAB
 def _check_stable(law: str, mat, lam, nu) -> None:
     """FitError unless the fitted law stiffens with stretch in uniaxial tension and compression
     over the data's range and a margin (STABLE_RANGE at least)."""
-    at = unstable_stretch(mat, nu, min(STABLE_RANGE[0], float(lam.min())), max(STABLE_RANGE[1], float(lam.max())))
+    stretch = min(STABLE_RANGE[0], float(lam.min())), max(STABLE_RANGE[1], float(lam.max()))
+    at = unstable_stretch(mat, nu, *stretch)
     if at is not None:
         raise FitError(f"the fitted {law} law is not stable: its uniaxial stress does not rise with stretch "
                        f"at stretch {at:.3g} ({mat.to_dict() if hasattr(mat, 'to_dict') else mat}); "
-                       + (_nu_hint(mat) if nu is not None else "") + "try another law or fewer terms")
+                       + (_nu_hint(mat, stretch) if nu is not None else "") + "try another law or fewer terms")
 
 
-def _nu_hint(mat) -> str:
+def _nu_hint(mat, stretch) -> str:
     """'give a larger --nu, at least X; or ' where a larger bulk modulus makes the fitted law
-    stable (a small --nu gives kappa << mu, unstable in compression), else ''."""
+    stable over `stretch` (the range _check_stable checks; a small --nu gives kappa << mu,
+    unstable in compression), else ''."""
     from tactileskin.materials import laws
 
     if not hasattr(mat, "K0") or not hasattr(mat, "law"):
         return ""
-    lo, _ = laws.bulk_range(mat)
+    lo, _ = laws.bulk_range(mat, stretch)
     if lo is None:
         return ""
     nu = lo if mat.law == "hyperfoam" else laws._nu_of(lo / mat.mu0)

@@ -93,20 +93,23 @@ def _sig(x: float, up: bool, digits: int) -> float:
     return float(f"{v:.{digits}g}")
 
 
-def bulk_range(law) -> tuple[float | None, float]:
+def bulk_range(law, stretch: tuple[float, float] | None = None) -> tuple[float | None, float]:
     """The valid range of `law`'s bulk parameter (kappa MPa, or nu) with its other parameters:
-    from the smallest at which its uniaxial stress rises with stretch (materials.fit.STABLE_RANGE;
-    None: no value up to the largest is stable) to the largest, K0 / mu0 = MAX_BULK_OVER_SHEAR.
+    from the smallest at which its uniaxial stress rises with stretch (over `stretch`, default
+    materials.fit.STABLE_RANGE; None: no value up to the largest is stable) to the largest,
+    K0 / mu0 = MAX_BULK_OVER_SHEAR.
     A bisection in log(K0 / mu0), stability assumed to grow with the bulk modulus: for error
     messages only (~50 stability checks)."""
-    from tactileskin.materials.fit import unstable_stretch
+    from tactileskin.materials.fit import STABLE_RANGE, unstable_stretch
+
+    stretch = STABLE_RANGE if stretch is None else stretch
 
     def stable(r):
         try:
             trial = _with_ratio(law, r)
         except ParameterError:  # nu rounds to -1
             return False
-        return unstable_stretch(trial, nu0(trial)) is None
+        return unstable_stretch(trial, nu0(trial), *stretch) is None
 
     value = lambda r: _nu_of(r) if _bulk_name(law) == "nu" else r * law.mu0  # noqa: E731
     hi = MAX_BULK_OVER_SHEAR
