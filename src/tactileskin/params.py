@@ -156,7 +156,13 @@ def _shipped(name: str) -> dict:
 
 
 def _is_number(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    """A finite int or float (an int too large for a float is not: math.isfinite overflows)."""
+    if not isinstance(v, (int, float)) or isinstance(v, bool):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
 
 
 def _check_numbers(value: dict, shipped: dict, where: str, key: str = "") -> None:
