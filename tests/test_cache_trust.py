@@ -847,3 +847,19 @@ def test_a_key_missing_from_a_geometry_file_is_refused_naming_it(geometry):
                           "--quality", "preview", "--out", str(out)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr[-800:]
     assert "indenters.toml: curved.radius" in run.stderr + run.stdout and not out.exists()
+
+def test_an_integer_past_pythons_digit_limit_is_an_invalid_toml_file(geometry, tmp_path):
+    """tomllib's int() of a 5000-digit integer raises ValueError (Python's 4300-digit limit),
+    not TOMLDecodeError: a geometry file holding one ended in a traceback from params.load and
+    from geometry_digest (every solve's cache key), a scene or material file from read_toml."""
+    from tactileskin.errors import ParameterError
+
+    f = geometry / "indenters.toml"
+    f.write_text(f.read_text().replace("radius = 12.0", "radius = 1" + "0" * 5000))
+    with pytest.raises(ParameterError, match=r"valid TOML"):
+        params.load("indenters")
+    params.geometry_digest()
+    g = tmp_path / "scene.toml"
+    g.write_text("depth = 1" + "0" * 5000 + "\n")
+    with pytest.raises(ParameterError, match=r"valid TOML"):
+        params.read_toml(g, "scene file")

@@ -73,6 +73,8 @@ def _parse(raw: bytes, path, what: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ParameterError(what, str(path), f"valid TOML ({e})") from None
+    except ValueError as e:  # an integer past Python's int() digit limit (4300)
+        raise ParameterError(what, str(path), "valid TOML", str(e)) from None
     except RecursionError:
         raise ParameterError(what, str(path), "valid TOML", "nested too deeply") from None
 
