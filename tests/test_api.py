@@ -276,3 +276,25 @@ def test_summary_states_the_depth_a_depth_ramp_pressed_to(fields):
                  refinement=5.0, **fields)
     want = fields.get("depth", 0.2 * 1.0)
     assert r.summary()["depth_mm"] == pytest.approx(want, rel=1e-9)
+
+
+def test_scene_help_gives_the_force_range_and_the_shortest_ramp():
+    """Scene's reference said force (0, 10000] while 1e-5 is refused (MIN_FORCE 1e-4), and rate
+    [1e-6, 1e6] with nothing of the ramp's shortest time (Scene(rate=1e6) at the default
+    0.4 mm depth is refused: 4e-7 s)."""
+    from tactileskin import loading
+    from tactileskin.errors import ParameterError
+
+    doc = ts.Scene.__doc__
+    force = next(ln for ln in doc.splitlines() if ln.startswith("force ("))
+    force += doc.split(force, 1)[1].splitlines()[1]
+    assert f"[{loading.MIN_FORCE:.4f}, {loading.MAX_FORCE:g}]" in force
+    with pytest.raises(ParameterError, match=r"force"):
+        ts.Scene(force=loading.MIN_FORCE / 10)
+    ts.Scene(force=loading.MIN_FORCE)
+    for name in ("rate", "force_rate"):
+        line = next(ln for ln in doc.splitlines() if ln.startswith(f"{name} ("))
+        nxt = doc.split(line, 1)[1].splitlines()[1]
+        assert "at least 1e-6 s" in line + nxt and loading.MIN_RAMP_TIME == 1e-6, name
+    with pytest.raises(ParameterError, match=r"^rate="):
+        ts.Scene(rate=1e6)
