@@ -55,9 +55,9 @@ def test_default_scene_keys_unchanged_and_loading_enters_them():
     # the same by a rate: 2e-10 mm at 1e6 mm/s after a 100 s ramp ends where it starts in float
     # time (ZeroDivisionError traceback); so does a force step of 1e-10 N at 1e6 N/s
     (dict(loading=[{"depth": 0.1, "rate": 0.001}, {"depth": 0.1000000002, "rate": 1e6}]),
-     r"loading\[1\].rate=1000000.0 is invalid; valid: <= 0.0002 mm/s.*2e-16 s.*1e-06 s"),
+     r"loading\[1\].rate=1000000.0 is invalid; valid: <= 0.000199 mm/s.*2e-16 s.*1e-06 s"),
     (dict(force=0.05, force_rate=0.05, loading=[{"force": 0.0500000001, "rate": 1e6}]),
-     r"loading\[0\].rate=1000000.0 is invalid; valid: <= 0.0001 N/s.*1e-06 s"),
+     r"loading\[0\].rate=1000000.0 is invalid; valid: <= 9.99e-05 N/s.*1e-06 s"),
 ])
 def test_bad_histories_name_the_parameter(fields, needle):
     with pytest.raises(ParameterError, match=needle):
@@ -564,3 +564,26 @@ def test_one_rate_range_for_the_scene_and_loading_segments():
     with pytest.raises(ParameterError, match=r"loading\[0\].rate.*\[1e-06, 1e\+06\]"):
         Scene(loading=[{"depth": 0.1, "rate": 2e6}])
     Scene(thickness=3, rate=6e5)  # 0.6 mm in 1e-6 s: the lower end runs as a segment's does
+
+
+@pytest.mark.parametrize("fields, name", [
+    ({"depth": 0.41256, "rate": 1e6}, "rate"),
+    ({"force": 0.00041256, "force_rate": 1e6}, "force_rate"),
+    ({"depth": 0.2, "rate": 1.0, "loading": [{"depth": 0.61256, "rate": 1e6}]}, r"loading\[0\].rate"),
+])
+def test_the_largest_rate_a_too_short_ramp_names_is_itself_accepted(fields, name):
+    """The bound was printed to 3 digits rounded to nearest: travel 0.41256 mm said rate
+    '<= 4.13e+05 mm/s', and rate = 4.13e5 was refused again (9.99e-07 s)."""
+    import re
+
+    from tactileskin.scene import Scene
+
+    with pytest.raises(ParameterError, match=rf"^{name}=.*valid: <= (\S+) ") as e:
+        Scene(thickness=3.0, **fields)
+    bound = float(re.search(r"valid: <= (\S+) ", str(e.value)).group(1))
+    key = name.replace("\\", "")
+    if key.startswith("loading"):
+        fields = {**fields, "loading": [{**fields["loading"][0], "rate": bound}]}
+    else:
+        fields = {**fields, key: bound}
+    Scene(thickness=3.0, **fields)

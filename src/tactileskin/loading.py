@@ -122,7 +122,12 @@ def check_ramp(name: str, rate: float, start: float, target: float, unit: str) -
     `time` below it: the ramp can end where it starts in float time); names `name`."""
     duration = abs(target - start) / rate
     if duration < MIN_RAMP_TIME:
-        raise ParameterError(name, rate, f"<= {abs(target - start) / MIN_RAMP_TIME:.3g} {unit}: "
+        most = abs(target - start) / MIN_RAMP_TIME
+        shown = float(f"{most:.3g}")
+        if shown > most:  # rounded up: the bound printed must itself be accepted
+            e = 10.0 ** (math.floor(math.log10(most)) - 2)
+            shown = float(f"{math.floor(most / e) * e:.3g}")
+        raise ParameterError(name, rate, f"<= {shown:.3g} {unit}: "
                              f"the ramp from {start:.12g} to {target:.12g} takes {duration:.3g} s, "
                              f"under the shortest ramp, {MIN_RAMP_TIME:g} s")
 
