@@ -78,7 +78,7 @@ def _end_with(parent: int, folder: Path) -> None:
 
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
-    except (OSError, AttributeError):  # no prctl: the child ends when its share is drawn
+    except (ImportError, OSError, AttributeError):  # no ctypes or prctl: the child ends when its share is drawn
         pass
     if os.getppid() != parent:
         end(None, None)
