@@ -246,3 +246,16 @@ def test_a_bulk_modulus_too_large_names_kappa_and_its_range():
     with pytest.raises(ParameterError, match=r"material 'x' neo_hookean.kappa=1000000000.0 is invalid; valid: "
                                              r"\[.*, 500\] MPa"):
         law_from_dict("neo_hookean", {"mu": 0.1, "kappa": 1e9}, "material 'x'")
+
+
+@pytest.mark.parametrize("law, table, valid", [
+    ("hyperfoam", {"mu": [0.1], "alpha": [2.0], "nu": 0.49999}, r"\(-1, 0.4999\] with"),
+])
+def test_a_bulk_range_stable_down_to_the_laws_own_bound_says_so(law, table, valid):
+    """A hyperfoam stable at every nu (a rubber's nu = 0.49999, over 0.4999) was told
+    'valid: [-0.999, 0.4999]' (nu = -0.9995 loads: the low end was where nu rounds to -1, not
+    a stability bound). Such an end is the law's own open bound."""
+    from tactileskin.materials.laws import law_from_dict
+
+    with pytest.raises(ParameterError, match=valid):
+        law_from_dict(law, table, "material 'x'")

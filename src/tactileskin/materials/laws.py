@@ -96,7 +96,8 @@ def _sig(x: float, up: bool, digits: int) -> float:
 def bulk_range(law, stretch: tuple[float, float] | None = None) -> tuple[float | None, float]:
     """The valid range of `law`'s bulk parameter (kappa MPa, or nu) with its other parameters:
     from the smallest at which its uniaxial stress rises with stretch (over `stretch`, default
-    materials.fit.STABLE_RANGE; None: no value up to the largest is stable) to the largest,
+    materials.fit.STABLE_RANGE; None: no value up to the largest is stable; _OPEN_END: stable
+    down to the parameter's own open bound, kappa > 0 or nu > -1) to the largest,
     K0 / mu0 = MAX_BULK_OVER_SHEAR.
     A bisection in log(K0 / mu0), stability assumed to grow with the bulk modulus: for error
     messages only (~50 stability checks)."""
@@ -122,7 +123,15 @@ def bulk_range(law, stretch: tuple[float, float] | None = None) -> tuple[float |
     for _ in range(50):
         m = 0.5 * (a + b)
         a, b = (a, m) if stable(math.exp(m)) else (m, b)
+    # stable down to K0 / mu0 = 1e-9 (nu = -1 + 4.5e-9): the law's own bound, the rest is float
+    # noise (a hyperfoam failed its check at nu = -1 + 5e-15 and was told 'valid: [-0.999, ...]')
+    if math.exp(b) < 1e-9:
+        return _OPEN_END[_bulk_name(law)], _sig(value(hi), False, 4)
     return _sig(value(math.exp(b)), True, 3), _sig(value(hi), False, 4)
+
+
+# the bulk parameter's own (open) lower bound: kappa > 0 MPa, nu > -1
+_OPEN_END = {"kappa": 0.0, "nu": -1.0}
 
 
 def bulk_error(law, where: str, why: str) -> ParameterError:
@@ -130,7 +139,7 @@ def bulk_error(law, where: str, why: str) -> ParameterError:
     lo, hi = bulk_range(law)
     name = _bulk_name(law)
     unit = " MPa" if name == "kappa" else ""
-    valid = (f"[{lo:g}, {hi:g}]{unit}" if lo is not None else
+    valid = (f"{'(' if lo == _OPEN_END[name] else '['}{lo:g}, {hi:g}]{unit}" if lo is not None else
              f"<= {hi:g}{unit}, and the law's other parameters stable (none of its values is)")
     return ParameterError(f"{where}.{name}", getattr(law, name), valid + f" with mu0 = {law.mu0:g} MPa", why)
 
