@@ -794,8 +794,8 @@ def test_a_date_in_a_geometry_file_is_refused_naming_its_key_and_keys_apart_from
         f.write_text(text.replace("radius = 12.0", f"radius = {value}"))
         keys.add(cache_key(sc))
         if '"' not in value and "'" not in value:
-            with pytest.raises(ParameterError, match=r"indenters.toml: curved.radius=.* is invalid; valid: a number "
-                                                     r"or text, not a TOML date or time"):
+            with pytest.raises(ParameterError, match=r"indenters.toml: curved.radius=.* is invalid; valid: a finite "
+                                                     r"number"):
                 params.load("indenters")
     assert len(keys) == 5
 
@@ -863,3 +863,21 @@ def test_an_integer_past_pythons_digit_limit_is_an_invalid_toml_file(geometry, t
     g.write_text("depth = 1" + "0" * 5000 + "\n")
     with pytest.raises(ParameterError, match=r"valid TOML"):
         params.read_toml(g, "scene file")
+
+
+def test_a_date_where_a_number_belongs_is_told_a_number_not_text(geometry):
+    """`radius = 2024-01-01` was told 'valid: a number or text, not a TOML date or time; quote
+    it if it is text': quoted, the radius was refused again ('a finite number'). Where the
+    shipped file has a number the error says a finite number; a date in a key of the user's own
+    (no shipped value) keeps the date message."""
+    from tactileskin.errors import ParameterError
+
+    f = geometry / "indenters.toml"
+    text = f.read_text()
+    f.write_text(text.replace("radius = 12.0", "radius = 2024-01-01"))
+    with pytest.raises(ParameterError, match=r"^indenters.toml: curved.radius=.* is invalid; valid: a finite number"):
+        params.load("indenters")
+    f.write_text(text.replace("radius = 12.0", "radius = 12.0\nmeasured = 2024-01-01"))
+    with pytest.raises(ParameterError, match=r"^indenters.toml: curved.measured=.* is invalid; valid: a number or "
+                                             r"text, not a TOML date"):
+        params.load("indenters")

@@ -101,9 +101,9 @@ def _parsed(name: str, data: bytes, path) -> dict:
     hit = _PARSED.get((name, data))
     if hit is None:
         hit = _parse(data, path, "parameter file")
-        _refuse_dates(hit, f"{name}.toml: ")
         if f"{name}.toml" not in NOT_SOLVED:  # the mold's reader (geometry.molds) names its own values
-            _check_numbers(hit, _shipped(name), f"{name}.toml: ")
+            _check_numbers(hit, _shipped(name), f"{name}.toml: ")  # first: a date there is told a number
+        _refuse_dates(hit, f"{name}.toml: ")
         hit = _Table.of(hit, f"{name}.toml: ")
         if len(_PARSED) > 64:  # only edits add entries; keep the memo small
             _PARSED.clear()
