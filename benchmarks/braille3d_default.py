@@ -49,7 +49,7 @@ def table(rows: list[dict]) -> str:
     for r in rows:
         ph = ", ".join(f"{k} {v:.1f}" for k, v in (r.get("phases") or {}).items() if k != "total")
         out.append(f"| {r['t']:g} | {r['material']} | {r['text'] or 'dot'} | {r['mesh'][0]:g} / {r['mesh'][1]:g} | "
-                   f"{r['dofs']:,} | {r['cpu']:.1f} | {r['wall']:.0f} | {r['incr']} / {r['newton']} | "
+                   f"{r['dofs']:,} | {r['cpu']:.1f} | {r['wall']:.1f} | {r['incr']} / {r['newton']} | "
                    f"{r['peak']:.5f} | {r['span']:.3f} | {r['rss_mb']:.0f} | {ph} |")
     return "\n".join(out)
 
