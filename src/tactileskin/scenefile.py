@@ -116,10 +116,30 @@ def read(path: str | Path | None) -> SceneFile:
     if fields:
         from tactileskin.scene import Scene
 
-        # unknown or invalid fields fail here, naming the field; with the listed indenter kind
+        # unknown or invalid fields fail here, naming the field; with a listed indenter kind
         # (its own fields: indenter_radius with sweep.indenters = ["sphere"])
-        Scene.from_dict({**fields, "indenter": axes["indenters"][0]} if axes.get("indenters") else fields)
+        Scene.from_dict({**fields, "indenter": base_indenter(axes["indenters"], fields)}
+                        if axes.get("indenters") else fields)
     return SceneFile(fields, quality, axes, str(path))
+
+
+INDENTER_FIELDS = ("indenter_radius", "indenter_axis", "indenter_file")
+
+
+def base_indenter(kinds, fields: dict) -> str:
+    """The kind of `kinds` (a sweep's indenters) its base scene is built with: the first that
+    takes each of the kind's own fields set in `fields` (indenter_radius with indenters =
+    ["flat", "sphere"]: the sphere; each case of another kind drops them), else the first
+    (its refusal names the field and the kinds that take it)."""
+    from tactileskin.geometry.indenters import registry
+
+    own = [f for f in INDENTER_FIELDS if fields.get(f) is not None]
+    for kind in kinds:
+        if kind not in registry.names():  # Scene.from_dict names the unknown kind
+            break
+        if all(f in registry.get(kind).scene_params for f in own):
+            return kind
+    return tuple(kinds)[0]
 
 
 def sweep_lists(table) -> dict:

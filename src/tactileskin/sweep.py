@@ -243,13 +243,14 @@ def load_spec(path: str | Path) -> dict:
 
     data = read_toml(path, "sweep file")
     validate.known_keys(data, ("sweep", "scene"), "sweep file table")
+    from tactileskin import scenefile
     from tactileskin.scenefile import resolve_paths, sweep_lists
 
     spec: dict = resolve_paths(sweep_lists(data.get("sweep", {})), path)
     if "scene" in data:
         base = resolve_paths(validate.table(data["scene"], "[scene]"), path)
         if "indenter" not in base and spec.get("indenters"):  # its kind's own fields need it there
-            base = {**base, "indenter": spec["indenters"][0]}
+            base = {**base, "indenter": scenefile.base_indenter(spec["indenters"], base)}
         spec["base"] = Scene.from_dict(base)
     return spec
 
