@@ -344,3 +344,19 @@ def test_a_chart_read_inside_a_thick_skin_keeps_the_contact_spot_fine(kw):
     assert sizing.sensors_inside(inside) and not sizing.sensors_inside(bone)
     assert spots(inside) == pytest.approx([0.2] * len(spots(inside)))
     assert spots(bone) == pytest.approx([0.6] * len(spots(bone)))
+
+
+def test_a_shapes_sphere_read_inside_a_thick_skin_keeps_its_contact_spot_fine():
+    """The shapes set's sphere is a contact spot too (R 1 mm pressed 0.3 mm: a = 0.71 mm, a dot's
+    size): read 0.4 mm deep in a t = 5 mm skin its spot was meshed 3x coarse (0.6 mm against
+    0.2), as the dots' were, since only the dot scenes carried the chart's sensor."""
+    from tactileskin.mesh import sizing
+
+    def spots(sc):
+        sec = sc.section()
+        return [b[4] for b in sizing.plan(sc, sec, dim=3, length=sec.fingertip.sample_length, z_symmetric=True).patches]
+
+    cfg = dict(thicknesses=(5.0,), sets=("shapes",), sphere_radius=1.0, max_depth=0.3)
+    inside = chart.sphere_scene(5.0, "silicone", chart.ChartConfig(**cfg, sensor_depth=0.4))
+    bone = chart.sphere_scene(5.0, "silicone", chart.ChartConfig(**cfg))
+    assert spots(inside) == pytest.approx([0.2]) and spots(bone) == pytest.approx([0.6])

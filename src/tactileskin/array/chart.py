@@ -57,15 +57,20 @@ def dot_scene(thickness, material, cfg: ChartConfig, text: str = "", skin: str |
     from tactileskin.scene import Scene
 
     size, ratio = cfg.mesh_for(thickness)
-    sd = cfg.sensor_depth_at(thickness)
-    # a chart read inside the skin (raw_map_of at sd) is meshed as a scene with a sensor there:
-    # mesh.sizing keeps the contact spot fine for sensors in the skin (its thick-skin coarsening
-    # was measured on the bone map only; 0.4 mm deep under it a t = 5 dot read +36 %)
-    inside = sd is not None and sd < float(thickness) - 1e-9
     return Scene(dim=3, skin=skin or cfg.skin, indenter="braille", thickness=thickness, material=material,
                  braille_text=text, braille_standard=cfg.standard, mesh_size=size,
-                 refinement=ratio, depth=cfg.depth_for(thickness),
-                 sensors=({"name": "chart_depth", "s": [0.0], "depth": float(sd)},) if inside else ())
+                 refinement=ratio, depth=cfg.depth_for(thickness), sensors=depth_sensor(cfg, thickness))
+
+
+def depth_sensor(cfg: ChartConfig, thickness) -> tuple:
+    """The sensors of a 3D chart scene: a chart read inside the skin (raw_map_of at its depth) is
+    meshed as a scene with a one-point sensor there, so mesh.sizing keeps the contact spot fine
+    for sensors in the skin (its thick-skin coarsening was measured on the bone map only; 0.4 mm
+    deep under it a t = 5 dot read +36 %); () for a chart read on the bone."""
+    sd = cfg.sensor_depth_at(thickness)
+    if sd is None or sd >= float(thickness) - 1e-9:
+        return ()
+    return ({"name": "chart_depth", "s": [0.0], "depth": float(sd)},)
 
 
 def accuracy_text(a: float) -> str:
@@ -90,7 +95,7 @@ def sphere_scene(thickness, material, cfg: ChartConfig):
     from tactileskin.scene import Scene
 
     sc = Scene(dim=3, skin="fingertip", indenter="sphere", indenter_radius=cfg.sphere_radius, thickness=thickness,
-               material=material, depth=cfg.depth_for(thickness))
+               material=material, depth=cfg.depth_for(thickness), sensors=depth_sensor(cfg, thickness))
     return with_quality(sc, cfg.sphere_quality)
 
 
