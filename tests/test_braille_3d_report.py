@@ -363,9 +363,11 @@ def test_force_cases_of_2d_and_3d_share_no_load_and_get_no_verdict():
         r.variant = v
     (g,) = markdown.discrimination_by_model(recs)
     assert g["verdict"][2] == "distinguishable"
-    assert g["verdict"][3] == markdown.NO_COMMON_LOAD and not g["changed"]
-    table = markdown.discrimination_table(recs)
-    assert markdown.NO_COMMON_LOAD in table[-1]
+    assert g["verdict"][3] == markdown.NO_COMMON_LOAD and g["distances"][3] == "–" and not g["changed"]
+    # the one-model table compares the first profile of each indenter (here the 2D ridge): one load
+    assert markdown.discrimination_table(recs)[-1].endswith("| distinguishable |")
+    mixed = markdown.discrimination_table([recs[0], recs[1], recs[3]])  # flat, curved 2D, dots 3D
+    assert mixed[-1].endswith(f"| – | {markdown.NO_COMMON_LOAD} |")
     both2d = markdown.discrimination_table(recs[:3])
     assert both2d[-1].endswith("| distinguishable |")
     depth_recs, _ = _paper_like()

@@ -130,11 +130,11 @@ NO_COMMON_LOAD = ("n/a (force control: the 2D cases are pressed by a force per m
 def _load_mixed(records, braille_dim: int | None = None) -> set:
     """Group keys (as _profiles_by_group with_text) whose force-controlled cases are of both
     dimensions: one force variant is F N/mm in 2D and F N in 3D, so their profiles are no pair."""
-    dims = defaultdict(set)
+    compared = defaultdict(dict)  # the record of each indenter label a group compares (its first)
     for key, rec in _grouped(records, True, False, braille_dim):
-        if getattr(rec.scene, "force", None) is not None:
-            dims[key].add(rec.scene.dim)
-    return {k for k, d in dims.items() if len(d) > 1}
+        compared[key].setdefault(rec.scene.indenter_label(), rec)
+    return {k for k, recs in compared.items()
+            if len({r.scene.dim for r in recs.values() if getattr(r.scene, "force", None) is not None}) > 1}
 
 
 PAPER_THICKNESSES = (1.0, 3.0, 5.0)  # the skins the paper's claims are about (mm)
@@ -355,8 +355,10 @@ def discrimination_table(records, rows=()) -> list[str]:
     mixed = _load_mixed(records)
     for (mat, t, variant), profs in groups:
         d, verdict = _discrimination_cells(profs)
-        verdict = (NO_COMMON_LOAD if (mat, t, variant) in mixed
-                   else _with_left_out(verdict, left.get((mat, t, variant), [])))
+        if (mat, t, variant) in mixed:  # distances between unrelated loads are no numbers to show
+            d, verdict = "–", NO_COMMON_LOAD
+        else:
+            verdict = _with_left_out(verdict, left.get((mat, t, variant), []))
         lines.append(f"| {mat} | {t:g} | {named.get(variant, variant) or '–'} | {d} | {verdict} |")
     return lines
 
@@ -382,7 +384,7 @@ def discrimination_by_model(records, rows=()) -> list[dict]:
         names = set().union(*braille[key].values())
         for dim in BRAILLE_MODELS:
             if dim in m["verdict"] and key in mixed[dim]:
-                m["verdict"][dim] = NO_COMMON_LOAD
+                m["distances"][dim], m["verdict"][dim] = "–", NO_COMMON_LOAD
             elif dim in m["verdict"] and braille[key].get(dim, set()) != names:
                 m["verdict"][dim] = "n/a (a Braille case of it failed, is suspect or was not run)"
             elif dim in m["verdict"]:  # a flat or curved case (both models share it) failed
