@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 from skfem import MeshTri
 
+from reuse_cases import fresh, random_state
+
 from tactileskin.fe import material_law
 from tactileskin.fe.model import Contact, Dirichlet, Model
 from tactileskin.fe.verification import Cylinder
@@ -31,20 +33,12 @@ def _model(reuse=True, material="silicone"):
 
 
 def _state(model, seed):
-    rng = np.random.default_rng(seed)
-    X = model.basis.doflocs.T
-    u = (X @ (0.04 * rng.standard_normal((2, 2))).T + 0.01 * rng.standard_normal(X.shape)).ravel()
-    u[model.fixed] = 0.0
-    return u
+    return random_state(model, seed)
 
 
 def _fresh(u, t=T, dt=DT, lam=None, commits=()):
-    m = _model(reuse=False)
-    for uc, tc, dtc in commits:
-        m.commit(m.evaluate(uc, tc, dtc, tangent=False), uc, tc, dtc)
-    ev = m.evaluate(u, t, dt, lam, tangent=True)
-    assert ev.ok
-    return ev.R, ev.K
+    """R and tangent of a model that reuses nothing (after the same commits)."""
+    return fresh(_model, u, t, dt, lam, commits)
 
 
 def test_plane_tangent_takes_d_from_the_kept_data():

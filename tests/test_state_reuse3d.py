@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from skfem import MeshTet
 
+from reuse_cases import fresh, random_state
+
 from tactileskin.fe import material_law
 from tactileskin.fe.model import Contact, Dirichlet, Model
 from tactileskin.fe.verification import Sphere
@@ -30,25 +32,15 @@ def _model(reuse=True):
 
 
 def _state(model, seed):
-    """A displacement with every element deformed (J > 0), fixed dofs zero."""
-    rng = np.random.default_rng(seed)
-    X = model.basis.doflocs.T
-    u = (X @ (0.04 * rng.standard_normal((3, 3))).T + 0.01 * rng.standard_normal(X.shape)).ravel()
-    u[model.fixed] = 0.0
-    return u
+    return random_state(model, seed)
 
 
 T, DT = 0.08, 0.05   # the sphere 0.08 mm into the top: contact points active
 
 
 def _fresh(u, t=T, dt=DT, lam=None, commits=()):
-    """R and tangent CSR data of a model that reuses nothing (after the same commits)."""
-    m = _model(reuse=False)
-    for uc, tc, dtc in commits:
-        m.commit(m.evaluate(uc, tc, dtc, tangent=False), uc, tc, dtc)
-    ev = m.evaluate(u, t, dt, lam, tangent=True)
-    assert ev.ok
-    return ev.R, ev.K
+    """R and tangent of a model that reuses nothing (after the same commits)."""
+    return fresh(_model, u, t, dt, lam, commits)
 
 
 def test_tangent_takes_d_from_the_kept_spectral_data():
