@@ -105,14 +105,14 @@ def _profiles_by_group(records, *, with_text: bool, paper_only: bool = False,
     all in one group per (material, thickness). braille_dim: only Braille cases of that
     dimension (None: any). Suspect results are left out (a verdict on them would be a
     verdict on a wrong number)."""
+    groups = _compared(records, with_text, paper_only, braille_dim)
+    return sorted((k, {n: (r.s, r.pressure) for n, r in recs.items()}) for k, recs in groups.items())
+
+
+def _compared(records, with_text: bool, paper_only: bool, braille_dim: int | None) -> dict:
+    """{group key: {indenter label: the record the group compares (its first)}}, the groups of
+    _profiles_by_group."""
     groups = defaultdict(dict)
-    for key, rec in _grouped(records, with_text, paper_only, braille_dim):
-        groups[key].setdefault(rec.scene.indenter_label(), (rec.s, rec.pressure))
-    return sorted(groups.items())
-
-
-def _grouped(records, with_text: bool, paper_only: bool, braille_dim: int | None):
-    """(group key, record) of each record a group of _profiles_by_group takes."""
     suspect = {id(r) for r in _suspect_records(records)}
     for rec in records:
         sc = rec.scene
@@ -120,7 +120,8 @@ def _grouped(records, with_text: bool, paper_only: bool, braille_dim: int | None
                 or id(rec) in suspect or _other_dim(sc.indenter.value, sc.dim, braille_dim)):
             continue
         variant = "" if paper_only else getattr(rec, "variant", "")
-        yield (material_of(rec), sc.thickness, variant), rec
+        groups[(material_of(rec), sc.thickness, variant)].setdefault(sc.indenter_label(), rec)
+    return groups
 
 
 NO_COMMON_LOAD = ("n/a (force control: the 2D cases are pressed by a force per mm of the section, "
@@ -130,10 +131,7 @@ NO_COMMON_LOAD = ("n/a (force control: the 2D cases are pressed by a force per m
 def _load_mixed(records, braille_dim: int | None = None) -> set:
     """Group keys (as _profiles_by_group with_text) whose force-controlled cases are of both
     dimensions: one force variant is F N/mm in 2D and F N in 3D, so their profiles are no pair."""
-    compared = defaultdict(dict)  # the record of each indenter label a group compares (its first)
-    for key, rec in _grouped(records, True, False, braille_dim):
-        compared[key].setdefault(rec.scene.indenter_label(), rec)
-    return {k for k, recs in compared.items()
+    return {k for k, recs in _compared(records, True, False, braille_dim).items()
             if len({r.scene.dim for r in recs.values() if getattr(r.scene, "force", None) is not None}) > 1}
 
 
