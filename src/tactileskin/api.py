@@ -126,9 +126,8 @@ def scenes(grid=None, *, quality: str | None = None, base=None) -> list:
                              "a sweep/scene TOML path, or None (the paper's grid)")
     mesh = {k: fields.pop(k) for k in scenefile.MESH_FIELDS if k in fields}
     b = base if base is not None else Scene()
-    if axes.get("indenters") and "indenter" not in fields and any(
-            fields.get(f) is not None for f in scenefile.INDENTER_FIELDS):
-        fields["indenter"] = scenefile.base_indenter(axes["indenters"], fields)  # as the CLI: its own fields
+    if any(fields.get(f) is not None for f in scenefile.INDENTER_FIELDS):  # else `base` keeps its indenter
+        fields = scenefile.with_base_indenter(fields, axes.get("indenters"))  # as the CLI: its own fields
     b = b.replace(**fields) if fields else b
     if "dim" in fields and "braille_dims" not in axes:  # a dim asked for: the Braille cases' too
         axes["braille_dims"] = (b.dim,)

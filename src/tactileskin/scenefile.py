@@ -118,12 +118,20 @@ def read(path: str | Path | None) -> SceneFile:
 
         # unknown or invalid fields fail here, naming the field; with a listed indenter kind
         # (its own fields: indenter_radius with sweep.indenters = ["sphere"])
-        Scene.from_dict({**fields, "indenter": base_indenter(axes["indenters"], fields)}
-                        if axes.get("indenters") else fields)
+        Scene.from_dict(with_base_indenter(fields, axes.get("indenters")))
     return SceneFile(fields, quality, axes, str(path))
 
 
 INDENTER_FIELDS = ("indenter_radius", "indenter_axis", "indenter_file")
+
+
+def with_base_indenter(fields: dict, kinds) -> dict:
+    """`fields` of a sweep's base scene with the indenter of `kinds` (its indenters list) that
+    takes the kind's own fields among them (base_indenter), unless they name one or no list is
+    given."""
+    if not kinds or "indenter" in fields:
+        return fields
+    return {**fields, "indenter": base_indenter(kinds, fields)}
 
 
 def base_indenter(kinds, fields: dict) -> str:

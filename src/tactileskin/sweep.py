@@ -249,9 +249,8 @@ def load_spec(path: str | Path) -> dict:
     spec: dict = resolve_paths(sweep_lists(data.get("sweep", {})), path)
     if "scene" in data:
         base = resolve_paths(validate.table(data["scene"], "[scene]"), path)
-        if "indenter" not in base and spec.get("indenters"):  # its kind's own fields need it there
-            base = {**base, "indenter": scenefile.base_indenter(spec["indenters"], base)}
-        spec["base"] = Scene.from_dict(base)
+        # its indenter kind's own fields need that kind there
+        spec["base"] = Scene.from_dict(scenefile.with_base_indenter(base, spec.get("indenters")))
     return spec
 
 

@@ -118,10 +118,10 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     if o.get("indenter") is not None:  # the base takes the kind's own options (--indenter-radius) with it
         axes["indenters"] = _names(o["indenter"], "indenter")
         changes["indenter"] = scenefile.base_indenter(axes["indenters"], {**fields, **changes})
-    elif "indenter" not in fields and axes.get("indenters"):
+    else:
         # the file's `indenters` list, as the option: its kind's own fields ([scene]
         # indenter_radius with indenters = ["sphere"]) were refused against the default flat plate
-        fields["indenter"] = scenefile.base_indenter(axes["indenters"], fields)
+        fields = scenefile.with_base_indenter(fields, axes.get("indenters"))
     base = Scene.from_dict(fields).replace(**changes)
     check_dim_kept(changes.get("dim", fields.get("dim")), base)
     if base.skin_kind.fixes_thickness and "thicknesses" not in axes:
