@@ -528,6 +528,26 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     Evaluated by the compiled point loop of `_hyperfoam_nb`; `pk2_tangent` of the embedded
     3x3 C is its oracle (same values to rounding, identical ok flags; tests/test_hyperfoam_nb.py).
     """
+    from tactileskin.materials import _hyperfoam_nb as nb
+
+    if not tangent:
+        mode, cols = nb.MODE_S, 0
+    elif out_of_plane:
+        mode, cols = nb.MODE_D3, 81
+    else:
+        mode, cols = nb.MODE_D2, 16
+    lead, S, D, ok, _ = _plane_points(mat, C2, detF, mode, cols, keep=False)
+    D = D.reshape(lead + _plane_d_shape(out_of_plane)) if tangent else None
+    return S, D, ok
+
+
+def _plane_d_shape(full: bool) -> tuple:
+    return (3, 3, 3, 3) if full else (2, 2, 2, 2)
+
+
+def _plane_points(mat: Hyperfoam, C2, detF, mode, d_cols: int, keep: bool):
+    """`_hyperfoam_nb.plane_kernel` over the points of C2 (..., 2, 2): (lead shape, S (..., 3, 3),
+    D (n, d_cols) or empty, ok (...), the kept data K (n, KEPT_PLANE + 3 terms) or empty)."""
     C2 = np.asarray(C2, dtype=float)
     _check_shape("C2", C2, 2)
     # imported on first use: numba's start-up and the cache load (~0.5-1 s) are not paid
@@ -535,23 +555,15 @@ def pk2_tangent_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = Fal
     from tactileskin.materials import _hyperfoam_nb as nb
 
     lead, n, Ck, dk, has_detF = _kernel_inputs(C2, 2, detF)
-    if not tangent:
-        mode, D = nb.MODE_S, np.empty((0, 0))
-    elif out_of_plane:
-        mode, D = nb.MODE_D3, np.empty((n, 81))
-    else:
-        mode, D = nb.MODE_D2, np.empty((n, 16))
     S = np.empty((n, 3, 3))
     ok = np.empty(n, dtype=bool)
+    D = np.empty((n, d_cols)) if d_cols else np.empty((0, 0))
+    K = np.empty((n, nb.KEPT_PLANE + 3 * mat.n_terms)) if keep else np.empty((0, 0))
     nb.plane_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
-                    float(mat.beta), S, D, ok, mode, np.empty((0, 0)), False)
+                    float(mat.beta), S, D, ok, mode, K, keep)
     ok = ok.reshape(lead)
     _log_debug_inadmissible(ok)
-    if tangent:
-        D = D.reshape(lead + ((3, 3, 3, 3) if out_of_plane else (2, 2, 2, 2)))
-    else:
-        D = None
-    return S.reshape(lead + (3, 3)), D, ok
+    return lead, S.reshape(lead + (3, 3)), D, ok, K
 
 
 class PlaneKept:
@@ -575,19 +587,10 @@ def pk2_kept_plane(mat: Hyperfoam, C2, *, detF=None, out_of_plane: bool = False)
     from which `tangent_kept_plane` gives D (the in-plane block, or with out_of_plane the full
     D) at this C2 without a second point loop of S (Newton's accepted iterate: the residual of
     the line search, then the tangent at the same state)."""
-    C2 = np.asarray(C2, dtype=float)
-    _check_shape("C2", C2, 2)
     from tactileskin.materials import _hyperfoam_nb as nb
 
-    lead, n, Ck, dk, has_detF = _kernel_inputs(C2, 2, detF)
-    S = np.empty((n, 3, 3))
-    ok = np.empty(n, dtype=bool)
-    K = np.empty((n, nb.KEPT_PLANE + 3 * mat.n_terms))
-    nb.plane_kernel(Ck, dk, has_detF, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
-                    float(mat.beta), S, np.empty((0, 0)), ok, nb.MODE_S, K, True)
-    ok = ok.reshape(lead)
-    _log_debug_inadmissible(ok)
-    return S.reshape(lead + (3, 3)), ok, PlaneKept(K, lead, bool(out_of_plane), _plane_params(mat))
+    lead, S, _, ok, K = _plane_points(mat, C2, detF, nb.MODE_S, 0, keep=True)
+    return S, ok, PlaneKept(K, lead, bool(out_of_plane), _plane_params(mat))
 
 
 def tangent_kept_plane(mat: Hyperfoam, kept: PlaneKept, *, in_plane: bool = False):
@@ -604,7 +607,7 @@ def tangent_kept_plane(mat: Hyperfoam, kept: PlaneKept, *, in_plane: bool = Fals
     mode, D = (nb.MODE_D3, np.empty((n, 81))) if full else (nb.MODE_D2, np.empty((n, 16)))
     nb.plane_tangent_kernel(kept.K, np.asarray(mat.mu, dtype=float), np.asarray(mat.alpha, dtype=float),
                             float(mat.beta), D, mode)
-    return D.reshape(kept.lead + ((3, 3, 3, 3) if full else (2, 2, 2, 2)))
+    return D.reshape(kept.lead + _plane_d_shape(full))
 
 
 def cauchy_principal(mat: Hyperfoam, stretches):
