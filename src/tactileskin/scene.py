@@ -254,13 +254,11 @@ class Scene:
         self._check_loading(set_)
 
     def _check_loading(self, set_) -> None:
-        from tactileskin import loading
-
         if self.force is not None:
             if self.depth is not None:
                 raise ParameterError("depth", self.depth, "not with force (force control finds the travel)",
                                      "give depth or force")
-            set_("force", check_range("force", self.force, loading.MIN_FORCE, loading.MAX_FORCE,
+            set_("force", check_range("force", self.force, _loading.MIN_FORCE, _loading.MAX_FORCE,
                                       unit="N (N/mm in 2D)"))
             if self.depth_fraction != DEPTH_FRACTION:  # the travel is the output: the record would show an input
                 raise ParameterError("depth_fraction", self.depth_fraction,
@@ -274,24 +272,22 @@ class Scene:
         if self.force_rate is not None:
             set_("force_rate", check_range("force_rate", self.force_rate, *RATE, unit="N/s (N/mm/s in 2D)"))
         if self.load_time is not None:
-            set_("load_time", check_range("load_time", self.load_time, loading.MIN_RAMP_TIME, loading.MAX_TIME,
+            set_("load_time", check_range("load_time", self.load_time, _loading.MIN_RAMP_TIME, _loading.MAX_TIME,
                                           unit="s"))
         self._check_first_ramp()
-        set_("loading", loading.segments_from(self.loading or [], max_depth=self.max_travel,
-                                              default_rate=self.rate) if self.loading else ())
-        loading.check_program(self.program())
+        set_("loading", _loading.segments_from(self.loading or [], max_depth=self.max_travel,
+                                               default_rate=self.rate) if self.loading else ())
+        _loading.check_program(self.program())
 
     def _check_first_ramp(self) -> None:
         """The first ramp (from first touch) takes at least loading.MIN_RAMP_TIME, as a
         [[loading]] ramp does; the error names the field that sets its duration."""
-        from tactileskin import loading
-
         if self.force is not None and self.force_rate is not None:
-            loading.check_ramp("force_rate", self.force_rate, 0.0, self.force, "N/s (N/mm/s in 2D)")
+            _loading.check_ramp("force_rate", self.force_rate, 0.0, self.force, "N/s (N/mm/s in 2D)")
         elif self.force is None or self.load_time is None:  # load_time's own range holds the rest
             travel = self.depth if self.depth is not None else self.depth_fraction * self.thickness
-            if travel / loading.MIN_RAMP_TIME >= RATE[0]:  # else no rate does: the depth's contact check names it
-                loading.check_ramp("rate", self.rate, 0.0, travel, "mm/s")
+            if travel / _loading.MIN_RAMP_TIME >= RATE[0]:  # else no rate does: the depth's contact check names it
+                _loading.check_ramp("rate", self.rate, 0.0, travel, "mm/s")
 
     # --- derived -----------------------------------------------------------------------
     @property
