@@ -80,10 +80,14 @@ def _nu_of(ratio: float) -> float:
     return (3 * ratio - 2) / (2 * (3 * ratio + 1))
 
 
+def _bulk_value(law, ratio: float) -> float:
+    """`law`'s bulk parameter (nu, or kappa MPa) at K0 / mu0 = ratio."""
+    return _nu_of(ratio) if _bulk_name(law) == "nu" else ratio * law.mu0
+
+
 def _with_ratio(law, ratio: float):
     """`law` with its bulk parameter set so that K0 / mu0 = ratio."""
-    value = _nu_of(ratio) if _bulk_name(law) == "nu" else ratio * law.mu0
-    return dataclasses.replace(law, **{_bulk_name(law): value})
+    return dataclasses.replace(law, **{_bulk_name(law): _bulk_value(law, ratio)})
 
 
 def _sig(x: float, up: bool, digits: int) -> float:
@@ -112,7 +116,7 @@ def bulk_range(law, stretch: tuple[float, float] | None = None) -> tuple[float |
             return False
         return unstable_stretch(trial, nu0(trial), *stretch) is None
 
-    value = lambda r: _nu_of(r) if _bulk_name(law) == "nu" else r * law.mu0  # noqa: E731
+    value = functools.partial(_bulk_value, law)
     hi = MAX_BULK_OVER_SHEAR
     if not stable(hi):
         return None, _sig(value(hi), False, 4)
