@@ -162,3 +162,42 @@ def test_a_failed_factorisation_is_not_kept_as_the_preconditioner():
     x = s.factor(A).solve(b)
     assert s.factorizations == n + 1
     assert np.linalg.norm(A @ x - b) <= 1e-9 * np.linalg.norm(b)
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="MKL is installed on x86-64 only")
+def test_pardiso_orderings_solve_the_same_system():
+    """Minimum degree (AMD) and METIS nested dissection: each is the one PARDISO analyses with,
+    and both solve the system to rounding (cond < 1e5)."""
+    rng = np.random.default_rng(5)
+    A = _laplacian_like(1600, 0.3, rng)
+    b = rng.standard_normal(1600)
+    xs = {}
+    for ordering, code in (("metis", 2), ("amd", 0)):
+        s = linsolve.SymmetricSolver(A, "pardiso", ordering=ordering)
+        assert s._pardiso.iparm[1] == code and s.describe()["ordering"] == ordering
+        xs[ordering] = s.factor(A).solve(b)
+        assert np.linalg.norm(A @ xs[ordering] - b) <= 1e-9 * np.linalg.norm(b)
+        s.close()
+    assert np.allclose(xs["amd"], xs["metis"], rtol=1e-8, atol=1e-10 * np.abs(xs["metis"]).max())
+
+
+def test_unknown_ordering_is_a_parameter_error():
+    A = sp.eye(3, format="csr")
+    with pytest.raises(ParameterError, match="linear solver ordering"):
+        linsolve.SymmetricSolver(A, "superlu", ordering="rcm")
+
+
+def test_ordering_by_dimension():
+    """2D tangents (2-11k free dofs): minimum degree, measured 7-12 % less factorisation CPU
+    than METIS and half the analysis; 3D keeps nested dissection."""
+    assert linsolve.default_ordering(2) == "amd"
+    assert linsolve.default_ordering(3) == "metis"
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="MKL is installed on x86-64 only")
+def test_a_2d_solve_uses_the_2d_ordering():
+    from tactileskin import fe
+    from tactileskin.scene import Scene
+
+    r = fe.solve(Scene(thickness=1, material="silicone", indenter="flat", mesh_size=1.0, refinement=2))
+    assert r.stats["linear_solver"]["ordering"] == linsolve.default_ordering(2) == "amd"

@@ -5,9 +5,10 @@ the element pattern), so the fill-reducing ordering and the symbolic factorisati
 done once per Model and each Newton iteration only refactorises numerically.
 
 Backends:
-- "pardiso": MKL PARDISO (real symmetric indefinite, mtype -2: Bunch-Kaufman pivoting,
-  METIS nested-dissection ordering) called through ctypes on the `mkl` wheel's mkl_rt
-  (x86-64 only). Phases: 11 analysis (once), 22 numerical factorisation, 33 solve.
+- "pardiso": MKL PARDISO (real symmetric indefinite, mtype -2: Bunch-Kaufman pivoting)
+  called through ctypes on the `mkl` wheel's mkl_rt (x86-64 only). Phases: 11 analysis
+  (once), 22 numerical factorisation, 33 solve. Fill-reducing ordering (default_ordering):
+  minimum degree for 2D tangents, METIS nested dissection for 3D ones.
 - "superlu": scipy's SuperLU, a fresh factorisation each time (any platform).
 `backend="auto"` takes PARDISO when mkl_rt loads. Measured (benchmarks/linsolve.py):
 numerical refactorisation 3-10x faster than SuperLU on the fingertip tangents, more on 3D.
@@ -57,6 +58,8 @@ log = logging.getLogger(__name__)
 BACKENDS = ("auto", "pardiso", "superlu")
 METHODS = ("direct", "reuse")
 PRECISIONS = ("double", "single")
+# PARDISO's fill-reducing orderings (iparm[1]): minimum degree (AMD) and METIS nested dissection
+ORDERINGS = {"amd": 0, "metis": 2}
 
 # GMRES with a stale factorisation: stop at this relative residual (what a direct solve of
 # the Newton system gives in practice; the Newton iteration counts do not change with it)
@@ -89,6 +92,14 @@ def default_threads(large: bool) -> int:
     if not large:
         return 1
     return max(1, min(available_cpus(), MAX_THREADS))
+
+
+def default_ordering(dim: int) -> str:
+    """PARDISO's ordering for a model of dimension dim. On the 2D fingertip tangents (1.9-10.5k
+    free dofs) minimum degree left 6-17 % fewer factor nonzeros than METIS: factorisation +
+    solve 7-12 % less CPU, the analysis half (benchmarks/pardiso_ordering.py). Nested
+    dissection is the choice for 3D meshes' separators."""
+    return "amd" if dim == 2 else "metis"
 
 
 class SingularMatrix(RuntimeError):
@@ -151,9 +162,10 @@ _PARDISO_ERRORS = {-1: "input inconsistent", -2: "not enough memory", -3: "reord
 class _Pardiso:
     """One PARDISO handle for a fixed upper-triangular CSR structure."""
 
-    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1, single: bool = False):
+    def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1, single: bool = False,
+                 ordering: str = "metis"):
         """single: factorise and solve in single precision (values, right-hand sides and
-        solutions float32 inside; `solve` returns float64)."""
+        solutions float32 inside; `solve` returns float64). ordering: a key of ORDERINGS."""
         self.lib = _load_mkl()
         self.n = n
         self.threads = threads
@@ -164,7 +176,7 @@ class _Pardiso:
         self.iparm = np.zeros(64, np.int32)
         ip = self.iparm
         ip[0] = 1    # non-default iparm
-        ip[1] = 2    # METIS nested dissection
+        ip[1] = ORDERINGS[ordering]
         # 0: iterative refinement only after perturbed pivots (2 steps then). A fixed 2 steps
         # doubled the solve time (t5 tangent, 15.8k dofs: 13.4 -> 6.5 ms) for the same residual
         ip[7] = 0
@@ -307,12 +319,15 @@ class SymmetricSolver:
     """
 
     def __init__(self, structure: sp.csr_matrix, backend: str = "auto", method: str = "direct",
-                 factor_cost: float | None = None, threads: int = 1, precision: str = "double"):
+                 factor_cost: float | None = None, threads: int = 1, precision: str = "double",
+                 ordering: str = "metis"):
         """factor_cost: the cost of one factorisation in preconditioned GMRES iterations (the
         refactorisation rule's unit); None: estimated from PARDISO's flop counts. threads:
         PARDISO's (default_threads gives the usual choice). precision "single" (PARDISO,
         method "reuse" only): the factorisation is single precision and only preconditions:
-        every solve is GMRES in double precision, to the same tolerance."""
+        every solve is GMRES in double precision, to the same tolerance. ordering: PARDISO's
+        fill-reducing ordering, "metis" or "amd" (default_ordering gives the usual choice;
+        SuperLU keeps its own)."""
         from tactileskin.errors import ParameterError
 
         if method not in METHODS:
@@ -324,6 +339,8 @@ class SymmetricSolver:
                                  "'double' for method 'direct' (single precision only preconditions GMRES)")
         if backend not in BACKENDS:
             raise ParameterError("linear solver backend", backend, ", ".join(BACKENDS))
+        if ordering not in ORDERINGS:
+            raise ParameterError("linear solver ordering", ordering, ", ".join(ORDERINGS))
         if backend == "auto":
             backend = "pardiso" if pardiso_available() else "superlu"
         if backend != "pardiso":
@@ -356,9 +373,11 @@ class SymmetricSolver:
             self._upper = np.flatnonzero(upper)
             indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[upper], minlength=self.n))])
             self._pattern = (indptr, A.indices[upper])
-            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper], threads, single=precision == "single")
+            self._pardiso = _Pardiso(self.n, indptr, A.indices[upper], threads, single=precision == "single",
+                                     ordering=ordering)
         self.threads = threads if backend == "pardiso" else 1
         self.precision = precision
+        self.ordering = ordering if backend == "pardiso" else "superlu"
 
     def begin_increment(self) -> None:
         """A new load increment's Newton solve starts. With method "reuse", the system at which
@@ -460,7 +479,7 @@ class SymmetricSolver:
                 # it (pivots lost to rounding): double precision from now on
                 log.info("PARDISO single precision does not precondition this tangent; switching to double")
                 self._pardiso.close()
-                self._pardiso = _Pardiso(self.n, *self._pattern, self.threads)
+                self._pardiso = _Pardiso(self.n, *self._pattern, self.threads, ordering=self.ordering)
                 self.precision = "double"
                 t0, c0 = self._factor_within_solve(A, t0, c0)
                 return self._direct(b)
@@ -499,7 +518,7 @@ class SymmetricSolver:
     def describe(self) -> dict:
         """The method used and its work counts (for result stats)."""
         return {"method": self.method, "backend": self.backend, "threads": self.threads,
-                "precision": self.precision,
+                "precision": self.precision, "ordering": self.ordering,
                 "factorizations": self.factorizations,
                 "krylov_iterations": self.krylov_iterations,
                 "cpu_s": {k: round(v, 4) for k, v in self.cpu.items()}}

@@ -29,7 +29,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tactileskin.errors import ConvergenceError
-from tactileskin.fe.linsolve import METHODS, PRECISIONS, SymmetricSolver, default_threads, pardiso_available
+from tactileskin.fe.linsolve import (METHODS, PRECISIONS, SymmetricSolver, default_ordering, default_threads,
+                                     pardiso_available)
 from tactileskin.fe.model import Evaluation, Model
 from tactileskin.solver_options import EASY_ITERATIONS, REUSE_MIN_DOFS, SHORT_STEP, SolverOptions  # noqa: F401 (API)
 
@@ -108,9 +109,10 @@ def _factor(model: Model, K, opts: SolverOptions):
         # single precision only preconditions: a "direct" solve keeps double
         precision = "single" if method == "reuse" and opts.factor_precision != "double" else "double"
         ls = model._linsolve = SymmetricSolver(K, opts.linear_solver, method,
-                                               threads=_threads(model, K.shape[0], opts), precision=precision)
-        log.debug("linear solver: %s, %s, %d free dofs, %d threads", ls.backend, ls.method, K.shape[0],
-                  ls.threads)
+                                               threads=_threads(model, K.shape[0], opts), precision=precision,
+                                               ordering=default_ordering(model.m))
+        log.debug("linear solver: %s, %s, %s ordering, %d free dofs, %d threads", ls.backend, ls.method,
+                  ls.ordering, K.shape[0], ls.threads)
     return ls.factor(K)
 
 
