@@ -90,12 +90,14 @@ def _write_parquet(path: Path, columns: list[str], rows) -> None:
     import pyarrow.parquet as pq
 
     from tactileskin.fileio import atomic_path, os_errors
+    from tactileskin.report.arrow import column
 
     data = {c: [r[i] if isinstance(r, tuple) else r.get(c) for r in rows] for i, c in enumerate(columns)}
     # typed as the DataFrame of ts.sweep: a column no row filled was written as type null
     # (pandas: object of None), one a row filled as double
     types = {**dict.fromkeys(FLOAT_COLUMNS + ("s_mm", "pressure_mpa"), pa.float64()), "error": pa.string()}
-    table = pa.table({c: pa.array(v, type=types.get(c)) for c, v in data.items()})
+    # arrow.column: pa.array's arrays without its import of pandas (~0.2 s CPU of the sweep)
+    table = pa.table({c: column(v, type=types.get(c)) for c, v in data.items()})
     with atomic_path(path) as tmp, os_errors(path):
         pq.write_table(table, tmp)
 
