@@ -156,12 +156,12 @@ def _write_sensors(path: Path, records) -> None:
 
 # figure_jobs drawn in a second process: the first two (the designer's figure in three
 # formats and Fig. 10, about half the drawing time of a paper sweep) while this one draws the
-# rest and the renders
+# rest, the renders and writes the tables
 BACKGROUND_JOBS = 2
 
 
 def _figures(records, rows, out: Path, cache, meanwhile=lambda: None) -> list[Path]:
-    """figure_jobs into `out`, and meanwhile() (the renders) while they are drawn; their files
+    """figure_jobs into `out`, and meanwhile() (the tables and renders) while they are drawn; their files
     are kept in the cache under their inputs' digest (figures.figures_key), and a sweep whose
     figures are there already (a cached rerun) writes those bytes instead of drawing them
     again. An entry whose bytes changed is not used."""
@@ -250,11 +250,8 @@ def _renders(records, out: Path, cache) -> list[Path]:
     return renders
 
 
-def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
-    from tactileskin.report.markdown import build_report
-
-    records, rows, failures = collect(outcomes, cache)
-
+def _write_tables(out: Path, rows, records) -> None:
+    """results.csv / .parquet, profiles.csv / .parquet and sensors.csv into `out`."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=RESULT_COLUMNS + ["dim", "variant"], extrasaction="ignore")
     w.writeheader()
@@ -271,15 +268,24 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
     _write_parquet(out / "profiles.parquet", PROFILE_COLUMNS, prof)
 
     _write_sensors(out / "sensors.csv", records)
+
+
+def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, figures: bool) -> dict:
+    from tactileskin.report.markdown import build_report
+
+    records, rows, failures = collect(outcomes, cache)
     renders: list[Path] = []
 
-    def draw_renders() -> None:
+    def meanwhile() -> None:
+        # the tables and renders, written while the second process draws its figures: that
+        # one had the longer share, so this one waited for it (~0.1 s) after writing them first
+        _write_tables(out, rows, records)
         if render and records:
             renders.extend(_renders(records, out, cache))
 
-    drawn = _figures(records, rows, out, cache, meanwhile=draw_renders) if records and figures else []
+    drawn = _figures(records, rows, out, cache, meanwhile=meanwhile) if records and figures else []
     if not (records and figures):
-        draw_renders()
+        meanwhile()
     report = build_report(rows, records, failures, drawn, renders, wall_s,
                           scenes=[oc.scene for oc in outcomes])
     atomic_write_text(out / "report.md", report)
