@@ -72,3 +72,16 @@ def test_invalid_thickness_names_parameter_and_range(ft, t):
 def test_s_out_of_range(ft):
     with pytest.raises(ParameterError, match="along the bone interface"):
         ft.section(1).point_at_s([20.0])
+
+
+def test_a_section_and_its_lookup_tables_are_built_once_per_fingertip_and_thickness(ft):
+    # equal fingertips (read again from the file) share the section of a thickness; a different
+    # thickness or fingertip gets its own, with its own arc-length map
+    a, b = ft.section(3.0), Fingertip.from_params().section(3)
+    assert a is b
+    other = ft.section(5.0)
+    assert other is not a and other.interface_length < a.interface_length
+    wide = Fingertip.from_params(half_width=9.0).section(3.0)
+    assert wide is not a and wide.interface_length != pytest.approx(a.interface_length, rel=1e-6)
+    pts = np.array([[0.0, 5.0], [2.0, 4.0]])
+    assert np.array_equal(a.s_of_point(pts), b.s_of_point(pts))

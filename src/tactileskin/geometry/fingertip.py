@@ -98,7 +98,7 @@ class Fingertip:
         return check_range("thickness", t, *self.thickness_bounds, unit="mm")
 
     def section(self, thickness: float) -> "Section":
-        return Section(self, self.check_thickness(thickness))
+        return _section(self, self.check_thickness(thickness))
 
     # --- outer contour -------------------------------------------------------------
     def outer(self, u) -> np.ndarray:
@@ -117,6 +117,13 @@ class Fingertip:
 
     def curvature(self, u) -> np.ndarray:
         return self.half_width * self.height / self.outer_speed(u) ** 3
+
+
+@functools.lru_cache(maxsize=16)
+def _section(fingertip: Fingertip, thickness: float) -> "Section":
+    """One Section per (fingertip, thickness) in a process: its arc-length table and lookup tree
+    (20,001 points, built lazily) are then built once, not once per solve of that thickness."""
+    return Section(fingertip, thickness)
 
 
 def _polar(p: np.ndarray) -> np.ndarray:
