@@ -33,12 +33,14 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from tactileskin._jit import njit
+
 # The loops take the dimension m and the nodes per element A as arguments; the entry points
 # below pass them as constants for P2 triangles (2, 6) and P2 tets (3, 10), so LLVM unrolls
 # the 2- and 3-trip loops (runtime trip counts cost ~5x: a vectorised body plus remainder
 # and alias checks for every tiny loop), and read them from the shapes otherwise.
-_impl = nb.njit(cache=True, error_model="numpy", inline="always")
-_jit = nb.njit(cache=True, error_model="numpy")
+_impl = njit(cache=True, error_model="numpy", inline="always")
+_jit = njit(cache=True, error_model="numpy")
 
 
 @_impl
@@ -429,7 +431,7 @@ def tangent_any(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, out):
                     G.shape[3], G.shape[2])
 
 
-@nb.njit(cache=True, error_model="numpy", parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def tangent_3_10_parallel(G, w, F, Fbar, Finv, alpha, J, theta, S, D, mixed, out, chunks):
     """tangent_3_10 on `chunks` contiguous element ranges run by numba's threads (each range
     with its own scratch arrays; numba.set_num_threads sets how many run at once). The same

@@ -16,10 +16,12 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from tactileskin._jit import njit
+
 # m (components per node) and A (nodes per element) as constants for P2 triangles (2, 6)
 # and P2 tets (3, 10), so LLVM unrolls the short loops (as in fe._kernels_nb)
-_impl = nb.njit(cache=True, error_model="numpy", inline="always")
-_jit = nb.njit(cache=True, error_model="numpy")
+_impl = njit(cache=True, error_model="numpy", inline="always")
+_jit = njit(cache=True, error_model="numpy")
 
 
 @_jit
@@ -78,7 +80,7 @@ def scatter_any(Ke, nptr, ne, na, off, indptr, out):
 # on numba's threads for the large P2-tet models only, as the tangent kernel: a parallel region
 # starts numba's OpenMP pool, after which a fork()ed child (multiprocessing's default on Linux)
 # hangs in its first parallel region, so 2D solves stay on this thread
-@nb.njit(cache=True, error_model="numpy", parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def scatter_3_10_threads(Ke, nptr, ne, na, off, indptr, out):
     return _scatter(Ke, nptr, ne, na, off, indptr, out, 3, 10)
 

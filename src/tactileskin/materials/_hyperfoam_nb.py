@@ -25,6 +25,7 @@ import math
 import numba
 import numpy as np
 
+from tactileskin._jit import njit
 from tactileskin.errors import TactileSkinError
 from tactileskin.materials import hyperfoam as _hf
 
@@ -179,7 +180,7 @@ def _plane_d(p11, p12, g00, g11, g22, g01, g02, g12, ic0, ic1, qv, Dp, mode):
     Dp[60], Dp[61], Dp[69], Dp[70] = G0, G1, G1, G2        # D_3a3b
 
 
-@numba.njit(_SIG, cache=True, nogil=True, error_model="numpy")
+@njit(_SIG, cache=True, nogil=True, error_model="numpy")
 def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode, K, keep):
     """Plane-strain S (n, 3, 3), D (n, 16) or (n, 81) (mode MODE_D2 / MODE_D3; untouched for
     MODE_S) and ok (n,) of the points C2 (n, 2, 2), written into S, D, ok; with `keep` (MODE_S)
@@ -273,7 +274,7 @@ def plane_kernel(C2, detF, has_detF, mu, alpha, beta, S, D, ok, mode, K, keep):
             _plane_d(p11, p12, g00, g11, g22, g01, g02, g12, ic0, ic1, qv, D[p], mode)
 
 
-@numba.njit(_SIG_D, cache=True, nogil=True, error_model="numpy")
+@njit(_SIG_D, cache=True, nogil=True, error_model="numpy")
 def plane_tangent_kernel(K, mu, alpha, beta, D, mode):
     """D (n, 16) or (n, 81) (MODE_D2 / MODE_D3) of the points whose data K `plane_kernel`
     kept: its tangent branch without the eigenproblem, logarithms, powers and stress, the same
@@ -527,7 +528,7 @@ def _solid_d(K, mu, alpha, beta, D, first, last):
 
 # compiled on first call (no signature): programs that never solve in 3D do not pay its ~6 s
 # compile on a fresh install; hyperfoam.pk2_tangent_solid passes one layout (C-contiguous)
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep):
     """S (n, 3, 3), D (n, 81) (untouched unless `tangent`), ok (n,) and, with `keep`, the
     spectral data K (n, KEPT) of the points C (n, 3, 3), written into S, D, ok, K:
@@ -535,7 +536,7 @@ def solid_kernel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep)
     _solid(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, 0, C.shape[0])
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+@njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent, K, keep, chunks):
     """solid_kernel on `chunks` contiguous point ranges run by numba's threads (as many at
     once as numba.set_num_threads allows); the same arithmetic per point, so the same bits."""
@@ -545,13 +546,13 @@ def solid_kernel_parallel(C, detF, has_detF, mu, alpha, beta, S, D, ok, tangent,
                (c + 1) * n // chunks)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def solid_tangent_kernel(K, mu, alpha, beta, D):
     """D (n, 81) of the points whose spectral data K (n, KEPT) `solid_kernel` kept."""
     _solid_d(K, mu, alpha, beta, D, 0, K.shape[0])
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+@njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def solid_tangent_kernel_parallel(K, mu, alpha, beta, D, chunks):
     """solid_tangent_kernel on `chunks` point ranges on numba's threads (the same bits)."""
     n = K.shape[0]

@@ -10,11 +10,11 @@ in the same order per entry, so the same bits:
 
 from __future__ import annotations
 
-import numba
+from tactileskin._jit import njit
 
 
-@numba.njit("void(float64[::1], float64[:, ::1], float64[::1], float64[::1], float64, float64[::1], "
-            "float64[::1], float64[::1], float64[::1])", cache=True, nogil=True, error_model="numpy")
+@njit("void(float64[::1], float64[:, ::1], float64[::1], float64[::1], float64, float64[::1], "
+     "float64[::1], float64[::1], float64[::1])", cache=True, nogil=True, error_model="numpy")
 def qlv_stress(S0, H, S0_old, S0_prev, gamma, decay, gain, back, S):
     """S (n,) from S0, S0_old, S0_prev (n,), H (terms, n) and the step's factors."""
     for j in range(S0.shape[0]):
