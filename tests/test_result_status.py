@@ -484,6 +484,30 @@ def test_braille_dots_pressed_less_than_their_patch_resolves_are_flagged():
         == ["coarse_mesh"]
 
 
+def test_late_dots_are_judged_against_the_dot_patch_size_meshed():
+    # mesh.sizing.spot_factor meshes a t >= 5 dot's spot at 3x the refined size at `default`
+    # (1.6 / 8: 0.6 mm, not 0.2): the flag and its message must use the 0.6 mm
+    sizes = {"global": 1.6, "refined": 0.2, "preview_global": 1.6, "preview_refined": 0.2, "thickness": 5.0}
+    normal3 = {k: v for k, v in NORMAL.items() if k != "reaction_n_per_mm"} | {"reaction_n": 0.5}
+    (f,) = quality.flags({**normal3, "mesh_sizes_mm": {**sizes, "dot_indentation": 0.18, "dot_patch": 0.6}})
+    assert f.code == "coarse_mesh" and "0.6 mm elements" in f.reason
+    assert quality.flags({**normal3, "mesh_sizes_mm": {**sizes, "dot_indentation": 0.28, "dot_patch": 0.6}}) == []
+    # results written before dot_patch was recorded keep the refined size
+    assert quality.flags({**normal3, "mesh_sizes_mm": {**sizes, "dot_indentation": 0.18}}) == []
+
+
+def test_a_t5_cell_records_the_dot_patch_size_it_meshed():
+    # t = 5 full cell on the fingertip at default (1.6 / 8): its dots touch after 0.069 mm; pressed
+    # 0.25 mm they go 0.18 mm past it, less than 0.45 of the 0.6 mm patch
+    from tactileskin.fe import solve
+
+    r = solve(Scene(thickness=5, indenter="braille", braille_text="\u283f", dim=3, depth=0.25, mesh_size=1.6,
+                    refinement=8))
+    sizes = r.summary()["mesh_sizes_mm"]
+    assert sizes["dot_patch"] == pytest.approx(0.6) and sizes["dot_indentation"] == pytest.approx(0.18, abs=0.01)
+    assert "coarse_mesh" in [f["code"] for f in r.summary()["flags"]] and "0.6 mm elements" in r.status
+
+
 def test_a_3d_lockup_the_mesh_does_not_resolve_is_flagged():
     # an R 2.5 sphere 0.6 mm into 1 mm silicone locks the law up (max |stress| ~50 mu0): on the
     # fingertip the peak read 4.09 / 3.79 / 3.57 MPa at preview / default / fine, on this pad 4.32 /

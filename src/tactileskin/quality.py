@@ -71,7 +71,8 @@ MIN_CONTACT_POINTS = 2
 # 6-15 points), peak 6.8e-6 and 1.6e-5 MPa, status ok; 6 points at 4e-3 mm (default): -4.3 %, as those.
 MIN_CONTACT_POINTS_3D = 3
 # ... and, for 3D Braille whose dots touch late (off a curved top's crown), the deepest-pressed dot
-# indented less than this fraction of the dot patch's element size (the refined size). The t = 0.5 mm
+# indented less than this fraction of the dot patch's element size (the size meshed there: "dot_patch",
+# the refined size where absent). The t = 0.5 mm
 # silicone full cell (dots at x = +-1.25 touch after 0.069 of 0.1 mm) at 0.2 / 0.1 / 0.075 mm (preview /
 # default / fine; indentation 0.16 / 0.31 / 0.41 of it) read -18 / -9.2 / -6.6 % from the Richardson
 # limit, status ok; from 0.5 on the measured cases stay within their presets' errors (t = 0.5 dot at
@@ -205,10 +206,10 @@ def flags(summary: dict) -> list[Flag]:
                        "measured from t = 0.5 mm at 0.4 t: 0.6 t read the peak 4 % and the reaction 6 % low, 2 t "
                        "12 % and 26 %, so use a smaller mesh size)")
         di = _num(sizes, "dot_indentation")
-        if di is not None and _num(sizes, "refined") is not None \
-                and di < MIN_DOT_INDENTATION_OVER_SIZE * sizes["refined"]:
+        patch = _num(sizes, "dot_patch") or _num(sizes, "refined")  # the size meshed at the dots
+        if di is not None and patch is not None and di < MIN_DOT_INDENTATION_OVER_SIZE * patch:
             why.append(f"the Braille dots are pressed {di:.3g} mm past their first touch, less than "
-                       f"{MIN_DOT_INDENTATION_OVER_SIZE:g} of the dot patch's {sizes['refined']:g} mm elements: "
+                       f"{MIN_DOT_INDENTATION_OVER_SIZE:g} of the dot patch's {patch:.3g} mm elements: "
                        "the contact under each dot is narrower than the mesh resolves (the t = 0.5 mm full cell "
                        "on the fingertip read 18 % low at preview, 9 % at default), so use a smaller mesh size "
                        "or a deeper press")

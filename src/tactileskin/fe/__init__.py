@@ -490,6 +490,10 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
             # quality judges how far the deepest-pressed one went in against the dot patch's size.
             # A centred dot is not judged: pressed 0.05 mm (a quarter of preview's patch) it read -2.9 %
             res.stats["mesh_sizes_mm"]["dot_indentation"] = max(0.0, travel - touch)
+            # ... against the size meshed there (mesh.sizing.spot_factor: a t >= 5 dot's at 3x)
+            patches = (getattr(sm, "sizes", None) or {}).get("patches") or ()
+            if patches:
+                res.stats["mesh_sizes_mm"]["dot_patch"] = float(max(b[4] for b in patches))
     log.info("%s: peak %.4g MPa, %d dofs, %d increments, %d Newton iterations, %.2f s",
              scene.label(), res.peak, res.stats["dofs"], stats.increments, stats.newton_iterations,
              stats.wall_s)
