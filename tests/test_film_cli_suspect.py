@@ -2,6 +2,7 @@
 film's warnings and the simulation's status into comparison.json and stderr, and exits 3."""
 
 import json
+import re
 
 import numpy as np
 
@@ -58,11 +59,20 @@ def test_every_number_printed_has_its_unit(tmp_path, capsys):
                                  background_gs=245), tmp_path / "scan.png")
     assert main(["film", "analyze", str(scan), "--out", str(tmp_path / "film")]) == 0
     out = capsys.readouterr().out
-    assert out.count("MPa/mm mm") == 2  # the two areas (before: "area 0.87" with no unit)
+    # the two areas: a pressure in MPa/mm integrated over s (mm) is in MPa ("MPa/mm mm" read as
+    # MPa/mm^2); a pressure in MPa gives MPa mm
+    assert "MPa/mm mm" not in out and len(re.findall(r"area [0-9.e+-]+ MPa;", out)) == 2
     _sim_dir(tmp_path / "sim")
     assert main(["film", "compare", str(tmp_path / "film"), str(tmp_path / "sim"), "-o", str(tmp_path / "c")]) == 0
     rows = [ln for ln in capsys.readouterr().out.splitlines() if ln.split()[:1] in (["peak"], ["span_mm"], ["auc"])]
-    assert len(rows) == 3 and rows[2].endswith("MPa/mm mm / MPa mm")
+    assert len(rows) == 3 and rows[2].endswith(" MPa / MPa mm")
+
+
+def test_area_units():
+    from tactileskin.film.scan import area_unit
+
+    assert [area_unit(u) for u in ("MPa", "MPa/mm", "kPa", "psi/mm", "MPa / mm")] == \
+        ["MPa mm", "MPa", "kPa mm", "psi", "MPa"]
 
 
 def test_the_figures_of_a_suspect_film_and_comparison_say_so(tmp_path, monkeypatch):

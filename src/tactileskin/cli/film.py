@@ -93,6 +93,7 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, rows, cm
     """
     from tactileskin.film import analyze_scan, load_calibration
     from tactileskin.film.plots import _check_cmap
+    from tactileskin.film.scan import area_unit
 
     _check_cmap(cmap)  # before any work, so a typo writes nothing
     if centre not in ("peak", "midspan"):
@@ -113,8 +114,8 @@ def analyze(scan, calibration, px_per_mm, box_px, box_mm, axis, centre, rows, cm
     click.echo(f"region x {x0}-{x1}, y {y0}-{y1} px {how}")
     m, f = fp.metrics, fp.folded["metrics"]
     click.echo(f"origin {fp.origin_mm:.3f} mm; two-sided: peak {m['peak']:.4g} {fp.unit}, "
-               f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g} {fp.unit} mm; folded: peak "
-               f"{f['peak']:.4g} {fp.unit}, span {f['span_mm']:.3f} mm, area {f['auc']:.4g} {fp.unit} mm; "
+               f"span {m['span_mm']:.3f} mm, area {m['auc']:.4g} {area_unit(fp.unit)}; folded: peak "
+               f"{f['peak']:.4g} {fp.unit}, span {f['span_mm']:.3f} mm, area {f['auc']:.4g} {area_unit(fp.unit)}; "
                f"asymmetry {fp.folded['asymmetry']:.3f}; saturated "
                f"{100 * fp.saturated_fraction:.1f} % of pixels")
     click.echo(f"wrote {out}")
@@ -136,12 +137,13 @@ def compare(film_dir, sim_dir, out):
     in comparison.json (`status`, `warnings`), and exits 3.
     """
     from tactileskin.film import compare as do_compare
+    from tactileskin.film.scan import area_unit
 
     comp = do_compare(film_dir, sim_dir)
     comp.write(out or film_dir)
     click.echo(f"{'metric':<8} {'film':>10} {'sim':>10} {'diff %':>8}   (film {comp.film_unit}, "
                "sim MPa; diff = 100 (sim - film)/film)")
-    units = {"peak": f"{comp.film_unit} / MPa", "span_mm": "mm", "auc": f"{comp.film_unit} mm / MPa mm"}
+    units = {"peak": f"{comp.film_unit} / MPa", "span_mm": "mm", "auc": f"{area_unit(comp.film_unit)} / MPa mm"}
     for k in ("peak", "span_mm", "auc"):
         click.echo(f"{k:<8} {comp.film_metrics[k]:>10.4g} {comp.sim_metrics[k]:>10.4g} "
                    f"{comp.percent_diff[k]:>+8.1f}   {units[k]}")

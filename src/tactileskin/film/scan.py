@@ -259,6 +259,15 @@ class FilmProfile:
         return {k: out / v for k, v in names.items()}
 
 
+def area_unit(unit: str) -> str:
+    """The unit of a pressure in `unit` integrated over s (mm): 'MPa' -> 'MPa mm', the paper's
+    'MPa/mm' -> 'MPa' (written as 'MPa/mm mm' it read as MPa/mm^2)."""
+    import re
+
+    base = re.sub(r"\s*/\s*mm$", "", str(unit).strip())
+    return base if base != str(unit).strip() else f"{base} mm"
+
+
 def unit_suffix(unit: str) -> str:
     """A unit as a column-name suffix: 'MPa' -> 'mpa', 'MPa/mm' -> 'mpa_per_mm'."""
     import re
