@@ -25,6 +25,18 @@ def test_two_files_of_one_stem_keep_distinct_labels():
     assert deeper == {"/x/a/m/gel.toml": "x/a/m/gel.toml", "/y/a/m/gel.toml": "y/a/m/gel.toml"}
 
 
+def test_labels_are_unique_and_carry_no_root_slash():
+    # a path that is the tail of another ('/x/soft.toml' in '/y/x/soft.toml') was labelled
+    # '//x/soft.toml' (the root joined as a part), and two spellings of one relative path
+    # ('soft.toml', './soft.toml') shared 'soft.toml' in the legends and results.csv
+    assert material_labels(["/x/soft.toml", "/y/x/soft.toml"]) == {
+        "/x/soft.toml": "x/soft.toml", "/y/x/soft.toml": "y/x/soft.toml"}
+    assert material_labels(["/a/soft.toml", "a/soft.toml"]) == {
+        "/a/soft.toml": "/a/soft.toml", "a/soft.toml": "a/soft.toml"}
+    got = material_labels(["soft.toml", "./soft.toml", "a/soft.toml", "b/soft.toml"])
+    assert len(set(got.values())) == 4 and got["a/soft.toml"] == "a/soft.toml"
+
+
 def test_a_file_named_as_a_preset_is_not_labelled_as_the_preset():
     # the paper checks key on the preset names: a user's silicone.toml is not the paper's silicone
     assert material_labels(["/home/alice/silicone.toml"]) == {"/home/alice/silicone.toml": "silicone.toml"}

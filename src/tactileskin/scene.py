@@ -484,12 +484,16 @@ def material_labels(materials) -> dict[str, str]:
         if stem not in taken and stems.count(stem) == 1:
             out[f] = stem
     rest = [f for f in files if f not in out]
+    # the parts below the root ('/x/gel.toml' -> x, gel.toml: no '//x/gel.toml' label)
+    parts = {f: [p for p in Path(f).parts if p != Path(f).anchor] for f in rest}
     k = 1
     while rest:
-        tails = {f: "/".join(Path(f).parts[-k:]) for f in rest}
+        tails = {f: "/".join(parts[f][-k:]) for f in rest}
         for f, tail in tails.items():
-            if list(tails.values()).count(tail) == 1 or k >= len(Path(f).parts):
+            if list(tails.values()).count(tail) == 1 and tail not in out.values():
                 out[f] = tail
+            elif k > max(len(parts[g]) for g in rest):  # one tail spelled twice ('gel.toml', './gel.toml')
+                out[f] = f
         rest = [f for f in rest if f not in out]
         k += 1
     return out
