@@ -121,3 +121,17 @@ def test_a_status_with_control_characters_is_valid_xml_and_round_trips(tmp_path,
     ET.parse(p)
     assert vtu_status(p) == status
     assert meshio.read(p).cell_data[SUSPECT_ARRAY][0].tolist() == [1]
+
+
+def test_a_status_longer_than_the_first_64_kib_reads_back(tmp_path):
+    """vtu_status read only the file's first 64 KiB: the comment starts there (after the XML
+    declaration, whatever the mesh's size) but a status longer than that (a user's names in
+    its reasons) ended past it and read back as None, a suspect result looking plain."""
+    from tactileskin.results import _write_vtu
+
+    fields = {"points": np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), "cell_type": "triangle",
+              "cells": np.array([[0, 1, 2]]), "point_data": {}}
+    status = "suspect: sensor '" + "s" * 70_000 + "' off the skin -- use --quality"
+    p = tmp_path / "result.vtu"
+    _write_vtu(p, fields, status=status)
+    assert vtu_status(p) == status

@@ -657,12 +657,23 @@ def _with_status(data: bytes, status: str) -> bytes:
 def vtu_status(path) -> str | None:
     """The status text a result.vtu was written with (summary.json's "ok" or "suspect: ..."),
     None for a file without one (written before, or not a result)."""
+    # the comment starts after the XML declaration (_with_status), whatever the mesh's size;
+    # a long status runs past the first chunk, so read on to its end
     with open(path, "rb") as fh:
-        head = fh.read(1 << 16).decode("utf-8", "replace")
-    i = head.find(_STATUS_COMMENT)
-    j = head.find(" -->", i)
-    if i < 0 or j < 0:
-        return None
+        data = fh.read(1 << 16)
+        i = data.find(_STATUS_COMMENT.encode())
+        if i < 0:
+            return None
+        j = data.find(b" -->", i)
+        while j < 0:
+            more = fh.read(1 << 16)
+            if not more:
+                return None
+            start = max(len(data) - 3, i)  # " -->" may straddle the chunks
+            data += more
+            j = data.find(b" -->", start)
+    head = data[:j].decode("utf-8", "replace")
+    i, j = head.find(_STATUS_COMMENT), len(head)
     return re.sub(r"\\(?:u([0-9a-f]{4});|(.))", lambda m: chr(int(m.group(1), 16)) if m.group(1) else m.group(2),
                   head[i + len(_STATUS_COMMENT):j], flags=re.S)
 
