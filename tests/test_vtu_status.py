@@ -135,3 +135,26 @@ def test_a_status_longer_than_the_first_64_kib_reads_back(tmp_path):
     p = tmp_path / "result.vtu"
     _write_vtu(p, fields, status=status)
     assert vtu_status(p) == status
+
+
+def test_an_old_status_with_a_separator_inside_a_reason_is_counted_by_its_flags(tmp_path):
+    """result.vtu written before quality.Flag turned '; ' into ', ' hold reasons like 'refining does
+    not cure it; use order 2': split on '; ' they counted one reason too many in '(+N more)'. The
+    summary.json beside the file lists the flags, so their reasons are the ones counted."""
+    from tactileskin.report.render import _titled
+    from tactileskin.results import _write_vtu
+
+    reasons = ["linear (P1) displacement elements with a nearly incompressible law lock, and refining does "
+               "not cure it; use order 2", "stress 9 MPa beyond 5 MPa", "volume ratio J = 0.2 outside [0.3, 3]"]
+    status = "suspect: " + "; ".join(reasons)
+    fields = {"points": np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), "cell_type": "triangle",
+              "cells": np.array([[0, 1, 2]]), "point_data": {}}
+    _write_vtu(tmp_path / "result.vtu", fields, status=status)
+    (tmp_path / "summary.json").write_text(json.dumps(
+        {"status": status, "flags": [{"code": c, "reason": r} for c, r in zip(("locking", "stress_range",
+                                                                                "volume_range"), reasons)]}))
+    title = _titled(tmp_path / "result.vtu", "t", 40)
+    assert "(+2 more)" in title and "(+3 more)" not in title
+    # a summary.json of another status (the folder rewritten) is not used: the status is split
+    (tmp_path / "summary.json").write_text(json.dumps({"status": "ok", "flags": []}))
+    assert "(+3 more)" in _titled(tmp_path / "result.vtu", "t", 40)

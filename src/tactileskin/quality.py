@@ -281,19 +281,24 @@ def kind(status_text: str) -> str:
     return k if k in ("ok", "suspect", "failed") else "failed"
 
 
-def suspect_title(text: str, status: str | None, width: int = 72, max_lines: int = 3) -> str:
+def suspect_title(text: str, status: str | None, width: int = 72, max_lines: int = 3,
+                  reasons: list[str] | None = None) -> str:
     """A figure's title `text`, with "SUSPECT: <reasons>" (the status text, summary.json's)
     below it when `status` is not "ok": wrapped to `width` characters so that it stays inside
     the figure (one 100-character line ran past both sides of an 8-inch one), at most
     `max_lines` lines. Reasons that do not fit are left out whole and counted, "(+2 more)"
     (the whole text is in summary.json); a first reason too long alone is cut with "...".
-    None (a file written without its status): `text` alone."""
+    None (a file written without its status): `text` alone. `reasons`: the status's reasons
+    where known apart (summary.json's flags; an older status held '; ' inside a reason), else
+    the status split on SEPARATOR."""
     import textwrap
 
     if status is None or kind(status) == "ok":
         return text
     word = kind(status).upper()
-    reasons = str(status).split(":", 1)[-1].strip().split(SEPARATOR)
+    body = str(status).split(":", 1)[-1].strip()
+    if not reasons or SEPARATOR.join(reasons) != body:
+        reasons = body.split(SEPARATOR)
 
     def wrap(s: str) -> list[str]:
         return textwrap.wrap(s, width, break_on_hyphens=False)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -676,6 +677,21 @@ def vtu_status(path) -> str | None:
     i, j = head.find(_STATUS_COMMENT), len(head)
     return re.sub(r"\\(?:u([0-9a-f]{4});|(.))", lambda m: chr(int(m.group(1), 16)) if m.group(1) else m.group(2),
                   head[i + len(_STATUS_COMMENT):j], flags=re.S)
+
+
+def vtu_reasons(path, status: str | None) -> list[str] | None:
+    """The reasons of a .vtu's `status` as the summary.json of its result lists them (its
+    flags; result_steps/ files: the folder above), None where that summary has another
+    status or none. A status written before quality.Flag kept '; ' out of a reason splits
+    into one reason too many; the flags do not."""
+    path = Path(path)
+    folder = path.parent.parent if path.parent.name == STEPS_DIR else path.parent
+    try:
+        doc = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+        flags = [str(f["reason"]) for f in doc["flags"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return flags if flags and doc.get("status") == status else None
 
 
 def add_vtu_field_data(path: Path, field_data: dict) -> None:

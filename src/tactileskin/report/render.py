@@ -151,9 +151,10 @@ def _titled(vtu: Path, title: str, width: int) -> str:
     """`title` with the SUSPECT note of the result's status, as result.vtu holds it
     (results.vtu_status; a file written without one: the title alone)."""
     from tactileskin.quality import suspect_title
-    from tactileskin.results import vtu_status
+    from tactileskin.results import vtu_reasons, vtu_status
 
-    return suspect_title(title, vtu_status(vtu), width)
+    status = vtu_status(vtu)
+    return suspect_title(title, status, width, reasons=vtu_reasons(vtu, status))
 
 
 def _quiet_vtk() -> None:
