@@ -402,6 +402,7 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
     iterations) after each converged increment; nothing is printed either way."""
     from tactileskin.geometry.indenters import (BrailleIndenter, first_contact_travel, indenter_symmetry,
                                                 mirrored_x, require_contact)
+    from tactileskin.errors import ConvergenceError
     from tactileskin.materials import get_material
     from tactileskin.materials.laws import nu0
 
@@ -433,13 +434,19 @@ def solve(scene, mesh=None, *, history: bool = False, options: SolverOptions | N
                 "displacement": model.u.reshape(-1, model.m).copy()}
 
     program = scene.program()
-    with blas_threads():
-        if len(program) == 1 and program[0].kind == "depth":
-            _start_near_first_touch(scene, model)
-            ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
-            res = None
-        else:
-            res, ev, stats = _run_history(scene, model, section, program, options, progress, history)
+    try:
+        with blas_threads():
+            if len(program) == 1 and program[0].kind == "depth":
+                _start_near_first_touch(scene, model)
+                ev, stats = run(model, scene.duration, options, history=history, record=record, progress=progress)
+                res = None
+            else:
+                res, ev, stats = _run_history(scene, model, section, program, options, progress, history)
+    except ConvergenceError as e:
+        hint = scene.skin_kind.convergence_hint(scene)  # what to change, where the skin knows
+        if not hint:
+            raise
+        raise ConvergenceError(f"{e}; {hint}", e.diagnosis) from None
     t2 = time.perf_counter()
     if res is None:
         res = make_result(model, ev, stats, s_of_point=section.s_of_point, scene=scene.to_dict())

@@ -500,6 +500,12 @@ def _travel_capped_dt(model: Model, t: float, dt: float, opts: SolverOptions) ->
     return dt * cap / step if step > cap else dt
 
 
+def _travel_text(model) -> str:
+    """' after <d> mm of indenter travel' of a contact model, '' otherwise."""
+    d = getattr(model, "d", None) if getattr(model, "contact", None) is not None else None
+    return "" if d is None else f" after {float(d):.4g} mm of indenter travel"
+
+
 @dataclass(frozen=True)
 class IncrementInfo:
     """What `run(..., progress=)` reports after each converged increment."""
@@ -554,14 +560,26 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
             log.info("increment t=%.5g dt=%.3g failed (%s); cutting back", t + dt, dt, f.why)
             if dt * opts.cutback < dt_min:
                 diag = {"time": t, "dt": dt, "reason": f.why, **f.diag}
-                d = getattr(model, "d", None) if getattr(model, "contact", None) is not None else None
-                where = "" if d is None else f" after {float(d):.4g} mm of indenter travel"
-                raise ConvergenceError(f"no convergence at t = {t:.6g} s{where} with dt = {dt:.3g} s: {f.why} "
+                raise ConvergenceError(f"no convergence at t = {t:.6g} s{_travel_text(model)} with dt = {dt:.3g} s: "
+                                       f"{f.why} "
                                        "(the skin or its mesh gives out there: the material law's lock-up, elements "
                                        "too coarse for the strain or the contact; try a smaller depth or force, or "
                                        "a finer mesh: quality fine)", diag) from None
             if opts.failed_dt_fraction > 0.0:
                 dt_cap = min(dt_cap, opts.failed_dt_fraction * dt)
+                # no increment is longer than dt_cap from here (but a last one 1e-3 longer): past
+                # max_increments a depth ramp cannot finish, so stop now rather than crawl there (a
+                # confined pad under the flat plate: ~390 steps of 1.2e-5 s, 15 s CPU, to fail).
+                # Force control keeps going: its errors name the force from the state it reached
+                need = (T - t) / (1.001 * dt_cap) - 1.0
+                if increment is None and need > opts.max_increments - stats.increments:
+                    raise ConvergenceError(
+                        f"no convergence at t = {t:.6g} s{_travel_text(model)} with dt = {dt:.3g} s: {f.why}, and "
+                        f"at the {dt_cap:.3g} s allowed after it the rest of the load needs {need:.0f} more "
+                        f"increments, past the {opts.max_increments} allowed (the skin or its mesh gives out there: "
+                        "the material law's lock-up, elements too coarse for the strain or the contact; try a "
+                        "smaller depth or force, or a finer mesh: quality fine)",
+                        {"time": t, "dt": dt, "dt_cap": dt_cap, "reason": f.why, **f.diag}) from None
             dt *= opts.cutback
             continue
         model.commit(ev, unew, t + dt, dt)

@@ -106,6 +106,12 @@ class Skin:
         return None
 
     @classmethod
+    def convergence_hint(cls, scene) -> str | None:
+        """What to change when a depth ramp of this skin fails to converge, where the skin knows
+        (a confined pad under the flat plate), else None."""
+        return None
+
+    @classmethod
     def top_extent(cls, scene) -> tuple[float, float] | None:
         return None
 
