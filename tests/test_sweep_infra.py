@@ -472,3 +472,32 @@ def test_ctrl_c_at_a_terminal_ends_a_sweep_with_workers_without_a_traceback(tmp_
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     gone, alive = psutil.wait_procs(workers, timeout=60)
     assert alive == []
+
+
+def _idle_periods(dask_worker) -> dict:
+    """A sweep worker's periodic monitors (client.run): {name: period s}."""
+    pcs = dask_worker.periodic_callbacks
+    return {name: pcs[name].callback_time / 1000 for name in ("tick", "monitor") if name in pcs}
+
+
+def test_a_sweeps_local_cluster_idles_quietly():
+    """Dask's servers sample their event loop every 20 ms (tick), the process every 0.5 s
+    (system monitor) and each nanny its worker's memory every 0.1 s, for diagnostics and a
+    dashboard a sweep has not: ~0.07 CPU s per s of sweep on 2 cores (main process and two
+    workers, benchmarks/results/sweep_overhead.md). The sweep's cluster samples less often;
+    the nanny still ends a worker that outgrows its memory (the case is then rerun)."""
+    from tactileskin.sweep import _Runner
+
+    runner = _Runner([], [], serial=False, scheduler=None, workers=1)
+    try:
+        client = runner._start(1)
+        workers = list(client.run(_idle_periods).values())
+        cluster = runner.cluster
+        servers = [cluster.scheduler, *cluster.workers.values()]  # the scheduler, the nanny
+        main = [{n: s.periodic_callbacks[n].callback_time / 1000 for n in ("tick", "monitor")} for s in servers]
+        nanny_memory = [w.memory_manager.memory_monitor_interval for w in cluster.workers.values()]
+    finally:
+        runner.close()
+    for periods in [*workers, *main]:
+        assert periods["tick"] >= 1.0 and periods["monitor"] >= 5.0, periods
+    assert nanny_memory and all(0.2 <= t <= 1.0 for t in nanny_memory), nanny_memory

@@ -482,7 +482,11 @@ class _Runner:
         # glibc's adaptive mmap threshold: every numpy temporary over 128 KiB is then
         # mmapped and unmapped, and a solve spent ~30 % of its time in the kernel (t1
         # silicone curved: 2.0 s in a worker, 1.0 s in a plain process; 1.4 s without it).
-        # The statistical profiler samples every 10 ms; nobody reads it here.
+        # The statistical profiler samples every 10 ms; nobody reads it here. Likewise each
+        # server's event-loop tick (every 20 ms) and system monitor (0.5 s), diagnostics for a
+        # dashboard the sweep has not, and the nannies' memory checks (0.1 s; 0.5 s still ends
+        # a worker that outgrows its memory, its case rerun): ~0.07 -> ~0.015 CPU s per s of
+        # sweep on 2 cores (benchmarks/results/sweep_overhead.md).
         # The nanny writes its pre-spawn variables into this process's environment too: the
         # PARDISO threads (read at solve time) go to the workers alone, by `env`, and
         # MKL_NUM_THREADS=1 is not set here, or a later lone solve or sweep in this process
@@ -500,6 +504,9 @@ class _Runner:
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                               "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": None,
                               "distributed.worker.profile.enabled": False,
+                              "distributed.admin.tick.interval": "1s",
+                              "distributed.admin.system-monitor.interval": "5s",
+                              "distributed.worker.memory.monitor-interval": "500ms",
                               "distributed.worker.multiprocessing-method": method}):
             # quiet: CRITICAL. On a loaded machine a worker's heartbeat can race the
             # scheduler's shutdown after the last result and log a CommClosedError traceback
