@@ -501,3 +501,47 @@ def test_a_sweeps_local_cluster_idles_quietly():
     for periods in [*workers, *main]:
         assert periods["tick"] >= 1.0 and periods["monitor"] >= 5.0, periods
     assert nanny_memory and all(0.2 <= t <= 1.0 for t in nanny_memory), nanny_memory
+
+
+def _loaded_loops() -> dict:
+    """{compiled loop: its loaded type signatures} of the package's serial numba loops in
+    this process (client.run on a worker)."""
+    import importlib
+
+    from numba.core.dispatcher import Dispatcher
+
+    from tactileskin.sweep import COMPILED_MODULES
+
+    return {f"{m}.{n}": sorted(map(str, d.overloads)) for m in COMPILED_MODULES
+            for n, d in vars(importlib.import_module(m)).items()
+            if isinstance(d, Dispatcher) and not d.targetoptions.get("parallel")}
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork()ed workers on Linux only")
+def test_forked_workers_start_with_the_cached_compiled_loops_loaded(monkeypatch):
+    """Each fork()ed worker loaded the compiled loops from numba's cache at its first case
+    (~0.25 s CPU each); the sweep's process loads them once before the workers fork, so a
+    worker has, before any case, every serial loop's signature numba's cache holds."""
+    import subprocess
+
+    from tactileskin import sweep, threads
+    from tactileskin.fe import _kernels_nb
+    from tactileskin.sweep import _Runner
+
+    loop = _kernels_nb.kinematics_2_6
+    if not any(key[1] == loop.targetctx.codegen().magic_tuple() for key in loop._cache._cache_file._load_index()):
+        # numba's cache has no 2D loop yet (a fresh checkout): one 2D solve, in its own process, fills it
+        subprocess.run([sys.executable, "-c", "from tactileskin import Scene, fe, planner; "
+                        "fe.solve(planner.with_quality(Scene(thickness=1.0), 'preview'))"], check=True)
+    monkeypatch.setattr(threads, "threads_started", lambda: False)
+    monkeypatch.setattr(sweep, "_other_threads", list)
+    monkeypatch.setattr("tactileskin.mesh._gmsh._meshed_3d_in", None)
+    runner = _Runner([], [], serial=False, scheduler=None, workers=2)
+    try:
+        states = list(runner._start(2).run(_loaded_loops).values())
+    finally:
+        runner.close()
+    assert len(states) == 2
+    for loaded in states:
+        assert loaded["tactileskin.fe._kernels_nb.kinematics_2_6"], loaded
+        assert loaded["tactileskin.fe._kernels_nb.tangent_2_6"] and loaded["tactileskin.fe._sparse_nb.scatter_2_6"], loaded

@@ -499,6 +499,9 @@ class _Runner:
             import tactileskin.mesh  # noqa: F401
             import multiprocessing.util
 
+            if n > 1:  # loaded once here, not by each worker at its first case
+                _load_compiled_loops()
+
             # in each worker fork()ed while this runner lives (a restarted one too), first thing
             multiprocessing.util.register_after_fork(self, _plain_streams)
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
@@ -544,6 +547,47 @@ class _Runner:
         _restore_environ(self._environ)  # a worker its nanny restarted set them again
         for name, level in self._log_levels.items():
             logging.getLogger(name).setLevel(level)
+
+
+# the modules of the compiled loops a 2D or 3D solve calls (numba, cache=True)
+COMPILED_MODULES = ("tactileskin.fe._kernels_nb", "tactileskin.fe._sparse_nb", "tactileskin.materials._hyperfoam_nb")
+
+
+def _load_compiled_loops() -> int:
+    """Load, before the workers fork(), every type signature numba's on-disk cache holds of the
+    package's serial compiled loops (COMPILED_MODULES): each fork()ed worker loaded them at its
+    first case, ~0.25 s CPU each (a preview case 0.70 -> 0.45 s in a fork()ed child), here
+    once, ~0.22 s (benchmarks/results/sweep_overhead.md). The loops numba compiles in
+    parallel (parallel=True) are left to the workers: loaded here they could start numba's
+    threads, and a child fork()ed after that solves on one (threads.forked_from_threads).
+    Numba's cache index is not public API: where it cannot be read, nothing is loaded and the
+    workers load what they call, as before. Returns the number of signatures loaded."""
+    import importlib
+
+    try:
+        from numba.core.dispatcher import Dispatcher
+    except ImportError:  # pragma: no cover - numba is a dependency
+        return 0
+    n = 0
+    for name in COMPILED_MODULES:
+        for d in vars(importlib.import_module(name)).values():
+            # (explicit signatures: compiled as the module loaded, and closed to more)
+            if not isinstance(d, Dispatcher) or d.targetoptions.get("parallel") or not d._can_compile:
+                continue
+            try:
+                index = d._cache._cache_file._load_index()
+                magic = d.targetctx.codegen().magic_tuple()
+                sigs = [key[0] for key in index if key[1] == magic and tuple(key[0]) not in d.overloads]
+            except Exception as e:  # noqa: BLE001 - numba's internals moved: the workers load them
+                log.debug("numba's cache index of %s not read (%s); not loaded before the workers start", d, e)
+                continue
+            for sig in sigs:
+                misses = sum(d._cache_misses.values())
+                d.compile(sig)
+                if sum(d._cache_misses.values()) != misses:  # compiled, not loaded: stale entry
+                    log.debug("%s%s compiled anew while loading the cache", d, sig)
+                n += 1
+    return n
 
 
 def _plain_streams(_runner) -> None:
