@@ -881,3 +881,33 @@ def test_a_date_where_a_number_belongs_is_told_a_number_not_text(geometry):
     with pytest.raises(ParameterError, match=r"^indenters.toml: curved.measured=.* is invalid; valid: a number or "
                                              r"text, not a TOML date"):
         params.load("indenters")
+
+
+def test_a_sweep_checks_the_code_once_per_stored_case_and_still_validates_it(tmp_path, monkeypatch):
+    """run_sweep's finish stored a case (store: the code check) and read it back with lookup,
+    which hashed the package's sources again (~3.4 ms, 18 x in a preview sweep's main
+    process): the entry just written under that check is read back by the cache's validation
+    alone. A result that does not pass it is still a failed case, its entry removed."""
+    import tactileskin.cache as cache_mod
+    import tactileskin.sweep as sw
+
+    scenes = [Scene(thickness=1.0), Scene(thickness=3.0)]
+    class Bad:  # written, but "s is not increasing": not a valid entry
+        def write_owned(self, directory):
+            (directory / "profile.csv").write_text("s_mm,pressure_mpa\n1.0,0.1\n0.0,0.2\n")
+            (directory / "summary.json").write_text('{"peak_mpa": 0.2, "span_mm": 1.0, "auc_mpa_mm": 0.1}')
+
+    bad = Bad()
+    monkeypatch.setattr(sw, "solve_case", lambda sc: _result() if sc.thickness == 1.0 else bad)
+    calls = []
+    real = cache_mod.code_changes
+    monkeypatch.setattr(cache_mod, "code_changes", lambda: calls.append(1) or real())
+    cache = ResultCache(tmp_path / "cache")
+    outcomes = run_sweep(scenes, cache, serial=True)
+    checks = len(calls)
+    assert [o.status for o in outcomes] == ["done", "failed"]
+    assert "validation" in outcomes[1].error
+    assert outcomes[0].record is not None and outcomes[0].record.summary["peak_mpa"] == pytest.approx(0.4)
+    assert cache.has(scenes[0]) and not (cache.root / outcomes[1].key).exists()
+    # per case: the scan's lookup, the claim's lookup under the lock, store; not a 4th in the read-back
+    assert checks == 3 * len(scenes), checks

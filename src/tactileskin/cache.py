@@ -462,6 +462,17 @@ class ResultCache:
             fileio.fix_tree_modes(tmp)
         return final
 
+    def store_record(self, scene: Scene, result, key: str) -> CaseRecord | None:
+        """store, then the entry read back through the cache's validation (as lookup: a damaged
+        one is logged and removed, None). Without lookup's second code check: the entry is the
+        one store just wrote under its own (each check hashes the package's ~130 sources)."""
+        final = self.store(scene, result, key)
+        rec, problem = self._check(final, scene, key)
+        if problem:
+            log.warning("cache entry %s is damaged (%s); it is removed and the case recomputed", final, problem)
+            self._discard(final)
+        return rec
+
     # --- files derived from entries (a sweep's figures) -------------------------------------
     def load_files(self, name: str) -> list[tuple[str, bytes]] | None:
         """The (file name, bytes) of the derived entry `name` (store_files), in their order, or

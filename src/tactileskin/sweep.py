@@ -725,8 +725,7 @@ def run_sweep(
         rec = None
         if status == "done":
             try:
-                cache.store(sc, result, keys[i])
-                rec = cache.lookup(sc, keys[i])
+                rec = cache.store_record(sc, result, keys[i])
                 if rec is None:
                     status, err = "failed", "the stored result did not pass the cache's validation"
             except TactileSkinError as e:
