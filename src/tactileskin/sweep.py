@@ -502,6 +502,10 @@ class _Runner:
             if n > 1:  # loaded once here, not by each worker at its first case
                 _load_compiled_loops()
 
+            # loaded here, not by the hook in each child: a terminal's Ctrl-C during that import,
+            # before the hook set SIGINT aside, ended a starting worker with a traceback
+            import tactileskin.sweep_worker  # noqa: F401
+
             # in each worker fork()ed while this runner lives (a restarted one too), first thing
             multiprocessing.util.register_after_fork(self, _plain_streams)
         with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
