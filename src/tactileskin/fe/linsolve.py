@@ -97,7 +97,7 @@ def default_threads(large: bool) -> int:
 def default_ordering(dim: int) -> str:
     """PARDISO's ordering for a model of dimension dim. On the 2D fingertip tangents (1.9-10.5k
     free dofs) minimum degree left 6-17 % fewer factor nonzeros than METIS: factorisation +
-    solve 7-12 % less CPU, the analysis half (benchmarks/pardiso_ordering.py). Nested
+    solve 7-12 % less CPU, analysis 37-47 % less (benchmarks/pardiso_ordering.py). Nested
     dissection is the choice for 3D meshes' separators."""
     return "amd" if dim == 2 else "metis"
 
