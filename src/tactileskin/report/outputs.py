@@ -278,7 +278,7 @@ def _write_outputs(out: Path, outcomes, cache, wall_s: float, *, render: bool, f
 
     def meanwhile() -> None:
         # the tables and renders, written while the second process draws its figures: that
-        # one had the longer share, so this one waited for it (~0.1 s) after writing them first
+        # one has the longer share of the drawing, so this one would otherwise wait for it
         _write_tables(out, rows, records)
         if render and records:
             renders.extend(_renders(records, out, cache))
