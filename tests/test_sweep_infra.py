@@ -545,3 +545,29 @@ def test_forked_workers_start_with_the_cached_compiled_loops_loaded(monkeypatch)
     for loaded in states:
         assert loaded["tactileskin.fe._kernels_nb.kinematics_2_6"], loaded
         assert loaded["tactileskin.fe._kernels_nb.tangent_2_6"] and loaded["tactileskin.fe._sparse_nb.scatter_2_6"], loaded
+
+
+def test_a_damaged_entry_of_numbas_cache_does_not_stop_a_sweep_from_starting(monkeypatch):
+    """The sweep's process loads every signature numba's cache index holds before the workers
+    fork, also those its cases never call (a 3D loop in a 2D sweep). An entry whose data file
+    is damaged (cut short: numba raises UnpicklingError as it loads it) ended the sweep with
+    that traceback before its first case; it is skipped, the workers load what they call."""
+    import pickle
+
+    from numba.core import types
+
+    from tactileskin import sweep
+    from tactileskin.fe import _kernels_nb
+
+    loop = _kernels_nb.kinematics_2_6
+    sig = (types.float32,)  # a signature the index names and this process has not loaded
+    files = loop._cache._cache_file
+    key = loop._cache._index_key(sig, loop.targetctx.codegen())
+    monkeypatch.setattr(files, "_load_index", lambda: {key: "damaged.nbc"})
+
+    def cut_short(name):
+        raise pickle.UnpicklingError("pickle data was truncated")
+
+    monkeypatch.setattr(files, "_load_data", cut_short)
+    sweep._load_compiled_loops()
+    assert tuple(sig) not in loop.overloads

@@ -565,7 +565,8 @@ def _load_compiled_loops() -> int:
     parallel (parallel=True) are left to the workers: loaded here they could start numba's
     threads, and a child fork()ed after that solves on one (threads.forked_from_threads).
     Numba's cache index is not public API: where it cannot be read, nothing is loaded and the
-    workers load what they call, as before. Returns the number of signatures loaded."""
+    workers load what they call, as before; so is an entry that fails to load (a damaged data
+    file). Returns the number of signatures loaded."""
     import importlib
 
     try:
@@ -587,7 +588,12 @@ def _load_compiled_loops() -> int:
                 continue
             for sig in sigs:
                 misses = sum(d._cache_misses.values())
-                d.compile(sig)
+                try:
+                    d.compile(sig)
+                except Exception as e:  # noqa: BLE001 - a damaged entry (numba raises as it loads
+                    # it), maybe of a loop no case calls: left to the workers, as before
+                    log.debug("%s%s not loaded from numba's cache (%s: %s)", d, sig, type(e).__name__, e)
+                    continue
                 if sum(d._cache_misses.values()) != misses:  # compiled, not loaded: stale entry
                     log.debug("%s%s compiled anew while loading the cache", d, sig)
                 n += 1
