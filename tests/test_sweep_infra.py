@@ -483,7 +483,7 @@ def _idle_periods(dask_worker) -> dict:
 def test_a_sweeps_local_cluster_idles_quietly():
     """Dask's servers sample their event loop every 20 ms (tick), the process every 0.5 s
     (system monitor) and each nanny its worker's memory every 0.1 s, for diagnostics and a
-    dashboard a sweep has not: ~0.07 CPU s per s of sweep on 2 cores (main process and two
+    dashboard a sweep has not: ~0.06 CPU s per s of sweep on 2 cores (main process and two
     workers, benchmarks/results/sweep_overhead.md). The sweep's cluster samples less often;
     the nanny still ends a worker that outgrows its memory (the case is then rerun)."""
     from tactileskin.sweep import _Runner

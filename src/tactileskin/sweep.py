@@ -485,7 +485,7 @@ class _Runner:
         # The statistical profiler samples every 10 ms; nobody reads it here. Likewise each
         # server's event-loop tick (every 20 ms) and system monitor (0.5 s), diagnostics for a
         # dashboard the sweep has not, and the nannies' memory checks (0.1 s; 0.5 s still ends
-        # a worker that outgrows its memory, its case rerun): ~0.07 -> ~0.015 CPU s per s of
+        # a worker that outgrows its memory, its case rerun): ~0.06 -> ~0.01 CPU s per s of
         # sweep on 2 cores (benchmarks/results/sweep_overhead.md).
         # The nanny writes its pre-spawn variables into this process's environment too: the
         # PARDISO threads (read at solve time) go to the workers alone, by `env`, and
@@ -560,8 +560,8 @@ COMPILED_MODULES = ("tactileskin.fe._kernels_nb", "tactileskin.fe._sparse_nb", "
 def _load_compiled_loops() -> int:
     """Load, before the workers fork(), every type signature numba's on-disk cache holds of the
     package's serial compiled loops (COMPILED_MODULES): each fork()ed worker loaded them at its
-    first case, ~0.25 s CPU each (a preview case 0.70 -> 0.45 s in a fork()ed child), here
-    once, ~0.22 s (benchmarks/results/sweep_overhead.md). The loops numba compiles in
+    first case, ~0.24 s CPU each (a preview case 0.60-0.69 -> 0.37-0.47 s in a fork()ed child),
+    here once, ~0.25 s (benchmarks/results/sweep_overhead.md). The loops numba compiles in
     parallel (parallel=True) are left to the workers: loaded here they could start numba's
     threads, and a child fork()ed after that solves on one (threads.forked_from_threads).
     Numba's cache index is not public API: where it cannot be read, nothing is loaded and the
