@@ -388,3 +388,22 @@ def test_a_confined_pad_under_the_flat_plate_fails_fast_naming_its_width_against
     # a pad 8 t wide still solves at 20 % (suspect: the law locks up, flagged)
     r = solve(Scene(skin="pad", pad_width=8.0, thickness=1.0, indenter="flat"))
     assert r.status.startswith("suspect")
+
+
+def test_the_confined_pad_hint_needs_both_sides_wide_in_3d():
+    """In 3D a pad bulges out at its free ends too, so its confinement is set by its shorter
+    side (as buckling_strain's): a 5 x 60 x 1 mm strip is no more confined than the 2D 5 t
+    section that solved, yet a failure of it said 'pad_length = 60 mm = 60 t ... is confined
+    ... use a narrower pad' (it is 5 t wide already). Force-controlled scenes get 'force'."""
+    def hint(**kw):
+        sc = Scene(skin="pad", thickness=1.0, indenter="flat", **kw)
+        return sc.skin_kind.convergence_hint(sc)
+
+    assert hint(dim=3, pad_width=5.0, pad_length=60.0) is None
+    assert hint(dim=3, pad_width=60.0, pad_length=5.0) is None
+    assert hint(dim=3, pad_width=8.0, pad_length=8.0) is None
+    both = hint(dim=3, pad_width=20.0, pad_length=30.0)
+    assert "pad_width = 20 mm = 20 t and pad_length = 30 mm = 30 t" in both
+    assert "pad_width = 60 mm = 60 t)" in hint(dim=2, pad_width=60.0, pad_length=5.0)  # 2D: plane strain
+    assert "a smaller force" in hint(dim=2, pad_width=60.0, force=1.0)
+    assert "a smaller depth" in hint(dim=2, pad_width=60.0)
