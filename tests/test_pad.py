@@ -373,9 +373,10 @@ def test_a_pad_too_wide_for_the_flat_plate_is_refused_at_once_naming_its_range()
 
 def test_a_confined_pad_under_the_flat_plate_fails_fast_naming_its_width_against_t():
     """--skin pad --pad-width 60 --indenter flat -t 1: the bonded layer, 60 t wide, is confined and
-    locks up (Newton fails at 0.045 of 0.2 mm). After an increment of 1.7e-5 s failed, increments
-    were capped below it and crawled ~390 more 1.2e-5 s steps (15 s CPU) before failing: the cap
-    left 13 700 increments to go, past max_increments (2000), so the run could never finish.
+    locks up (Newton fails at 0.045-0.051 of 0.2 mm). After an increment of 1.7e-5 s failed,
+    increments were capped below it and crawled 390-870 more tiny steps (15-24 s CPU; the count
+    differs between CPUs) before failing: the cap left 13 700 increments to go, past
+    max_increments (2000), so the run could never finish.
     It now stops there, and the error names pad_width against t and what solved."""
     from tactileskin.errors import ConvergenceError
     from tactileskin.fe import solve
@@ -384,7 +385,7 @@ def test_a_confined_pad_under_the_flat_plate_fails_fast_naming_its_width_against
     with pytest.raises(ConvergenceError, match=r"pad_width = 60 mm = 60 t\).*8 t") as err:
         solve(Scene(skin="pad", pad_width=60.0, thickness=1.0, indenter="flat"), progress=seen.append)
     assert "increments" in str(err.value)
-    assert seen and seen[-1].increment < 60  # before: ~400
+    assert seen and seen[-1].increment < 60  # before: 400-900
     # a pad 8 t wide still solves at 20 % (suspect: the law locks up, flagged)
     r = solve(Scene(skin="pad", pad_width=8.0, thickness=1.0, indenter="flat"))
     assert r.status.startswith("suspect")

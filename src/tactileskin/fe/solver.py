@@ -569,7 +569,8 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
                 dt_cap = min(dt_cap, opts.failed_dt_fraction * dt)
                 # no increment is longer than dt_cap from here (but a last one 1e-3 longer): past
                 # max_increments a depth ramp cannot finish, so stop now rather than crawl there (a
-                # confined pad under the flat plate: ~390 steps of 1.2e-5 s, 15 s CPU, to fail).
+                # confined pad under the flat plate: ~390 to 870 tiny steps, 15 to 24 s CPU, to fail:
+                # benchmarks/confined_pad.py).
                 # Force control keeps going: its errors name the force from the state it reached
                 need = (T - t) / (1.001 * dt_cap) - 1.0
                 if increment is None and need > opts.max_increments - stats.increments:
