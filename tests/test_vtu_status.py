@@ -137,6 +137,21 @@ def test_a_status_longer_than_the_first_64_kib_reads_back(tmp_path):
     assert vtu_status(p) == status
 
 
+def test_a_status_comment_without_its_end_is_read_in_linear_time(tmp_path):
+    """A damaged file whose status comment never ends (cut off, or edited) is read to its end to
+    answer None; appending each 64 KiB chunk to an immutable bytes copied all read so far, so a
+    32 MiB file took ~9 s (64 MiB: 34 s; a large 3D result's hundreds of MiB: many minutes)."""
+    import time
+
+    p = tmp_path / "result.vtu"
+    with open(p, "wb") as fh:
+        fh.write(b'<?xml version="1.0"?>\n<!-- tactileskin status: suspect: x')
+        fh.write(b"A" * (32 << 20))
+    c0 = time.process_time()
+    assert vtu_status(p) is None
+    assert time.process_time() - c0 < 2.0
+
+
 def test_an_old_status_with_a_separator_inside_a_reason_is_counted_by_its_flags(tmp_path):
     """result.vtu written before quality.Flag turned '; ' into ', ' hold reasons like 'refining does
     not cure it; use order 2': split on '; ' they counted one reason too many in '(+N more)'. The
