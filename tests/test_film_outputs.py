@@ -244,3 +244,19 @@ def test_a_centre_row_profile_leaves_its_spread_empty(tmp_path, scan, sim):
         else:
             assert max(float(v) for v in sd) > 0
         assert main(["film", "compare", str(film), str(sim)]) == 0
+
+
+@pytest.mark.parametrize("out, plot, needle", [
+    ("c.json", "c.svg", "--plot"),   # was written: PNG bytes in a file named .svg
+    ("c.json", "c.pdf", "--plot"),
+    ("c.csv", None, "--out"),        # was written: the calibration JSON in a file named .csv
+])
+def test_calibrate_refuses_a_file_name_of_another_format(tmp_path, capsys, out, plot, needle):
+    (tmp_path / "cal.csv").write_text("force_n,area_mm2,gray\n30,100,40\n17,100,120\n2,100,220\n")
+    args = ["film", "calibrate", str(tmp_path / "cal.csv"), "--out", str(tmp_path / out)]
+    if plot:
+        args += ["--plot", str(tmp_path / plot)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert needle in err and (".png" if needle == "--plot" else ".json") in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cal.csv"]

@@ -18,14 +18,14 @@ def command() -> None:
 @command.command()
 @click.argument("cal_csv", type=click.Path(dir_okay=False))
 @click.option("--out", "-o", type=click.Path(dir_okay=False), required=True,
-              help="Calibration JSON to write.")
+              help="Calibration JSON to write (.json).")
 @click.option("--model", type=click.Choice(["auto", *models.MODELS]), default="auto",
               show_default=True, help="Fitting function; auto selects by AICc.")
 @click.option("--activation-range", nargs=2, type=float, default=None,
               help="Clip range LO HI (MPa) of the pressure readings, 0 <= LO < HI (default 0 .. the "
                    "reading at the darkest press); a reading below LO is unactivated film: 0.")
 @click.option("--plot", type=click.Path(dir_okay=False), default=None,
-              help="Also write a PNG of the fit, its 90 % band and residuals.")
+              help="Also write a PNG (.png) of the fit, its 90 % band and residuals.")
 def calibrate(cal_csv, out, model, activation_range, plot):
     """Fit grayscale -> pressure (P = F/A, MPa) from calibration presses in CAL_CSV.
 
@@ -38,6 +38,11 @@ def calibrate(cal_csv, out, model, activation_range, plot):
     from tactileskin.errors import ParameterError
     from tactileskin.film import calibrate_csv
 
+    # the writers' formats are fixed: a name of another format got JSON / PNG bytes under it
+    if Path(out).suffix.lower() != ".json":
+        raise ParameterError("--out", out, "a path ending in .json")
+    if plot and Path(plot).suffix.lower() != ".png":
+        raise ParameterError("--plot", plot, "a path ending in .png")
     if plot and Path(plot).absolute() == Path(out).absolute():
         raise ParameterError("--plot", plot, "a file other than --out")
     for path, what in ((out, "--out"), (plot, "--plot")):
