@@ -181,7 +181,8 @@ def test_parse_values_refuses_non_finite(text):
 
 
 @pytest.mark.parametrize("text, says", [("", "none of them empty"), ("1,,2", "none of them empty"),
-                                         ("2,", "none of them empty"), ("0.5:5:1e-6", "at most 1000 values")])
+                                         ("2,", "none of them empty"), ("0.5:5:1e-6", "at most 1000 values"),
+                                         ("5:1:1", "start <= stop")])  # said only "step > 0"
 def test_parse_values_names_what_is_wrong(text, says):
     with pytest.raises(ParameterError, match=says):  # a tiny positive step is not "step > 0"
         sweep.parse_values(text, "thickness")

@@ -68,7 +68,7 @@ def parse_values(text: str, name: str) -> list[float]:
         except ParameterError:
             raise
         except ValueError:
-            raise ParameterError(name, text, "comma-separated finite numbers or start:stop:step with step > 0") from None
+            raise ParameterError(name, text, "comma-separated finite numbers or start:stop:step with start <= stop and step > 0") from None
     if not out:
         raise ParameterError(name, text, "at least one value")
     return out
