@@ -417,3 +417,15 @@ def test_the_nu_hint_holds_over_the_datas_own_compression():
         fit("neo_hookean", lam, P, nu=-0.6)
     nu_min = float(re.search(r"at least ([-0-9.e]+)", str(e.value)).group(1))
     assert fit("neo_hookean", lam, P, nu=nu_min).law.kappa > 0
+
+
+def test_an_indentation_csv_without_test_indentation_says_so(tmp_path, capsys):
+    """A depth_mm, force_n file fitted as the default uniaxial test was refused only as a
+    header without stretch and stress columns; the message now names --test indentation."""
+    csv = tmp_path / "ind.csv"
+    csv.write_text("depth_mm,force_n\n0,0\n0.05,0.001\n0.1,0.003\n0.15,0.006\n0.2,0.009\n0.25,0.013\n")
+    with pytest.raises(FitDataError, match="--test indentation"):
+        read_uniaxial_csv(csv)
+    assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(tmp_path / "m.toml")]) == 2
+    assert "--test indentation" in capsys.readouterr().err
+    assert not (tmp_path / "m.toml").exists()
