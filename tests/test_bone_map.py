@@ -269,3 +269,12 @@ def test_the_section_plane_the_figure_names_is_drawn(tmp_path, section_z):
     rgb = mpimg.imread(png)[:, :, :3] * 255
     red = np.abs(rgb - np.array([214, 39, 40])).sum(axis=-1) < 60  # tab:red
     assert red.sum() > 200  # a dashed line across both panels, not a stray pixel
+
+
+def test_console_positions_drop_rounding_noise():
+    """The dome's map peak on the axis printed 's = 3.67e-16 mm' (its arc-length grid's
+    rounding); positions within 1e-9 mm of 0 now print 0, others as before (3 digits)."""
+    from tactileskin.cli.solve import _mm
+
+    assert _mm(3.673940224324153e-16) == "0" and _mm(-1e-17) == "0" and _mm(0.0) == "0"
+    assert _mm(-2.884615384615384) == "-2.88" and _mm(0.0123456) == "0.0123" and _mm(12.34) == "12.3"

@@ -97,10 +97,10 @@ def command(out, history, compare_2d, scene_opts, sensors_file=None):
         t.add_row("bone profile on plane", f"z = {res.stats.get('profile_plane_z', 0.0):g} mm")
         if "peak_map_mpa" in s:
             t.add_row("peak of the bone map P(s, z)", f"{s['peak_map_mpa']:.4g} MPa at s = "
-                      f"{s['peak_map_s_mm']:.3g} mm, z = {s['peak_map_z_mm']:.3g} mm (>= t from the skin's edges)")
+                      f"{_mm(s['peak_map_s_mm'])} mm, z = {_mm(s['peak_map_z_mm'])} mm (>= t from the skin's edges)")
         if "peak_map_edge_mpa" in s:
-            t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {s['peak_map_edge_s_mm']:.3g} mm, "
-                      f"z = {s['peak_map_edge_z_mm']:.3g} mm (a corner singularity: grows with mesh refinement)")
+            t.add_row("at the skin's bonded edge", f"{s['peak_map_edge_mpa']:.4g} MPa at s = {_mm(s['peak_map_edge_s_mm'])} mm, "
+                      f"z = {_mm(s['peak_map_edge_z_mm'])} mm (a corner singularity: grows with mesh refinement)")
         t.add_row("force on the indenter (whole)", f"{quality.reaction_of(s):.4g} N")
     else:
         t.add_row("reaction (half section)", f"{quality.reaction_of(s):.4g} N/mm")
@@ -263,6 +263,12 @@ def _compare_doc(scene, s3: dict, r2) -> dict:
     return {"scene_3d": scene.label(), "scene_2d": scene.replace(dim=2).label(),
             "status": "suspect: " + "; ".join(bad) if bad else "ok",
             **{k: {"2d": a, "3d": b, "relative_difference": d} for k, (a, b, d) in rows.items()}}
+
+
+def _mm(x: float) -> str:
+    """A position on the bone map (mm), 3 digits; within 1e-9 mm of 0 it is 0 (a map grid's
+    rounding printed the axis as 3.67e-16)."""
+    return "0" if abs(x) < 1e-9 else f"{x:.3g}"
 
 
 def _print_compare_2d(doc: dict, s2: dict) -> None:
