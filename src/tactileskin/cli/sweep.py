@@ -38,7 +38,7 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 @click.option("--serial", is_flag=True, help="Run in this process, without Dask.")
 @click.option("--cache", "cache_dir", type=click.Path(file_okay=False), default=None,
               help="Result cache folder (default OUT/cache).")
-@click.option("--no-render", is_flag=True, help="Skip the pyvista renders.")
+@click.option("--no-render", is_flag=True, help="Skip the Fig. 9 renders (fig9_CASE.png: matplotlib in 2D, pyvista in 3D).")
 def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir, no_render):
     """Run a sweep; rerunning reuses every finished case from the cache."""
     from rich.markup import escape
