@@ -429,3 +429,15 @@ def test_an_indentation_csv_without_test_indentation_says_so(tmp_path, capsys):
     assert main(["material", "fit", str(csv), "--law", "neo_hookean", "-o", str(tmp_path / "m.toml")]) == 2
     assert "--test indentation" in capsys.readouterr().err
     assert not (tmp_path / "m.toml").exists()
+
+
+@pytest.mark.parametrize("header", ["depth,stress_mpa", "depth_mm,load_n", "force_n,strain_pct"])
+def test_the_indentation_hint_needs_both_indentation_columns(tmp_path, header):
+    """'depth,stress_mpa' got 'an indentation test's columns: add --test indentation', and
+    with that option the file is refused again (no force column): the hint needs a depth
+    and a force column."""
+    csv = tmp_path / "d.csv"
+    csv.write_text(header + "\n0,0\n0.1,0.01\n0.2,0.03\n")
+    with pytest.raises(FitDataError) as e:
+        read_uniaxial_csv(csv)
+    assert "--test indentation" not in str(e.value)

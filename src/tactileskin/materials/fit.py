@@ -436,10 +436,12 @@ def read_uniaxial_csv(path) -> tuple[np.ndarray, np.ndarray]:
             i_s, strain = col(_STRAIN), True
         i_p = col(_STRESS)
         if i_s is None or i_p is None:
-            from tactileskin.materials.indentation import _DEPTH  # it imports this module
+            from tactileskin.materials.indentation import _DEPTH, _FORCE  # it imports this module
 
-            # a sphere indentation's file given without --test indentation
-            hint = "an indentation test's columns: add --test indentation" if col(_DEPTH) is not None else ""
+            # a sphere indentation's file given without --test indentation (both of its columns:
+            # a depth column alone would be refused again with the option)
+            both = col(_DEPTH) is not None and col(_FORCE) is not None
+            hint = "an indentation test's columns: add --test indentation" if both else ""
             raise FitDataError("data header", ",".join(head),
                                "a stretch (or strain) column and a stress column (nominal_stress_mpa)", hint)
         body = rows[1:]
