@@ -260,3 +260,15 @@ def test_calibrate_refuses_a_file_name_of_another_format(tmp_path, capsys, out, 
     err = capsys.readouterr().err
     assert needle in err and (".png" if needle == "--plot" else ".json") in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cal.csv"]
+
+
+@pytest.mark.parametrize("out", [".tactileskin-files.json", "sub/.tactileskin-files.json"])
+def test_calibrate_refuses_the_folders_record_as_its_output(tmp_path, capsys, out):
+    """-o .tactileskin-files.json passed the .json check: the calibration was written there and
+    then replaced by the folder's record of it (exit 0, 'wrote ...', the calibration lost).
+    The record's and its lock's names are refused before the fit, nothing written."""
+    (tmp_path / "cal.csv").write_text("force_n,area_mm2,gray\n30,100,40\n17,100,120\n2,100,220\n")
+    assert main(["film", "calibrate", str(tmp_path / "cal.csv"), "--out", str(tmp_path / out)]) == 2
+    assert "record" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cal.csv"]
+

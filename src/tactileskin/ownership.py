@@ -54,6 +54,8 @@ def claim_file(path, what: str = "--out") -> Path:
     path = Path(path)
     if path.is_dir():
         raise OutputError(path, f"{what} must be a file name, and this is a folder")
+    if path.name in (OWNED_FILES, RECORD_LOCK):  # the write's own record replaced the output
+        raise OutputError(path, f"that is tactileskin's record of the folder's files: give {what} another file name")
     if path.exists() or path.is_symlink():
         try:
             ours = (not path.is_symlink() and path.is_file()
