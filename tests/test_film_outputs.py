@@ -272,3 +272,12 @@ def test_calibrate_refuses_the_folders_record_as_its_output(tmp_path, capsys, ou
     assert "record" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cal.csv"]
 
+
+def test_calibrate_takes_the_names_its_message_asks_for(tmp_path):
+    """'-o .json' was refused as 'valid: a path ending in .json' (Path('.json').suffix is ''):
+    the name check is the one mesh and export make (ends with), in any case."""
+    (tmp_path / "cal.csv").write_text("force_n,area_mm2,gray\n30,100,40\n17,100,120\n2,100,220\n")
+    assert main(["film", "calibrate", str(tmp_path / "cal.csv"), "-o", str(tmp_path / ".json"),
+                 "--plot", str(tmp_path / "F.PNG")]) == 0
+    assert json.loads((tmp_path / ".json").read_text())["model"]
+    assert (tmp_path / "F.PNG").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
