@@ -278,3 +278,23 @@ def test_console_positions_drop_rounding_noise():
 
     assert _mm(3.673940224324153e-16) == "0" and _mm(-1e-17) == "0" and _mm(0.0) == "0"
     assert _mm(-2.884615384615384) == "-2.88" and _mm(0.0123456) == "0.0123" and _mm(12.34) == "12.3"
+
+
+def test_map_planes_on_the_axis_and_the_section_are_exact(monkeypatch):
+    """A whole slab z in [-5, 5] in 154 intervals: linspace put its middle row at z = -8.9e-16,
+    which a peak on the axis (peak_map_z_mm, profile_plane_z from the map) carried into the
+    console, the figure's label and the quality flags. The axis and the section plane are
+    exact rows now."""
+    from types import SimpleNamespace
+
+    from tactileskin.fe import output
+
+    X = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [-5.0, 5.0, 5.0]])  # one facet, z from -5 to 5
+    monkeypatch.setattr(output, "_facet_nodes", lambda model, boundary: np.array([[0, 1, 2]]))
+    model = SimpleNamespace(basis=SimpleNamespace(doflocs=X))
+    assert np.linspace(-5.0, 5.0, 155)[77] != 0.0  # the rounding this guards against
+    z = map_planes(model, "bone_interface", 0.0, dz=10 / 153.9)
+    assert z.size == 155 and z[77] == 0.0 and np.signbit(z[77]) == False  # noqa: E712
+    third = np.linspace(-5.0, 5.0, 155)[100]
+    z = map_planes(model, "bone_interface", float(f"{third:.12g}"), dz=10 / 153.9)
+    assert z.size == 155 and float(f"{third:.12g}") in z

@@ -183,8 +183,15 @@ def map_planes(model: Model, boundary: str, section_z: float, dz: float | None =
     if not dz > 0:
         raise ParameterError("bone map dz", dz, "> 0 mm")
     n = int(min(max(np.ceil((z1 - z0) / dz), 1), max_planes))
+    tol = 1e-9 * max(z1 - z0, 1.0)
     z = np.linspace(z0, z1, n + 1)
-    if np.min(np.abs(z - section_z)) > 1e-9 * max(z1 - z0, 1.0):
+    # linspace's rounding: on a whole slab (-5, 5) in 154 intervals the middle row is z = -8.9e-16,
+    # and a peak there printed as such; the axis and the section plane are exact rows
+    z[np.abs(z) <= tol] = 0.0
+    near = np.abs(z - section_z) <= tol
+    if near.any():
+        z[near] = section_z
+    else:
         z = np.sort(np.append(z, section_z))
     return z
 
