@@ -191,3 +191,32 @@ def test_unnamed_indentation_columns_are_range_checked_by_their_role(tmp_path):
     # a load cell's noise near contact (a small negative reading) is read, as before, for the fit
     csv.write_text("0,0\n0.01,-0.0004\n0.05,0.01\n0.1,0.03\n")
     assert read_indentation_csv(csv)[1].tolist() == [0.0, -0.0004, 0.01, 0.03]
+
+
+def test_an_indentation_fit_that_misses_a_point_by_more_than_the_uniaxial_limit_is_suspect(tmp_path, capsys):
+    """A uniaxial fit missing a test point by more than MAX_REL_ERR (10 %) is suspect (exit 3);
+    an indentation fit 18.8 % off exited 0 and printed as plainly ok. Forces rising faster than
+    Hertz's d^1.5 (here d^1.8) fit with R^2 0.99 but 48 % off at depth 0.046 mm: now the
+    same rule, from the same threshold, marks it suspect in the console and in the file (exit 3);
+    the exact data and 5 % noise on one point stay ok."""
+    from tactileskin.materials.fit import MAX_REL_ERR
+
+    d = np.linspace(0.02, 0.2, 8)
+    exact = bonded_sphere_force(0.3, d, R, T)
+    steep = exact * (d / 0.2) ** 0.3
+    f = fit_indentation("neo_hookean", d, steep, radius=R, thickness=T)
+    assert f.quality["r2"] > 0.98 and f.quality["max_rel_err"] > MAX_REL_ERR
+    assert any("misses the test by up to" in w and f"more than {MAX_REL_ERR:.0%}" in w and "at depth 0.04571 mm" in w
+               for w in f.warnings), f.warnings
+    noisy = exact.copy()
+    noisy[4] *= 1.05
+    assert fit_indentation("neo_hookean", d, noisy, radius=R, thickness=T).warnings == []
+    assert fit_indentation("neo_hookean", d, exact, radius=R, thickness=T).warnings == []
+    csv = tmp_path / "steep.csv"
+    csv.write_text("depth_mm,force_n\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(d, steep)))
+    out = tmp_path / "steep.toml"
+    assert main(["material", "fit", str(csv), "--test", "indentation", "--radius", str(R), "--thickness", str(T),
+                 "--law", "neo_hookean", "-o", str(out)]) == 3
+    text = capsys.readouterr().out
+    assert "suspect fit: the law misses the test by up to" in text and "exit status 3" in text
+    assert "SUSPECT: the law misses the test" in out.read_text()

@@ -285,18 +285,30 @@ def fit(law: str, stretch, stress, *, nu: float | None = None, terms: int | None
     _check_loadable(law, mat, lam)
     q["nfev"] = int(sol.nfev)
     q["warnings"] = extrapolation_warnings(mat, lam, P, nu)
-    if q["max_rel_err"] > MAX_REL_ERR:
-        big = np.abs(P) >= REL_FLOOR * np.abs(P).max()
-        at = lam[big][np.argmax(np.abs(pred - P)[big] / np.abs(P[big]))]
-        q["warnings"].append(f"the law misses the test by up to {100 * q['max_rel_err']:.3g} % (at stretch {at:.4g}; "
-                             f"more than {MAX_REL_ERR:.0%}): it does not describe this material over the test's range; "
-                             "try a law with more terms (yeoh, ogden) or fit the range the skin reaches")
+    miss = misfit_warning(P, pred, lam, "stretch", "",
+                          "it does not describe this material over the test's range; try a law with more "
+                          "terms (yeoh, ogden) or fit the range the skin reaches")
+    if miss:
+        q["warnings"].append(miss)
     if mat.mu0 > SOFT_MU_MAX:
         q["warnings"].append(f"shear modulus {mat.mu0:.4g} MPa: stiffer than the soft elastomers of skins "
                              f"(up to about {SOFT_MU_MAX:g} MPa); is the stress column in kPa or Pa? MPa is expected")
     for w in q["warnings"]:  # shown by describe() (the CLI prints it and exits 3)
         log.info("fit of %s: %s", law, w)
     return Fit(law=mat, stretch=lam, stress=P, predicted=pred, nu=nu, quality=q)
+
+
+def misfit_warning(measured, predicted, x, x_name: str, x_unit: str, remedy: str) -> str | None:
+    """The suspect-fit warning of every test kind the fitter takes when the law misses a point by
+    more than MAX_REL_ERR (relative, over the points _quality weighs), naming where; else None."""
+    y, res = np.asarray(measured, float), np.asarray(predicted, float) - np.asarray(measured, float)
+    big = np.abs(y) >= REL_FLOOR * np.abs(y).max()
+    rel = np.abs(res[big]) / np.abs(y[big])
+    i = int(np.argmax(rel))
+    if not rel[i] > MAX_REL_ERR:
+        return None
+    return (f"the law misses the test by up to {100 * rel[i]:.3g} % (at {x_name} {np.asarray(x)[big][i]:.4g}"
+            f"{' ' + x_unit if x_unit else ''}; more than {MAX_REL_ERR:.0%}): {remedy}")
 
 
 def _slope_at_one(mat, nu) -> float:

@@ -141,13 +141,18 @@ def fit_indentation(law: str, depth, force, *, radius: float, thickness: float) 
                            "forces that rise with depth as a sphere on a layer gives (F ~ d^1.5)",
                            ("the force falls with depth at some rows; " if falls else "")
                            + "check the columns (depth_mm, force_n) and their units")
-    from tactileskin.materials.fit import SOFT_MU_MAX, _check_loadable
+    from tactileskin.materials.fit import SOFT_MU_MAX, _check_loadable, misfit_warning
 
     _check_loadable(law, mat, None)
-    # as the uniaxial fit's: a modulus past any skin elastomer's is most often a unit slip
-    q["warnings"] = [] if mat.mu0 <= SOFT_MU_MAX else [
-        f"shear modulus {mat.mu0:.4g} MPa: stiffer than the soft elastomers of skins (up to about "
-        f"{SOFT_MU_MAX:g} MPa); is the force column in mN? N is expected (and depth in mm)"]
+    # the uniaxial fit's rules: a point missed past MAX_REL_ERR, and a modulus past any skin
+    # elastomer's (most often a unit slip)
+    miss = misfit_warning(F, pred, d, "depth", "mm",
+                          "the bonded-layer Hertz force (F ~ d^1.5) does not describe this test; check the "
+                          "radius, the thickness and that depth is measured from first contact")
+    q["warnings"] = [miss] if miss else []
+    if mat.mu0 > SOFT_MU_MAX:
+        q["warnings"].append(f"shear modulus {mat.mu0:.4g} MPa: stiffer than the soft elastomers of skins (up to "
+                             f"about {SOFT_MU_MAX:g} MPa); is the force column in mN? N is expected (and depth in mm)")
     q["rmse_n"] = q.pop("rmse_mpa")
     q["chi_max"] = float(np.sqrt(R * d.max()) / t)
     q["rel_floor"] = REL_FLOOR
