@@ -157,7 +157,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
     """
     import pandas as pd
 
-    from tactileskin.cache import ResultCache, out_cache
+    from tactileskin.cache import ResultCache, open_cache, out_cache
     from tactileskin.report.outputs import PROFILE_COLUMNS, profile_rows
 
     for name, value in (("out", out), ("cache", cache)):
@@ -169,8 +169,9 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         validate.boolean(value, name)  # serial="no" is truthy: it ran serially
     scs = scenes(grid, quality=quality, base=base)
     if cache is None:
-        cache = out_cache(out) if out is not None else default_cache_dir()
-    rc = ResultCache(cache)
+        rc = ResultCache(out_cache(out) if out is not None else default_cache_dir())
+    else:  # the user's folder: refused unless new, empty or a cache
+        rc = open_cache(cache, "cache")
     if out is None:
         records, rows = _sweep_rows(scs, rc, scheduler, workers, serial, None, report)
     else:

@@ -53,6 +53,7 @@ import json
 import logging
 import math
 import os
+import re
 import shutil
 from dataclasses import dataclass
 from functools import lru_cache
@@ -347,6 +348,43 @@ def out_cache(out) -> Path:
         raise OutputError(path, f"it is a symbolic link (to {target}), and the out folder's cache is its own; "
                                 "to share a cache folder, name it with --cache (cache= in Python)")
     return path
+
+
+# the names a cache holds: case entries (cache_key), derived entries (figures-, render-: the
+# sweep's report), their .lock files; anything else in a folder means it is not a cache
+_ENTRY_NAME = re.compile(r"^(?:figures-|render-)?[0-9a-f]{24}$")
+
+
+def open_cache(root, what: str = "--cache") -> "ResultCache":
+    """The cache in `root`, a folder the user named (`what`: the option or parameter): refused
+    (OutputError, nothing written) unless it is new, empty, or holds a cache's files only: its
+    entries (each with its cache.json or files.json) and locks. A folder of the user's own files
+    would get entries and locks among them, and lookup's removal of a damaged entry is for the
+    cache's own folders."""
+    from tactileskin.fileio import OutputError
+
+    root = Path(root)
+    if root.is_dir():
+        with fileio.os_errors(root):
+            names = sorted(p.name for p in root.iterdir() if not fileio.is_temporary(p.name)
+                           and not _cache_file(root / p.name))
+        if names:
+            shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+            raise OutputError(root, f"{what} must be a new or empty folder, or a cache made by tactileskin; "
+                                    f"this one holds other files ({shown})")
+    elif root.exists() or root.is_symlink():
+        raise OutputError(root, f"{what} must be a folder (new or empty, or a cache made by tactileskin), "
+                                "and this is not")
+    return ResultCache(root)
+
+
+def _cache_file(p: Path) -> bool:
+    if p.is_symlink():
+        return False
+    if p.suffix == ".lock":
+        return _ENTRY_NAME.match(p.stem) is not None and p.is_file()
+    return (_ENTRY_NAME.match(p.name) is not None and p.is_dir()
+            and ((p / "cache.json").is_file() or (p / DERIVED_MANIFEST).is_file()))
 
 
 class ResultCache:

@@ -135,7 +135,7 @@ def result_cache(cache):
     api.default_cache_dir(), as ts.sweep takes it (a path failed with "AttributeError: 'str'
     object has no attribute 'key'")."""
     from tactileskin import validate
-    from tactileskin.cache import ResultCache
+    from tactileskin.cache import ResultCache, open_cache
 
     if isinstance(cache, ResultCache):
         return cache
@@ -143,7 +143,7 @@ def result_cache(cache):
         from tactileskin.api import default_cache_dir
 
         return ResultCache(default_cache_dir())
-    return ResultCache(validate.path(cache, "cache", "a folder path (str or os.PathLike), a ResultCache or None"))
+    return open_cache(validate.path(cache, "cache", "a folder path (str or os.PathLike), a ResultCache or None"), "cache")
 
 
 def solve_cached(scenes, cache, on_event=None, workers: int | None = None) -> dict:

@@ -123,7 +123,7 @@ def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bi
     from rich.markup import escape
 
     from tactileskin.array.chart import ChartConfig, compute, validate_surrogate
-    from tactileskin.cache import ResultCache, out_cache
+    from tactileskin.cache import ResultCache, open_cache, out_cache
     from tactileskin.cli._console import new_console
     from tactileskin.report.array_chart import suspect, write_outputs
     from tactileskin.sweep import parse_values
@@ -167,7 +167,7 @@ def command(out, config, thickness, material, pitch, noise, noise_mpa, taxel, bi
 
     check_materials(cfg.materials)
     out = Path(out)
-    cache = ResultCache(cache_dir or out_cache(out))
+    cache = open_cache(cache_dir) if cache_dir else ResultCache(out_cache(out))
     say = lambda msg: console.print(escape(msg), highlight=False)  # noqa: E731
     with claimed_output(out, "array"):
         rows = None

@@ -51,7 +51,7 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
 
     from tactileskin import staging
     from tactileskin.report.outputs import SWEEP_ALWAYS_WRITTEN, write_outputs
-    from tactileskin.cache import out_cache
+    from tactileskin.cache import open_cache, out_cache
     from tactileskin.sweep import ResultCache, check_reachable, run_sweep
 
     console = new_console()
@@ -59,7 +59,7 @@ def command(out, scene_opts, braille_dim, scheduler, workers, serial, cache_dir,
         check_reachable(scheduler)  # before the folder is claimed: a refusal leaves nothing
     scenes = scenes_from_options(scene_opts, braille_dim)
     out = Path(out)
-    cache = ResultCache(cache_dir or out_cache(out))
+    cache = open_cache(cache_dir) if cache_dir else ResultCache(out_cache(out))
     with claimed_output(out, "sweep"):  # before any solving
         # an edited report.md or results.csv would be refused only after every case was solved
         staging.check_replaceable(out, SWEEP_ALWAYS_WRITTEN)

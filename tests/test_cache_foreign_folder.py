@@ -1,0 +1,60 @@
+"""--cache DIR took any folder: a user's folder of their own files got case entries, .lock files
+and figure/render entries written among them (--out refuses such a folder). A non-empty folder
+that is not a tactileskin cache is refused naming --cache and what it must be, before any case
+and with nothing written; a new, an empty, and an existing cache (shared between sweeps: the
+option's purpose) are taken."""
+
+from __future__ import annotations
+
+import pytest
+from test_output_safety import fake_solve  # noqa: F401 - the fixture: a result without solving
+
+from tactileskin.cli import main
+
+SWEEP = ["sweep", "-t", "1", "-m", "silicone", "-i", "flat", "--serial", "--no-render"]
+
+
+def _tree(folder):
+    return sorted((p.relative_to(folder).as_posix(), p.read_bytes() if p.is_file() else None)
+                  for p in folder.rglob("*"))
+
+
+@pytest.mark.parametrize("command", [SWEEP, ["array", "--set", "paper", "-t", "1", "--pitch", "1"]])
+def test_a_folder_of_the_users_files_is_refused_as_cache(tmp_path, capsys, fake_solve, command):
+    users = tmp_path / "users"
+    (users / "photos").mkdir(parents=True)
+    (users / "notes.txt").write_text("mine")
+    (users / "photos" / "a.jpg").write_bytes(b"\xff\xd8")
+    before = _tree(users)
+    out = tmp_path / "out"
+    assert main([*command, "--out", str(out), "--cache", str(users)]) == 2
+    cap = capsys.readouterr()
+    err = cap.err.strip()
+    assert "Traceback" not in cap.err + cap.out and len(err.splitlines()) == 1, err
+    assert str(users) in err and "--cache" in err and "new or empty folder, or a cache made by tactileskin" in err
+    assert "notes.txt" in err
+    assert _tree(users) == before and fake_solve == [] and not out.exists()
+
+
+def test_a_cache_is_shared_between_sweeps_and_a_new_or_empty_folder_taken(tmp_path, capsys, fake_solve):
+    shared = tmp_path / "shared"
+    assert main([*SWEEP, "--out", str(tmp_path / "a"), "--cache", str(shared)]) in (0, 3)
+    assert len(fake_solve) == 1 and any(p.is_dir() for p in shared.iterdir())
+    assert main([*SWEEP, "--out", str(tmp_path / "b"), "--cache", str(shared)]) in (0, 3)  # the cache's own files
+    assert len(fake_solve) == 1  # taken from the shared cache, not solved again
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main([*SWEEP, "--out", str(tmp_path / "c"), "--cache", str(empty)]) in (0, 3)
+    assert len(fake_solve) == 2
+
+
+def test_the_api_refuses_a_users_folder_as_cache(tmp_path, fake_solve):
+    import tactileskin as ts
+    from tactileskin.fileio import OutputError
+
+    users = tmp_path / "users"
+    users.mkdir()
+    (users / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match=r"cache must be a new or empty folder, or a cache made by tactileskin"):
+        ts.sweep({"thickness": [1.0], "material": ["silicone"], "indenter": ["flat"]}, cache=users, serial=True)
+    assert sorted(p.name for p in users.iterdir()) == ["notes.txt"] and fake_solve == []
