@@ -151,7 +151,7 @@ def test_an_empty_scene_file_is_refused(tmp_path, capsys, cmd, text):
 @pytest.mark.parametrize("cmd", ["solve", "sweep", "mesh", "export"])
 def test_help_states_the_valid_ranges_from_the_validation_constants(cmd):
     """--help gave units but no ranges (-t, --depth, --rate, --mesh-size, --refinement,
-    --indenter-radius, --pad-width/--pad-length, --force), no default of --rate/--force-rate,
+    --indenter-radius (each kind's: the next test), --pad-width/--pad-length, --force), no default of --rate/--force-rate,
     no text for --formulation, and `sweep -i` named only three of the six indenters."""
     from click.testing import CliRunner
 
@@ -159,13 +159,12 @@ def test_help_states_the_valid_ranges_from_the_validation_constants(cmd):
     from tactileskin.cli import cli
     from tactileskin.errors import range_text
     from tactileskin.geometry.fingertip import Fingertip
-    from tactileskin.geometry.indenters.base import RADIUS
     from tactileskin.skins import pad
 
     text = " ".join(CliRunner().invoke(cli, [cmd, "--help"]).output.split())
     wanted = [f"fingertip {range_text(*Fingertip.from_params().thickness_bounds)}", range_text(*pad.THICKNESS),
               f"(0, {scene.MAX_DEPTH_FRACTION:g} t]", range_text(*scene.MESH_SIZE), range_text(*scene.REFINEMENT),
-              range_text(*RADIUS, lo_open=True), range_text(*pad.SIZE)]
+              range_text(*pad.SIZE)]
     if cmd != "mesh":  # the physics options
         wanted += [range_text(*scene.RATE), f"Default {scene.Scene.rate:g}", "--force-rate",
                    range_text(loading.MIN_FORCE, loading.MAX_FORCE, unit="N"), "mixed (locking-free; default)"]
@@ -190,3 +189,24 @@ def test_help_states_the_default_indenter_and_dim_and_what_a_skin_file_fixes(cmd
     assert f"Indenter kind. Default {Scene().indenter.value}." in text
     assert f"3D slab. Default {Scene().dim}" in text
     assert "solved on its own mesh" in text and "--skin-bonded" in text and "'normal:-y'" in text
+
+
+@pytest.mark.parametrize("cmd", ["solve", "sweep", "mesh", "export", "build"])
+def test_help_gives_each_indenter_kinds_radius_range_as_its_check_takes_it(cmd):
+    """`solve --help` (and sweep's) gave --indenter-radius as (0.1, 1000] while a sphere above
+    100 mm is refused (its printed part): the help now gives each kind's range, the very range
+    its check refuses outside of."""
+    from click.testing import CliRunner
+
+    from tactileskin.cli import cli
+
+    text = " ".join(CliRunner().invoke(cli, [cmd, "--help"]).output.split())
+    assert "sphere (0.1, 100]" in text and "cylinder (0.1, 1000]" in text, text
+    for kind, hi in (("sphere", 100.0), ("cylinder", 1000.0)):
+        extra = {"dim": 3} if kind == "sphere" else {}
+        Scene(indenter=kind, indenter_radius=hi, **extra)                  # the help's upper end is taken
+        with pytest.raises(ParameterError, match="indenter_radius"):
+            Scene(indenter=kind, indenter_radius=hi * 1.001, **extra)      # and just past it refused
+    from tactileskin.scene_doc import FIELDS
+
+    assert "(0.1, 1000] (sphere: (0.1, 100]" in FIELDS["indenter_radius"][1]  # help(Scene) agrees

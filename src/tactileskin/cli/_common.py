@@ -83,9 +83,9 @@ class _HelpText:
     @staticmethod
     def radius() -> str:
         from tactileskin.errors import range_text
-        from tactileskin.geometry.indenters.base import RADIUS
+        from tactileskin.geometry.indenters.base import radius_ranges
 
-        return "in " + range_text(*RADIUS, lo_open=True)
+        return ", ".join(f"{k} {range_text(*r, lo_open=True)}" for k, r in radius_ranges().items())
 
     @staticmethod
     def pad_size() -> str:
@@ -149,7 +149,7 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
                      help="Text for a Braille indenter" + (" (repeatable)." if grid else ".")),
         click.option("--braille-standard", type=str, default=None, help="Braille standard name."),
         opt("--indenter-radius", type=float, default=None,
-            help=lambda: f"Sphere or cylinder radius (mm), {h.radius()}; required by both."),
+            help=lambda: f"Indenter radius (mm): {h.radius()}; required by those kinds."),
         click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
                      help="Cylinder axis: z along the finger (2D-exact), x across it (3D)."),
         click.option("--indenter-file", type=str, default=None,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from tactileskin.cli._common import _RangeHelpOption, _rule_forms
+from tactileskin.cli._common import _HelpText, _RangeHelpOption, _rule_forms
 
 
 GEOMETRY_OPTIONS = ("thickness", "indenter", "indenter_radius", "indenter_axis", "braille_text", "braille_standard",
@@ -63,7 +63,8 @@ def _scene_options(path: str) -> dict:
 @click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "sphere", "cylinder", "all", "none"]),
               default="all", show_default=True,
               help="Which indenter(s) to make ('all': the paper's flat, curved and braille).")
-@click.option("--indenter-radius", type=float, default=None, help="Sphere or cylinder indenter radius (mm).")
+@click.option("--indenter-radius", type=float, default=None, cls=_RangeHelpOption,
+              help=lambda: f"Sphere or cylinder indenter radius (mm): {_HelpText.radius()}.")
 @click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
               help="Cylinder indenter axis: z along the finger (default) or x across it.")
 @click.option("--braille-text", type=str, default="", help="Text for the Braille indenter (default: one dot).")

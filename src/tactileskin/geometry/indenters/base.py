@@ -71,6 +71,8 @@ class Indenter:
     # 3D: touches in compact spots (`contact_patches`), meshed on the local plan at the local
     # presets' sizes (data/presets.json "braille_mesh"); False: the strip plan ("mesh")
     local_3d: ClassVar[bool] = False
+    # (lo, hi] mm of indenter_radius for a kind that reads it: what its check takes and --help quotes
+    radius_range: ClassVar[tuple[float, float] | None] = None
 
     @classmethod
     def model_2d(cls, scene) -> str | None:
@@ -213,7 +215,14 @@ class Indenter:
         raise NotImplementedError
 
 
-RADIUS = (0.1, 1000.0)  # mm: indenter_radius of a sphere or cylinder, (lo, hi]
+RADIUS = (0.1, 1000.0)  # mm: indenter_radius of a sphere or cylinder, (lo, hi] (a kind may take less)
+
+
+def radius_ranges() -> dict[str, tuple[float, float]]:
+    """{kind: its radius_range} of the registered kinds that read indenter_radius."""
+    from tactileskin.geometry.indenters.registry import get, names
+
+    return {n: get(n).radius_range for n in names() if "indenter_radius" in get(n).scene_params}
 
 
 def check_radius(value, kind: str, lo: float = RADIUS[0], hi: float = RADIUS[1], hint: str = "") -> float:

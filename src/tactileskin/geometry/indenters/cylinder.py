@@ -14,7 +14,7 @@ import numpy as np
 
 from tactileskin import params
 from tactileskin.errors import ParameterError
-from tactileskin.geometry.indenters.base import Indenter, check_radius, hertz_halfwidth, stem_params
+from tactileskin.geometry.indenters.base import RADIUS, Indenter, check_radius, hertz_halfwidth, stem_params
 from tactileskin.geometry.indenters.registry import register
 
 AXES = ("z", "x")
@@ -30,6 +30,7 @@ class CylinderIndenter(Indenter):
     name = "cylinder"
     order = 10
     scene_params = ("indenter_radius", "indenter_axis")
+    radius_range = RADIUS
 
     @classmethod
     def model_2d(cls, scene) -> str | None:
@@ -37,7 +38,7 @@ class CylinderIndenter(Indenter):
 
     @classmethod
     def check_scene(cls, scene) -> dict:
-        radius = check_radius(scene.indenter_radius, cls.name)
+        radius = check_radius(scene.indenter_radius, cls.name, *cls.radius_range)
         axis = "z" if scene.indenter_axis is None else scene.indenter_axis
         if axis not in AXES:
             raise ParameterError("indenter_axis", axis, "'z' (along the finger) or 'x' (across it)")
@@ -54,7 +55,7 @@ class CylinderIndenter(Indenter):
     @classmethod
     def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None,
                     indenter_axis=None, **_):
-        R = check_radius(indenter_radius, cls.name)
+        R = check_radius(indenter_radius, cls.name, *cls.radius_range)
         axis = indenter_axis or "z"
         q = params.load("indenters")
         chord = min(float(q["curved"]["chord_width"]), 1.8 * R)

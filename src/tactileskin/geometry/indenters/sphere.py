@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tactileskin.errors import ParameterError
-from tactileskin.geometry.indenters.base import Indenter, check_radius, hertz_halfwidth, stem_params
+from tactileskin.geometry.indenters.base import RADIUS, Indenter, check_radius, hertz_halfwidth, stem_params
 from tactileskin.geometry.indenters.registry import register
 
 
@@ -39,10 +39,11 @@ class SphereIndenter(Indenter):
     scene_params = ("indenter_radius",)
     section_2d = None
     local_3d = True
+    radius_range = (RADIUS[0], MAX_RADIUS)
 
     @classmethod
     def check_scene(cls, scene) -> dict:
-        radius = check_radius(scene.indenter_radius, cls.name, hi=MAX_RADIUS, hint=RADIUS_HINT)
+        radius = check_radius(scene.indenter_radius, cls.name, *cls.radius_range, hint=RADIUS_HINT)
         if scene.dim == 2:
             raise ParameterError("dim", 2, "3 for the sphere indenter",
                                  "a sphere is not uniform along the finger; its plane-strain section "
@@ -65,7 +66,7 @@ class SphereIndenter(Indenter):
 
     @classmethod
     def from_params(cls, *, y0, dim, length, row=None, warn=True, indenter_radius=None, **_):
-        R = check_radius(indenter_radius, cls.name, hi=MAX_RADIUS, hint=RADIUS_HINT)
+        R = check_radius(indenter_radius, cls.name, *cls.radius_range, hint=RADIUS_HINT)
         # the standard stem: a ball narrower than it gets a mount block (solids._add_stem)
         return cls(kind=cls.name, y0=y0, dim=dim, width=2.0 * R, length=2.0 * R, radius=R, **stem_params())
 
