@@ -17,7 +17,7 @@ class ParameterError(TactileSkinError, ValueError):
     """
 
     def __init__(self, name: str, value, valid: str, hint: str = ""):
-        self.name, self.value, self.valid = name, value, valid
+        self.name, self.value, self.valid, self.hint = name, value, valid, hint
         msg = f"{name}={value!r} is invalid; valid: {valid}"
         if hint:
             msg += f" ({hint})"

@@ -78,7 +78,8 @@ def _names(v, name: str, choices: tuple | None) -> tuple:
         raise ParameterError(name, v, "at least one value")
     for x in items:
         if not isinstance(x, str) or (choices is not None and x not in choices):
-            raise ParameterError(name, x, "a string" if choices is None else " or ".join(choices))
+            raise ParameterError(name, x, "a string" if choices is None else " or ".join(choices),
+                                 validate.did_you_mean(x, choices) if choices and isinstance(x, str) else "")
     return _distinct(name, tuple(items))
 
 

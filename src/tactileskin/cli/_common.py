@@ -6,6 +6,7 @@ import functools
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.scene import Formulation, IndenterKind, Scene
 
 
@@ -141,7 +142,7 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         opt("--material", "-m", type=str, default=None,
             help=lambda: f"Material preset name or .toml file{names}. Default {h.default('material', grid)}."),
         opt("--indenter", "-i", default=None,
-            type=str if grid else click.Choice([k.value for k in IndenterKind]),
+            type=str if grid else Choice([k.value for k in IndenterKind]),
             help=lambda: (f"Indenters: {', '.join(k.value for k in IndenterKind)}{names}. "
                           f"Default {h.default('indenter', grid)}.") if grid
             else f"Indenter kind. Default {h.default('indenter')}."),
@@ -150,22 +151,22 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
         click.option("--braille-standard", type=str, default=None, help="Braille standard name."),
         opt("--indenter-radius", type=float, default=None,
             help=lambda: f"Indenter radius (mm): {h.radius()}; required by those kinds."),
-        click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
+        click.option("--indenter-axis", type=Choice(["z", "x"]), default=None,
                      help="Cylinder axis: z along the finger (2D-exact), x across it (3D)."),
         click.option("--indenter-file", type=str, default=None,
                      help="Closed STL/OBJ/PLY/OFF or STEP surface (mm) of a 'file' indenter."),
         opt("--depth", type=str if grid else float, default=None,
             help=lambda: f"Indentation depth (mm){many}, {h.depth()}; default {h.depth_default()}."),
-        click.option("--dim", type=click.Choice(["2", "3"]), default=None,
+        click.option("--dim", type=Choice(["2", "3"]), default=None,
                      help="2D plane-strain section or 3D slab. Default 2 (a dome or a 3D skin file: 3)."),
-        click.option("--quality", type=click.Choice(QUALITIES), default=None,
+        click.option("--quality", type=Choice(QUALITIES), default=None,
                      help="Mesh preset of the scene's dimension (data/presets.json; "
                           "docs/speed_vs_error.md). Default: the `default` sizes."),
         opt("--mesh-size", type=float, default=None,
             help=lambda: f"Global element size (mm), {h.scene_range('MESH_SIZE')}; overrides --quality."),
         opt("--refinement", type=float, default=None,
             help=lambda: f"Global / refined element size ratio, {h.scene_range('REFINEMENT')}; overrides --quality."),
-        click.option("--order", type=click.Choice(["1", "2"]), default=None, help="Element order (default 2)."),
+        click.option("--order", type=Choice(["1", "2"]), default=None, help="Element order (default 2)."),
         click.option("--skin", type=str, default=None,
                      help="Skin geometry: fingertip (default), pad, dome (rounded 3D tip) or file."),
         click.option("--skin-file", type=str, default=None,
@@ -196,7 +197,7 @@ def scene_options(f=None, *, grid: bool = False, physics: bool = True):
             opt("--force-rate", type=float, default=None,
                 help=lambda: f"Force rate (N/s, N/mm/s in 2D) for --force, {h.scene_range('RATE')}. "
                              f"Default: the depth ramp's time ({h.depth_default()} / rate)."),
-            opt("--formulation", type=click.Choice([k.value for k in Formulation]), default=None,
+            opt("--formulation", type=Choice([k.value for k in Formulation]), default=None,
                 help=lambda: f"{h.formulation()}."),
             click.option("--elastic", is_flag=True, default=None,
                          help="Ignore viscoelasticity (the Prony series)."),

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from tactileskin import validate as validate_mod  # `validate` is also an option's name
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import claimed_output
 from tactileskin.errors import ParameterError
 
@@ -81,7 +82,7 @@ def load_config(path) -> dict:
               help="Depth cap (mm) for thick skins: a t whose 20 % depth exceeds it is indented by this "
                    "instead (below the dot height 0.48 mm the Braille plate never touches). Default none.")
 @click.option("--sphere-radius", type=float, default=None, help="Radius (mm) of the shapes set's sphere. Default 2.5.")
-@click.option("--sphere-quality", type=click.Choice(["preview", "default", "fine"]), default=None,
+@click.option("--sphere-quality", type=Choice(["preview", "default", "fine"]), default=None,
               help="3D mesh preset of the sphere solves. Default preview.")
 @click.option("--sensor-depth", type=float, default=None,
               help="Taxels at this depth (mm) below the contact surface, inside every skin of the chart "
@@ -92,12 +93,12 @@ def load_config(path) -> dict:
                    "(a sensor sheet on a stand-off, the skin cast over it; 0 < height < the thinnest t; read at "
                    "the depth t - height), not with --sensor-depth. Default: the bonded surface.")
 @click.option("--seed", type=int, default=None, help="Random seed. Default 0.")
-@click.option("--skin", type=click.Choice(["pad", "fingertip"]), default=None,
+@click.option("--skin", type=Choice(["pad", "fingertip"]), default=None,
               help="Skin of the 3D dot solves: pad (flat, a dot's response translates exactly; default) or "
                    "fingertip (the paper's; validation refuses x-asymmetric texts, solved mirrored there).")
 @click.option("--validate", default=None,
               help="Braille texts to solve in full and compare with the superposition, e.g. '⠿,l,c'.")
-@click.option("--letters-model", type=click.Choice(["interaction", "sum", "full"]), default=None,
+@click.option("--letters-model", type=Choice(["interaction", "sum", "full"]), default=None,
               help="Letters from superposed single-dot solves, each dot's load from the lone dot's surface "
                    "deflection and load-approach law (interaction, default; a second lone-dot solve at 0.9 x "
                    "the depth; on the pad below the dot height; past it the blank plate plus plate-aware dots; "

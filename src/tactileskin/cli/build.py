@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import _HelpText, _RangeHelpOption, _rule_forms
 
 
@@ -60,18 +61,18 @@ def _scene_options(path: str) -> dict:
 @click.option("--out", "-o", "out_dir", type=click.Path(file_okay=False), default="out", show_default=True,
               help="Output folder: new, empty or a previous build's (only the files that build wrote "
                    "are replaced; others stay).")
-@click.option("--indenter", "-i", type=click.Choice(["flat", "curved", "braille", "sphere", "cylinder", "all", "none"]),
+@click.option("--indenter", "-i", type=Choice(["flat", "curved", "braille", "sphere", "cylinder", "all", "none"]),
               default="all", show_default=True,
               help="Which indenter(s) to make ('all': the paper's flat, curved and braille).")
 @click.option("--indenter-radius", type=float, default=None, cls=_RangeHelpOption,
               help=lambda: f"Sphere or cylinder indenter radius (mm): {_HelpText.radius()}.")
-@click.option("--indenter-axis", type=click.Choice(["z", "x"]), default=None,
+@click.option("--indenter-axis", type=Choice(["z", "x"]), default=None,
               help="Cylinder indenter axis: z along the finger (default) or x across it.")
 @click.option("--braille-text", type=str, default="", help="Text for the Braille indenter (default: one dot).")
 @click.option("--braille-standard", type=str, default="standard_american", show_default=True,
               help="Braille standard name (data/geometry/braille.toml).")
 @click.option("--no-molds", is_flag=True, help="Skip the casting mold.")
-@click.option("--skin", type=click.Choice(["fingertip", "pad", "dome"]), default="fingertip", show_default=True,
+@click.option("--skin", type=Choice(["fingertip", "pad", "dome"]), default="fingertip", show_default=True,
               help="Skin geometry: the paper's fingertip, a flat pad (--pad-width, --pad-length) or a "
                    "finger with a rounded tip (--dome-length, --dome-tip).")
 @click.option("--skin-file", type=str, default=None,

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import scene_from_options, scene_options
 
 
 @click.command("export")
 @scene_options
 @click.option("--out", "-o", type=click.Path(dir_okay=False), required=True, help="Deck to write (.inp).")
-@click.option("--dialect", type=click.Choice(["abaqus", "calculix"]), default=None,
+@click.option("--dialect", type=Choice(["abaqus", "calculix"]), default=None,
               help="abaqus (2D default): analytical rigid indenter, *VISCOELASTIC Prony, hard contact; "
                    "calculix (3D: the only one): meshed indenter, instantaneous hyperfoam (ccx has no "
                    "Prony), penalty contact.")

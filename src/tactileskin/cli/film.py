@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import claimed_output
 from tactileskin.film import models
 
@@ -19,7 +20,7 @@ def command() -> None:
 @click.argument("cal_csv", type=click.Path(dir_okay=False))
 @click.option("--out", "-o", type=click.Path(dir_okay=False), required=True,
               help="Calibration JSON to write (.json).")
-@click.option("--model", type=click.Choice(["auto", *models.MODELS]), default="auto",
+@click.option("--model", type=Choice(["auto", *models.MODELS]), default="auto",
               show_default=True, help="Fitting function; auto selects by AICc.")
 @click.option("--activation-range", nargs=2, type=float, default=None,
               help="Clip range LO HI (MPa) of the pressure readings, 0 <= LO < HI (default 0 .. the "
@@ -79,11 +80,11 @@ def calibrate(cal_csv, out, model, activation_range, plot):
               help="Region X0 Y0 X1 Y1 (pixels). Default: the activated strip, found on the "
                    "scan (refused if ambiguous); the region used is printed and saved.")
 @click.option("--box-mm", nargs=4, type=float, default=None, help="Region X0 Y0 X1 Y1 (mm).")
-@click.option("--axis", type=click.Choice(["x", "y"]), default="x", show_default=True,
+@click.option("--axis", type=Choice(["x", "y"]), default="x", show_default=True,
               help="Direction of the strip in the image.")
 @click.option("--centre", default="peak", show_default=True,
               help="Origin of s: peak, midspan, or a position in mm from the image edge.")
-@click.option("--rows", type=click.Choice(["all", "centre"]), default="all", show_default=True,
+@click.option("--rows", type=Choice(["all", "centre"]), default="all", show_default=True,
               help="Across the strip: all (the profile is the mean of the region's rows) or centre (the "
                    "row through the peak: a round press's centre line, one row's noise).")
 @click.option("--cmap", default="viridis", show_default=True,

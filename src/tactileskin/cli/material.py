@@ -6,6 +6,8 @@ from pathlib import Path
 
 import click
 
+from tactileskin.cli._choice import Choice
+
 MARK = "# written by tactileskin material fit"
 EXIT_SUSPECT = 3  # the material file was written, but the fit is suspect (as `solve`)
 
@@ -34,7 +36,7 @@ def list_() -> None:
               help="Poisson ratio of the test, in (-1, 0.4999] (default: incompressible; hyperfoam needs it).")
 @click.option("--terms", type=int, default=None, help="Terms of yeoh (1-3), ogden or hyperfoam (1-3).")
 @click.option("--name", default=None, help="Material name (default: the CSV's name).")
-@click.option("--test", "test", type=click.Choice(["uniaxial", "indentation"]), default="uniaxial", show_default=True,
+@click.option("--test", "test", type=Choice(["uniaxial", "indentation"]), default="uniaxial", show_default=True,
               help="uniaxial: stretch-stress; indentation: depth_mm, force_n of a sphere on a bonded layer.")
 @click.option("--radius", type=float, default=None, help="Indentation: sphere radius R (mm).")
 @click.option("--thickness", type=float, default=None, help="Indentation: layer thickness t (mm), bonded to a rigid base.")

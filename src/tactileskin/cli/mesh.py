@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import scene_from_options, scene_options
 
 
@@ -11,7 +12,7 @@ from tactileskin.cli._common import scene_from_options, scene_options
 @scene_options(physics=False)
 @click.option("--out", "-o", type=click.Path(dir_okay=False), default=None,
               help="Mesh file to write: .msh (gmsh 2.2), .vtu (ParaView) or .inp (Abaqus/CalculiX).")
-@click.option("--cell", type=click.Choice(["tri", "quad"]), default="tri", show_default=True,
+@click.option("--cell", type=Choice(["tri", "quad"]), default="tri", show_default=True,
               help="2D cell shape (quad: all-quadrilateral, 9-node when order 2; for export: "
                    "the solver meshes with triangles).")
 def command(out, cell, scene_opts):

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from tactileskin.cli._choice import Choice
 from tactileskin.cli._common import _field_changes, check_dim_kept, claimed_output, has_2d_section, scene_options
 from tactileskin.errors import ParameterError
 
@@ -26,7 +27,7 @@ BRAILLE_DIM_CHOICES = {"2": (2,), "3": (3,), "both": (2, 3)}
 @click.option("--out", "-o", "out", type=click.Path(file_okay=False), default="out", show_default=True,
               help="Output folder: results.csv/.parquet, profiles.csv/.parquet, figures, report.md (a "
                    "new or empty folder, or one written by `sweep`; other files are never touched).")
-@click.option("--braille-dim", "braille_dim", type=click.Choice(["2", "3", "both"]), default=None,
+@click.option("--braille-dim", "braille_dim", type=Choice(["2", "3", "both"]), default=None,
               help="Braille cases as the paper's 2D ridge section (2), as the 3D slab with real "
                    "dots (3), or both side by side in the report. Default: both at the default "
                    "quality (--quality default, or none and no mesh sizes; the paper sweep then takes "
@@ -142,7 +143,14 @@ def scenes_from_options(scene_opts: dict, braille_dim: str | None = None):
     elif "braille_dims" not in axes and (o.get("dim") is not None or "dim" in fields):
         axes["braille_dims"] = (base.dim,)  # a dim asked for: the Braille cases' too
     # the preset per scene (it depends on the indenter and dim), explicit mesh sizes over it
-    return expand_grid(base=base, quality=o.get("quality") or sf.quality, overrides=mesh or None, **axes)
+    try:
+        return expand_grid(base=base, quality=o.get("quality") or sf.quality, overrides=mesh or None, **axes)
+    except ParameterError as e:
+        # the grid's refusal of its dims names the API's braille_dims: name what the user gave
+        if e.name != "braille_dims" or not (braille_dim or "braille_dims" in sf.axes):
+            raise
+        name, value = ("--braille-dim", braille_dim) if braille_dim else ("sweep.braille_dims", e.value)
+        raise ParameterError(name, value, e.valid, e.hint) from None
 
 
 def _case_status(cache, oc) -> str:
