@@ -58,3 +58,24 @@ def test_the_api_refuses_a_users_folder_as_cache(tmp_path, fake_solve):
     with pytest.raises(OutputError, match=r"cache must be a new or empty folder, or a cache made by tactileskin"):
         ts.sweep({"thickness": [1.0], "material": ["silicone"], "indenter": ["flat"]}, cache=users, serial=True)
     assert sorted(p.name for p in users.iterdir()) == ["notes.txt"] and fake_solve == []
+
+
+def test_a_users_folder_named_by_tactileskin_cache_is_refused_too(tmp_path, monkeypatch, fake_solve):
+    # TACTILESKIN_CACHE is the user's choice of folder, as cache= is: the same rule, naming it
+    import tactileskin as ts
+    from tactileskin.array.chart import result_cache
+    from tactileskin.fileio import OutputError
+
+    users = tmp_path / "users"
+    users.mkdir()
+    (users / "notes.txt").write_text("mine")
+    monkeypatch.setenv("TACTILESKIN_CACHE", str(users))
+    for call in (lambda: ts.sweep({"thickness": [1.0], "material": ["silicone"], "indenter": ["flat"]},
+                                  serial=True, report=False),
+                 lambda: result_cache(None)):
+        with pytest.raises(OutputError, match=r"TACTILESKIN_CACHE must be a new or empty folder"):
+            call()
+    assert sorted(p.name for p in users.iterdir()) == ["notes.txt"] and fake_solve == []
+    monkeypatch.setenv("TACTILESKIN_CACHE", str(tmp_path / "new"))
+    ts.sweep({"thickness": [1.0], "material": ["silicone"], "indenter": ["flat"]}, serial=True, report=False)
+    assert len(fake_solve) == 1 and any((tmp_path / "new").iterdir())

@@ -49,6 +49,16 @@ def default_cache_dir() -> Path:
     return Path(base) / "tactileskin"
 
 
+def default_cache():
+    """The ResultCache of default_cache_dir(). A TACTILESKIN_CACHE folder is the user's choice, like
+    `cache=`: refused unless new, empty or a cache (cache.open_cache)."""
+    from tactileskin.cache import ResultCache, open_cache
+
+    if os.environ.get("TACTILESKIN_CACHE"):
+        return open_cache(default_cache_dir(), "TACTILESKIN_CACHE")
+    return ResultCache(default_cache_dir())
+
+
 def solve(scene=None, *, quality: str | None = None, history: bool = False, progress=None, **fields):
     """Solve one scene and return its Result (profile, metrics, fields; .write(folder) saves it).
 
@@ -169,7 +179,7 @@ def sweep(grid=None, *, quality: str | None = None, out=None, cache=None, worker
         validate.boolean(value, name)  # serial="no" is truthy: it ran serially
     scs = scenes(grid, quality=quality, base=base)
     if cache is None:
-        rc = ResultCache(out_cache(out) if out is not None else default_cache_dir())
+        rc = ResultCache(out_cache(out)) if out is not None else default_cache()
     else:  # the user's folder: refused unless new, empty or a cache
         rc = open_cache(cache, "cache")
     if out is None:

@@ -140,9 +140,9 @@ def result_cache(cache):
     if isinstance(cache, ResultCache):
         return cache
     if cache is None:
-        from tactileskin.api import default_cache_dir
+        from tactileskin.api import default_cache
 
-        return ResultCache(default_cache_dir())
+        return default_cache()
     return open_cache(validate.path(cache, "cache", "a folder path (str or os.PathLike), a ResultCache or None"), "cache")
 
 
