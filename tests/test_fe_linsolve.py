@@ -201,3 +201,36 @@ def test_a_2d_solve_uses_the_2d_ordering():
 
     r = fe.solve(Scene(thickness=1, material="silicone", indenter="flat", mesh_size=1.0, refinement=2))
     assert r.stats["linear_solver"]["ordering"] == linsolve.default_ordering(2) == "amd"
+
+
+def _laplacian_3d(k: int, shift: float) -> sp.csr_matrix:
+    """7-point 3D Laplacian (k^3 unknowns), diagonal shifted: a small 3D-like sparsity with
+    nested-dissection separators."""
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(k, k))
+    A = sp.kronsum(sp.kronsum(T, T), T).tocsr()
+    A = (A - shift * sp.eye(k ** 3)).tocsr()
+    A.sort_indices()
+    return A
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="MKL is installed on x86-64 only")
+@pytest.mark.parametrize("extra", [{24: 1}, {24: 2}, {23: 1}, {1: 3}])
+def test_pardiso_iparm_overrides_are_set_and_solve_the_same_system(extra):
+    """_Pardiso's iparm overrides (benchmarks/pardiso_options3d.py) are what PARDISO runs with,
+    and each solves a small 3D system (2 threads) as the plain settings do, to rounding
+    (cond < 1e3: relative difference < 1e-10)."""
+    A = _laplacian_3d(14, 0.05)
+    n = A.shape[0]
+    b = np.random.default_rng(6).standard_normal(n)
+    up = sp.triu(A, format="csr")
+    xs = []
+    for kw in ({}, extra):
+        p = linsolve._Pardiso(n, up.indptr, up.indices, threads=2, iparm=kw)
+        for k, v in kw.items():
+            assert p.iparm[k] == v
+        p.factor(up.data)
+        xs.append(p.solve(b))
+        p.close()
+        assert np.linalg.norm(A @ xs[-1] - b) <= 1e-10 * np.linalg.norm(b)
+    assert np.max(np.abs(xs[1] - xs[0])) <= 1e-10 * np.max(np.abs(xs[0]))
+

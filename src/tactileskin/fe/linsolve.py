@@ -163,9 +163,10 @@ class _Pardiso:
     """One PARDISO handle for a fixed upper-triangular CSR structure."""
 
     def __init__(self, n: int, indptr: np.ndarray, indices: np.ndarray, threads: int = 1, single: bool = False,
-                 ordering: str = "metis"):
+                 ordering: str = "metis", iparm: dict | None = None):
         """single: factorise and solve in single precision (values, right-hand sides and
-        solutions float32 inside; `solve` returns float64). ordering: a key of ORDERINGS."""
+        solutions float32 inside; `solve` returns float64). ordering: a key of ORDERINGS.
+        iparm: further components {index: value} (0-based, set before the analysis)."""
         self.lib = _load_mkl()
         self.n = n
         self.threads = threads
@@ -186,6 +187,12 @@ class _Pardiso:
         ip[18] = -1  # report the factorisation MFlops
         ip[34] = 1   # zero-based indexing
         ip[27] = 1 if single else 0
+        # iparm[24] (substitution algorithm) stays 0: on the default t = 5 dot (2 threads) 1 took
+        # more wall at low load (22.7 -> 26.4 s; solve phase 13.6 -> 17.6 s CPU), less only on a
+        # loaded machine; iparm[23] = 1, iparm[1] = 3 and AMD did not pay on the 3D tangents
+        # either (benchmarks/results/pardiso_options3d.md)
+        for k, v in (iparm or {}).items():
+            ip[k] = v
         self.perturbed = 0
         self._alive = False
         self._call(11, np.zeros(0, self.dtype), np.zeros(0, self.dtype))
