@@ -79,3 +79,15 @@ def test_a_users_folder_named_by_tactileskin_cache_is_refused_too(tmp_path, monk
     monkeypatch.setenv("TACTILESKIN_CACHE", str(tmp_path / "new"))
     ts.sweep({"thickness": [1.0], "material": ["silicone"], "indenter": ["flat"]}, serial=True, report=False)
     assert len(fake_solve) == 1 and any((tmp_path / "new").iterdir())
+
+
+@pytest.mark.parametrize("clutter", [".DS_Store", ".nfs000000000012a4c600000001", "Thumbs.db", "desktop.ini"])
+def test_a_cache_with_the_file_systems_own_files_is_still_a_cache(tmp_path, capsys, fake_solve, clutter):
+    # Finder's .DS_Store (a cache opened by hand), NFS's .nfsXXXX (a lock unlinked while another
+    # client held it open) and Windows' Thumbs.db / desktop.ini are written by the system, not the
+    # user: a shared cache holding one was refused as "not a cache" and could not be used again
+    shared = tmp_path / "shared"
+    assert main([*SWEEP, "--out", str(tmp_path / "a"), "--cache", str(shared)]) in (0, 3)
+    (shared / clutter).write_bytes(b"\0")
+    assert main([*SWEEP, "--out", str(tmp_path / "b"), "--cache", str(shared)]) in (0, 3), capsys.readouterr().err
+    assert len(fake_solve) == 1

@@ -353,6 +353,11 @@ def out_cache(out) -> Path:
 # the names a cache holds: case entries (cache_key), derived entries (figures-, render-: the
 # sweep's report), their .lock files; anything else in a folder means it is not a cache
 _ENTRY_NAME = re.compile(r"^(?:figures-|render-)?[0-9a-f]{24}$")
+# what the system writes into any folder, a cache too: Finder's .DS_Store and ._ companions (a
+# cache opened by hand, one on a network or exFAT volume), NFS's .nfsXXXX (a file unlinked
+# while another client holds it open: a lock), Windows' Thumbs.db and desktop.ini, a mount
+# point's lost+found
+_SYSTEM_NAME = re.compile(r"^(?:\.DS_Store|\._.+|\.nfs[0-9a-f]+|Thumbs\.db|desktop\.ini|lost\+found)$")
 
 
 def open_cache(root, what: str = "--cache") -> "ResultCache":
@@ -367,7 +372,7 @@ def open_cache(root, what: str = "--cache") -> "ResultCache":
     if root.is_dir():
         with fileio.os_errors(root):
             names = sorted(p.name for p in root.iterdir() if not fileio.is_temporary(p.name)
-                           and not _cache_file(root / p.name))
+                           and not _SYSTEM_NAME.match(p.name) and not _cache_file(root / p.name))
         if names:
             shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
             raise OutputError(root, f"{what} must be a new or empty folder, or a cache made by tactileskin; "
