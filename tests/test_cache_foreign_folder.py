@@ -91,3 +91,19 @@ def test_a_cache_with_the_file_systems_own_files_is_still_a_cache(tmp_path, caps
     (shared / clutter).write_bytes(b"\0")
     assert main([*SWEEP, "--out", str(tmp_path / "b"), "--cache", str(shared)]) in (0, 3), capsys.readouterr().err
     assert len(fake_solve) == 1
+
+
+def test_a_cache_entry_without_its_cache_json_is_named_as_such(tmp_path, capsys, fake_solve):
+    # a shared cache copied by a cut-short cp/rsync holds key-named entries without cache.json:
+    # still refused (lookup would remove the folder), but the error said the cache held "other
+    # files", as for a folder of the user's own, with nothing to say what to do
+    shared = tmp_path / "shared"
+    assert main([*SWEEP, "--out", str(tmp_path / "a"), "--cache", str(shared)]) in (0, 3)
+    entry = next(p for p in shared.iterdir() if p.is_dir() and (p / "cache.json").is_file())
+    (entry / "cache.json").unlink()
+    capsys.readouterr()
+    assert main([*SWEEP, "--out", str(tmp_path / "b"), "--cache", str(shared)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and entry.name in err, err
+    assert "other files" not in err and "no cache.json" in err and "remove" in err, err
+    assert entry.is_dir() and len(fake_solve) == 1

@@ -375,6 +375,11 @@ def open_cache(root, what: str = "--cache") -> "ResultCache":
                            and not _SYSTEM_NAME.match(p.name) and not _cache_file(root / p.name))
         if names:
             shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+            if all(_ENTRY_NAME.match(n) and (root / n).is_dir() and not (root / n).is_symlink()
+                   for n in names):  # a cache's entries, their manifests lost
+                raise OutputError(root, f"its entries {shown} have no cache.json or files.json (damaged, as by "
+                                        f"a copy cut short), so {what} is not taken for a cache tactileskin "
+                                        "made; remove them (their cases are solved again)")
             raise OutputError(root, f"{what} must be a new or empty folder, or a cache made by tactileskin; "
                                     f"this one holds other files ({shown})")
     elif root.exists() or root.is_symlink():
