@@ -414,7 +414,11 @@ class ResultCache:
         if code_changes():
             return None  # not the code the key names runs here (logged): not reused
         key = key or self.key(scene)
-        p = self.root / key
+        return self._validated(self.root / key, scene, key, repair)
+
+    def _validated(self, p: Path, scene: Scene, key: str, repair: bool) -> CaseRecord | None:
+        """The entry at p through the cache's validation; with repair a damaged one is logged
+        (WARNING, naming its path) and removed."""
         rec, problem = self._check(p, scene, key)
         if problem and repair:
             log.warning("cache entry %s is damaged (%s); it is removed and the case recomputed", p, problem)
@@ -514,12 +518,7 @@ class ResultCache:
         """store, then the entry read back through the cache's validation (as lookup: a damaged
         one is logged and removed, None). Without lookup's second code check: the entry is the
         one store just wrote under its own (each check hashes the package's ~130 sources)."""
-        final = self.store(scene, result, key)
-        rec, problem = self._check(final, scene, key)
-        if problem:
-            log.warning("cache entry %s is damaged (%s); it is removed and the case recomputed", final, problem)
-            self._discard(final)
-        return rec
+        return self._validated(self.store(scene, result, key), scene, key, repair=True)
 
     # --- files derived from entries (a sweep's figures) -------------------------------------
     def load_files(self, name: str) -> list[tuple[str, bytes]] | None:
