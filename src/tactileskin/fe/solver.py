@@ -500,6 +500,11 @@ def _travel_capped_dt(model: Model, t: float, dt: float, opts: SolverOptions) ->
     return dt * cap / step if step > cap else dt
 
 
+# what a depth ramp that cannot go on means, and what to try
+_GIVES_OUT = ("the skin or its mesh gives out there: the material law's lock-up, elements too coarse for the "
+              "strain or the contact; try a smaller depth or force, or a finer mesh: quality fine")
+
+
 def _travel_text(model) -> str:
     """' after <d> mm of indenter travel' of a contact model, '' otherwise."""
     d = getattr(model, "d", None) if getattr(model, "contact", None) is not None else None
@@ -561,10 +566,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
             if dt * opts.cutback < dt_min:
                 diag = {"time": t, "dt": dt, "reason": f.why, **f.diag}
                 raise ConvergenceError(f"no convergence at t = {t:.6g} s{_travel_text(model)} with dt = {dt:.3g} s: "
-                                       f"{f.why} "
-                                       "(the skin or its mesh gives out there: the material law's lock-up, elements "
-                                       "too coarse for the strain or the contact; try a smaller depth or force, or "
-                                       "a finer mesh: quality fine)", diag) from None
+                                       f"{f.why} ({_GIVES_OUT})", diag) from None
             if opts.failed_dt_fraction > 0.0:
                 dt_cap = min(dt_cap, opts.failed_dt_fraction * dt)
                 # no increment is longer than dt_cap from here (but a last one 1e-3 longer): past
@@ -577,9 +579,7 @@ def run(model: Model, T: float, opts: SolverOptions | None = None, *, history: b
                     raise ConvergenceError(
                         f"no convergence at t = {t:.6g} s{_travel_text(model)} with dt = {dt:.3g} s: {f.why}, and "
                         f"at the {dt_cap:.3g} s allowed after it the rest of the load needs {need:.0f} more "
-                        f"increments, past the {opts.max_increments} allowed (the skin or its mesh gives out there: "
-                        "the material law's lock-up, elements too coarse for the strain or the contact; try a "
-                        "smaller depth or force, or a finer mesh: quality fine)",
+                        f"increments, past the {opts.max_increments} allowed ({_GIVES_OUT})",
                         {"time": t, "dt": dt, "dt_cap": dt_cap, "reason": f.why, **f.diag}) from None
             dt *= opts.cutback
             continue
